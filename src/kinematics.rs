@@ -1,0 +1,188 @@
+//! Fold angles ↔ node positions of a single vertex, and loop closure (SPEC §2):
+//! R_z(α_0) R_x(ρ_1) R_z(α_1) … R_x(ρ_{n−1}) R_z(α_{n−1}) R_x(ρ_0) = I.
+//!
+//! Frame convention (fixed here, tested below): ray 0 is +x, sector 0 lies in the xy-plane
+//! on the +y side. Going CCW, the frame of ray k is T_k with T_0 = I, T_1 = R_z(α_0) and
+//! T_{k+1} = T_k R_x(ρ_k) R_z(α_k); node k is T_k e_x. A positive ρ_k (valley) lifts the
+//! sectors after ray k towards +z.
+
+use crate::error::{NanofoldError, Result};
+use crate::sphere::Vec3;
+use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
+
+fn rot_x(angle: f64) -> Matrix3<f64> {
+    *Rotation3::from_axis_angle(&Vector3::x_axis(), angle).matrix()
+}
+
+fn rot_z(angle: f64) -> Matrix3<f64> {
+    *Rotation3::from_axis_angle(&Vector3::z_axis(), angle).matrix()
+}
+
+/// Node positions of the rays for the given sector and fold angles, sector 0 fixed in the
+/// xy-plane. `fold_angles[0]` is used only by [`closure_rotation`]; for an open chain
+/// (`sector_angles.len() == n − 1`) the boundary rays' fold angles are ignored.
+pub fn forward(sector_angles: &[f64], fold_angles: &[f64]) -> Vec<Vec3> {
+    let n = fold_angles.len();
+    let mut nodes = Vec::with_capacity(n);
+    let mut frame = Matrix3::identity();
+    nodes.push(Vec3::x());
+    for k in 1..n {
+        frame = if k == 1 {
+            rot_z(sector_angles[0])
+        } else {
+            frame * rot_x(fold_angles[k - 1]) * rot_z(sector_angles[k - 1])
+        };
+        nodes.push(frame.column(0).into_owned());
+    }
+    nodes
+}
+
+/// The closed chain's holonomy: identity exactly when the loop closes.
+pub fn closure_rotation(sector_angles: &[f64], fold_angles: &[f64]) -> Matrix3<f64> {
+    let n = fold_angles.len();
+    let mut frame = rot_z(sector_angles[0]);
+    for k in 1..n {
+        frame = frame * rot_x(fold_angles[k]) * rot_z(sector_angles[k]);
+    }
+    frame * rot_x(fold_angles[0])
+}
+
+/// Rotation vector (axis × angle) of a rotation matrix, accurate near the identity where
+/// the closure residual lives: θ = atan2(|v|, (tr − 1)/2) with v the skew part (sin θ·axis).
+/// nalgebra's `scaled_axis` goes through arccos of the trace, which loses half the digits
+/// there; it is used only near θ = π where the skew part vanishes.
+fn rotation_vector(m: &Matrix3<f64>) -> Vector3<f64> {
+    let v = 0.5 * Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]);
+    let sin_theta = v.norm();
+    let cos_theta = 0.5 * (m.trace() - 1.0);
+    if cos_theta < -0.5 {
+        return Rotation3::from_matrix_unchecked(*m).scaled_axis();
+    }
+    if sin_theta == 0.0 {
+        return Vector3::zeros();
+    }
+    v * (sin_theta.atan2(cos_theta) / sin_theta)
+}
+
+/// Loop-closure residual: the rotation angle of the holonomy, radians.
+pub fn closure_residual(sector_angles: &[f64], fold_angles: &[f64]) -> f64 {
+    rotation_vector(&closure_rotation(sector_angles, fold_angles)).norm()
+}
+
+/// Outcome of [`solve_closure`].
+#[derive(Debug, Clone, Copy)]
+pub struct ClosureSolve {
+    pub iterations: usize,
+    pub residual: f64,
+}
+
+/// Restores loop closure by Newton's method on the fold angles listed in `free`, the
+/// others held. The holonomy's spatial derivative with respect to ρ_k is the world axis of
+/// ray k (the node x_k), so the Jacobian of its rotation vector r is J_l(r)⁻¹ [x_k …];
+/// steps are minimum-norm (SVD) so more than three free creases are allowed.
+pub fn solve_closure(
+    sector_angles: &[f64],
+    fold_angles: &mut [f64],
+    free: &[usize],
+    tol: f64,
+    max_iterations: usize,
+) -> Result<ClosureSolve> {
+    let n = fold_angles.len();
+    let mut residual = f64::INFINITY;
+    for iteration in 0..=max_iterations {
+        let holonomy = closure_rotation(sector_angles, fold_angles);
+        let r = rotation_vector(&holonomy);
+        residual = r.norm();
+        if residual <= tol {
+            return Ok(ClosureSolve { iterations: iteration, residual });
+        }
+        if iteration == max_iterations {
+            break;
+        }
+        let nodes = forward(sector_angles, fold_angles);
+        let jl_inv = left_jacobian_inverse(&r);
+        let mut jac = DMatrix::zeros(3, free.len());
+        for (col, &k) in free.iter().enumerate() {
+            // ρ_0 acts last, on the right: its spatial axis is holonomy·e_x ≈ x_0.
+            let axis = if k == 0 { holonomy.column(0).into_owned() } else { nodes[k % n] };
+            jac.set_column(col, &(jl_inv * axis));
+        }
+        let rhs = DVector::from_column_slice(&[-r.x, -r.y, -r.z]);
+        let svd = jac.svd(true, true);
+        let step = svd
+            .solve(&rhs, 1e-12)
+            .map_err(|e| NanofoldError::Numerical { stage: "loop closure".into(), message: e.to_string() })?;
+        // Damp huge steps (far from the solution the linearisation is poor).
+        let largest = step.amax();
+        let scale = if largest > 0.5 { 0.5 / largest } else { 1.0 };
+        for (col, &k) in free.iter().enumerate() {
+            fold_angles[k] += scale * step[col];
+        }
+    }
+    Err(NanofoldError::Numerical {
+        stage: "loop closure".into(),
+        message: format!("Newton did not converge: residual {residual:.3e} rad after {max_iterations} iterations"),
+    })
+}
+
+/// Inverse of SO(3)'s left Jacobian: maps a spatial angular velocity to d(rotation vector).
+fn left_jacobian_inverse(r: &Vector3<f64>) -> Matrix3<f64> {
+    let theta = r.norm();
+    let k = r.cross_matrix();
+    if theta < 1e-8 {
+        return Matrix3::identity() - 0.5 * k + k * k / 12.0;
+    }
+    let coeff = 1.0 / (theta * theta) - (1.0 + theta.cos()) / (2.0 * theta * theta.sin());
+    Matrix3::identity() - 0.5 * k + coeff * k * k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sphere::{fold_angle, geodesic};
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
+
+    #[test]
+    fn flat_state_puts_nodes_at_cumulative_angles() {
+        let sectors = [0.5, 1.0, 2.0, TAU - 3.5];
+        let nodes = forward(&sectors, &[0.0; 4]);
+        let mut phi = 0.0_f64;
+        for (k, x) in nodes.iter().enumerate() {
+            assert!((x - Vec3::new(phi.cos(), phi.sin(), 0.0)).norm() < 1e-15);
+            phi += sectors[k];
+        }
+        assert!(closure_residual(&sectors, &[0.0; 4]) < 1e-14);
+    }
+
+    #[test]
+    fn fold_angles_round_trip_through_positions() {
+        // A degree-4 vertex folded by a kinematic move from flat.
+        let sectors = [1.2, 1.7, 1.4, TAU - 4.3];
+        let mut rho = vec![0.0, 0.9, 0.0, 0.0];
+        rho[0] = 0.3;
+        solve_closure(&sectors, &mut rho, &[0, 2, 3], 1e-14, 50).unwrap();
+        let nodes = forward(&sectors, &rho);
+        let n = 4;
+        for k in 0..n {
+            let measured = fold_angle(&nodes[(k + n - 1) % n], &nodes[k], &nodes[(k + 1) % n]);
+            assert!((measured - rho[k]).abs() < 1e-12, "ray {k}: {measured} vs {}", rho[k]);
+            assert!((geodesic(&nodes[k], &nodes[(k + 1) % n]) - sectors[k]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn straight_crease_line_closes_for_equal_fold_angles() {
+        // A plus-shaped vertex: one straight crease line folds alone, ρ = (ρ, 0, ρ, 0).
+        let sectors = [FRAC_PI_2; 4];
+        for rho in [0.1, 1.0, 2.5, PI] {
+            assert!(closure_residual(&sectors, &[rho, 0.0, rho, 0.0]) < 1e-14);
+        }
+        // Opposite signs on one straight line do not close: the residual is |2ρ|.
+        for rho in [0.1_f64, 1.0] {
+            assert!((closure_residual(&sectors, &[rho, 0.0, -rho, 0.0]) - 2.0 * rho).abs() < 1e-12);
+        }
+        // Rays 0 and 2 at 0° and 135° are no straight line: no closure at ρ ≠ 0.
+        let skew = [FRAC_PI_4, FRAC_PI_2, 3.0 * FRAC_PI_4, FRAC_PI_2];
+        assert!(closure_residual(&skew, &[1.0, 0.0, 1.0, 0.0]) > 1e-3);
+    }
+}

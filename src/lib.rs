@@ -1,0 +1,9 @@
+//! nanofold: rigid origami of single-vertex crease patterns — unfolding by constrained
+//! energy minimisation on the sphere (SPEC §3–5).
+
+pub mod error;
+pub mod kinematics;
+pub mod pattern;
+pub mod sphere;
+
+pub use error::{NanofoldError, Result};

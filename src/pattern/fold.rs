@@ -1,0 +1,322 @@
+//! FOLD (1.1/1.2) import: find the single vertex where the creases meet, its rays in CCW
+//! order and its sector angles; `edges_foldAngle` (degrees, valley positive) is the folded
+//! state. Locked creases use the custom key `edges_nanofold:locked` (FOLD's namespace rule).
+
+use super::{Assignment, Chain, FoldMesh, RawCrease, RawRay, RawVertex};
+use crate::error::{NanofoldError, Result};
+use serde_json::Value;
+use std::f64::consts::TAU;
+
+/// Custom FOLD key for creases held at their folded angle.
+pub const LOCKED_KEY: &str = "edges_nanofold:locked";
+
+fn array<'a>(value: &'a Value, key: &str) -> Result<&'a Vec<Value>> {
+    match value.get(key) {
+        None => Err(NanofoldError::MissingField { field: key.to_string() }),
+        Some(Value::Array(items)) => Ok(items),
+        Some(other) => Err(NanofoldError::invalid(key, short(other), "expected an array")),
+    }
+}
+
+fn short(value: &Value) -> String {
+    let text = value.to_string();
+    if text.len() > 40 {
+        format!("{}…", &text[..40])
+    } else {
+        text
+    }
+}
+
+fn number(value: &Value, field: &str) -> Result<f64> {
+    let x = value
+        .as_f64()
+        .ok_or_else(|| NanofoldError::invalid(field, short(value), "expected a number"))?;
+    if !x.is_finite() {
+        return Err(NanofoldError::invalid(field, x, "must be finite"));
+    }
+    Ok(x)
+}
+
+fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> {
+    let i = value
+        .as_u64()
+        .ok_or_else(|| NanofoldError::invalid(field, short(value), "expected a non-negative integer"))?;
+    if i as usize >= bound {
+        return Err(NanofoldError::invalid(field, i, format!("there are only {bound} {what}")));
+    }
+    Ok(i as usize)
+}
+
+/// Reads the key frame of a FOLD object into a raw vertex.
+pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
+    // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).
+    let coords_json = array(value, "vertices_coords")?;
+    let mut coords = Vec::with_capacity(coords_json.len());
+    for (i, c) in coords_json.iter().enumerate() {
+        let field = format!("vertices_coords[{i}]");
+        let items = c
+            .as_array()
+            .ok_or_else(|| NanofoldError::invalid(&field, short(c), "expected [x, y] or [x, y, z]"))?;
+        if items.len() < 2 || items.len() > 3 {
+            return Err(NanofoldError::invalid(&field, short(c), "expected [x, y] or [x, y, z]"));
+        }
+        let x = number(&items[0], &field)?;
+        let y = number(&items[1], &field)?;
+        if items.len() == 3 && number(&items[2], &field)? != 0.0 {
+            return Err(NanofoldError::invalid(
+                &field,
+                short(c),
+                "z must be 0: nanofold reads the flat crease pattern and takes the folded state from edges_foldAngle",
+            ));
+        }
+        coords.push([x, y]);
+    }
+    let nv = coords.len();
+
+    let edges_json = array(value, "edges_vertices")?;
+    let mut edges = Vec::with_capacity(edges_json.len());
+    for (i, e) in edges_json.iter().enumerate() {
+        let field = format!("edges_vertices[{i}]");
+        let items = e
+            .as_array()
+            .filter(|a| a.len() == 2)
+            .ok_or_else(|| NanofoldError::invalid(&field, short(e), "expected [u, v]"))?;
+        let u = index(&items[0], &field, nv, "vertices")?;
+        let v = index(&items[1], &field, nv, "vertices")?;
+        if u == v {
+            return Err(NanofoldError::invalid(&field, short(e), "an edge needs two distinct vertices"));
+        }
+        edges.push([u, v]);
+    }
+    let ne = edges.len();
+
+    let assignment_json = array(value, "edges_assignment")?;
+    if assignment_json.len() != ne {
+        return Err(NanofoldError::invalid(
+            "edges_assignment",
+            format!("{} entries", assignment_json.len()),
+            format!("expected one per edge ({ne})"),
+        ));
+    }
+    let mut letters = Vec::with_capacity(ne);
+    for (i, a) in assignment_json.iter().enumerate() {
+        let field = format!("edges_assignment[{i}]");
+        let letter = a
+            .as_str()
+            .ok_or_else(|| NanofoldError::invalid(&field, short(a), "expected a one-letter string"))?;
+        letters.push(letter.to_string());
+    }
+
+    let (angle_key, angles_json) = match (value.get("edges_foldAngle"), value.get("edges_foldAngles")) {
+        (Some(_), _) => ("edges_foldAngle", array(value, "edges_foldAngle")?),
+        (None, Some(_)) => ("edges_foldAngles", array(value, "edges_foldAngles")?),
+        (None, None) => {
+            return Err(NanofoldError::MissingField {
+                field: "edges_foldAngle (the folded state, degrees)".to_string(),
+            })
+        }
+    };
+    if angles_json.len() != ne {
+        return Err(NanofoldError::invalid(
+            angle_key,
+            format!("{} entries", angles_json.len()),
+            format!("expected one per edge ({ne})"),
+        ));
+    }
+
+    let locked: Vec<bool> = match value.get(LOCKED_KEY) {
+        None => vec![false; ne],
+        Some(v) => {
+            let items = v
+                .as_array()
+                .filter(|a| a.len() == ne)
+                .ok_or_else(|| NanofoldError::invalid(LOCKED_KEY, short(v), format!("expected {ne} booleans")))?;
+            items
+                .iter()
+                .enumerate()
+                .map(|(i, b)| {
+                    b.as_bool().ok_or_else(|| {
+                        NanofoldError::invalid(format!("{LOCKED_KEY}[{i}]"), short(b), "expected true or false")
+                    })
+                })
+                .collect::<Result<_>>()?
+        }
+    };
+
+    let faces_vertices = match value.get("faces_vertices") {
+        None => None,
+        Some(v) => {
+            let items = v
+                .as_array()
+                .ok_or_else(|| NanofoldError::invalid("faces_vertices", short(v), "expected an array"))?;
+            let mut faces = Vec::with_capacity(items.len());
+            for (i, f) in items.iter().enumerate() {
+                let field = format!("faces_vertices[{i}]");
+                let ids = f
+                    .as_array()
+                    .ok_or_else(|| NanofoldError::invalid(&field, short(f), "expected an array of vertex ids"))?;
+                faces.push(ids.iter().map(|id| index(id, &field, nv, "vertices")).collect::<Result<Vec<_>>>()?);
+            }
+            Some(faces)
+        }
+    };
+
+    // Classify edges; B edges are boundary, the rest creases (C/J refused).
+    let mut is_crease = vec![false; ne];
+    for (i, letter) in letters.iter().enumerate() {
+        if letter != "B" && letter != "b" {
+            Assignment::from_letter(letter, &format!("edges_assignment[{i}]"))?;
+            is_crease[i] = true;
+        }
+    }
+    let mut crease_degree = vec![0usize; nv];
+    for (i, e) in edges.iter().enumerate() {
+        if is_crease[i] {
+            crease_degree[e[0]] += 1;
+            crease_degree[e[1]] += 1;
+        }
+    }
+    let centers: Vec<usize> = (0..nv).filter(|&v| crease_degree[v] >= 2).collect();
+    let center = match centers.len() {
+        0 => {
+            return Err(NanofoldError::invalid(
+                "edges_assignment",
+                "no vertex with two or more creases",
+                "a single-vertex pattern needs its creases to meet at one vertex",
+            ))
+        }
+        1 => centers[0],
+        count => return Err(NanofoldError::MultipleVertices { count }),
+    };
+    for (i, e) in edges.iter().enumerate() {
+        if is_crease[i] && e[0] != center && e[1] != center {
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{i}]"),
+                format!("[{}, {}]", e[0], e[1]),
+                format!("crease does not meet the vertex {center} where the creases meet"),
+            ));
+        }
+    }
+
+    // Rays: every edge at the centre, by polar angle.
+    let c = coords[center];
+    struct Spoke {
+        edge: usize,
+        direction: f64,
+    }
+    let mut spokes = Vec::new();
+    for (i, e) in edges.iter().enumerate() {
+        if e[0] != center && e[1] != center {
+            continue;
+        }
+        let other = if e[0] == center { e[1] } else { e[0] };
+        let (dx, dy) = (coords[other][0] - c[0], coords[other][1] - c[1]);
+        if dx == 0.0 && dy == 0.0 {
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{i}]"),
+                format!("[{}, {}]", e[0], e[1]),
+                "edge has zero length",
+            ));
+        }
+        spokes.push(Spoke { edge: i, direction: dy.atan2(dx).rem_euclid(TAU) });
+    }
+    spokes.sort_by(|a, b| a.direction.total_cmp(&b.direction));
+    for pair in spokes.windows(2) {
+        if pair[1].direction - pair[0].direction < 1e-12 {
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{}]", pair[1].edge),
+                format!("edges {} and {}", pair[0].edge, pair[1].edge),
+                "two edges leave the vertex in the same direction",
+            ));
+        }
+    }
+    let boundary_spokes: Vec<usize> =
+        (0..spokes.len()).filter(|&k| !is_crease[spokes[k].edge]).collect();
+    let m = spokes.len();
+    let gap = |k: usize| -> f64 {
+        let next = spokes[(k + 1) % m].direction;
+        let here = spokes[k].direction;
+        if k + 1 == m {
+            next + TAU - here
+        } else {
+            next - here
+        }
+    };
+    let (chain, start, ray_count) = match boundary_spokes.len() {
+        0 => (Chain::Closed, 0, m),
+        2 => {
+            // The paper is the angular gap between the two boundary rays that holds creases.
+            let (b0, b1) = (boundary_spokes[0], boundary_spokes[1]);
+            let creases_between = (b0 + 1..b1).count();
+            if creases_between > 0 {
+                (Chain::Open, b0, b1 - b0 + 1)
+            } else {
+                (Chain::Open, b1, m - b1 + b0 + 1)
+            }
+        }
+        k => {
+            return Err(NanofoldError::invalid(
+                "edges_assignment",
+                format!("{k} boundary (B) edges at vertex {center}"),
+                "a vertex has 0 (interior) or 2 (on the sheet's edge) boundary edges",
+            ))
+        }
+    };
+
+    let mut rays = Vec::with_capacity(ray_count);
+    let mut sector_angles = Vec::new();
+    let mut sector_fields = Vec::new();
+    let mut order_of_edge = vec![usize::MAX; ne];
+    let mut crease_edges: Vec<usize> = spokes.iter().map(|s| s.edge).filter(|&e| is_crease[e]).collect();
+    crease_edges.sort_unstable();
+    for (order, &e) in crease_edges.iter().enumerate() {
+        order_of_edge[e] = order;
+    }
+    for j in 0..ray_count {
+        let k = (start + j) % m;
+        let edge = spokes[k].edge;
+        if is_crease[edge] {
+            let field = format!("{angle_key}[{edge}]");
+            let degrees = number(&angles_json[edge], &field)?;
+            rays.push(RawRay::Crease(RawCrease {
+                label: format!("edges[{edge}]"),
+                assignment: Assignment::from_letter(&letters[edge], &format!("edges_assignment[{edge}]"))?,
+                folded_angle: degrees.to_radians(),
+                locked: locked[edge],
+                fold_edge: Some(edge),
+                order: order_of_edge[edge],
+                angle_field: field,
+            }));
+        } else {
+            rays.push(RawRay::Boundary);
+        }
+        let last = match chain {
+            Chain::Closed => false,
+            Chain::Open => j + 1 == ray_count,
+        };
+        if !last {
+            sector_angles.push(gap(k));
+            sector_fields.push(format!(
+                "vertices_coords (sector between edges {} and {})",
+                edge,
+                spokes[(k + 1) % m].edge
+            ));
+        }
+    }
+
+    Ok(RawVertex {
+        name: name.to_string(),
+        chain,
+        rays,
+        sector_angles,
+        sector_fields,
+        mesh: Some(FoldMesh {
+            vertices_coords: coords,
+            edges_vertices: edges,
+            edges_assignment: letters,
+            faces_vertices,
+            center,
+            ray0_direction: spokes[start].direction,
+        }),
+    })
+}
