@@ -1,9 +1,12 @@
 //! nanofold: rigid origami of single-vertex crease patterns — unfolding by constrained
 //! energy minimisation on the sphere (SPEC §3–5).
 
+pub mod energy;
 pub mod error;
 pub mod kinematics;
 pub mod pattern;
+pub mod qp;
 pub mod sphere;
+pub mod unfold;
 
 pub use error::{NanofoldError, Result};

@@ -21,12 +21,17 @@ pub fn geodesic(a: &Vec3, b: &Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
+/// sin γ below which the geodesic's gradient is taken as zero (see [`geodesic_with_gradient`]).
+pub const KINK_WINDOW: f64 = 1e-12;
+
 /// Geodesic distance and its gradients with respect to `a` and `b`.
 ///
 /// For unit vectors ∂γ/∂a = −(b − cos γ a)/sin γ; for general vectors the gradient is that of
 /// the direction, divided by |a|. At sin γ = 0 (coincident or antipodal points) γ is not
-/// differentiable; the zero vector is returned there, a valid subgradient of the V-shaped
-/// minimum that the energies have at antipodal pairs (SPEC §9).
+/// differentiable and its gradient has unit length in a direction set by rounding; within
+/// [`KINK_WINDOW`] of that the zero vector is returned, a valid subgradient of the V-shaped
+/// minimum the energies have at antipodal pairs (SPEC §9), so that rounding noise does not
+/// steer the search at the flat state.
 #[inline]
 pub fn geodesic_with_gradient(a: &Vec3, b: &Vec3) -> (f64, Vec3, Vec3) {
     let na = a.norm();
@@ -36,7 +41,7 @@ pub fn geodesic_with_gradient(a: &Vec3, b: &Vec3) -> (f64, Vec3, Vec3) {
     let cross = ua.cross(&ub);
     let sin_gamma = cross.norm();
     let gamma = sin_gamma.atan2(ua.dot(&ub));
-    if sin_gamma == 0.0 {
+    if sin_gamma <= KINK_WINDOW {
         return (gamma, Vec3::zeros(), Vec3::zeros());
     }
     // (ua×ub)×ua = ub − cos γ ua, of length sin γ.
