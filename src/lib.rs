@@ -4,7 +4,9 @@
 pub mod energy;
 pub mod error;
 pub mod kinematics;
+pub mod output;
 pub mod pattern;
+pub mod plot;
 pub mod qp;
 pub mod sphere;
 pub mod unfold;

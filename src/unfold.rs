@@ -91,10 +91,13 @@ pub struct UnfoldModel {
 }
 
 /// Constraints restored by Newton projection, one row each.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum ConstraintRow {
     Arc(usize),
     Held(usize),
+    /// Component `k` (of the tangent plane at x_v) of x_v + x_w = 0: an antipodal pair held
+    /// at its kink (see [`Unfolder::pin_antipodal_pairs`]).
+    Antipodal { v: usize, w: usize, k: usize },
 }
 
 impl UnfoldModel {
@@ -219,6 +222,11 @@ pub struct Workspace {
 }
 
 impl Workspace {
+    fn resize_rows(&mut self, model: &UnfoldModel) {
+        self.jacobian = DMatrix::zeros(self.rows.len(), 2 * model.free.len());
+        self.residual = DVector::zeros(self.rows.len());
+    }
+
     fn new(model: &UnfoldModel) -> Workspace {
         let rows = model.constraint_rows();
         let m = model.free.len();
@@ -236,7 +244,7 @@ impl Workspace {
 }
 
 /// Fills the tangent bases of the free nodes.
-fn fill_bases(model: &UnfoldModel, nodes: &[Vec3], basis: &mut [[Vec3; 2]]) {
+pub fn fill_bases(model: &UnfoldModel, nodes: &[Vec3], basis: &mut [[Vec3; 2]]) {
     for &i in &model.free {
         basis[i] = tangent_basis(&nodes[i]);
     }
@@ -254,6 +262,7 @@ fn fill_residuals(model: &UnfoldModel, rows: &[ConstraintRow], nodes: &[Vec3], o
                 let held = model.held[h];
                 wrap(model.fold_angle_at(nodes, held.ray) - held.target)
             }
+            ConstraintRow::Antipodal { v, w, k } => tangent_basis(&nodes[v])[k].dot(&(nodes[v] + nodes[w])),
         };
     }
 }
@@ -284,12 +293,17 @@ fn fill_jacobian(model: &UnfoldModel, rows: &[ConstraintRow], nodes: &[Vec3], ba
                 put(out, r, ray, &ga);
                 put(out, r, next, &gn);
             }
+            ConstraintRow::Antipodal { v, w, k } => {
+                let e = tangent_basis(&nodes[v])[k];
+                put(out, r, v, &e);
+                put(out, r, w, &e);
+            }
         }
     }
 }
 
 /// Moves the free nodes by the tangent coordinates `y` (scaled by `t`) and renormalises.
-fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVector<f64>, t: f64, out: &mut [Vec3]) {
+pub fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVector<f64>, t: f64, out: &mut [Vec3]) {
     out.copy_from_slice(nodes);
     for (slot, &i) in model.free.iter().enumerate() {
         let d = basis[i][0] * y[2 * slot] + basis[i][1] * y[2 * slot + 1];
@@ -300,7 +314,7 @@ fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVector
 /// Newton projection onto the constraints (SPEC §5 "restore"): minimum-norm steps in the
 /// tangent space, the factorisation reused while it converges (chord Newton) and refreshed
 /// when it stalls. Returns the final max residual; Err when it does not reach `tol`.
-fn restore(model: &UnfoldModel, ws: &mut Workspace, nodes: &mut [Vec3], tol: f64, row_space: Option<&RowSpace>) -> Result<f64> {
+pub fn restore(model: &UnfoldModel, ws: &mut Workspace, nodes: &mut [Vec3], tol: f64, row_space: Option<&RowSpace>) -> Result<f64> {
     let mut basis = ws.basis.clone();
     let mut owned: Option<RowSpace> = None;
     let mut previous = f64::INFINITY;
@@ -324,7 +338,15 @@ fn restore(model: &UnfoldModel, ws: &mut Workspace, nodes: &mut [Vec3], tol: f64
         }
         previous = worst;
         let rs = owned.as_ref().or(row_space).expect("a factorisation");
-        let z = rs.solve_min_norm(&ws.residual);
+        let mut z = rs.solve_min_norm(&ws.residual);
+        // Trust region: near the flat state A has singular values ~ρ, so a minimum-norm
+        // step can be far larger than the residual; allow up to 10·√residual (what the
+        // ill-conditioning legitimately needs) and no more.
+        let cap = 10.0 * worst.sqrt();
+        let largest = z.amax();
+        if largest > cap {
+            z *= cap / largest;
+        }
         retract(model, nodes, &basis, &z, -1.0, &mut moved);
         nodes.copy_from_slice(&moved);
     }
@@ -395,7 +417,7 @@ pub struct Unfolder<'a> {
     model: &'a UnfoldModel,
     energy: Box<dyn Energy>,
     settings: UnfoldSettings,
-    ws: Workspace,
+    pub ws: Workspace,
     pub nodes: Vec<Vec3>,
     pub energy_value: f64,
     step_scale: Option<f64>,
@@ -404,6 +426,8 @@ pub struct Unfolder<'a> {
     pub crossings_refused: usize,
     /// Direction QPs solved with reduced accuracy.
     pub qp_almost_solved: usize,
+    /// Times antipodal pairs were pinned.
+    pub pins: usize,
 }
 
 impl<'a> Unfolder<'a> {
@@ -425,6 +449,7 @@ impl<'a> Unfolder<'a> {
             last_direction_norm: 0.0,
             crossings_refused: 0,
             qp_almost_solved: 0,
+            pins: 0,
         })
     }
 
@@ -443,8 +468,9 @@ impl<'a> Unfolder<'a> {
         Ok((DirectionProblem { q, a: self.ws.jacobian.clone() }, row_space))
     }
 
-    /// First-order degrees of freedom at the current state.
+    /// First-order degrees of freedom at the current state (antipodal pins dropped).
     pub fn null_dimension(&mut self) -> Result<usize> {
+        self.unpin();
         Ok(self.direction_problem()?.1.null_dimension())
     }
 
@@ -466,6 +492,9 @@ impl<'a> Unfolder<'a> {
         self.last_direction_norm = largest;
         let slope = y.norm_squared();
         if largest <= 1e-14 * (1.0 + problem.q.amax()) || !largest.is_finite() {
+            if self.pin_antipodal_pairs() {
+                return Ok(StepOutcome::Moved { displacement: 0.0 });
+            }
             return Ok(StepOutcome::Stationary);
         }
         let cap = self.settings.max_step_rad / largest;
@@ -504,6 +533,7 @@ impl<'a> Unfolder<'a> {
                         self.energy_value = value;
                         self.step_scale = Some(t);
                         self.ws.trial = trial;
+                        self.pin_antipodal_pairs();
                         return Ok(StepOutcome::Moved { displacement });
                     }
                 }
@@ -512,33 +542,117 @@ impl<'a> Unfolder<'a> {
             t *= 0.5;
         }
         self.step_scale = None;
+        if self.pin_antipodal_pairs() {
+            return Ok(StepOutcome::Moved { displacement: 0.0 });
+        }
         Ok(StepOutcome::Stationary)
     }
 
-    /// Random kick inside the first-order feasible directions, then restoration.
+    /// Near the flat state the separable energy has V-shaped kinks at antipodal node
+    /// pairs (SPEC §9): γ = π − distance, minimal for the pair, with a subgradient of unit
+    /// size whose direction is rounding noise. A projected gradient cannot settle on a
+    /// kink, and the Newton projection keeps nudging pairs off it, which costs more energy
+    /// than the ρ² left to gain. Once every |ρ| < 1e-3, pairs within 1e-5 of antipodal are
+    /// held there by the equality x_v + x_w = 0, as an active-set method would, provided the
+    /// projection onto the pinned set does not raise the energy; pins are dropped before
+    /// restarts and before the degrees of freedom are counted. Returns whether it moved.
+    fn pin_antipodal_pairs(&mut self) -> bool {
+        if self.model.max_fold_angle(&self.nodes) >= 1e-3 {
+            return false;
+        }
+        let n = self.model.node_count;
+        let mut added = false;
+        let rows_before = self.ws.rows.len();
+        for v in 0..n {
+            for w in v + 1..n {
+                if w < 2 {
+                    continue;
+                }
+                let distance_from_antipode = PI - geodesic(&self.nodes[v], &self.nodes[w]);
+                let pinned = self.ws.rows.contains(&ConstraintRow::Antipodal { v: w, w: v, k: 0 });
+                if distance_from_antipode < 1e-5 && !pinned {
+                    // Row basis from the free node of the pair (w ≥ 2).
+                    for k in 0..2 {
+                        self.ws.rows.push(ConstraintRow::Antipodal { v: w, w: v, k });
+                    }
+                    added = true;
+                }
+            }
+        }
+        if !added {
+            return false;
+        }
+        self.ws.resize_rows(self.model);
+        // Project onto the pinned set at once; keep the pins only if that does not cost
+        // energy beyond rounding.
+        let mut projected = self.nodes.clone();
+        let restored = restore(self.model, &mut self.ws, &mut projected, self.settings.restore_tol, None);
+        let mut gradient = vec![Vec3::zeros(); self.model.node_count];
+        let value = if restored.is_ok() {
+            self.energy.value_and_gradient(&projected, &self.model.arcs, &mut self.ws.energy, &mut gradient)
+        } else {
+            f64::INFINITY
+        };
+        if value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs() && find_crossing(self.model, &self.nodes, &projected).is_none() {
+            self.nodes = projected;
+            self.energy_value = value;
+            self.ws.gradient = gradient;
+            self.pins += 1;
+            self.step_scale = None;
+            true
+        } else {
+            self.ws.rows.truncate(rows_before);
+            self.ws.resize_rows(self.model);
+            false
+        }
+    }
+
+    /// Drops every antipodal pin.
+    fn unpin(&mut self) {
+        self.ws.rows.retain(|r| !matches!(r, ConstraintRow::Antipodal { .. }));
+        self.ws.resize_rows(self.model);
+    }
+
+    /// Random kick inside the first-order feasible directions, then restoration; a kick
+    /// whose restoration fails is halved (up to five times) before giving up on it.
     fn kick(&mut self, rng: &mut SplitMix64, size: f64) -> Result<()> {
+        self.unpin();
+        let mut size = size;
+        for _ in 0..6 {
+            if self.try_kick(rng, size)? {
+                return Ok(());
+            }
+            size *= 0.5;
+        }
+        Ok(())
+    }
+
+    fn try_kick(&mut self, rng: &mut SplitMix64, size: f64) -> Result<bool> {
         let (_, row_space) = self.direction_problem()?;
         let m = self.model.free.len();
         let noise = DVector::from_iterator(2 * m, (0..2 * m).map(|_| rng.next_f64() - 0.5));
         let mut direction = row_space.project_to_null(&noise);
         let largest = direction.amax();
         if largest == 0.0 {
-            return Ok(());
+            return Ok(true);
         }
         direction *= size / largest;
         let basis = self.ws.basis.clone();
         let mut trial = self.nodes.clone();
         retract(self.model, &self.nodes, &basis, &direction, 1.0, &mut trial);
-        restore(self.model, &mut self.ws, &mut trial, self.settings.restore_tol, None)?;
+        if restore(self.model, &mut self.ws, &mut trial, self.settings.restore_tol, None).is_err() {
+            return Ok(false);
+        }
         let value = self.energy.value_and_gradient(&trial, &self.model.arcs, &mut self.ws.energy, &mut self.ws.gradient);
-        if value.is_finite() && find_crossing(self.model, &self.nodes, &trial).is_none() {
+        let accepted = value.is_finite() && find_crossing(self.model, &self.nodes, &trial).is_none();
+        if accepted {
             self.nodes = trial;
             self.energy_value = value;
         } else {
             self.energy_value = self.energy.value_and_gradient(&self.nodes, &self.model.arcs, &mut self.ws.energy, &mut self.ws.gradient);
         }
         self.step_scale = None;
-        Ok(())
+        Ok(accepted)
     }
 }
 

@@ -1,0 +1,254 @@
+//! Files a run writes: `trajectory.json` and the FOLD animation `unfold.fold`, each written
+//! to a temporary file and renamed, so nothing is left half-written.
+
+use crate::error::{NanofoldError, Result};
+use crate::pattern::{Chain, FoldMesh, Pattern, RayRole};
+use crate::sphere::Vec3;
+use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::f64::consts::TAU;
+use std::path::Path;
+
+/// Writes `contents` to `path` through a temporary file in the same folder and a rename.
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
+    let err = |message: String| NanofoldError::Output { path: path.display().to_string(), message };
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("output");
+    let temporary = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    std::fs::write(&temporary, contents).map_err(|e| err(e.to_string()))?;
+    std::fs::rename(&temporary, path).map_err(|e| {
+        let _ = std::fs::remove_file(&temporary);
+        err(e.to_string())
+    })
+}
+
+/// Indices of the recorded steps to show as snapshots: the first step past each tenth of
+/// the way from the folded state to flat (by the largest fold angle), and the last step.
+pub fn snapshot_indices(report: &UnfoldReport, count: usize) -> Vec<usize> {
+    let traj = &report.trajectory;
+    if traj.is_empty() {
+        return Vec::new();
+    }
+    let max_abs = |angles: &[f64]| angles.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let start = max_abs(&traj[0].fold_angles).max(1e-300);
+    let mut picks = vec![0];
+    for j in 1..count {
+        let level = start * (1.0 - j as f64 / (count - 1) as f64);
+        if let Some(i) = traj.iter().position(|r| max_abs(&r.fold_angles) <= level + 1e-15) {
+            if !picks.contains(&i) {
+                picks.push(i);
+            }
+        }
+    }
+    let last = traj.len() - 1;
+    if !picks.contains(&last) {
+        picks.push(last);
+    }
+    picks.sort_unstable();
+    picks
+}
+
+/// The mesh written to FOLD: the input's for FOLD input, else one synthesised from the
+/// vertex (centre, unit-length rays, chords between ray tips, triangular faces).
+struct ExportMesh {
+    coords_2d: Vec<[f64; 2]>,
+    center: usize,
+    ray0_direction: f64,
+    edges_vertices: Vec<[usize; 2]>,
+    edges_assignment: Vec<String>,
+    /// Crease index (file order) of each edge, if it is a crease.
+    edge_crease: Vec<Option<usize>>,
+    faces_vertices: Option<Vec<Vec<usize>>>,
+}
+
+fn export_mesh(pattern: &Pattern) -> ExportMesh {
+    if let Some(FoldMesh { vertices_coords, edges_vertices, edges_assignment, faces_vertices, center, ray0_direction }) = &pattern.mesh {
+        let mut edge_crease = vec![None; edges_vertices.len()];
+        for (i, c) in pattern.creases.iter().enumerate() {
+            if let Some(e) = c.fold_edge {
+                edge_crease[e] = Some(i);
+            }
+        }
+        return ExportMesh {
+            coords_2d: vertices_coords.clone(),
+            center: *center,
+            ray0_direction: *ray0_direction,
+            edges_vertices: edges_vertices.clone(),
+            edges_assignment: edges_assignment.clone(),
+            edge_crease,
+            faces_vertices: faces_vertices.clone(),
+        };
+    }
+    let n = pattern.ray_count();
+    let directions = pattern.flat_ray_directions();
+    let mut coords_2d = vec![[0.0, 0.0]];
+    coords_2d.extend(directions.iter().map(|phi| [phi.cos(), phi.sin()]));
+    let mut edges_vertices = Vec::new();
+    let mut edges_assignment = Vec::new();
+    let mut edge_crease = Vec::new();
+    for (k, role) in pattern.rays.iter().enumerate() {
+        edges_vertices.push([0, k + 1]);
+        let (letter, crease) = match role {
+            RayRole::Crease(i) => (pattern.creases[*i].assignment.letter().to_string(), Some(*i)),
+            RayRole::Boundary => ("B".to_string(), None),
+            RayRole::Virtual => ("F".to_string(), None),
+        };
+        edges_assignment.push(letter);
+        edge_crease.push(crease);
+    }
+    let mut faces = Vec::new();
+    for k in 0..pattern.sector_angles.len() {
+        let next = (k + 1) % n;
+        edges_vertices.push([k + 1, next + 1]);
+        edges_assignment.push("B".to_string());
+        edge_crease.push(None);
+        faces.push(vec![0, k + 1, next + 1]);
+    }
+    ExportMesh {
+        coords_2d,
+        center: 0,
+        ray0_direction: 0.0,
+        edges_vertices,
+        edges_assignment,
+        edge_crease,
+        faces_vertices: Some(faces),
+    }
+}
+
+/// 3D position of every mesh vertex for the given node positions: each vertex moves with
+/// the (split) sector that contains it.
+fn place_vertices(pattern: &Pattern, mesh: &ExportMesh, nodes: &[Vec3]) -> Vec<[f64; 3]> {
+    let directions = pattern.flat_ray_directions();
+    let n = pattern.ray_count();
+    let sectors = pattern.sector_angles.len();
+    let c = mesh.coords_2d[mesh.center];
+    let (s0, c0) = mesh.ray0_direction.sin_cos();
+    mesh.coords_2d
+        .iter()
+        .map(|p| {
+            // Into the vertex frame: centre at the origin, ray 0 along +x.
+            let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
+            let v = [c0 * dx + s0 * dy, -s0 * dx + c0 * dy];
+            let theta = v[1].atan2(v[0]).rem_euclid(TAU);
+            let mut k = (0..sectors).rev().find(|&k| directions[k] <= theta + 1e-12).unwrap_or(0);
+            if pattern.chain == Chain::Open && theta > directions[n - 1] + 1e-9 {
+                k = if theta - directions[n - 1] < TAU - theta { sectors - 1 } else { 0 };
+            }
+            let (su, cu) = directions[k].sin_cos();
+            let a = v[0] * cu + v[1] * su;
+            let b = -v[0] * su + v[1] * cu;
+            let xk = nodes[k];
+            let normal = xk.cross(&nodes[(k + 1) % n]).normalize();
+            let q = a * xk + b * normal.cross(&xk);
+            // Back to the pattern's orientation.
+            [c[0] + c0 * q.x - s0 * q.y, c[1] + s0 * q.x + c0 * q.y, q.z]
+        })
+        .collect()
+}
+
+fn edge_angles_degrees(mesh: &ExportMesh, crease_angles: &[f64]) -> Vec<f64> {
+    mesh.edge_crease
+        .iter()
+        .map(|c| c.map_or(0.0, |i| crease_angles[i].to_degrees()))
+        .collect()
+}
+
+/// Builds the FOLD animation: the key frame is the first snapshot, `file_frames` the rest.
+pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldReport) -> Value {
+    let mesh = export_mesh(pattern);
+    let picks = snapshot_indices(report, 11);
+    let frame = |index: usize| {
+        let step = &report.trajectory[index];
+        (place_vertices(pattern, &mesh, &step.nodes), edge_angles_degrees(&mesh, &model.crease_angles(&step.nodes)), step.iteration)
+    };
+    let (coords0, angles0, _) = if picks.is_empty() {
+        let nodes = model.folded_nodes();
+        (place_vertices(pattern, &mesh, &nodes), edge_angles_degrees(&mesh, &model.crease_angles(&nodes)), 0)
+    } else {
+        frame(picks[0])
+    };
+    let frames: Vec<Value> = picks
+        .iter()
+        .skip(1)
+        .map(|&i| {
+            let (coords, angles, iteration) = frame(i);
+            json!({
+                "frame_title": format!("iteration {iteration}"),
+                "frame_classes": ["foldedForm"],
+                "frame_attributes": ["3D"],
+                "frame_parent": 0,
+                "frame_inherit": true,
+                "vertices_coords": coords,
+                "edges_foldAngle": angles,
+            })
+        })
+        .collect();
+    let mut root = json!({
+        "file_spec": 1.1,
+        "file_creator": "nanofold",
+        "file_classes": ["animation"],
+        "frame_title": format!("{}: unfolding, iteration 0 (verdict {})", pattern.name, report.verdict.as_str()),
+        "frame_classes": ["foldedForm"],
+        "frame_attributes": ["3D"],
+        "vertices_coords": coords0,
+        "edges_vertices": mesh.edges_vertices,
+        "edges_assignment": mesh.edges_assignment,
+        "edges_foldAngle": angles0,
+        "file_frames": frames,
+    });
+    if let Some(faces) = mesh.faces_vertices {
+        root["faces_vertices"] = json!(faces);
+    }
+    root
+}
+
+#[derive(Serialize)]
+struct TrajectoryStep<'a> {
+    iteration: usize,
+    energy: f64,
+    fold_angles_rad: &'a [f64],
+    max_arc_residual_rad: f64,
+    direction_norm: f64,
+    /// Unit vectors of every ray (virtual rays included), in ray order.
+    nodes: Vec<[f64; 3]>,
+}
+
+/// `trajectory.json`: settings, crease table and every recorded step (thinned evenly to at
+/// most `max_steps`, first and last kept).
+pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &UnfoldReport, max_steps: usize) -> Value {
+    let total = report.trajectory.len();
+    let stride = total.div_ceil(max_steps.max(1)).max(1);
+    let mut chosen: Vec<usize> = (0..total).step_by(stride).collect();
+    if total > 0 && chosen.last() != Some(&(total - 1)) {
+        chosen.push(total - 1);
+    }
+    let steps: Vec<TrajectoryStep> = chosen
+        .iter()
+        .map(|&i| {
+            let r = &report.trajectory[i];
+            TrajectoryStep {
+                iteration: r.iteration,
+                energy: r.energy,
+                fold_angles_rad: &r.fold_angles,
+                max_arc_residual_rad: r.max_arc_residual,
+                direction_norm: r.direction_norm,
+                nodes: r.nodes.iter().map(|x| [x.x, x.y, x.z]).collect(),
+            }
+        })
+        .collect();
+    json!({
+        "pattern": pattern.name,
+        "units": {"angles": "rad", "nodes": "unit vectors, vertex at the origin, sector 0 in the xy-plane"},
+        "settings": settings,
+        "creases": pattern.creases,
+        "rays": pattern.rays,
+        "sector_angles_rad": pattern.sector_angles,
+        "verdict": report.verdict,
+        "evidence": report.evidence,
+        "recorded_steps": total,
+        "steps_written": steps.len(),
+        "steps": steps,
+    })
+}
