@@ -51,13 +51,13 @@ pub struct SolverArgs {
     #[arg(long, value_enum, default_value_t = EnergyKind::Separable)]
     pub energy: EnergyKind,
     /// Exponent p (default 2 separable, 4 non-separable).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub p: Option<f64>,
     /// Direction solver: the direct null-space projection or the Clarabel QP.
     #[arg(long, value_enum, default_value_t = QpMethod::Direct)]
     pub qp: QpMethod,
     /// Flat when every |fold angle| ≤ this (rad).
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub flat_tol: f64,
     /// Iteration limit.
     #[arg(long, default_value_t = 20_000)]

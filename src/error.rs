@@ -6,12 +6,8 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum NanofoldError {
     /// The input file could not be read.
-    #[error("cannot read {path}: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error("cannot read {path}: {error}")]
+    Io { path: String, error: std::io::Error },
     /// The input is not valid JSON.
     #[error("{path}: malformed JSON: {message}")]
     Json { path: String, message: String },

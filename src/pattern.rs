@@ -177,9 +177,9 @@ impl Pattern {
     /// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
     /// `vertices_coords`).
     pub fn load(path: &Path, options: &LoadOptions) -> Result<Pattern> {
-        let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| NanofoldError::Io {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         let name = path
             .file_name()

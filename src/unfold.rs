@@ -751,9 +751,23 @@ fn record(model: &UnfoldModel, solver: &Unfolder, iteration: usize) -> StepRecor
     }
 }
 
+/// Largest fold angle at which a stall counts as "near flat" rather than a local minimum.
+const NEAR_FLAT: f64 = 1e-4;
+
 /// Backs a flat-folded (|ρ| = π, coincident charges) start off the singularity: every fold
 /// angle is scaled by (1 − 10⁻³) and the constraints restored (documented in README).
 const FLAT_FOLDED_BACKOFF: f64 = 1e-3;
+
+/// Does a node touch an arc it is not on (γ(v,a) + γ(v,b) − α below 1e-9 rad)? This is
+/// the flat-folded case of coincident charges, where rounding may leave the energy finite
+/// but astronomically large.
+pub fn touching_charges(model: &UnfoldModel, nodes: &[Vec3]) -> bool {
+    model.arcs.iter().any(|arc| {
+        (0..model.node_count)
+            .filter(|&v| v != arc.a && v != arc.b)
+            .any(|v| geodesic(&nodes[v], &nodes[arc.a]) + geodesic(&nodes[v], &nodes[arc.b]) - arc.length < 1e-9)
+    })
+}
 
 /// Unfolds a pattern: the main job.
 pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldReport> {
@@ -792,7 +806,7 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
     }
 
     let energy = settings.energy.build(settings.p);
-    if !energy.value(&start, &model.arcs, &mut EnergyWorkspace::default()).is_finite() {
+    if touching_charges(&model, &start) || !energy.value(&start, &model.arcs, &mut EnergyWorkspace::default()).is_finite() {
         let scaled: Vec<f64> = model.folded_ray_angles.iter().map(|r| r * (1.0 - FLAT_FOLDED_BACKOFF)).collect();
         start = kinematics::forward(&model.sector_angles, &scaled);
         adjustments.push(format!(
@@ -859,6 +873,14 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
                     verdict = Verdict::Stuck;
                     evidence = format!(
                         "{why} at max |ρ| = {:.3e} rad after {iteration} iterations ({restarts_used} restarts)",
+                        model.max_fold_angle(&solver.nodes)
+                    );
+                } else if model.max_fold_angle(&solver.nodes) < NEAR_FLAT {
+                    // SPEC §4/§5: a stall this close to flat is the solver meeting the singular
+                    // constraint Jacobian of the flat state, not a minimum of the energy.
+                    verdict = Verdict::Stuck;
+                    evidence = format!(
+                        "stalled {:.3e} rad from flat after {iteration} iterations and {restarts_used} restarts: the constraint Jacobian is singular at the flat state, so this is a solver limit near flat, not a local minimum",
                         model.max_fold_angle(&solver.nodes)
                     );
                 } else if dof == 0 {

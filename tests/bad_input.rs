@@ -1,0 +1,110 @@
+//! Every bad input gets a clear error naming the field and the value.
+
+use nanofold::pattern::{LoadOptions, Pattern};
+
+fn error_of(text: &str) -> String {
+    match Pattern::from_str(text, "test", "test.json", &LoadOptions::default()) {
+        Ok(_) => panic!("accepted bad input: {text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn native(sectors: &str, creases: &str) -> String {
+    format!(r#"{{"chain":"closed","angle_unit":"deg","sector_angles":{sectors},"creases":[{creases}]}}"#)
+}
+
+const FOUR: &str = r#"{"assignment":"V","fold_angle":0},{"assignment":"V","fold_angle":0},{"assignment":"V","fold_angle":0},{"assignment":"V","fold_angle":0}"#;
+
+#[test]
+fn malformed_json() {
+    assert!(error_of("{ not json").contains("malformed JSON"));
+}
+
+#[test]
+fn missing_keys() {
+    assert!(error_of(r#"{"chain":"closed","angle_unit":"deg","creases":[]}"#).contains("missing key `sector_angles`"));
+    let fold = r#"{"vertices_coords":[[0,0],[1,0],[0,1]],"edges_vertices":[[0,1],[0,2]]}"#;
+    assert!(error_of(fold).contains("missing key `edges_assignment`"));
+    let fold = r#"{"vertices_coords":[[0,0],[1,0],[0,1]],"edges_vertices":[[0,1],[0,2]],"edges_assignment":["V","V"]}"#;
+    assert!(error_of(fold).contains("edges_foldAngle"));
+}
+
+#[test]
+fn non_finite_numbers() {
+    // JSON has no NaN; an overflowing literal is refused by the parser.
+    assert!(error_of(&native("[90, 90, 90, 1e999]", FOUR)).contains("malformed JSON"));
+    let fold = r#"{"vertices_coords":[[0,0],[1,"x"]],"edges_vertices":[],"edges_assignment":[],"edges_foldAngle":[]}"#;
+    let e = error_of(fold);
+    assert!(e.contains("vertices_coords[1]") && e.contains("expected a number"), "{e}");
+}
+
+#[test]
+fn zero_or_negative_sectors() {
+    let e = error_of(&native("[0, 120, 120, 120]", FOUR));
+    assert!(e.contains("sector_angles[0]") && e.contains("positive"), "{e}");
+    let e = error_of(&native("[100, -10, 130, 140]", FOUR));
+    assert!(e.contains("sector_angles[1]"), "{e}");
+}
+
+#[test]
+fn too_much_paper_at_a_boundary_vertex() {
+    let text = r#"{"chain":"open","angle_unit":"deg","sector_angles":[200, 200],"creases":[{"assignment":"V","fold_angle":10}]}"#;
+    let e = error_of(text);
+    assert!(e.contains("sector_angles") && e.contains("400"), "{e}");
+}
+
+#[test]
+fn fold_angle_out_of_range() {
+    let creases = r#"{"assignment":"V","fold_angle":190},{"assignment":"V","fold_angle":0},{"assignment":"V","fold_angle":0},{"assignment":"V","fold_angle":0}"#;
+    let e = error_of(&native("[90, 90, 90, 90]", creases));
+    assert!(e.contains("creases[0].fold_angle") && e.contains("190"), "{e}");
+}
+
+#[test]
+fn fold_angle_sign_contradicts_assignment() {
+    let creases = r#"{"assignment":"M","fold_angle":30},{"assignment":"V","fold_angle":0},{"assignment":"M","fold_angle":30},{"assignment":"V","fold_angle":0}"#;
+    let e = error_of(&native("[90, 90, 90, 90]", creases));
+    assert!(e.contains("creases[0].fold_angle") && e.contains("mountain"), "{e}");
+}
+
+#[test]
+fn loop_closure_violation_reports_the_residual() {
+    let creases = r#"{"assignment":"V","fold_angle":30},{"assignment":"V","fold_angle":0},{"assignment":"M","fold_angle":-30},{"assignment":"V","fold_angle":0}"#;
+    let e = error_of(&native("[90, 90, 90, 90]", creases));
+    assert!(e.contains("loop closure") && e.contains("residual 1.047e0"), "{e}");
+}
+
+#[test]
+fn cut_and_join_edges_are_refused() {
+    let fold = r#"{"vertices_coords":[[0,0],[1,0],[-1,0]],"edges_vertices":[[0,1],[0,2]],"edges_assignment":["C","V"],"edges_foldAngle":[0,0]}"#;
+    let e = error_of(fold);
+    assert!(e.contains("edges_assignment[0]") && e.contains("\"C\""), "{e}");
+}
+
+#[test]
+fn multi_vertex_patterns_are_refused() {
+    // Two crease vertices: (0,0) and (2,0), joined by a crease.
+    let fold = r#"{"vertices_coords":[[0,0],[2,0],[-1,0],[3,0]],"edges_vertices":[[0,1],[0,2],[1,3]],"edges_assignment":["V","V","V"],"edges_foldAngle":[10,10,10]}"#;
+    assert_eq!(error_of(fold), "2 vertices with creases; only single-vertex patterns are supported");
+}
+
+#[test]
+fn unknown_native_field_and_values() {
+    assert!(error_of(&native("[90, 90, 90, 90]", FOUR).replace("\"deg\"", "\"grad\"")).contains("angle_unit"));
+    assert!(error_of(&native("[90, 90, 90, 90]", FOUR).replace("closed", "loop")).contains("chain"));
+    let e = error_of(&native("[90, 90, 90, 90]", &FOUR.replacen("\"V\"", "\"X\"", 1)));
+    assert!(e.contains("creases[0].assignment"), "{e}");
+}
+
+#[test]
+fn flat_folded_input_is_backed_off_by_the_documented_rule() {
+    // Half-paper folded exactly flat: coincident sectors, infinite energy.
+    let text = r#"{"vertices_coords":[[0,0],[1,0],[-1,0],[1,1],[-1,1],[-1,-1],[1,-1]],
+        "edges_vertices":[[0,1],[0,2],[1,3],[3,4],[4,2],[2,5],[5,6],[6,1]],
+        "edges_assignment":["V","V","B","B","B","B","B","B"],"edges_foldAngle":[180,180,0,0,0,0,0,0]}"#;
+    let pattern = Pattern::from_str(text, "flat_folded", "t", &LoadOptions::default()).unwrap();
+    let report = nanofold::unfold::unfold(&pattern, &Default::default()).unwrap();
+    assert_eq!(report.verdict, nanofold::unfold::Verdict::Flat);
+    assert!(report.adjustments.iter().any(|a| a.contains("flat-folded")));
+    assert!(report.energy_initial.is_finite());
+}

@@ -1,0 +1,180 @@
+//! Numerical methods against independent answers: closed forms, finite differences and a
+//! second method (proptest over random states).
+
+use nanofold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::kinematics::{closure_residual, solve_closure};
+use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::qp::{solve_clarabel, solve_direct};
+use nanofold::sphere::{fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3};
+use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
+use proptest::prelude::*;
+use std::f64::consts::{PI, TAU};
+
+fn unit() -> impl Strategy<Value = Vec3> {
+    (-1.0..1.0f64, 0.0..TAU).prop_map(|(z, phi)| {
+        let r = (1.0 - z * z).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    })
+}
+
+/// Random sectors (each in [0.15, 0.9π]) summing to 2π, and a folded state reached by a
+/// kinematic move: n − 3 creases driven from flat to random angles, three following by
+/// loop closure. None when the continuation loses the branch.
+fn random_vertex(n: usize, weights: &[f64], drive: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+    let total: f64 = weights[..n].iter().sum();
+    let sectors: Vec<f64> = weights[..n].iter().map(|w| w / total * TAU).collect();
+    if sectors.iter().any(|&a| !(0.15..0.9 * PI).contains(&a)) {
+        return None;
+    }
+    let mut rho = vec![0.0; n];
+    let free = [0, 1, 2];
+    for s in 1..=30 {
+        for k in 3..n {
+            rho[k] = drive[k] * s as f64 / 30.0;
+        }
+        solve_closure(&sectors, &mut rho, &free, 1e-14, 60).ok()?;
+    }
+    if rho.iter().any(|r| r.abs() > 0.97 * PI) {
+        return None;
+    }
+    Some((sectors, rho))
+}
+
+fn native_json(sectors: &[f64], rho: &[f64]) -> String {
+    let creases: Vec<String> = rho.iter().map(|r| format!(r#"{{"assignment":"U","fold_angle":{r}}}"#)).collect();
+    format!(r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#, creases.join(","))
+}
+
+fn fd_check(f: impl Fn(&Vec3) -> f64, x: &Vec3, grad: &Vec3, tol: f64) -> Result<(), TestCaseError> {
+    let h = 1e-6;
+    for i in 0..3 {
+        let mut plus = *x;
+        let mut minus = *x;
+        plus[i] += h;
+        minus[i] -= h;
+        let fd = (f(&plus) - f(&minus)) / (2.0 * h);
+        prop_assert!((fd - grad[i]).abs() <= tol * (1.0 + fd.abs()), "component {i}: fd {fd} vs analytic {}", grad[i]);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn geodesic_stable_form_matches_cosine_rule(a in unit(), b in unit()) {
+        let g = geodesic(&a, &b);
+        prop_assume!(g > 1e-3 && g < PI - 1e-3);
+        prop_assert!((g - geodesic_cosine_rule(&a, &b)).abs() < 1e-12);
+        prop_assert!((g - geodesic(&b, &a)).abs() == 0.0);
+    }
+
+    #[test]
+    fn geodesic_triangle_inequality(a in unit(), b in unit(), c in unit()) {
+        prop_assert!(geodesic(&a, &c) <= geodesic(&a, &b) + geodesic(&b, &c) + 1e-14);
+    }
+
+    #[test]
+    fn geodesic_gradient_matches_finite_differences(a in unit(), b in unit()) {
+        let g = geodesic(&a, &b);
+        prop_assume!(g > 1e-2 && g < PI - 1e-2);
+        let (_, ga, gb) = geodesic_with_gradient(&a, &b);
+        fd_check(|x| geodesic(x, &b), &a, &ga, 1e-6)?;
+        fd_check(|x| geodesic(&a, x), &b, &gb, 1e-6)?;
+    }
+
+    #[test]
+    fn fold_angle_gradient_matches_finite_differences(p in unit(), a in unit(), q in unit()) {
+        prop_assume!(geodesic(&p, &a) > 0.1 && geodesic(&p, &a) < 3.0 && geodesic(&q, &a) > 0.1 && geodesic(&q, &a) < 3.0);
+        let (rho, [gp, ga, gq]) = fold_angle_with_gradient(&p, &a, &q);
+        prop_assume!(rho.abs() < 3.0);
+        fd_check(|x| fold_angle(x, &a, &q), &p, &gp, 1e-5)?;
+        fd_check(|x| fold_angle(&p, &a, x), &q, &gq, 1e-5)?;
+        // The axis gradient is exact for unit axes: compare tangential components only.
+        let h = 1e-6;
+        for e in [a.cross(&Vec3::z()).normalize(), a.cross(&a.cross(&Vec3::z())).normalize()] {
+            let fd = (fold_angle(&p, &(a + h * e), &q) - fold_angle(&p, &(a - h * e), &q)) / (2.0 * h);
+            prop_assert!((fd - ga.dot(&e)).abs() <= 1e-5 * (1.0 + fd.abs()));
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn energy_gradients_match_finite_differences(
+        n in 4usize..9,
+        weights in proptest::collection::vec(1.0..3.0f64, 12),
+        drive in proptest::collection::vec(-1.0..1.0f64, 12),
+        separable in any::<bool>(),
+    ) {
+        let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
+        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let model = UnfoldModel::new(&pattern);
+        let nodes = model.folded_nodes();
+        let kind = if separable { EnergyKind::Separable } else { EnergyKind::NonSeparable };
+        let energy = kind.build(None);
+        let mut ws = EnergyWorkspace::default();
+        let mut grad = vec![Vec3::zeros(); nodes.len()];
+        let u = energy.value_and_gradient(&nodes, &model.arcs, &mut ws, &mut grad);
+        prop_assume!(u.is_finite());
+        prop_assert!((u - energy.value(&nodes, &model.arcs, &mut ws)).abs() <= 1e-12 * u);
+        let h = 1e-7;
+        for v in 0..nodes.len() {
+            for i in 0..3 {
+                let mut plus = nodes.clone();
+                let mut minus = nodes.clone();
+                plus[v][i] += h;
+                minus[v][i] -= h;
+                let fd = (energy.value(&plus, &model.arcs, &mut ws) - energy.value(&minus, &model.arcs, &mut ws)) / (2.0 * h);
+                prop_assert!((fd - grad[v][i]).abs() <= 1e-5 * (1.0 + u), "node {v} comp {i}: fd {fd} vs {}", grad[v][i]);
+            }
+        }
+    }
+
+    #[test]
+    fn clarabel_and_direct_projection_agree(
+        n in 4usize..10,
+        weights in proptest::collection::vec(1.0..3.0f64, 12),
+        drive in proptest::collection::vec(-1.0..1.0f64, 12),
+    ) {
+        let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
+        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let model = UnfoldModel::new(&pattern);
+        let mut solver = Unfolder::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
+        let (problem, _) = solver.direction_problem().unwrap();
+        let direct = solve_direct(&problem).unwrap();
+        let clarabel = solve_clarabel(&problem).unwrap();
+        let scale = 1.0 + problem.q.amax();
+        prop_assert!((&direct.y - &clarabel.y).amax() <= 1e-10 * scale, "differ by {:e} (scale {scale:e})", (&direct.y - &clarabel.y).amax());
+        prop_assert!((&problem.a * &direct.y).amax() <= 1e-12 * scale);
+    }
+
+}
+
+proptest! {
+    // About half the draws give a valid vertex (the others are skipped), so ~24 unfold.
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn random_vertices_unfold_without_panic_and_keep_constraints(
+        n in 4usize..13,
+        weights in proptest::collection::vec(1.0..3.0f64, 12),
+        drive in proptest::collection::vec(-1.2..1.2f64, 12),
+    ) {
+        let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
+        prop_assert!(closure_residual(&sectors, &rho) < 1e-12);
+        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let settings = UnfoldSettings { max_iterations: 5000, ..Default::default() };
+        let report = unfold(&pattern, &settings).unwrap();
+        for step in &report.trajectory {
+            prop_assert!(step.max_arc_residual <= 1e-10, "arc residual {:e} at step {}", step.max_arc_residual, step.iteration);
+            prop_assert!(step.energy.is_finite());
+        }
+        if report.verdict == Verdict::Flat {
+            prop_assert!(report.final_fold_angles_rad.iter().all(|r| r.abs() <= 1e-6));
+        }
+        prop_assert!(report.verdict != Verdict::LocalMinimum && report.verdict != Verdict::Locked, "{:?}: {}", report.verdict, report.evidence);
+    }
+}
