@@ -12,7 +12,13 @@ const DEG: f64 = PI / 180.0;
 
 /// Steps the driven creases linearly from flat to their targets; the unknown creases
 /// follow by Newton from the previous step (the first step starts from `first_guess`·h).
-fn fold_by_continuation(sectors_deg: &[f64], driven: &[(usize, f64)], unknown: &[usize], first_guess: &[f64], steps: usize) -> Vec<f64> {
+fn fold_by_continuation(
+    sectors_deg: &[f64],
+    driven: &[(usize, f64)],
+    unknown: &[usize],
+    first_guess: &[f64],
+    steps: usize,
+) -> Vec<f64> {
     let sectors: Vec<f64> = sectors_deg.iter().map(|a| a * DEG).collect();
     let n = sectors.len();
     let mut rho = vec![0.0; n];
@@ -29,7 +35,10 @@ fn fold_by_continuation(sectors_deg: &[f64], driven: &[(usize, f64)], unknown: &
         solve_closure(&sectors, &mut rho, unknown, 1e-15, 100).expect("closure along the path");
     }
     let degrees: Vec<f64> = rho.iter().map(|r| r / DEG).collect();
-    assert!(degrees.iter().all(|r| r.abs() < 180.0), "a crease passed through ±180° (sectors through each other): {degrees:?}");
+    assert!(
+        degrees.iter().all(|r| r.abs() < 180.0),
+        "a crease passed through ±180° (sectors through each other): {degrees:?}"
+    );
     degrees
 }
 
@@ -146,7 +155,16 @@ fn write(name: &str, file: &Value) {
 
 fn main() {
     // Half-paper: one straight crease, 80% folded.
-    write("half_paper", &fold_file("half-paper, one straight valley crease, 144° (80%)", &[0.0, 180.0], &[144.0, 144.0], None, false));
+    write(
+        "half_paper",
+        &fold_file(
+            "half-paper, one straight valley crease, 144° (80%)",
+            &[0.0, 180.0],
+            &[144.0, 144.0],
+            None,
+            false,
+        ),
+    );
 
     // Corner cube (SPEC §8): sectors 45, 90, 90, 90, 45 from the flap's centre crease (ray 0).
     // Its two-step path, taken to 90%: step 1 drives ray 0 to 162° with ray 1 held flat,
@@ -161,24 +179,63 @@ fn main() {
     }
     let corner_cube: Vec<f64> = rho.iter().map(|r| r / DEG).collect();
     println!("corner cube after step 1 {step1:?}\n  at 90% {corner_cube:?}");
-    write("corner_cube", &fold_file("corner cube (SPEC §8), 90% along its two-step folding path", &cumulative(&cc), &corner_cube, None, false));
+    write(
+        "corner_cube",
+        &fold_file(
+            "corner cube (SPEC §8), 90% along its two-step folding path",
+            &cumulative(&cc),
+            &corner_cube,
+            None,
+            false,
+        ),
+    );
 
     // Waterbomb base: diagonals valley, midlines mountain; diagonals driven to 135° (75%).
     let wb = [45.0; 8];
-    let waterbomb = fold_by_continuation(&wb, &[(1, 135.0), (3, 135.0), (5, 135.0), (7, 135.0)], &[0, 2, 4, 6], &[-1.0, -1.0, -1.0, -1.0], 135);
+    let waterbomb = fold_by_continuation(
+        &wb,
+        &[(1, 135.0), (3, 135.0), (5, 135.0), (7, 135.0)],
+        &[0, 2, 4, 6],
+        &[-1.0, -1.0, -1.0, -1.0],
+        135,
+    );
     println!("waterbomb {waterbomb:?}");
-    write("waterbomb", &fold_file("waterbomb base, diagonals at 135° (75%)", &cumulative(&wb), &waterbomb, None, false));
+    write(
+        "waterbomb",
+        &fold_file(
+            "waterbomb base, diagonals at 135° (75%)",
+            &cumulative(&wb),
+            &waterbomb,
+            None,
+            false,
+        ),
+    );
 
     // Generic degree-4 vertex (no Kawasaki condition): ray 0 driven to 120°.
     let g4 = [70.0, 100.0, 120.0, 70.0];
     let generic = fold_by_continuation(&g4, &[(0, 120.0)], &[1, 2, 3], &[-1.0, 1.0, 1.0], 120);
     println!("generic degree-4 {generic:?}");
-    write("degree4_generic", &fold_file("generic degree-4 vertex, 70/100/120/70°", &cumulative(&g4), &generic, None, false));
+    write(
+        "degree4_generic",
+        &fold_file(
+            "generic degree-4 vertex, 70/100/120/70°",
+            &cumulative(&g4),
+            &generic,
+            None,
+            false,
+        ),
+    );
 
     // The same vertex with ray 0 locked: no degree of freedom left, it cannot unfold.
     write(
         "degree4_locked",
-        &fold_file("generic degree-4 vertex with crease 0 locked (must not unfold)", &cumulative(&g4), &generic, Some(&[true, false, false, false]), false),
+        &fold_file(
+            "generic degree-4 vertex with crease 0 locked (must not unfold)",
+            &cumulative(&g4),
+            &generic,
+            Some(&[true, false, false, false]),
+            false,
+        ),
     );
 
     // Miura-ori-like degree-4 vertex: sectors (60, 120, 120, 60), three mountains and a valley.
@@ -187,13 +244,31 @@ fn main() {
     let mi = [60.0, 120.0, 120.0, 60.0];
     let miura = fold_by_continuation(&mi, &[(1, 150.0)], &[0, 2, 3], &[-1.0, -1.0, -1.0], 150);
     println!("miura {miura:?}");
-    write("miura_vertex", &fold_file("Miura-like degree-4 vertex, 60/120/120/60°, 83% folded", &cumulative(&mi), &miura, None, false));
+    write(
+        "miura_vertex",
+        &fold_file(
+            "Miura-like degree-4 vertex, 60/120/120/60°, 83% folded",
+            &cumulative(&mi),
+            &miura,
+            None,
+            false,
+        ),
+    );
 
     // Asymmetric degree-6 vertex: three creases driven, three follow.
     let d6 = [40.0, 75.0, 55.0, 65.0, 50.0, 75.0];
-    let degree6 = fold_by_continuation(&d6, &[(0, 80.0), (2, -60.0), (4, 70.0)], &[1, 3, 5], &[1.0, 1.0, -1.0], 80);
+    let degree6 = fold_by_continuation(
+        &d6,
+        &[(0, 80.0), (2, -60.0), (4, 70.0)],
+        &[1, 3, 5],
+        &[1.0, 1.0, -1.0],
+        80,
+    );
     println!("degree6 {degree6:?}");
-    write("degree6_asymmetric", &fold_file("asymmetric degree-6 vertex", &cumulative(&d6), &degree6, None, false));
+    write(
+        "degree6_asymmetric",
+        &fold_file("asymmetric degree-6 vertex", &cumulative(&d6), &degree6, None, false),
+    );
 
     // 16-fold symmetric vertex: alternate creases driven to 120°, the others follow.
     let s16 = [22.5; 16];
@@ -201,11 +276,26 @@ fn main() {
     let unknown: Vec<usize> = (1..16).step_by(2).collect();
     let sym16 = fold_by_continuation(&s16, &driven, &unknown, &[-1.0; 8], 120);
     println!("16-fold {sym16:?}");
-    write("symmetric16", &fold_file("16-fold symmetric vertex, alternate creases at 120°", &cumulative(&s16), &sym16, None, false));
+    write(
+        "symmetric16",
+        &fold_file(
+            "16-fold symmetric vertex, alternate creases at 120°",
+            &cumulative(&s16),
+            &sym16,
+            None,
+            false,
+        ),
+    );
 
     // Sheet-corner (boundary) vertex: two creases in a 90° corner, an open chain.
     write(
         "sheet_corner",
-        &fold_file("sheet-corner vertex, creases at 30° and 60°", &[0.0, 30.0, 60.0, 90.0], &[0.0, 120.0, -100.0, 0.0], None, true),
+        &fold_file(
+            "sheet-corner vertex, creases at 30° and 60°",
+            &[0.0, 30.0, 60.0, 90.0],
+            &[0.0, 120.0, -100.0, 0.0],
+            None,
+            true,
+        ),
     );
 }

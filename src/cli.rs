@@ -12,7 +12,11 @@ use serde_json::json;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser)]
-#[command(name = "nanofold", version, about = "Rigid origami: unfold single-vertex crease patterns to flat")]
+#[command(
+    name = "nanofold",
+    version,
+    about = "Rigid origami: unfold single-vertex crease patterns to flat"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -73,7 +77,10 @@ pub struct SolverArgs {
 impl SolverArgs {
     fn settings(&self) -> Result<UnfoldSettings> {
         if let Some(p) = self.p {
-            anyhow::ensure!(p.is_finite() && p > 0.0, "invalid --p {p}: the exponent must be a positive number");
+            anyhow::ensure!(
+                p.is_finite() && p > 0.0,
+                "invalid --p {p}: the exponent must be a positive number"
+            );
         }
         anyhow::ensure!(
             self.flat_tol.is_finite() && self.flat_tol > 0.0,
@@ -97,7 +104,10 @@ impl SolverArgs {
     }
 
     fn load_options(&self) -> LoadOptions {
-        LoadOptions { closure_tol: self.closure_tol, ..LoadOptions::default() }
+        LoadOptions {
+            closure_tol: self.closure_tol,
+            ..LoadOptions::default()
+        }
     }
 }
 
@@ -134,7 +144,11 @@ fn run_unfold(pattern_path: &Path, solver: &SolverArgs, out: Option<PathBuf>, as
     let trajectory = serde_json::to_string(&trajectory_json(&pattern, &settings, &report, 1000))?;
     let fold = serde_json::to_string_pretty(&fold_animation(&pattern, &model, &report))?;
     let svg = unfold_svg(&pattern, &report)?;
-    for (name, contents) in [("trajectory.json", trajectory.as_bytes()), ("unfold.fold", fold.as_bytes()), ("unfold.svg", svg.as_bytes())] {
+    for (name, contents) in [
+        ("trajectory.json", trajectory.as_bytes()),
+        ("unfold.fold", fold.as_bytes()),
+        ("unfold.svg", svg.as_bytes()),
+    ] {
         write_atomic(&dir.join(name), contents).with_context(|| format!("writing {}", dir.display()))?;
     }
     let mut summary = summary(&pattern, pattern_path, &report);
@@ -155,7 +169,12 @@ fn run_unfold(pattern_path: &Path, solver: &SolverArgs, out: Option<PathBuf>, as
             report.max_arc_residual, report.planarity_residual, report.restarts_used
         );
         for (c, rho) in pattern.creases.iter().zip(&report.final_fold_angles_rad) {
-            println!("  {:<12} {:>11.6}° -> {:>12.3e} rad", c.label, c.folded_angle.to_degrees(), rho);
+            println!(
+                "  {:<12} {:>11.6}° -> {:>12.3e} rad",
+                c.label,
+                c.folded_angle.to_degrees(),
+                rho
+            );
         }
         for note in &report.adjustments {
             println!("  note: {note}");
@@ -188,7 +207,10 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool) -> Result
             Err(e) => {
                 all_readable = false;
                 if as_json {
-                    println!("{}", json!({"file": path.display().to_string(), "error": e.to_string()}));
+                    println!(
+                        "{}",
+                        json!({"file": path.display().to_string(), "error": e.to_string()})
+                    );
                 } else {
                     println!("{}: error: {e}", path.display());
                 }
@@ -201,7 +223,12 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool) -> Result
 /// Runs the parsed command; Ok(false) means "finished, but exit non-zero".
 pub fn run(cli: Cli) -> Result<bool> {
     match cli.command {
-        Command::Unfold { pattern, solver, out, json } => run_unfold(&pattern, &solver, out, json).map(|_| true),
+        Command::Unfold {
+            pattern,
+            solver,
+            out,
+            json,
+        } => run_unfold(&pattern, &solver, out, json).map(|_| true),
         Command::Check { patterns, solver, json } => run_check(&patterns, &solver, json),
     }
 }

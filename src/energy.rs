@@ -200,7 +200,13 @@ impl Energy for MidpointEnergy {
         }
         total
     }
-    fn value_and_gradient(&self, nodes: &[Vec3], arcs: &[Arc], _ws: &mut EnergyWorkspace, gradient: &mut [Vec3]) -> f64 {
+    fn value_and_gradient(
+        &self,
+        nodes: &[Vec3],
+        arcs: &[Arc],
+        _ws: &mut EnergyWorkspace,
+        gradient: &mut [Vec3],
+    ) -> f64 {
         gradient.iter_mut().for_each(|g| *g = Vec3::zeros());
         let mut total = 0.0;
         for arc in arcs {

@@ -94,7 +94,10 @@ pub fn solve_closure(
         let r = rotation_vector(&holonomy);
         residual = r.norm();
         if residual <= tol {
-            return Ok(ClosureSolve { iterations: iteration, residual });
+            return Ok(ClosureSolve {
+                iterations: iteration,
+                residual,
+            });
         }
         if iteration == max_iterations {
             break;
@@ -104,14 +107,19 @@ pub fn solve_closure(
         let mut jac = DMatrix::zeros(3, free.len());
         for (col, &k) in free.iter().enumerate() {
             // ρ_0 acts last, on the right: its spatial axis is holonomy·e_x ≈ x_0.
-            let axis = if k == 0 { holonomy.column(0).into_owned() } else { nodes[k % n] };
+            let axis = if k == 0 {
+                holonomy.column(0).into_owned()
+            } else {
+                nodes[k % n]
+            };
             jac.set_column(col, &(jl_inv * axis));
         }
         let rhs = DVector::from_column_slice(&[-r.x, -r.y, -r.z]);
         let svd = jac.svd(true, true);
-        let step = svd
-            .solve(&rhs, 1e-12)
-            .map_err(|e| NanofoldError::Numerical { stage: "loop closure".into(), message: e.to_string() })?;
+        let step = svd.solve(&rhs, 1e-12).map_err(|e| NanofoldError::Numerical {
+            stage: "loop closure".into(),
+            message: e.to_string(),
+        })?;
         // Damp huge steps (far from the solution the linearisation is poor).
         let largest = step.amax();
         let scale = if largest > 0.5 { 0.5 / largest } else { 1.0 };

@@ -12,8 +12,14 @@ use std::path::Path;
 
 /// Writes `contents` to `path` through a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
-    let err = |message: String| NanofoldError::Output { path: path.display().to_string(), message };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let err = |message: String| NanofoldError::Output {
+        path: path.display().to_string(),
+        message,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("output");
     let temporary = dir.join(format!(".{name}.tmp-{}", std::process::id()));
@@ -64,7 +70,15 @@ struct ExportMesh {
 }
 
 fn export_mesh(pattern: &Pattern) -> ExportMesh {
-    if let Some(FoldMesh { vertices_coords, edges_vertices, edges_assignment, faces_vertices, center, ray0_direction }) = &pattern.mesh {
+    if let Some(FoldMesh {
+        vertices_coords,
+        edges_vertices,
+        edges_assignment,
+        faces_vertices,
+        center,
+        ray0_direction,
+    }) = &pattern.mesh
+    {
         let mut edge_crease = vec![None; edges_vertices.len()];
         for (i, c) in pattern.creases.iter().enumerate() {
             if let Some(e) = c.fold_edge {
@@ -132,9 +146,16 @@ fn place_vertices(pattern: &Pattern, mesh: &ExportMesh, nodes: &[Vec3]) -> Vec<[
             let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
             let v = [c0 * dx + s0 * dy, -s0 * dx + c0 * dy];
             let theta = v[1].atan2(v[0]).rem_euclid(TAU);
-            let mut k = (0..sectors).rev().find(|&k| directions[k] <= theta + 1e-12).unwrap_or(0);
+            let mut k = (0..sectors)
+                .rev()
+                .find(|&k| directions[k] <= theta + 1e-12)
+                .unwrap_or(0);
             if pattern.chain == Chain::Open && theta > directions[n - 1] + 1e-9 {
-                k = if theta - directions[n - 1] < TAU - theta { sectors - 1 } else { 0 };
+                k = if theta - directions[n - 1] < TAU - theta {
+                    sectors - 1
+                } else {
+                    0
+                };
             }
             let (su, cu) = directions[k].sin_cos();
             let a = v[0] * cu + v[1] * su;
@@ -161,11 +182,19 @@ pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldRep
     let picks = snapshot_indices(report, 11);
     let frame = |index: usize| {
         let step = &report.trajectory[index];
-        (place_vertices(pattern, &mesh, &step.nodes), edge_angles_degrees(&mesh, &model.crease_angles(&step.nodes)), step.iteration)
+        (
+            place_vertices(pattern, &mesh, &step.nodes),
+            edge_angles_degrees(&mesh, &model.crease_angles(&step.nodes)),
+            step.iteration,
+        )
     };
     let (coords0, angles0, _) = if picks.is_empty() {
         let nodes = model.folded_nodes();
-        (place_vertices(pattern, &mesh, &nodes), edge_angles_degrees(&mesh, &model.crease_angles(&nodes)), 0)
+        (
+            place_vertices(pattern, &mesh, &nodes),
+            edge_angles_degrees(&mesh, &model.crease_angles(&nodes)),
+            0,
+        )
     } else {
         frame(picks[0])
     };

@@ -296,7 +296,11 @@ impl Pattern {
             }
             if k < sector_angles.len() {
                 let alpha = sector_angles[k];
-                let pieces = if alpha >= PI { (alpha / (PI / 2.0)).ceil() as usize } else { 1 };
+                let pieces = if alpha >= PI {
+                    (alpha / (PI / 2.0)).ceil() as usize
+                } else {
+                    1
+                };
                 if pieces > 1 {
                     adjustments.push(format!(
                         "sector {k} ({:.3}°) split into {pieces} by virtual flat rays",
@@ -332,8 +336,12 @@ impl Pattern {
         if chain == Chain::Closed {
             let residual = kinematics::closure_residual(&pattern.sector_angles, &pattern.folded_ray_angles());
             pattern.closure_residual = residual;
-            if !(residual <= options.closure_tol) {
-                let field = if pattern.mesh.is_some() { "edges_foldAngle" } else { "creases[].fold_angle" };
+            if residual.is_nan() || residual > options.closure_tol {
+                let field = if pattern.mesh.is_some() {
+                    "edges_foldAngle"
+                } else {
+                    "creases[].fold_angle"
+                };
                 return Err(NanofoldError::ClosureViolated {
                     field: field.to_string(),
                     residual,
@@ -401,7 +409,11 @@ fn check_crease_angle(c: &RawCrease) -> Result<()> {
         return Err(NanofoldError::invalid(&c.angle_field, rho, "fold angle must be finite"));
     }
     if rho.abs() > PI + 1e-12 {
-        return Err(NanofoldError::invalid(&c.angle_field, shown, "fold angle must lie in [−180°, 180°]"));
+        return Err(NanofoldError::invalid(
+            &c.angle_field,
+            shown,
+            "fold angle must lie in [−180°, 180°]",
+        ));
     }
     const SIGN_TOL: f64 = 1e-9;
     let contradiction = match c.assignment {
@@ -416,7 +428,11 @@ fn check_crease_angle(c: &RawCrease) -> Result<()> {
             Assignment::Valley => "a valley (V) crease needs a fold angle ≥ 0",
             _ => "a flat (F) crease needs fold angle 0",
         };
-        return Err(NanofoldError::invalid(&c.angle_field, shown, format!("{rule} ({})", c.label)));
+        return Err(NanofoldError::invalid(
+            &c.angle_field,
+            shown,
+            format!("{rule} ({})", c.label),
+        ));
     }
     Ok(())
 }

@@ -9,7 +9,10 @@ use plotters::prelude::*;
 use std::path::Path;
 
 fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
-    NanofoldError::Output { path: "unfold.svg".into(), message: e.to_string() }
+    NanofoldError::Output {
+        path: "unfold.svg".into(),
+        message: e.to_string(),
+    }
 }
 
 /// Colour of series `i`.
@@ -40,7 +43,12 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
         let last = traj.last().map_or(1, |r| r.iteration.max(1));
         let mut chart = ChartBuilder::on(&top)
             .caption(
-                format!("{}: fold angles while unfolding ({}, {} iterations)", pattern.name, report.verdict.as_str(), report.iterations),
+                format!(
+                    "{}: fold angles while unfolding ({}, {} iterations)",
+                    pattern.name,
+                    report.verdict.as_str(),
+                    report.iterations
+                ),
                 ("sans-serif", 20),
             )
             .margin(12)
@@ -107,8 +115,11 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
                     outline.push(to_plot(&p));
                 }
                 let colour = series_colour(k);
-                view.draw_series(std::iter::once(Polygon::new(outline.clone(), colour.mix(0.35).filled())))
-                    .map_err(plot_error)?;
+                view.draw_series(std::iter::once(Polygon::new(
+                    outline.clone(),
+                    colour.mix(0.35).filled(),
+                )))
+                .map_err(plot_error)?;
                 outline.push((0.0, 0.0, 0.0));
                 view.draw_series(std::iter::once(PathElement::new(outline, BLACK.stroke_width(1))))
                     .map_err(plot_error)?;

@@ -65,9 +65,14 @@ pub fn solve_clarabel(problem: &DirectionProblem) -> Result<DirectionSolution> {
         .tol_feas(1e-13)
         .presolve_enable(false)
         .build()
-        .map_err(|e| NanofoldError::Numerical { stage: "QP settings".into(), message: format!("{e:?}") })?;
-    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-        .map_err(|e| NanofoldError::Numerical { stage: "QP setup".into(), message: e.to_string() })?;
+        .map_err(|e| NanofoldError::Numerical {
+            stage: "QP settings".into(),
+            message: format!("{e:?}"),
+        })?;
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| NanofoldError::Numerical {
+        stage: "QP setup".into(),
+        message: e.to_string(),
+    })?;
     solver.solve();
     let status = match solver.solution.status {
         SolverStatus::Solved => QpStatus::Solved,
@@ -133,7 +138,12 @@ impl RowSpace {
         let svd = a.clone().svd(true, true);
         let (u, v_t) = match (svd.u, svd.v_t) {
             (Some(u), Some(v_t)) => (u, v_t),
-            _ => return Err(NanofoldError::Numerical { stage: "SVD".into(), message: "no singular vectors".into() }),
+            _ => {
+                return Err(NanofoldError::Numerical {
+                    stage: "SVD".into(),
+                    message: "no singular vectors".into(),
+                })
+            }
         };
         let sigma_max = svd.singular_values.max();
         let keep: Vec<usize> = (0..svd.singular_values.len())
@@ -143,9 +153,17 @@ impl RowSpace {
         let u = u.select_columns(keep.iter());
         let sigma = DVector::from_iterator(keep.len(), keep.iter().map(|&i| svd.singular_values[i]));
         if sigma.iter().any(|s| !s.is_finite()) {
-            return Err(NanofoldError::Numerical { stage: "SVD".into(), message: "non-finite singular value".into() });
+            return Err(NanofoldError::Numerical {
+                stage: "SVD".into(),
+                message: "non-finite singular value".into(),
+            });
         }
-        Ok(RowSpace { v_t, u, sigma, dimension })
+        Ok(RowSpace {
+            v_t,
+            u,
+            sigma,
+            dimension,
+        })
     }
 
     /// Numerical rank of A.

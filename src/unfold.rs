@@ -12,7 +12,9 @@ use crate::error::{NanofoldError, Result};
 use crate::kinematics;
 use crate::pattern::{Assignment, Chain, Pattern, RayRole};
 use crate::qp::{self, DirectionProblem, QpMethod, RowSpace};
-use crate::sphere::{fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc, side_of_arc, Vec3};
+use crate::sphere::{
+    fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc, side_of_arc, Vec3,
+};
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -97,7 +99,11 @@ enum ConstraintRow {
     Held(usize),
     /// Component `k` (of the tangent plane at x_v) of x_v + x_w = 0: an antipodal pair held
     /// at its kink (see [`Unfolder::pin_antipodal_pairs`]).
-    Antipodal { v: usize, w: usize, k: usize },
+    Antipodal {
+        v: usize,
+        w: usize,
+        k: usize,
+    },
 }
 
 impl UnfoldModel {
@@ -107,7 +113,11 @@ impl UnfoldModel {
             .sector_angles
             .iter()
             .enumerate()
-            .map(|(k, &length)| Arc { a: k, b: (k + 1) % n, length })
+            .map(|(k, &length)| Arc {
+                a: k,
+                b: (k + 1) % n,
+                length,
+            })
             .collect();
         let fold_rays: Vec<usize> = (0..n).filter(|&k| pattern.rays[k] != RayRole::Boundary).collect();
         let mut held = Vec::new();
@@ -119,7 +129,10 @@ impl UnfoldModel {
                     if c.assignment == Assignment::Flat {
                         held.push(HeldFold { ray: k, target: 0.0 });
                     } else if c.locked {
-                        held.push(HeldFold { ray: k, target: c.folded_angle });
+                        held.push(HeldFold {
+                            ray: k,
+                            target: c.folded_angle,
+                        });
                     }
                 }
                 RayRole::Boundary => {}
@@ -158,7 +171,10 @@ impl UnfoldModel {
 
     /// Largest |ρ| over every ray that folds (creases and virtual rays).
     pub fn max_fold_angle(&self, nodes: &[Vec3]) -> f64 {
-        self.fold_rays.iter().map(|&r| self.fold_angle_at(nodes, r).abs()).fold(0.0, f64::max)
+        self.fold_rays
+            .iter()
+            .map(|&r| self.fold_angle_at(nodes, r).abs())
+            .fold(0.0, f64::max)
     }
 
     /// Largest |γ(x_a, x_b) − α| over all arcs.
@@ -268,7 +284,13 @@ fn fill_residuals(model: &UnfoldModel, rows: &[ConstraintRow], nodes: &[Vec3], o
 }
 
 /// Jacobian of the constraint rows in the tangent coordinates (2 per free node).
-fn fill_jacobian(model: &UnfoldModel, rows: &[ConstraintRow], nodes: &[Vec3], basis: &[[Vec3; 2]], out: &mut DMatrix<f64>) {
+fn fill_jacobian(
+    model: &UnfoldModel,
+    rows: &[ConstraintRow],
+    nodes: &[Vec3],
+    basis: &[[Vec3; 2]],
+    out: &mut DMatrix<f64>,
+) {
     out.fill(0.0);
     let put = |out: &mut DMatrix<f64>, r: usize, node: usize, g: &Vec3| {
         if node >= 2 {
@@ -314,7 +336,13 @@ pub fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVe
 /// Newton projection onto the constraints (SPEC §5 "restore"): minimum-norm steps in the
 /// tangent space, the factorisation reused while it converges (chord Newton) and refreshed
 /// when it stalls. Returns the final max residual; Err when it does not reach `tol`.
-pub fn restore(model: &UnfoldModel, ws: &mut Workspace, nodes: &mut [Vec3], tol: f64, row_space: Option<&RowSpace>) -> Result<f64> {
+pub fn restore(
+    model: &UnfoldModel,
+    ws: &mut Workspace,
+    nodes: &mut [Vec3],
+    tol: f64,
+    row_space: Option<&RowSpace>,
+) -> Result<f64> {
     let mut basis = ws.basis.clone();
     let mut owned: Option<RowSpace> = None;
     let mut previous = f64::INFINITY;
@@ -323,7 +351,10 @@ pub fn restore(model: &UnfoldModel, ws: &mut Workspace, nodes: &mut [Vec3], tol:
         fill_residuals(model, &ws.rows, nodes, &mut ws.residual);
         let worst = ws.residual.amax();
         if !worst.is_finite() {
-            return Err(NanofoldError::Numerical { stage: "constraint restoration".into(), message: "non-finite residual".into() });
+            return Err(NanofoldError::Numerical {
+                stage: "constraint restoration".into(),
+                message: "non-finite residual".into(),
+            });
         }
         if worst <= tol {
             return Ok(worst);
@@ -465,7 +496,13 @@ impl<'a> Unfolder<'a> {
             q[2 * slot + 1] = self.ws.basis[i][1].dot(&self.ws.gradient[i]);
         }
         let row_space = RowSpace::new(&self.ws.jacobian)?;
-        Ok((DirectionProblem { q, a: self.ws.jacobian.clone() }, row_space))
+        Ok((
+            DirectionProblem {
+                q,
+                a: self.ws.jacobian.clone(),
+            },
+            row_space,
+        ))
     }
 
     /// First-order degrees of freedom at the current state (antipodal pins dropped).
@@ -503,16 +540,28 @@ impl<'a> Unfolder<'a> {
         while t * largest > 1e-16 {
             let mut trial = std::mem::take(&mut self.ws.trial);
             retract(model, &self.nodes, &basis, &y, t, &mut trial);
-            let restored = restore(model, &mut self.ws, &mut trial, self.settings.restore_tol, Some(&row_space));
+            let restored = restore(
+                model,
+                &mut self.ws,
+                &mut trial,
+                self.settings.restore_tol,
+                Some(&row_space),
+            );
             if restored.is_ok() {
                 if find_crossing(model, &self.nodes, &trial).is_some() {
                     self.crossings_refused += 1;
                 } else {
-                    let value = self.energy.value_and_gradient(&trial, &model.arcs, &mut self.ws.energy, &mut self.ws.trial_gradient);
+                    let value = self.energy.value_and_gradient(
+                        &trial,
+                        &model.arcs,
+                        &mut self.ws.energy,
+                        &mut self.ws.trial_gradient,
+                    );
                     // Armijo with strict decrease; where U's change is lost in rounding (near
                     // flat U varies as ρ², so values resolve ρ only to √ε) fall back on the
                     // approximate Wolfe test of Hager–Zhang, which reads the slope instead.
-                    let armijo = value < self.energy_value && value <= self.energy_value - self.settings.armijo * t * slope;
+                    let armijo =
+                        value < self.energy_value && value <= self.energy_value - self.settings.armijo * t * slope;
                     let noise = 1e-12 * self.energy_value.abs();
                     let approximate_wolfe = !armijo && (value - self.energy_value).abs() <= noise && {
                         let slope_at_trial: f64 = model
@@ -527,7 +576,12 @@ impl<'a> Unfolder<'a> {
                         slope_at_trial <= APPROXIMATE_WOLFE_SLOPE * slope && slope_at_trial < 0.0
                     };
                     if value.is_finite() && (armijo || approximate_wolfe) {
-                        let displacement = self.nodes.iter().zip(&trial).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+                        let displacement = self
+                            .nodes
+                            .iter()
+                            .zip(&trial)
+                            .map(|(a, b)| (a - b).norm())
+                            .fold(0.0, f64::max);
                         std::mem::swap(&mut self.nodes, &mut trial);
                         std::mem::swap(&mut self.ws.gradient, &mut self.ws.trial_gradient);
                         self.energy_value = value;
@@ -586,14 +640,24 @@ impl<'a> Unfolder<'a> {
         // Project onto the pinned set at once; keep the pins only if that does not cost
         // energy beyond rounding.
         let mut projected = self.nodes.clone();
-        let restored = restore(self.model, &mut self.ws, &mut projected, self.settings.restore_tol, None);
+        let restored = restore(
+            self.model,
+            &mut self.ws,
+            &mut projected,
+            self.settings.restore_tol,
+            None,
+        );
         let mut gradient = vec![Vec3::zeros(); self.model.node_count];
         let value = if restored.is_ok() {
-            self.energy.value_and_gradient(&projected, &self.model.arcs, &mut self.ws.energy, &mut gradient)
+            self.energy
+                .value_and_gradient(&projected, &self.model.arcs, &mut self.ws.energy, &mut gradient)
         } else {
             f64::INFINITY
         };
-        if value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs() && find_crossing(self.model, &self.nodes, &projected).is_none() {
+        if value.is_finite()
+            && value <= self.energy_value + 1e-12 * self.energy_value.abs()
+            && find_crossing(self.model, &self.nodes, &projected).is_none()
+        {
             self.nodes = projected;
             self.energy_value = value;
             self.ws.gradient = gradient;
@@ -643,13 +707,20 @@ impl<'a> Unfolder<'a> {
         if restore(self.model, &mut self.ws, &mut trial, self.settings.restore_tol, None).is_err() {
             return Ok(false);
         }
-        let value = self.energy.value_and_gradient(&trial, &self.model.arcs, &mut self.ws.energy, &mut self.ws.gradient);
+        let value =
+            self.energy
+                .value_and_gradient(&trial, &self.model.arcs, &mut self.ws.energy, &mut self.ws.gradient);
         let accepted = value.is_finite() && find_crossing(self.model, &self.nodes, &trial).is_none();
         if accepted {
             self.nodes = trial;
             self.energy_value = value;
         } else {
-            self.energy_value = self.energy.value_and_gradient(&self.nodes, &self.model.arcs, &mut self.ws.energy, &mut self.ws.gradient);
+            self.energy_value = self.energy.value_and_gradient(
+                &self.nodes,
+                &self.model.arcs,
+                &mut self.ws.energy,
+                &mut self.ws.gradient,
+            );
         }
         self.step_scale = None;
         Ok(accepted)
@@ -778,7 +849,10 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
     let initial_fold_angles = pattern.creases.iter().map(|c| c.folded_angle).collect::<Vec<_>>();
 
     if !pattern.flat_foldable {
-        let energy = settings.energy.build(settings.p).value(&start, &model.arcs, &mut EnergyWorkspace::default());
+        let energy = settings
+            .energy
+            .build(settings.p)
+            .value(&start, &model.arcs, &mut EnergyWorkspace::default());
         let excess = pattern.angle_sum - 2.0 * PI;
         return Ok(UnfoldReport {
             verdict: Verdict::NotFlatFoldable,
@@ -806,8 +880,16 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
     }
 
     let energy = settings.energy.build(settings.p);
-    if touching_charges(&model, &start) || !energy.value(&start, &model.arcs, &mut EnergyWorkspace::default()).is_finite() {
-        let scaled: Vec<f64> = model.folded_ray_angles.iter().map(|r| r * (1.0 - FLAT_FOLDED_BACKOFF)).collect();
+    if touching_charges(&model, &start)
+        || !energy
+            .value(&start, &model.arcs, &mut EnergyWorkspace::default())
+            .is_finite()
+    {
+        let scaled: Vec<f64> = model
+            .folded_ray_angles
+            .iter()
+            .map(|r| r * (1.0 - FLAT_FOLDED_BACKOFF))
+            .collect();
         start = kinematics::forward(&model.sector_angles, &scaled);
         adjustments.push(format!(
             "start has touching charges (flat-folded, infinite energy): fold angles scaled by {} and constraints restored",
@@ -862,7 +944,10 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
                 evidence = if restarts_used == 0 {
                     format!("every fold angle ≤ {:.0e} rad", settings.flat_tol)
                 } else {
-                    format!("every fold angle ≤ {:.0e} rad after {restarts_used} restart(s) from perturbed states", settings.flat_tol)
+                    format!(
+                        "every fold angle ≤ {:.0e} rad after {restarts_used} restart(s) from perturbed states",
+                        settings.flat_tol
+                    )
                 };
                 break;
             }

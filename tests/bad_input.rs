@@ -35,7 +35,10 @@ fn non_finite_numbers() {
     assert!(error_of(&native("[90, 90, 90, 1e999]", FOUR)).contains("malformed JSON"));
     let fold = r#"{"vertices_coords":[[0,0],[1,"x"]],"edges_vertices":[],"edges_assignment":[],"edges_foldAngle":[]}"#;
     let e = error_of(fold);
-    assert!(e.contains("vertices_coords[1]") && e.contains("expected a number"), "{e}");
+    assert!(
+        e.contains("vertices_coords[1]") && e.contains("expected a number"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -85,7 +88,10 @@ fn cut_and_join_edges_are_refused() {
 fn multi_vertex_patterns_are_refused() {
     // Two crease vertices: (0,0) and (2,0), joined by a crease.
     let fold = r#"{"vertices_coords":[[0,0],[2,0],[-1,0],[3,0]],"edges_vertices":[[0,1],[0,2],[1,3]],"edges_assignment":["V","V","V"],"edges_foldAngle":[10,10,10]}"#;
-    assert_eq!(error_of(fold), "2 vertices with creases; only single-vertex patterns are supported");
+    assert_eq!(
+        error_of(fold),
+        "2 vertices with creases; only single-vertex patterns are supported"
+    );
 }
 
 #[test]

@@ -15,16 +15,30 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 #[test]
 fn unfold_writes_outputs_and_json_summary() {
     let dir = temp_dir("unfold");
-    let out = nanofold().args(["unfold", "patterns/corner_cube.fold", "--json", "--out"]).arg(&dir).output().unwrap();
+    let out = nanofold()
+        .args(["unfold", "patterns/corner_cube.fold", "--json", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for key in ["verdict", "iterations", "seconds", "energy_initial", "energy_final", "final_fold_angles_rad", "max_arc_residual", "planarity_residual"] {
+    for key in [
+        "verdict",
+        "iterations",
+        "seconds",
+        "energy_initial",
+        "energy_final",
+        "final_fold_angles_rad",
+        "max_arc_residual",
+        "planarity_residual",
+    ] {
         assert!(summary.get(key).is_some(), "missing {key}");
     }
     assert_eq!(summary["verdict"], "flat");
     assert_eq!(summary["final_fold_angles_rad"].as_array().unwrap().len(), 5);
 
-    let fold: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("unfold.fold")).unwrap()).unwrap();
+    let fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("unfold.fold")).unwrap()).unwrap();
     let frames = fold["file_frames"].as_array().unwrap();
     assert!(frames.len() >= 3);
     let vertices = fold["vertices_coords"].as_array().unwrap().len();
@@ -37,21 +51,35 @@ fn unfold_writes_outputs_and_json_summary() {
     for v in last["vertices_coords"].as_array().unwrap() {
         assert!(v[2].as_f64().unwrap().abs() < 1e-5);
     }
-    let trajectory: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("trajectory.json")).unwrap()).unwrap();
+    let trajectory: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("trajectory.json")).unwrap()).unwrap();
     assert_eq!(trajectory["steps"][0]["fold_angles_rad"].as_array().unwrap().len(), 5);
-    assert!(std::fs::read_to_string(dir.join("unfold.svg")).unwrap().starts_with("<svg"));
+    assert!(std::fs::read_to_string(dir.join("unfold.svg"))
+        .unwrap()
+        .starts_with("<svg"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn errors_exit_nonzero_and_write_nothing() {
     let dir = temp_dir("error");
-    let out = nanofold().args(["unfold", "patterns/does_not_exist.fold", "--out"]).arg(&dir).output().unwrap();
+    let out = nanofold()
+        .args(["unfold", "patterns/does_not_exist.fold", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let message = String::from_utf8_lossy(&out.stderr);
-    assert!(message.contains("does_not_exist.fold") && message.lines().count() == 1, "{message}");
+    assert!(
+        message.contains("does_not_exist.fold") && message.lines().count() == 1,
+        "{message}"
+    );
     assert!(!dir.exists());
-    let out = nanofold().args(["unfold", "patterns/corner_cube.fold", "--p", "-1", "--out"]).arg(&dir).output().unwrap();
+    let out = nanofold()
+        .args(["unfold", "patterns/corner_cube.fold", "--p", "-1", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--p"));
     assert!(!dir.exists());
@@ -59,13 +87,22 @@ fn errors_exit_nonzero_and_write_nothing() {
 
 #[test]
 fn check_prints_one_line_per_pattern_and_fails_only_on_unreadable_input() {
-    let out = nanofold().args(["check", "--json", "patterns/degree4_locked.fold", "patterns/cone.json"]).output().unwrap();
+    let out = nanofold()
+        .args(["check", "--json", "patterns/degree4_locked.fold", "patterns/cone.json"])
+        .output()
+        .unwrap();
     assert!(out.status.success());
-    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
     assert_eq!(lines.len(), 2);
     assert_eq!(lines[0]["verdict"], "locked");
     assert_eq!(lines[1]["verdict"], "not_flat_foldable");
-    let out = nanofold().args(["check", "patterns/half_paper.fold", "Cargo.toml"]).output().unwrap();
+    let out = nanofold()
+        .args(["check", "patterns/half_paper.fold", "Cargo.toml"])
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 2);
 }

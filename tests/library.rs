@@ -30,16 +30,27 @@ fn every_library_pattern_gets_its_expected_verdict() {
         let (pattern, report) = run(name);
         assert_eq!(report.verdict, verdict, "{name}: {}", report.evidence);
         assert_eq!(report.final_fold_angles_rad.len(), pattern.creases.len());
-        assert!(report.max_arc_residual <= 1e-10, "{name}: arc residual {:e}", report.max_arc_residual);
+        assert!(
+            report.max_arc_residual <= 1e-10,
+            "{name}: arc residual {:e}",
+            report.max_arc_residual
+        );
         for step in &report.trajectory {
-            assert!(step.energy.is_finite() && step.fold_angles.iter().all(|r| r.is_finite()), "{name}: non-finite step");
+            assert!(
+                step.energy.is_finite() && step.fold_angles.iter().all(|r| r.is_finite()),
+                "{name}: non-finite step"
+            );
         }
         if verdict == Verdict::Flat {
             let worst = report.final_fold_angles_rad.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
             assert!(worst <= 1e-6, "{name}: flat with |ρ| = {worst:e}");
             // The end state is the exact flat layout (nodes at cumulative sector angles on
             // the equator) up to the fold angles left: the out-of-plane offsets they make.
-            assert!(report.flat_layout_error <= 2.0 * worst.max(1e-9), "{name}: layout error {:e} vs |ρ| {worst:e}", report.flat_layout_error);
+            assert!(
+                report.flat_layout_error <= 2.0 * worst.max(1e-9),
+                "{name}: layout error {:e} vs |ρ| {worst:e}",
+                report.flat_layout_error
+            );
             assert!(report.planarity_residual <= 2.0 * worst.max(1e-9));
             assert!(report.energy_final < report.energy_initial);
         }

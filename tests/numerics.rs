@@ -5,7 +5,9 @@ use nanofold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::kinematics::{closure_residual, solve_closure};
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::qp::{solve_clarabel, solve_direct};
-use nanofold::sphere::{fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3};
+use nanofold::sphere::{
+    fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3,
+};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
 use proptest::prelude::*;
 use std::f64::consts::{PI, TAU};
@@ -41,8 +43,14 @@ fn random_vertex(n: usize, weights: &[f64], drive: &[f64]) -> Option<(Vec<f64>, 
 }
 
 fn native_json(sectors: &[f64], rho: &[f64]) -> String {
-    let creases: Vec<String> = rho.iter().map(|r| format!(r#"{{"assignment":"U","fold_angle":{r}}}"#)).collect();
-    format!(r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#, creases.join(","))
+    let creases: Vec<String> = rho
+        .iter()
+        .map(|r| format!(r#"{{"assignment":"U","fold_angle":{r}}}"#))
+        .collect();
+    format!(
+        r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#,
+        creases.join(",")
+    )
 }
 
 fn fd_check(f: impl Fn(&Vec3) -> f64, x: &Vec3, grad: &Vec3, tol: f64) -> Result<(), TestCaseError> {
@@ -53,7 +61,11 @@ fn fd_check(f: impl Fn(&Vec3) -> f64, x: &Vec3, grad: &Vec3, tol: f64) -> Result
         plus[i] += h;
         minus[i] -= h;
         let fd = (f(&plus) - f(&minus)) / (2.0 * h);
-        prop_assert!((fd - grad[i]).abs() <= tol * (1.0 + fd.abs()), "component {i}: fd {fd} vs analytic {}", grad[i]);
+        prop_assert!(
+            (fd - grad[i]).abs() <= tol * (1.0 + fd.abs()),
+            "component {i}: fd {fd} vs analytic {}",
+            grad[i]
+        );
     }
     Ok(())
 }

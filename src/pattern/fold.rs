@@ -42,7 +42,11 @@ fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> 
         .as_u64()
         .ok_or_else(|| NanofoldError::invalid(field, short(value), "expected a non-negative integer"))?;
     if i as usize >= bound {
-        return Err(NanofoldError::invalid(field, i, format!("there are only {bound} {what}")));
+        return Err(NanofoldError::invalid(
+            field,
+            i,
+            format!("there are only {bound} {what}"),
+        ));
     }
     Ok(i as usize)
 }
@@ -84,7 +88,11 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
         let u = index(&items[0], &field, nv, "vertices")?;
         let v = index(&items[1], &field, nv, "vertices")?;
         if u == v {
-            return Err(NanofoldError::invalid(&field, short(e), "an edge needs two distinct vertices"));
+            return Err(NanofoldError::invalid(
+                &field,
+                short(e),
+                "an edge needs two distinct vertices",
+            ));
         }
         edges.push([u, v]);
     }
@@ -155,7 +163,11 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
                 let ids = f
                     .as_array()
                     .ok_or_else(|| NanofoldError::invalid(&field, short(f), "expected an array of vertex ids"))?;
-                faces.push(ids.iter().map(|id| index(id, &field, nv, "vertices")).collect::<Result<Vec<_>>>()?);
+                faces.push(
+                    ids.iter()
+                        .map(|id| index(id, &field, nv, "vertices"))
+                        .collect::<Result<Vec<_>>>()?,
+                );
             }
             Some(faces)
         }
@@ -218,7 +230,10 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
                 "edge has zero length",
             ));
         }
-        spokes.push(Spoke { edge: i, direction: dy.atan2(dx).rem_euclid(TAU) });
+        spokes.push(Spoke {
+            edge: i,
+            direction: dy.atan2(dx).rem_euclid(TAU),
+        });
     }
     spokes.sort_by(|a, b| a.direction.total_cmp(&b.direction));
     for pair in spokes.windows(2) {
@@ -230,8 +245,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
             ));
         }
     }
-    let boundary_spokes: Vec<usize> =
-        (0..spokes.len()).filter(|&k| !is_crease[spokes[k].edge]).collect();
+    let boundary_spokes: Vec<usize> = (0..spokes.len()).filter(|&k| !is_crease[spokes[k].edge]).collect();
     let m = spokes.len();
     let gap = |k: usize| -> f64 {
         let next = spokes[(k + 1) % m].direction;

@@ -40,12 +40,24 @@ pub(crate) fn read_native(value: &Value, name: &str) -> Result<RawVertex> {
     let to_rad = match vertex.angle_unit.as_str() {
         "deg" | "degrees" => std::f64::consts::PI / 180.0,
         "rad" | "radians" => 1.0,
-        other => return Err(NanofoldError::invalid("angle_unit", format!("\"{other}\""), "expected \"deg\" or \"rad\"")),
+        other => {
+            return Err(NanofoldError::invalid(
+                "angle_unit",
+                format!("\"{other}\""),
+                "expected \"deg\" or \"rad\"",
+            ))
+        }
     };
     let chain = match vertex.chain.as_str() {
         "closed" => Chain::Closed,
         "open" => Chain::Open,
-        other => return Err(NanofoldError::invalid("chain", format!("\"{other}\""), "expected \"closed\" or \"open\"")),
+        other => {
+            return Err(NanofoldError::invalid(
+                "chain",
+                format!("\"{other}\""),
+                "expected \"closed\" or \"open\"",
+            ))
+        }
     };
     let nc = vertex.creases.len();
     let expected = match chain {
