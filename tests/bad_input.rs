@@ -114,3 +114,12 @@ fn flat_folded_input_is_backed_off_by_the_documented_rule() {
     assert!(report.adjustments.iter().any(|a| a.contains("flat-folded")));
     assert!(report.energy_initial.is_finite());
 }
+
+#[test]
+fn locked_key_must_hold_one_boolean_per_edge() {
+    let base = r#"{"vertices_coords":[[0,0],[1,0],[-1,0]],"edges_vertices":[[0,1],[0,2]],"edges_assignment":["V","V"],"edges_foldAngle":[10,10]"#;
+    let e = error_of(&format!(r#"{base},"edges_nanofold:locked":[true]}}"#));
+    assert!(e.contains("edges_nanofold:locked") && e.contains("2 booleans"), "{e}");
+    let e = error_of(&format!(r#"{base},"edges_nanofold:locked":[true,"yes"]}}"#));
+    assert!(e.contains("edges_nanofold:locked[1]"), "{e}");
+}

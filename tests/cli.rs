@@ -83,6 +83,16 @@ fn errors_exit_nonzero_and_write_nothing() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--p"));
     assert!(!dir.exists());
+    for flag in ["--flat-tol", "--closure-tol"] {
+        let out = nanofold()
+            .args(["unfold", "patterns/corner_cube.fold", flag, "-1", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        assert!(String::from_utf8_lossy(&out.stderr).contains(flag), "{flag}");
+        assert!(!dir.exists());
+    }
 }
 
 #[test]
