@@ -70,7 +70,7 @@ pub struct SolverArgs {
     #[arg(long, default_value_t = 3)]
     pub restarts: usize,
     /// Largest accepted loop-closure residual of the input's folded state (rad).
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub closure_tol: f64,
 }
 
