@@ -2,10 +2,14 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
+use nanofold::constraints::{
+    default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
+    Setup, Source,
+};
 use nanofold::energy::EnergyKind;
 use nanofold::output::{fold_animation, trajectory_json, write_atomic};
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::plot::unfold_svg;
+use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::qp::QpMethod;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldReport, UnfoldSettings};
 use serde_json::json;
@@ -15,7 +19,7 @@ use std::path::{Path, PathBuf};
 #[command(
     name = "nanofold",
     version,
-    about = "Rigid origami: unfold single-vertex crease patterns to flat"
+    about = "Rigid origami: unfold single-vertex crease patterns to flat and extract their constraint curves"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -47,6 +51,59 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
+    /// (SPEC §6); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
+    Constraints(ConstraintsArgs),
+}
+
+/// Arguments of `nanofold constraints`. Crease indices are the file's: FOLD edge index for
+/// FOLD input, position in `creases` for the native schema. Angles are in degrees.
+#[derive(Args)]
+pub struct ConstraintsArgs {
+    /// A FOLD file (.fold) or a native vertex (.json).
+    pub pattern: PathBuf,
+    /// The driving crease.
+    #[arg(long)]
+    pub drive: usize,
+    /// Hold crease J at DEG degrees (repeatable), e.g. --lock 1=0.
+    #[arg(long = "lock", value_name = "J=DEG", allow_hyphen_values = true)]
+    pub locks: Vec<String>,
+    /// Polynomial degree 1..=20, or `auto` with --tol.
+    #[arg(long, default_value = "4")]
+    pub degree: String,
+    /// With --degree auto: the largest accepted fit error, rad.
+    #[arg(long, allow_negative_numbers = true)]
+    pub tol: Option<f64>,
+    /// Where the samples come from: an exact sweep or an unfolding trajectory.
+    #[arg(long, value_enum, default_value_t = Source::Sweep)]
+    pub source: Source,
+    /// Driving-angle range A:B in degrees (default: flat to the folded angle).
+    #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
+    pub range: Option<String>,
+    /// Number of sweep samples.
+    #[arg(long, default_value_t = 201)]
+    pub samples: usize,
+    /// Export format besides constraints.json.
+    #[arg(long, value_enum, default_value_t = ExportFormat::Json)]
+    pub format: ExportFormat,
+    /// Output folder (default: output/<pattern name>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Largest accepted loop-closure residual of the input's folded state (rad).
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
+    pub closure_tol: f64,
+}
+
+/// Export format of `nanofold constraints`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    /// constraints.json only.
+    Json,
+    /// Also constraints.xml: a MuJoCo `<equality>` snippet (degree ≤ 4).
+    Mujoco,
 }
 
 #[derive(Args, Clone)]
@@ -220,6 +277,157 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool) -> Result
     Ok(all_readable)
 }
 
+/// Parses "J=DEG" into (crease index, rad).
+fn parse_lock(pattern: &Pattern, text: &str) -> Result<(usize, f64)> {
+    let (index, degrees) = text
+        .split_once('=')
+        .with_context(|| format!("invalid --lock {text:?}: expected J=DEG, e.g. --lock 1=0"))?;
+    let index: usize = index
+        .trim()
+        .parse()
+        .with_context(|| format!("invalid --lock {text:?}: crease index {index:?} is not a number"))?;
+    let degrees: f64 = degrees
+        .trim()
+        .parse()
+        .with_context(|| format!("invalid --lock {text:?}: angle {degrees:?} is not a number of degrees"))?;
+    let crease = crease_index(pattern, index, "--lock")?;
+    Ok((crease, degrees.to_radians()))
+}
+
+fn crease_index(pattern: &Pattern, index: usize, flag: &str) -> Result<usize> {
+    pattern.crease_from_user_index(index).with_context(|| {
+        format!(
+            "invalid {flag} {index}: no crease with this index in {} (its creases are {:?})",
+            pattern.name,
+            pattern.user_indices()
+        )
+    })
+}
+
+/// Parses "A:B" (degrees) into [a, b] rad.
+fn parse_range(text: &str) -> Result<[f64; 2]> {
+    let (a, b) = text
+        .split_once(':')
+        .with_context(|| format!("invalid --range {text:?}: expected A:B in degrees, e.g. --range 0:180"))?;
+    let parse = |v: &str| -> Result<f64> {
+        v.trim()
+            .parse::<f64>()
+            .with_context(|| format!("invalid --range {text:?}: {v:?} is not a number of degrees"))
+    };
+    Ok([parse(a)?.to_radians(), parse(b)?.to_radians()])
+}
+
+fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
+    anyhow::ensure!(
+        args.closure_tol.is_finite() && args.closure_tol > 0.0,
+        "invalid --closure-tol {}: must be a positive number",
+        args.closure_tol
+    );
+    let degree = match args.degree.as_str() {
+        "auto" => None,
+        text => {
+            let degree: usize = text
+                .parse()
+                .with_context(|| format!("invalid --degree {text:?}: expected 1..=20 or auto"))?;
+            anyhow::ensure!(args.tol.is_none(), "--tol applies only to --degree auto");
+            Some(degree)
+        }
+    };
+    if degree.is_none() && args.tol.is_none() {
+        anyhow::bail!("--degree auto needs --tol RAD (the largest accepted fit error)");
+    }
+    if args.format == ExportFormat::Mujoco && degree.is_none_or(|d| d > 4) {
+        anyhow::bail!(
+            "invalid --degree {}: MuJoCo's polycoef holds a quartic at most; use --degree 1..=4 with --format mujoco",
+            args.degree
+        );
+    }
+    let options = LoadOptions {
+        closure_tol: args.closure_tol,
+        ..LoadOptions::default()
+    };
+    let pattern = Pattern::load(&args.pattern, &options)?;
+    let driver = crease_index(&pattern, args.drive, "--drive")?;
+    let locks = args
+        .locks
+        .iter()
+        .map(|text| parse_lock(&pattern, text))
+        .collect::<Result<Vec<_>>>()?;
+    let range = args.range.as_deref().map(parse_range).transpose()?;
+    let setup = Setup::new(&pattern, driver, &locks)?;
+    let samples = match args.source {
+        Source::Sweep => {
+            let domain = match range {
+                Some(d) => d,
+                None => default_domain(&pattern, driver)?,
+            };
+            sweep_samples(&pattern, &setup, domain, args.samples)?
+        }
+        Source::Unfold => unfold_samples(&pattern, &setup, range, &UnfoldSettings::default())?,
+    };
+    let (poly, report) = match degree {
+        Some(d) => {
+            let poly = ConstraintPoly::fit(&pattern, &samples, d)?;
+            let report = ConstraintReport::new(&pattern, &samples, &poly)?;
+            (poly, report)
+        }
+        None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default())?,
+    };
+    // Render everything before writing anything.
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(&pattern.name));
+    let report_json = serde_json::to_string_pretty(&report)?;
+    let svg = constraints_svg(&pattern, &samples, &poly)?;
+    let mut files = vec![("constraints.json", report_json.clone()), ("constraints.svg", svg)];
+    if args.format == ExportFormat::Mujoco {
+        files.push(("constraints.xml", mujoco_snippet(&report)?));
+    }
+    for (name, contents) in &files {
+        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {} curve(s) of {} over [{:.4}°, {:.4}°], degree {}, {} samples ({:?}, closure residual of samples {:.1e} rad)",
+        pattern.name,
+        report.curves.len(),
+        report.driver_label,
+        report.domain_deg[0],
+        report.domain_deg[1],
+        report.degree,
+        report.samples,
+        report.source,
+        report.samples_max_closure_residual
+    );
+    for (crease, value) in &report.locked {
+        println!("  locked crease {crease} at {:.6}°", value.to_degrees());
+    }
+    for curve in &report.curves {
+        println!(
+            "  {:<12} fit error {:.3e} rad, closure residual {:.3e} rad; coefficients (deg):",
+            curve.label, curve.max_fit_error_rad, curve.max_closure_residual
+        );
+        let terms: Vec<String> = curve
+            .coeffs_deg
+            .iter()
+            .enumerate()
+            .map(|(k, c)| format!("{c:+.6e}·θ^{k}"))
+            .collect();
+        println!("      {}", terms.join(" "));
+    }
+    println!(
+        "  all curves together: loop-closure residual {:.3e} rad",
+        report.max_closure_residual
+    );
+    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
+    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    Ok(())
+}
+
 /// Runs the parsed command; Ok(false) means "finished, but exit non-zero".
 pub fn run(cli: Cli) -> Result<bool> {
     match cli.command {
@@ -230,5 +438,6 @@ pub fn run(cli: Cli) -> Result<bool> {
             json,
         } => run_unfold(&pattern, &solver, out, json).map(|_| true),
         Command::Check { patterns, solver, json } => run_check(&patterns, &solver, json),
+        Command::Constraints(args) => run_constraints(&args).map(|_| true),
     }
 }

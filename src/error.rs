@@ -34,6 +34,21 @@ pub enum NanofoldError {
     /// A numerical routine failed in a way the caller should hear about.
     #[error("numerical failure in {stage}: {message}")]
     Numerical { stage: String, message: String },
+    /// A sweep cannot reach the requested configuration; says where it stopped and why.
+    #[error("cannot reach {what}: stopped at {reached}: {reason}")]
+    Unreachable {
+        what: String,
+        reached: String,
+        reason: String,
+    },
+    /// A fitted constraint was evaluated outside the interval it was fitted on.
+    #[error("{driver} = {value_deg:.6}° is outside the fitted domain [{lower_deg:.6}°, {upper_deg:.6}°] of the constraint polynomial")]
+    OutsideFitDomain {
+        driver: String,
+        value_deg: f64,
+        lower_deg: f64,
+        upper_deg: f64,
+    },
     /// Writing an output file failed.
     #[error("cannot write {path}: {message}")]
     Output { path: String, message: String },

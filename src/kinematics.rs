@@ -69,6 +69,10 @@ pub fn closure_residual(sector_angles: &[f64], fold_angles: &[f64]) -> f64 {
     rotation_vector(&closure_rotation(sector_angles, fold_angles)).norm()
 }
 
+/// Singular values of the closure Jacobian below this fraction of the largest are treated
+/// as zero by the Newton solvers.
+const SINGULAR_CUTOFF: f64 = 1e-9;
+
 /// Outcome of [`solve_closure`].
 #[derive(Debug, Clone, Copy)]
 pub struct ClosureSolve {
@@ -87,7 +91,6 @@ pub fn solve_closure(
     tol: f64,
     max_iterations: usize,
 ) -> Result<ClosureSolve> {
-    let n = fold_angles.len();
     let mut residual = f64::INFINITY;
     for iteration in 0..=max_iterations {
         let holonomy = closure_rotation(sector_angles, fold_angles);
@@ -102,21 +105,13 @@ pub fn solve_closure(
         if iteration == max_iterations {
             break;
         }
-        let nodes = forward(sector_angles, fold_angles);
-        let jl_inv = left_jacobian_inverse(&r);
-        let mut jac = DMatrix::zeros(3, free.len());
-        for (col, &k) in free.iter().enumerate() {
-            // ρ_0 acts last, on the right: its spatial axis is holonomy·e_x ≈ x_0.
-            let axis = if k == 0 {
-                holonomy.column(0).into_owned()
-            } else {
-                nodes[k % n]
-            };
-            jac.set_column(col, &(jl_inv * axis));
-        }
+        let jac = rotation_vector_jacobian(sector_angles, fold_angles, &holonomy, &r, free);
         let rhs = DVector::from_column_slice(&[-r.x, -r.y, -r.z]);
         let svd = jac.svd(true, true);
-        let step = svd.solve(&rhs, 1e-12).map_err(|e| NanofoldError::Numerical {
+        // Relative cutoff: near a singular configuration a tiny singular value would
+        // amplify the residual into a jump along the kernel, onto another branch.
+        let cutoff = SINGULAR_CUTOFF * svd.singular_values.max();
+        let step = svd.solve(&rhs, cutoff).map_err(|e| NanofoldError::Numerical {
             stage: "loop closure".into(),
             message: e.to_string(),
         })?;
@@ -131,6 +126,71 @@ pub fn solve_closure(
         stage: "loop closure".into(),
         message: format!("Newton did not converge: residual {residual:.3e} rad after {max_iterations} iterations"),
     })
+}
+
+/// Continues Newton (undamped, minimum-norm) after [`solve_closure`] until the step stops
+/// shrinking. Near a singular configuration (the flat state of a degree-4 vertex) the
+/// residual is quadratic in the error along the Jacobian's kernel, so a residual of 1e-13
+/// still allows angle errors near 3e-7; Newton converges linearly there and these extra
+/// steps take the angles to rounding level. Returns the number of steps taken.
+pub fn refine_closure(sector_angles: &[f64], fold_angles: &mut [f64], free: &[usize], max_iterations: usize) -> usize {
+    let mut previous_step = f64::INFINITY;
+    for iteration in 0..max_iterations {
+        let (r, jac) = closure_jacobian(sector_angles, fold_angles, free);
+        if r.norm() == 0.0 {
+            return iteration;
+        }
+        let rhs = DVector::from_column_slice(&[-r.x, -r.y, -r.z]);
+        let svd = jac.svd(true, true);
+        let cutoff = SINGULAR_CUTOFF * svd.singular_values.max();
+        let Ok(step) = svd.solve(&rhs, cutoff) else {
+            return iteration;
+        };
+        let size = step.amax();
+        if size.is_nan() || size >= 0.9 * previous_step || size > 1e-3 {
+            return iteration;
+        }
+        for (col, &k) in free.iter().enumerate() {
+            fold_angles[k] += step[col];
+        }
+        previous_step = size;
+        if size < 1e-15 {
+            return iteration + 1;
+        }
+    }
+    max_iterations
+}
+
+/// The closure residual vector r (rotation vector of the holonomy) and its Jacobian
+/// ∂r/∂ρ_k for the rays in `columns`: the implicit-function-theorem data of SPEC §6.
+pub fn closure_jacobian(sector_angles: &[f64], fold_angles: &[f64], columns: &[usize]) -> (Vector3<f64>, DMatrix<f64>) {
+    let holonomy = closure_rotation(sector_angles, fold_angles);
+    let r = rotation_vector(&holonomy);
+    let jac = rotation_vector_jacobian(sector_angles, fold_angles, &holonomy, &r, columns);
+    (r, jac)
+}
+
+fn rotation_vector_jacobian(
+    sector_angles: &[f64],
+    fold_angles: &[f64],
+    holonomy: &Matrix3<f64>,
+    r: &Vector3<f64>,
+    columns: &[usize],
+) -> DMatrix<f64> {
+    let n = fold_angles.len();
+    let nodes = forward(sector_angles, fold_angles);
+    let jl_inv = left_jacobian_inverse(r);
+    let mut jac = DMatrix::zeros(3, columns.len());
+    for (col, &k) in columns.iter().enumerate() {
+        // ρ_0 acts last, on the right: its spatial axis is holonomy·e_x ≈ x_0.
+        let axis = if k == 0 {
+            holonomy.column(0).into_owned()
+        } else {
+            nodes[k % n]
+        };
+        jac.set_column(col, &(jl_inv * axis));
+    }
+    jac
 }
 
 /// Inverse of SO(3)'s left Jacobian: maps a spatial angular velocity to d(rotation vector).

@@ -1,6 +1,7 @@
 //! nanofold: rigid origami of single-vertex crease patterns — unfolding by constrained
 //! energy minimisation on the sphere (SPEC §3–5).
 
+pub mod constraints;
 pub mod energy;
 pub mod error;
 pub mod kinematics;

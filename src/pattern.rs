@@ -381,6 +381,22 @@ impl Pattern {
         directions
     }
 
+    /// The index a user types for crease `i`: its FOLD edge index for FOLD input, its
+    /// position in `creases` for the native schema.
+    pub fn user_index(&self, crease: usize) -> usize {
+        self.creases[crease].fold_edge.unwrap_or(crease)
+    }
+
+    /// The crease a user index names, if any (inverse of [`Pattern::user_index`]).
+    pub fn crease_from_user_index(&self, index: usize) -> Option<usize> {
+        (0..self.creases.len()).find(|&i| self.user_index(i) == index)
+    }
+
+    /// Every valid user index, for error messages.
+    pub fn user_indices(&self) -> Vec<usize> {
+        (0..self.creases.len()).map(|i| self.user_index(i)).collect()
+    }
+
     /// Degrees of freedom of the folded vertex: n − 3 for a closed chain, n − 2 crease
     /// rays for an open one, less one per held crease (locked or flat).
     pub fn degrees_of_freedom(&self) -> i64 {

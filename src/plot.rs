@@ -1,6 +1,7 @@
-//! SVG figures: fold angles against iteration and 3D views of the vertex (like the
-//! thesis's figures 3-3 to 3-5), drawn with plotters.
+//! SVG figures drawn with plotters: the unfolding (fold angles against iteration and 3D
+//! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
+use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
 use crate::output::{snapshot_indices, write_atomic};
 use crate::pattern::Pattern;
@@ -10,7 +11,7 @@ use std::path::Path;
 
 fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
     NanofoldError::Output {
-        path: "unfold.svg".into(),
+        path: "SVG figure".into(),
         message: e.to_string(),
     }
 }
@@ -133,4 +134,128 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
 /// Writes `unfold.svg`.
 pub fn write_unfold_svg(path: &Path, pattern: &Pattern, report: &UnfoldReport) -> Result<()> {
     write_atomic(path, unfold_svg(pattern, report)?.as_bytes())
+}
+
+/// Renders `constraints.svg`: every crease against the driving angle, exact samples as
+/// lines and the fitted polynomials dashed (like the thesis's figure 5-9), and the fit
+/// error |f − exact| on a log scale below.
+pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 800)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let (top, bottom) = root.split_vertically(480);
+        let x_deg: Vec<f64> = samples.drive_angles.iter().map(|x| x.to_degrees()).collect();
+        let domain_deg = (poly.domain[0].to_degrees(), poly.domain[1].to_degrees());
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for angles in &samples.fold_angles {
+            for a in angles {
+                lo = lo.min(a.to_degrees());
+                hi = hi.max(a.to_degrees());
+            }
+        }
+        let pad = 0.05 * (hi - lo).max(1.0);
+        let driver = &pattern.creases[poly.driver];
+        let mut chart = ChartBuilder::on(&top)
+            .caption(
+                format!(
+                    "{}: fold angles against {} (lines: exact loop closure, dashed: degree-{} fit)",
+                    pattern.name,
+                    driver.label,
+                    poly.degree()
+                ),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(52)
+            .build_cartesian_2d(domain_deg.0..domain_deg.1, (lo - pad)..(hi + pad))
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc(format!("{} (deg)", driver.label))
+            .y_desc("fold angle (deg)")
+            .draw()
+            .map_err(plot_error)?;
+        let fine = 400;
+        for (c, crease) in pattern.creases.iter().enumerate() {
+            let colour = series_colour(c);
+            let role = if c == poly.driver {
+                "driver"
+            } else if poly.locked.iter().any(|&(l, _)| l == c) {
+                "locked"
+            } else {
+                "fitted"
+            };
+            chart
+                .draw_series(LineSeries::new(
+                    x_deg
+                        .iter()
+                        .zip(&samples.fold_angles)
+                        .map(|(&x, a)| (x, a[c].to_degrees())),
+                    colour.mix(0.45).stroke_width(4),
+                ))
+                .map_err(plot_error)?
+                .label(format!("{} ({role})", crease.label))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.mix(0.45).stroke_width(4)));
+            if let Some(j) = poly.dependents.iter().position(|&d| d == c) {
+                let curve = &poly.curves[j];
+                let points = (0..=fine).map(|i| {
+                    let x = poly.domain[0] + (poly.domain[1] - poly.domain[0]) * i as f64 / fine as f64;
+                    (x.to_degrees(), curve.eval(x).to_degrees())
+                });
+                chart
+                    .draw_series(DashedLineSeries::new(points, 8, 5, colour.stroke_width(2)))
+                    .map_err(plot_error)?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(plot_error)?;
+
+        // Fit error per dependent, at the samples.
+        let errors: Vec<Vec<f64>> = poly
+            .dependents
+            .iter()
+            .zip(&poly.curves)
+            .map(|(&c, curve)| {
+                samples
+                    .drive_angles
+                    .iter()
+                    .zip(&samples.fold_angles)
+                    .map(|(&x, a)| (curve.eval(x) - a[c]).abs().max(1e-17))
+                    .collect()
+            })
+            .collect();
+        let top_error = errors.iter().flatten().copied().fold(1e-16, f64::max) * 3.0;
+        let bottom_error = (errors.iter().flatten().copied().fold(f64::INFINITY, f64::min)).max(1e-17) / 3.0;
+        let mut error_chart = ChartBuilder::on(&bottom)
+            .caption("fit error |f(θ) − exact| (rad)", ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(64)
+            .build_cartesian_2d(domain_deg.0..domain_deg.1, (bottom_error..top_error).log_scale())
+            .map_err(plot_error)?;
+        error_chart
+            .configure_mesh()
+            .x_desc(format!("{} (deg)", driver.label))
+            .y_desc("rad")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(plot_error)?;
+        for (&c, series) in poly.dependents.iter().zip(&errors) {
+            error_chart
+                .draw_series(LineSeries::new(
+                    x_deg.iter().copied().zip(series.iter().copied()),
+                    series_colour(c).stroke_width(2),
+                ))
+                .map_err(plot_error)?;
+        }
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
 }

@@ -116,3 +116,85 @@ fn check_prints_one_line_per_pattern_and_fails_only_on_unreadable_input() {
     assert!(!out.status.success());
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 2);
 }
+
+#[test]
+fn constraints_command_writes_json_svg_and_mujoco() {
+    let dir = temp_dir("constraints");
+    let out = nanofold()
+        .args([
+            "constraints",
+            "patterns/corner_cube.fold",
+            "--drive",
+            "0",
+            "--lock",
+            "1=0",
+            "--range",
+            "0:180",
+            "--format",
+            "mujoco",
+            "--json",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in ["driver", "locked", "degree", "domain_rad", "samples", "curves"] {
+        assert!(report.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(report["locked"]["1"], 0.0);
+    assert_eq!(report["degree"], 4);
+    let curves = report["curves"].as_array().unwrap();
+    assert_eq!(curves.len(), 3);
+    for curve in curves {
+        for key in [
+            "crease",
+            "coeffs_rad",
+            "coeffs_deg",
+            "max_fit_error_rad",
+            "max_closure_residual",
+        ] {
+            assert!(curve.get(key).is_some(), "missing curves[].{key}");
+        }
+        assert_eq!(curve["coeffs_rad"].as_array().unwrap().len(), 5);
+    }
+    // The file on disk is the same report.
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("constraints.json")).unwrap()).unwrap();
+    assert_eq!(on_disk, report);
+    let xml = std::fs::read_to_string(dir.join("constraints.xml")).unwrap();
+    assert_eq!(xml.matches("joint2=\"crease_0\"").count(), 3);
+    assert!(std::fs::read_to_string(dir.join("constraints.svg"))
+        .unwrap()
+        .starts_with("<svg"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn constraints_bad_arguments_fail_clearly_and_write_nothing() {
+    let dir = temp_dir("constraints-bad");
+    let cases: [(&[&str], &str); 7] = [
+        (&["--drive", "9"], "no crease with this index"),
+        (&["--drive", "0", "--lock", "0=0"], "cannot drive a locked crease"),
+        (&["--drive", "0", "--degree", "0"], "--degree"),
+        (&["--drive", "0", "--degree", "21"], "--degree"),
+        (&["--drive", "0", "--degree", "5", "--format", "mujoco"], "quartic"),
+        (&["--drive", "0", "--range", "0:180"], "158.70"),
+        (&["--drive", "0", "--degree", "auto"], "--tol"),
+    ];
+    for (args, expected) in cases {
+        let out = nanofold()
+            .args(["constraints", "patterns/degree4_generic.fold"])
+            .args(args)
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(!dir.exists(), "{args:?} wrote {}", dir.display());
+    }
+}
