@@ -296,3 +296,34 @@ fn bad_constraint_requests_get_clear_errors() {
         .to_string();
     assert!(err.contains("folded angle"), "{err}");
 }
+
+#[test]
+fn every_closed_library_pattern_yields_curves_once_locked_to_one_degree_of_freedom() {
+    // Lock every crease after the first four at its folded angle and sweep the driver ±10°
+    // about its folded value: the curves exist, close the loop and fit.
+    for name in [
+        "half_paper.fold",
+        "corner_cube.fold",
+        "waterbomb.fold",
+        "degree4_generic.fold",
+        "miura_vertex.fold",
+        "degree6_asymmetric.fold",
+        "symmetric16.fold",
+        "degree4_native.json",
+    ] {
+        let pattern = load(name);
+        let locks: Vec<(usize, f64)> = (4..pattern.creases.len())
+            .map(|c| (c, pattern.creases[c].folded_angle))
+            .collect();
+        let setup = Setup::new(&pattern, 0, &locks).unwrap();
+        let folded = pattern.creases[0].folded_angle;
+        let domain = [(folded - 0.17).max(-PI), (folded + 0.17).min(PI)];
+        let samples = sweep_samples(&pattern, &setup, domain, 41).unwrap();
+        assert!(samples.max_closure_residual <= 1e-12, "{name}");
+        let poly = ConstraintPoly::fit(&pattern, &samples, 4).unwrap();
+        let report = ConstraintReport::new(&pattern, &samples, &poly).unwrap();
+        assert!(report.max_fit_error() < 1e-3, "{name}: {:e}", report.max_fit_error());
+        assert!(mujoco_snippet(&report).is_ok());
+        assert!(nanofold::plot::constraints_svg(&pattern, &samples, &poly).is_ok());
+    }
+}

@@ -153,19 +153,35 @@ pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize)
         })
         .collect();
     let driver_label = pattern.creases[setup.driver].label.clone();
-    let start_drive = rho[driver_ray];
+    let folded_drive = rho[driver_ray];
 
-    // Stage 1: move the locked creases from their folded values to the lock values, driver
-    // held at its folded value.
-    let mut continuation = Continuation::new(sectors, &free_rays, rho.clone(), 0.0, 0.02);
+    // Stage 1: move the locked creases from their folded values to the lock values, first
+    // with the driver held at its folded value, and if that path is blocked with the driver
+    // moving too (minimum-norm).
     if lock_rays.iter().any(|&(_, from, to)| from != to) {
-        let held: Vec<usize> = lock_rays.iter().map(|&(ray, _, _)| ray).chain([driver_ray]).collect();
+        let held: Vec<usize> = lock_rays.iter().map(|&(ray, _, _)| ray).collect();
         let lerp = |s: f64, r: &mut [f64]| {
             for &(ray, from, to) in &lock_rays {
                 r[ray] = from + s * (to - from);
             }
         };
-        continuation.advance(1.0, &held, &lerp).map_err(|stop| {
+        let driver_free: Vec<usize> = free_rays.iter().copied().chain([driver_ray]).collect();
+        let mut first_stop = None;
+        for (moving, also_held) in [(&free_rays, Some(driver_ray)), (&driver_free, None)] {
+            let held_now: Vec<usize> = held.iter().copied().chain(also_held).collect();
+            let mut continuation = Continuation::new(sectors, moving, rho.clone(), 0.0, 0.02);
+            match continuation.advance(1.0, &held_now, &lerp) {
+                Ok(()) => {
+                    rho = continuation.rho;
+                    first_stop = None;
+                    break;
+                }
+                Err(stop) => {
+                    first_stop.get_or_insert(stop);
+                }
+            }
+        }
+        if let Some(stop) = first_stop {
             let (reached, why) = match stop {
                 Stop::NoSolution { reached } => (reached, "loop closure has no solution there".to_string()),
                 Stop::FoldsThrough { reached, ray } => {
@@ -183,20 +199,21 @@ pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize)
                 })
                 .collect::<Vec<_>>()
                 .join(", ");
-            NanofoldError::Unreachable {
+            return Err(NanofoldError::Unreachable {
                 what: format!(
-                    "the locks with {driver_label} at its folded {:.4}°",
-                    start_drive.to_degrees()
+                    "the locked angles from the folded state with {driver_label} held at {:.4}°",
+                    folded_drive.to_degrees()
                 ),
                 reached: format!("{locks} ({:.1}% of the way)", 100.0 * reached),
-                reason: why,
-            }
-        })?;
+                reason: format!("{why}; with {driver_label} free the path is blocked too"),
+            });
+        }
     }
-    rho = continuation.rho.clone();
     for &(ray, _, to) in &lock_rays {
         rho[ray] = to;
     }
+    let start_drive = rho[driver_ray];
+    let starts_flat = rho.iter().all(|a| a.abs() < 1e-6);
 
     // Stage 2: the driver sweep, outwards from its folded value in both directions.
     let grid: Vec<f64> = (0..samples)
@@ -216,6 +233,11 @@ pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize)
         for target in targets {
             path.advance(target, &held, &set_driver).map_err(|stop| {
                 let (reached, reason) = match stop {
+                    Stop::NoSolution { reached } if (reached - start_drive).abs() < 1e-9 => (
+                        reached,
+                        "the vertex is rigid there: with these creases held, no closed configuration moves the driver"
+                            .to_string(),
+                    ),
                     Stop::NoSolution { reached } => (
                         reached,
                         "loop closure has no solution beyond it (the driven crease reaches a turning point or a limit)"
@@ -231,12 +253,20 @@ pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize)
                 };
                 NanofoldError::Unreachable {
                     what: format!(
-                        "{driver_label} from its folded {:.4}° to {:.4}°",
+                        "{driver_label} from {:.4}° (folded {:.4}°) to {:.4}°",
                         start_drive.to_degrees(),
+                        folded_drive.to_degrees(),
                         target.to_degrees()
                     ),
                     reached: format!("{driver_label} = {:.6}°", reached.to_degrees()),
-                    reason,
+                    reason: if starts_flat {
+                        format!(
+                            "{reason}; the locked angles were reached only at the flat state, where branches of \
+                             motion cross, so no branch is selected: lock other creases, or lock these at their folded angles"
+                        )
+                    } else {
+                        reason
+                    },
                 }
             })?;
             points.push((target, path.rho.clone()));
