@@ -37,7 +37,7 @@ pub fn series_colour(i: usize) -> RGBColor {
 pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 760)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
         let (top, bottom) = root.split_vertically(400);
         let traj = &report.trajectory;
@@ -100,7 +100,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
             view.with_projection(|mut p| {
                 p.yaw = 0.6;
                 p.pitch = 0.45;
-                p.scale = 0.85;
+                p.scale = 1.3;
                 p.into_matrix()
             });
             // plotters' 3D y axis is vertical: plot (x, z, y) so the pattern's z is up.
