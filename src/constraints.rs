@@ -7,7 +7,7 @@ pub mod chebyshev;
 pub mod sweep;
 
 use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_residual, refine_closure, solve_closure};
+use crate::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, Pattern};
 use crate::unfold::{unfold, UnfoldSettings};
 use chebyshev::{eval_monomial, Chebyshev};
@@ -443,6 +443,37 @@ impl ConstraintPoly {
         }
         Ok(angles)
     }
+}
+
+/// G = ∂f/∂θ_c from the implicit function theorem on exact loop closure (T4.18):
+/// J_dep G = −J_driver, with J the closure Jacobian at the given crease angles (file order,
+/// which must close the loop). An error at a singular configuration, where G is undefined.
+pub fn implicit_jacobian(pattern: &Pattern, setup: &Setup, crease_angles: &[f64]) -> Result<Vec<f64>> {
+    let mut rho = setup.base_ray_angles(pattern);
+    for (c, crease) in pattern.creases.iter().enumerate() {
+        rho[crease.ray] = crease_angles[c];
+    }
+    let dependent_rays: Vec<usize> = setup.dependents.iter().map(|&c| pattern.creases[c].ray).collect();
+    let driver_ray = pattern.creases[setup.driver].ray;
+    let (_, j_dep) = closure_jacobian(&pattern.sector_angles, &rho, &dependent_rays);
+    let (_, j_driver) = closure_jacobian(&pattern.sector_angles, &rho, &[driver_ray]);
+    let svd = j_dep.svd(true, true);
+    let (largest, smallest) = (svd.singular_values.max(), svd.singular_values.min());
+    if smallest < 1e-9 * largest {
+        return Err(NanofoldError::Numerical {
+            stage: "implicit-function Jacobian".into(),
+            message: format!(
+                "singular configuration (σ_min/σ_max = {:.1e}): the dependents are not a function of {} here",
+                smallest / largest,
+                pattern.creases[setup.driver].label
+            ),
+        });
+    }
+    let g = svd.solve(&(-j_driver), 0.0).map_err(|e| NanofoldError::Numerical {
+        stage: "implicit-function Jacobian".into(),
+        message: e.to_string(),
+    })?;
+    Ok(g.iter().copied().collect())
 }
 
 /// One exported curve.

@@ -327,3 +327,25 @@ fn every_closed_library_pattern_yields_curves_once_locked_to_one_degree_of_freed
         assert!(nanofold::plot::constraints_svg(&pattern, &samples, &poly).is_ok());
     }
 }
+
+#[test]
+fn polynomial_jacobian_matches_the_implicit_function_theorem() {
+    // Two independent routes to G = ∂f/∂θ_c (T4.18): the fitted polynomial's derivative and
+    // the implicit function theorem on the exact closure Jacobian.
+    let pattern = load("corner_cube.fold");
+    let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
+    let samples = sweep_samples(&pattern, &setup, [0.0, PI], 201).unwrap();
+    let (poly, _) = fit_to_tolerance(&pattern, &samples, 1e-9).unwrap();
+    let mut worst: f64 = 0.0;
+    for (theta, angles) in samples.drive_angles.iter().zip(&samples.fold_angles).skip(1) {
+        let exact = implicit_jacobian(&pattern, &setup, angles).unwrap();
+        let fitted = poly.jacobian(*theta).unwrap();
+        for (e, f) in exact.iter().zip(&fitted) {
+            worst = worst.max((e - f).abs());
+        }
+    }
+    assert!(worst < 1e-6, "G: polynomial vs implicit function theorem {worst:e}");
+    // At the flat state the dependents are no function of the driver: a clear error.
+    let err = implicit_jacobian(&pattern, &setup, &samples.fold_angles[0]).unwrap_err();
+    assert!(err.to_string().contains("singular configuration"), "{err}");
+}
