@@ -69,7 +69,7 @@ pub struct ConstraintsArgs {
     #[arg(long = "lock", value_name = "J=DEG", allow_hyphen_values = true)]
     pub locks: Vec<String>,
     /// Polynomial degree 1..=20, or `auto` with --tol.
-    #[arg(long, default_value = "4")]
+    #[arg(long, default_value = "4", allow_hyphen_values = true)]
     pub degree: String,
     /// With --degree auto: the largest accepted fit error, rad.
     #[arg(long, allow_negative_numbers = true)]

@@ -174,7 +174,7 @@ fn constraints_command_writes_json_svg_and_mujoco() {
 #[test]
 fn constraints_bad_arguments_fail_clearly_and_write_nothing() {
     let dir = temp_dir("constraints-bad");
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["--drive", "9"], "no crease with this index"),
         (&["--drive", "0", "--lock", "0=0"], "cannot drive a locked crease"),
         (&["--drive", "0", "--degree", "0"], "--degree"),
@@ -182,6 +182,8 @@ fn constraints_bad_arguments_fail_clearly_and_write_nothing() {
         (&["--drive", "0", "--degree", "5", "--format", "mujoco"], "quartic"),
         (&["--drive", "0", "--range", "0:180"], "158.70"),
         (&["--drive", "0", "--degree", "auto"], "--tol"),
+        (&["--drive", "0", "--degree", "-1"], "--degree"),
+        (&["--drive", "0", "--samples", "2"], "--samples"),
     ];
     for (args, expected) in cases {
         let out = nanofold()
