@@ -380,7 +380,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         .unwrap_or_else(|| PathBuf::from("output").join(&pattern.name));
     let report_json = serde_json::to_string_pretty(&report)?;
     let svg = constraints_svg(&pattern, &samples, &poly)?;
-    let mut files = vec![("constraints.json", report_json.clone()), ("constraints.svg", svg)];
+    let mut files = vec![("constraints.json", report_json), ("constraints.svg", svg)];
     if args.format == ExportFormat::Mujoco {
         files.push(("constraints.xml", mujoco_snippet(&report)?));
     }

@@ -72,11 +72,16 @@ impl<'a> Continuation<'a> {
             return;
         }
         // J_free Δfree = −J_held Δheld (first order), minimum-norm.
-        let (_, j_free) = closure_jacobian(self.sectors, &self.rho, self.free);
-        let (_, j_held) = closure_jacobian(self.sectors, &self.rho, held);
+        // One Jacobian for both column sets: free rays first, then held rays.
+        let columns: Vec<usize> = self.free.iter().chain(held).copied().collect();
+        let (_, jac) = closure_jacobian(self.sectors, &self.rho, &columns);
+        let (j_free, j_held) = (
+            jac.columns(0, self.free.len()),
+            jac.columns(self.free.len(), held.len()),
+        );
         let delta_held = DVector::from_iterator(held.len(), held.iter().map(|&k| trial[k] - self.rho[k]));
         let rhs = -(j_held * delta_held);
-        if let Ok(delta) = j_free.svd(true, true).solve(&rhs, 1e-10) {
+        if let Ok(delta) = j_free.into_owned().svd(true, true).solve(&rhs, 1e-10) {
             for (i, &k) in self.free.iter().enumerate() {
                 trial[k] = self.rho[k] + delta[i];
             }
