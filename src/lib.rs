@@ -2,6 +2,7 @@
 //! energy minimisation on the sphere (SPEC §3–5).
 
 pub mod constraints;
+pub mod dynamics;
 pub mod energy;
 pub mod error;
 pub mod kinematics;
@@ -9,6 +10,7 @@ pub mod output;
 pub mod pattern;
 pub mod plot;
 pub mod qp;
+pub mod scene;
 pub mod sphere;
 pub mod unfold;
 

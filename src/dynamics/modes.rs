@@ -1,0 +1,76 @@
+//! Linearised stability and natural frequencies at an equilibrium (SPEC §7, T5.14):
+//! M(θ*) δθ̈ + K δθ = 0, i.e. the eigenvalues λ of M⁻¹K and f = √λ / 2π.
+
+use super::{Data, Model};
+use crate::error::{NanofoldError, Result};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// Eigen-analysis of one equilibrium, modes sorted by descending eigenvalue.
+#[derive(Debug, Clone)]
+pub struct Modes {
+    /// θ* where M was evaluated, rad.
+    pub equilibrium: DVector<f64>,
+    /// λ of M⁻¹K, rad²/s², descending.
+    pub eigenvalues: Vec<f64>,
+    /// √λ / 2π, Hz, descending.
+    pub frequencies_hz: Vec<f64>,
+    /// Mode shapes as columns, each scaled to unit max-norm with its largest entry positive.
+    pub mode_shapes: DMatrix<f64>,
+    /// K positive definite, so every λ > 0 and the equilibrium is a strict energy minimum.
+    pub stable: bool,
+}
+
+/// Solves K φ = λ M φ through the Cholesky factor M = L Lᵀ: (L⁻¹ K L⁻ᵀ) v = λ v, φ = L⁻ᵀ v.
+pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
+    let n = model.dof();
+    let mut data = Data::new(model);
+    model.update_kinematics(equilibrium, &mut data);
+    model.update_mass_matrix(&mut data);
+    let numerical = |message: String| NanofoldError::Numerical {
+        stage: "modes".into(),
+        message,
+    };
+    let cholesky = data
+        .mass_matrix
+        .clone()
+        .cholesky()
+        .ok_or_else(|| numerical("mass matrix is not positive definite".into()))?;
+    let l = cholesky.l();
+    let stiffness = DMatrix::from_diagonal(&model.stiffness());
+    let l_inv_k = l
+        .solve_lower_triangular(&stiffness)
+        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
+    let a = l
+        .solve_lower_triangular(&l_inv_k.transpose())
+        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
+    let symmetric = 0.5 * (&a + a.transpose());
+    let eigen = SymmetricEigen::new(symmetric);
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| eigen.eigenvalues[j].total_cmp(&eigen.eigenvalues[i]));
+    let shapes_unscaled = l
+        .transpose()
+        .solve_upper_triangular(&eigen.eigenvectors)
+        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
+    let mut mode_shapes = DMatrix::zeros(n, n);
+    let mut eigenvalues = Vec::with_capacity(n);
+    for (column, &k) in order.iter().enumerate() {
+        let shape = shapes_unscaled.column(k);
+        let largest = shape
+            .iter()
+            .copied()
+            .fold(0.0_f64, |a, b| if b.abs() > a.abs() { b } else { a });
+        mode_shapes.set_column(column, &(shape / largest));
+        eigenvalues.push(eigen.eigenvalues[k]);
+    }
+    let stable = model.joints.iter().all(|j| j.stiffness > 0.0) && eigenvalues.iter().all(|&l| l > 0.0);
+    Ok(Modes {
+        equilibrium: DVector::from_column_slice(equilibrium),
+        frequencies_hz: eigenvalues
+            .iter()
+            .map(|&l| l.max(0.0).sqrt() / std::f64::consts::TAU)
+            .collect(),
+        eigenvalues,
+        mode_shapes,
+        stable,
+    })
+}

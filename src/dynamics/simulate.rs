@@ -1,0 +1,634 @@
+//! Response of a scene to its actuation (SPEC §7): the model chosen from time scales, the
+//! dynamics integrated by diffsol with contact location on its dense output, or the
+//! quasi-static path K θ = τ(t) when inertia cannot matter.
+//!
+//! The integrator sees scaled time s = t ω_slow and state y = (θ, dθ/ds), so angles and rates
+//! are both O(1) and one absolute tolerance fits all components (SPEC §1: masses ~1e-12 kg,
+//! stiffnesses ~1e-9 N·m give rates ~1e4 rad/s in SI).
+
+use super::contact::{Collision, ContactSet};
+use super::modes::modes;
+use super::Data;
+use crate::error::{NanofoldError, Result};
+use crate::scene::{Actuation, Scene};
+use diffsol::{NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason};
+use indicatif::{ProgressBar, ProgressStyle};
+use nalgebra::DVector;
+use std::cell::{Cell, RefCell};
+use std::time::Instant;
+
+/// `auto` takes the quasi-static path when the forcing lasts at least this many fastest periods.
+pub const QUASI_STATIC_RATIO: f64 = 1e3;
+/// `auto` integrates with BDF rather than Tsit45 when a run spans more fastest periods than this.
+pub const EXPLICIT_PERIOD_LIMIT: f64 = 1e4;
+/// Contact scanning: sub-intervals of each solver step (catches in-and-out crossings within a step).
+const CONTACT_SUBDIVISIONS: usize = 4;
+/// Contact scanning of the quasi-static path: largest change of a drive angle between checks, rad.
+const QUASI_STATIC_ANGLE_STEP: f64 = 2e-3;
+/// The quasi-static check integrates the dynamics over this many slowest periods.
+const CHECK_PERIODS: f64 = 30.0;
+
+/// Which equations to solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    Dynamic,
+    QuasiStatic,
+}
+
+/// The user's choice: a model, or `Auto` from the time-scale ratio.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelChoice {
+    Auto,
+    Dynamic,
+    QuasiStatic,
+}
+
+/// diffsol's integrators; `Auto` picks Tsit45 for short runs and BDF for long (stiff) ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    Auto,
+    Bdf,
+    Esdirk34,
+    TrBdf2,
+    Tsit45,
+}
+
+/// Settings of one run.
+#[derive(Debug, Clone)]
+pub struct SimulationSettings {
+    pub model: ModelChoice,
+    pub method: Method,
+    /// Relative tolerance; the absolute tolerance is the same number in rad (and rad per scaled time).
+    pub rtol: f64,
+    /// Integrate through contacts (for tests and what-if runs).
+    pub ignore_collisions: bool,
+    /// Overrides the scene's `time.t_end_s`.
+    pub t_end: Option<f64>,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+impl Default for SimulationSettings {
+    fn default() -> Self {
+        SimulationSettings {
+            model: ModelChoice::Auto,
+            method: Method::Auto,
+            rtol: 1e-8,
+            ignore_collisions: false,
+            t_end: None,
+            progress: false,
+        }
+    }
+}
+
+/// Natural periods (over the flat and the target configurations) against the forcing.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct TimeScales {
+    pub fastest_period_s: f64,
+    pub slowest_period_s: f64,
+    /// 0 for a step, the longest ramp time t_p for a ramp.
+    pub forcing_time_s: f64,
+    /// forcing_time / fastest_period.
+    pub ratio: f64,
+}
+
+/// One output time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    pub time: f64,
+    pub angles: DVector<f64>,
+    pub rates: DVector<f64>,
+    /// ½ θ̇ᵀ M θ̇, J.
+    pub kinetic_energy: f64,
+    /// ½ Σ K θ², J.
+    pub elastic_energy: f64,
+    /// −τ(t)·θ, J: with the elastic energy, the potential of a constant (step) torque.
+    pub actuator_potential: f64,
+}
+
+impl Sample {
+    /// Kinetic + elastic + actuator potential: conserved for a step without drag.
+    pub fn total_energy(&self) -> f64 {
+        self.kinetic_energy + self.elastic_energy + self.actuator_potential
+    }
+}
+
+/// Everything a run found.
+#[derive(Debug, Clone)]
+pub struct Response {
+    pub model: ModelKind,
+    /// The integrator used (dynamic runs).
+    pub method: Option<Method>,
+    pub rtol: f64,
+    pub time_scales: TimeScales,
+    /// Linear bound on |θ_dynamic − θ_quasi-static|: each mode's response to the jumps in
+    /// the drive rate (ramp) or drive angle (step), summed over modes, rad.
+    pub quasi_static_error_estimate: f64,
+    /// max |θ_dynamic − θ_quasi-static| over a short dynamic run at the start, when the
+    /// quasi-static model was chosen: (window s, error rad).
+    pub measured_quasi_static_error: Option<(f64, f64)>,
+    /// Time the run stopped (collision or the end of the span), s.
+    pub t_end: f64,
+    pub collision: Option<Collision>,
+    pub samples: Vec<Sample>,
+    pub steps: usize,
+    pub rhs_evaluations: usize,
+    pub seconds: f64,
+}
+
+/// Fastest and slowest natural periods over the flat and the target configurations.
+pub fn time_scales(scene: &Scene) -> Result<TimeScales> {
+    let n = scene.model.dof();
+    let mut fastest = f64::INFINITY;
+    let mut slowest: f64 = 0.0;
+    for angles in [DVector::zeros(n), scene.target_angles.clone()] {
+        let m = modes(&scene.model, angles.as_slice())?;
+        for f in m.frequencies_hz {
+            fastest = fastest.min(1.0 / f);
+            slowest = slowest.max(1.0 / f);
+        }
+    }
+    let forcing = scene.forcing_time();
+    Ok(TimeScales {
+        fastest_period_s: fastest,
+        slowest_period_s: slowest,
+        forcing_time_s: forcing,
+        ratio: forcing / fastest,
+    })
+}
+
+/// The jump the dynamics cannot follow: the drive rate at the start of a ramp (rad/s), or
+/// the drive angle of a step (rad). Linear modal bound of the lag (see [`Response`]).
+fn quasi_static_error_estimate(scene: &Scene) -> Result<f64> {
+    let n = scene.model.dof();
+    let modes = modes(&scene.model, &vec![0.0; n])?;
+    let mut data = Data::new(&scene.model);
+    scene.model.update_kinematics(&vec![0.0; n], &mut data);
+    scene.model.update_mass_matrix(&mut data);
+    let mass = &data.mass_matrix;
+    // Ramp: M ë + K e = 0 with ė(0) = −ṙ  ⇒ |e_i| ≤ Σ_k |φ̂_ki| |φ̂_kᵀ M ṙ| / ω_k.
+    // Step: e(0) = −θ_target            ⇒ |e_i| ≤ Σ_k |φ̂_ki| |φ̂_kᵀ M θ_target|.
+    let (jump, per_mode_scale): (DVector<f64>, Box<dyn Fn(f64) -> f64>) = match &scene.actuation {
+        Actuation::Step => (scene.target_angles.clone(), Box::new(|_| 1.0)),
+        Actuation::Ramp {
+            etch_rate,
+            radius_of_curvature,
+        } => (
+            DVector::from_fn(n, |i, _| {
+                if scene.actuated[i] {
+                    scene.target_angles[i].signum() * etch_rate / radius_of_curvature[i]
+                } else {
+                    0.0
+                }
+            }),
+            Box::new(|lambda: f64| 1.0 / lambda.sqrt()),
+        ),
+    };
+    let mut bound = DVector::<f64>::zeros(n);
+    for k in 0..n {
+        let shape = modes.mode_shapes.column(k);
+        let modal_mass = shape.dot(&(mass * shape));
+        let normalised = shape / modal_mass.sqrt();
+        let amplitude = normalised.dot(&(mass * &jump)).abs() * per_mode_scale(modes.eigenvalues[k]);
+        bound += normalised.abs() * amplitude;
+    }
+    Ok(bound.amax())
+}
+
+/// Runs a scene.
+pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response> {
+    let started = Instant::now();
+    if !(settings.rtol.is_finite() && settings.rtol > 0.0 && settings.rtol < 1.0) {
+        return Err(NanofoldError::invalid("--rtol", settings.rtol, "must lie in (0, 1)"));
+    }
+    let t_end = settings.t_end.unwrap_or(scene.t_end);
+    if !(t_end.is_finite() && t_end > 0.0) {
+        return Err(NanofoldError::invalid("t_end", t_end, "must be a finite time > 0 s"));
+    }
+    let scales = time_scales(scene)?;
+    let estimate = quasi_static_error_estimate(scene)?;
+    let kind = match settings.model {
+        ModelChoice::Dynamic => ModelKind::Dynamic,
+        ModelChoice::QuasiStatic => ModelKind::QuasiStatic,
+        ModelChoice::Auto if scales.ratio >= QUASI_STATIC_RATIO => ModelKind::QuasiStatic,
+        ModelChoice::Auto => ModelKind::Dynamic,
+    };
+    let contacts = (!settings.ignore_collisions).then(|| ContactSet::new(&scene.model, scene.substrate_edge_y));
+    let output_times = output_times(t_end, scene.outputs.samples);
+    let mut response = Response {
+        model: kind,
+        method: None,
+        rtol: settings.rtol,
+        time_scales: scales,
+        quasi_static_error_estimate: estimate,
+        measured_quasi_static_error: None,
+        t_end,
+        collision: None,
+        samples: Vec::new(),
+        steps: 0,
+        rhs_evaluations: 0,
+        seconds: 0.0,
+    };
+    match kind {
+        ModelKind::Dynamic => {
+            let method = resolve_method(settings.method, t_end, &scales);
+            let run = integrate(
+                scene,
+                method,
+                settings.rtol,
+                &output_times,
+                contacts.as_ref(),
+                settings.progress,
+            )?;
+            response.method = Some(method);
+            response.steps = run.steps;
+            response.rhs_evaluations = run.rhs_evaluations;
+            response.collision = run.collision;
+            response.samples = run.samples;
+        }
+        ModelKind::QuasiStatic => {
+            let (samples, collision, steps) = quasi_static(scene, &output_times, contacts.as_ref());
+            response.samples = samples;
+            response.collision = collision;
+            response.steps = steps;
+            let window = (CHECK_PERIODS * scales.slowest_period_s).min(t_end);
+            let check_times = output_times_in(window, 201);
+            let method = resolve_method(settings.method, window, &scales);
+            let run = integrate(scene, method, settings.rtol, &check_times, None, false)?;
+            let mut drive = vec![0.0; scene.model.dof()];
+            let error = run
+                .samples
+                .iter()
+                .map(|s| {
+                    scene.drive_angles(s.time, &mut drive);
+                    s.angles
+                        .iter()
+                        .zip(&drive)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max)
+                })
+                .fold(0.0, f64::max);
+            response.measured_quasi_static_error = Some((window, error));
+        }
+    }
+    if let Some(c) = &response.collision {
+        response.t_end = c.time;
+    }
+    response.seconds = started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+fn resolve_method(method: Method, t_end: f64, scales: &TimeScales) -> Method {
+    match method {
+        Method::Auto if t_end / scales.fastest_period_s > EXPLICIT_PERIOD_LIMIT => Method::Bdf,
+        Method::Auto => Method::Tsit45,
+        other => other,
+    }
+}
+
+fn output_times_in(t_end: f64, samples: usize) -> Vec<f64> {
+    (0..samples).map(|k| t_end * k as f64 / (samples - 1) as f64).collect()
+}
+
+fn output_times(t_end: f64, samples: usize) -> Vec<f64> {
+    output_times_in(t_end, samples.max(2))
+}
+
+/// Fills a sample's energies.
+fn sample(scene: &Scene, data: &mut Data, time: f64, angles: &[f64], rates: &[f64]) -> Sample {
+    let model = &scene.model;
+    model.update_kinematics(angles, data);
+    model.update_mass_matrix(data);
+    let mut torques = vec![0.0; model.dof()];
+    scene.torques(time, &mut torques);
+    Sample {
+        time,
+        angles: DVector::from_column_slice(angles),
+        rates: DVector::from_column_slice(rates),
+        kinetic_energy: model.kinetic_energy(rates, data),
+        elastic_energy: 0.5
+            * model
+                .joints
+                .iter()
+                .zip(angles)
+                .map(|(j, a)| j.stiffness * a * a)
+                .sum::<f64>(),
+        actuator_potential: -torques.iter().zip(angles).map(|(t, a)| t * a).sum::<f64>(),
+    }
+}
+
+/// The quasi-static path θ(t) = K⁻¹ τ(t) = θ_drive(t), scanned for contacts.
+fn quasi_static(
+    scene: &Scene,
+    output_times: &[f64],
+    contacts: Option<&ContactSet>,
+) -> (Vec<Sample>, Option<Collision>, usize) {
+    let model = &scene.model;
+    let n = model.dof();
+    let mut data = Data::new(model);
+    let t_last = *output_times.last().unwrap_or(&0.0);
+    let moving_until = match scene.actuation {
+        // A step jumps at t = 0: scan the straight path to the target as if at t = 0⁺.
+        Actuation::Step => 0.0,
+        Actuation::Ramp { .. } => scene.forcing_time().min(t_last),
+    };
+    let largest = scene.target_angles.amax();
+    let subdivisions = ((largest / QUASI_STATIC_ANGLE_STEP).ceil() as usize).max(1);
+    let mut collision = None;
+    if let Some(contacts) = contacts {
+        let mut angles = vec![0.0; n];
+        model.update_kinematics(&angles, &mut data);
+        collision = contacts.touching(0.0, &data);
+        if collision.is_none() {
+            let mut gaps = vec![0.0; contacts.len()];
+            let mut scratch = vec![0.0; contacts.len()];
+            contacts.gaps(&data, &mut gaps);
+            let mut path = |t: f64, out: &mut [f64]| match scene.actuation {
+                Actuation::Step => {
+                    for (o, target) in out.iter_mut().zip(scene.target_angles.iter()) {
+                        *o = t * target;
+                    }
+                }
+                Actuation::Ramp { .. } => scene.drive_angles(t * moving_until, out),
+            };
+            // Scan the path over its parameter u ∈ [0, 1].
+            collision = contacts
+                .locate(
+                    model,
+                    &mut data,
+                    0.0,
+                    1.0,
+                    subdivisions,
+                    &mut gaps,
+                    &mut scratch,
+                    &mut angles,
+                    &mut path,
+                )
+                .map(|mut c| {
+                    c.time *= moving_until;
+                    c
+                });
+        }
+    }
+    let stop = collision.as_ref().map_or(f64::INFINITY, |c| c.time);
+    let mut samples = Vec::new();
+    let mut angles = vec![0.0; n];
+    let mut rates = vec![0.0; n];
+    let mut record = |t: f64, samples: &mut Vec<Sample>| {
+        scene.drive_angles(t, &mut angles);
+        // dθ/dt of the ramp: a/ρ_c while releasing, 0 after.
+        let h = 1e-6 * scene.forcing_time().max(1e-300);
+        let mut later = vec![0.0; n];
+        scene.drive_angles(t + h, &mut later);
+        for i in 0..n {
+            rates[i] = if matches!(scene.actuation, Actuation::Step) {
+                0.0
+            } else {
+                (later[i] - angles[i]) / h
+            };
+        }
+        samples.push(sample(scene, &mut data, t, &angles, &rates));
+    };
+    for &t in output_times.iter().filter(|&&t| t < stop) {
+        record(t, &mut samples);
+    }
+    if stop.is_finite() {
+        record(stop, &mut samples);
+    }
+    (samples, collision, subdivisions)
+}
+
+/// Result of one diffsol run.
+struct DynamicRun {
+    samples: Vec<Sample>,
+    collision: Option<Collision>,
+    steps: usize,
+    rhs_evaluations: usize,
+}
+
+/// Integrates M θ̈ + C θ̇ + K θ = τ(t) + Q_drag from rest at θ = 0.
+fn integrate(
+    scene: &Scene,
+    method: Method,
+    rtol: f64,
+    output_times: &[f64],
+    contacts: Option<&ContactSet>,
+    progress: bool,
+) -> Result<DynamicRun> {
+    let model = &scene.model;
+    let n = model.dof();
+    let flat = modes(model, &vec![0.0; n])?;
+    let slowest_omega = flat.eigenvalues.last().copied().unwrap_or(1.0).sqrt();
+    let time_unit = 1.0 / slowest_omega;
+    let evaluations = Cell::new(0usize);
+    let failure: RefCell<Option<NanofoldError>> = RefCell::new(None);
+    let workspace = RefCell::new((Data::new(model), vec![0.0; n], vec![0.0; n], DVector::zeros(n)));
+    let rhs = |y: &[f64], s: f64, dy: &mut [f64]| {
+        evaluations.set(evaluations.get() + 1);
+        let mut guard = workspace.borrow_mut();
+        let (data, rates, torques, accel) = &mut *guard;
+        let (angles, scaled_rates) = y.split_at(n);
+        for (r, v) in rates.iter_mut().zip(scaled_rates) {
+            *r = v / time_unit;
+        }
+        scene.torques(s * time_unit, torques);
+        if let Err(e) = model.accelerations(angles, rates, torques, data, accel) {
+            failure.borrow_mut().get_or_insert(e);
+            dy.iter_mut().for_each(|d| *d = f64::NAN);
+            return;
+        }
+        dy[..n].copy_from_slice(scaled_rates);
+        for (d, a) in dy[n..].iter_mut().zip(accel.iter()) {
+            *d = a * time_unit * time_unit;
+        }
+    };
+    // Jacobian-vector products by central differences (diffsol assembles J from them).
+    let shifted = RefCell::new((vec![0.0; 2 * n], vec![0.0; 2 * n], vec![0.0; 2 * n]));
+    let jacobian_times = |y: &[f64], s: f64, v: &[f64], jv: &mut [f64]| {
+        let mut guard = shifted.borrow_mut();
+        let (y_shift, f_plus, f_minus) = &mut *guard;
+        let v_norm = v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        if v_norm == 0.0 {
+            jv.iter_mut().for_each(|x| *x = 0.0);
+            return;
+        }
+        let y_norm = y.iter().fold(1.0_f64, |a, b| a.max(b.abs()));
+        let h = f64::EPSILON.cbrt() * y_norm / v_norm;
+        for sign in [1.0, -1.0] {
+            for ((ys, yi), vi) in y_shift.iter_mut().zip(y).zip(v) {
+                *ys = yi + sign * h * vi;
+            }
+            rhs(y_shift, s, if sign > 0.0 { f_plus } else { f_minus });
+        }
+        for ((j, p), m) in jv.iter_mut().zip(f_plus.iter()).zip(f_minus.iter()) {
+            *j = (p - m) / (2.0 * h);
+        }
+    };
+    let problem = OdeBuilder::<NalgebraMat<f64>>::new()
+        .rtol(rtol)
+        .atol(vec![rtol; 2 * n])
+        .rhs_implicit(
+            |y: &[f64], _p: &[f64], s: f64, dy: &mut [f64]| rhs(y, s, dy),
+            |y: &[f64], _p: &[f64], s: f64, v: &[f64], jv: &mut [f64]| jacobian_times(y, s, v, jv),
+        )
+        .init(
+            |_p: &[f64], _t: f64, y: &mut [f64]| y.iter_mut().for_each(|x| *x = 0.0),
+            2 * n,
+        )
+        .build()
+        .map_err(|e| ode_error(&e))?;
+    let s_end = output_times.last().copied().unwrap_or(0.0) / time_unit;
+    let bar = if progress {
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% t = {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let driver = Driver {
+        scene,
+        contacts,
+        output_times,
+        time_unit,
+        s_end,
+        bar: &bar,
+    };
+    let result = match method {
+        Method::Bdf | Method::Auto => driver.run(problem.bdf::<NalgebraLU<f64>>().map_err(|e| ode_error(&e))?),
+        Method::Esdirk34 => driver.run(problem.esdirk34::<NalgebraLU<f64>>().map_err(|e| ode_error(&e))?),
+        Method::TrBdf2 => driver.run(problem.tr_bdf2::<NalgebraLU<f64>>().map_err(|e| ode_error(&e))?),
+        Method::Tsit45 => driver.run(problem.tsit45().map_err(|e| ode_error(&e))?),
+    };
+    bar.finish_and_clear();
+    if let Some(e) = failure.borrow_mut().take() {
+        return Err(e);
+    }
+    let (samples, collision, steps) = result?;
+    Ok(DynamicRun {
+        samples,
+        collision,
+        steps,
+        rhs_evaluations: evaluations.get(),
+    })
+}
+
+fn ode_error(e: &diffsol::error::DiffsolError) -> NanofoldError {
+    NanofoldError::Numerical {
+        stage: "ODE integration (diffsol)".into(),
+        message: e.to_string(),
+    }
+}
+
+/// Steps a diffsol solver to the end or the first contact, sampling the dense output.
+struct Driver<'r> {
+    scene: &'r Scene,
+    contacts: Option<&'r ContactSet>,
+    output_times: &'r [f64],
+    time_unit: f64,
+    s_end: f64,
+    bar: &'r ProgressBar,
+}
+
+impl Driver<'_> {
+    fn run<'a, Eqn, S>(&self, mut solver: S) -> Result<(Vec<Sample>, Option<Collision>, usize)>
+    where
+        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        let model = &self.scene.model;
+        let n = model.dof();
+        let mut data = Data::new(model);
+        let mut samples = Vec::with_capacity(self.output_times.len());
+        let mut state = solver.state().y.clone();
+        let mut angles = vec![0.0; n];
+        let mut rates = vec![0.0; n];
+        let split = |y: &NalgebraVec<f64>, angles: &mut [f64], rates: &mut [f64]| {
+            for i in 0..n {
+                angles[i] = y[i];
+                rates[i] = y[n + i] / self.time_unit;
+            }
+        };
+        split(&state, &mut angles, &mut rates);
+        samples.push(sample(self.scene, &mut data, 0.0, &angles, &rates));
+        let mut next_output = 1;
+        let mut gaps = Vec::new();
+        let mut gaps_scratch = Vec::new();
+        if let Some(contacts) = self.contacts {
+            model.update_kinematics(&angles, &mut data);
+            if let Some(c) = contacts.touching(0.0, &data) {
+                return Ok((samples, Some(c), 0));
+            }
+            gaps = vec![0.0; contacts.len()];
+            gaps_scratch = vec![0.0; contacts.len()];
+            contacts.gaps(&data, &mut gaps);
+        }
+        solver.set_stop_time(self.s_end).map_err(|e| ode_error(&e))?;
+        let mut steps = 0;
+        let mut s_previous = 0.0;
+        loop {
+            let reason = solver.step().map_err(|e| ode_error(&e))?;
+            steps += 1;
+            let s_now = solver.state().t;
+            let mut collision = None;
+            if let Some(contacts) = self.contacts {
+                let mut path = |t: f64, out: &mut [f64]| {
+                    if solver.interpolate_inplace(t, &mut state).is_ok() {
+                        for (i, o) in out.iter_mut().enumerate() {
+                            *o = state[i];
+                        }
+                    }
+                };
+                collision = contacts
+                    .locate(
+                        model,
+                        &mut data,
+                        s_previous,
+                        s_now,
+                        CONTACT_SUBDIVISIONS,
+                        &mut gaps,
+                        &mut gaps_scratch,
+                        &mut angles,
+                        &mut path,
+                    )
+                    .map(|mut c| {
+                        c.time *= self.time_unit;
+                        c
+                    });
+            }
+            let s_stop = collision.as_ref().map_or(s_now, |c| c.time / self.time_unit);
+            while next_output < self.output_times.len() && self.output_times[next_output] / self.time_unit <= s_stop {
+                let s = (self.output_times[next_output] / self.time_unit).min(s_now);
+                solver.interpolate_inplace(s, &mut state).map_err(|e| ode_error(&e))?;
+                split(&state, &mut angles, &mut rates);
+                samples.push(sample(
+                    self.scene,
+                    &mut data,
+                    self.output_times[next_output],
+                    &angles,
+                    &rates,
+                ));
+                next_output += 1;
+            }
+            if let Some(c) = collision {
+                solver
+                    .interpolate_inplace(c.time / self.time_unit, &mut state)
+                    .map_err(|e| ode_error(&e))?;
+                split(&state, &mut angles, &mut rates);
+                samples.push(sample(self.scene, &mut data, c.time, &angles, &rates));
+                return Ok((samples, Some(c), steps));
+            }
+            self.bar.set_position((1000.0 * s_now / self.s_end) as u64);
+            self.bar.set_message(format!("{:.3e} s", s_now * self.time_unit));
+            if matches!(reason, OdeSolverStopReason::TstopReached) || s_now >= self.s_end {
+                break;
+            }
+            s_previous = s_now;
+        }
+        Ok((samples, None, steps))
+    }
+}
