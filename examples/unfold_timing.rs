@@ -46,7 +46,9 @@ fn main() {
     let mut patterns: Vec<Pattern> = std::fs::read_dir("patterns")
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "fold" || x == "json"))
+        .filter(|p| {
+            p.extension().is_some_and(|x| x == "fold" || x == "json") && !p.to_string_lossy().ends_with(".scene.json")
+        })
         .map(|p| Pattern::load(&p, &LoadOptions::default()).unwrap())
         .collect();
     patterns.sort_by(|a, b| a.name.cmp(&b.name));

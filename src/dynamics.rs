@@ -10,7 +10,7 @@ pub mod modes;
 pub mod simulate;
 
 use crate::error::{NanofoldError, Result};
-use nalgebra::{Cholesky, DMatrix, DVector, Isometry3, Matrix3, Point3, Rotation3, Translation3, Unit, Vector3};
+use nalgebra::{Cholesky, DMatrix, DVector, Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 
 /// A revolute hinge in the flat reference configuration: the twist ξ = (−ω × q, ω) (T4.2).
 #[derive(Debug, Clone)]
@@ -120,9 +120,9 @@ impl Data {
 
 /// Rotation about `axis` through `point` by `angle`: the exponential e^{ξ̂θ} of a revolute twist.
 fn joint_exponential(axis: &Unit<Vector3<f64>>, point: &Point3<f64>, angle: f64) -> Isometry3<f64> {
-    let rotation = Rotation3::from_axis_angle(axis, angle);
+    let rotation = UnitQuaternion::from_axis_angle(axis, angle);
     let translation = point.coords - rotation * point.coords;
-    Isometry3::from_parts(Translation3::from(translation), rotation.into())
+    Isometry3::from_parts(Translation3::from(translation), rotation)
 }
 
 impl Model {
@@ -137,19 +137,23 @@ impl Model {
     }
 
     /// Forward kinematics by the product of exponentials (T4.1):
-    /// gᵢ(θ) = e^{ξ̂₁θ₁} ⋯ e^{ξ̂ᵢθᵢ} gᵢ(0); fills the joint axes and points, the plate poses
-    /// and the plate corners (all that contact detection needs).
+    /// gᵢ(θ) = e^{ξ̂₁θ₁} ⋯ e^{ξ̂ᵢθᵢ} gᵢ(0); fills the joint axes and points and the plate poses.
     pub fn update_poses(&self, fold_angles: &[f64], data: &mut Data) {
         let mut chain = Isometry3::identity();
         for (i, (joint, plate)) in self.joints.iter().zip(&self.plates).enumerate() {
             data.axes[i] = chain.rotation * joint.axis.into_inner();
             data.points[i] = (chain * joint.point).coords;
             chain *= joint_exponential(&joint.axis, &joint.point, fold_angles[i]);
-            let pose = chain * plate.reference_pose;
+            data.poses[i] = chain * plate.reference_pose;
+        }
+    }
+
+    /// The plates' corners in the world frame (contact detection); needs the poses.
+    pub fn update_corners(&self, data: &mut Data) {
+        for (i, plate) in self.plates.iter().enumerate() {
             for (c, corner) in plate.corners().iter().enumerate() {
-                data.corners[4 * i + c] = pose * corner;
+                data.corners[4 * i + c] = data.poses[i] * corner;
             }
-            data.poses[i] = pose;
         }
     }
 
@@ -387,6 +391,7 @@ impl Model {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Rotation3;
 
     /// Two plates with non-parallel hinges, so every term of ∂M is exercised.
     pub(crate) fn skew_chain() -> Model {

@@ -206,6 +206,7 @@ impl ContactSet {
             let t_right = t_start + (t_end - t_start) * s as f64 / subdivisions as f64;
             angles_at(t_right, angles);
             model.update_poses(angles, data);
+            model.update_corners(data);
             self.gaps(data, gaps_scratch);
             let mut earliest: Option<(f64, usize)> = None;
             for k in 0..self.len() {
@@ -217,11 +218,13 @@ impl ContactSet {
                 let mut gap_at = |t: f64| {
                     angles_at(t, angles);
                     model.update_poses(angles, data);
+                    model.update_corners(data);
                     self.gap(k, data)
                 };
                 let hi = illinois(&mut gap_at, (t_left, g0), (t_right, g1));
                 angles_at(hi, angles);
                 model.update_poses(angles, data);
+                model.update_corners(data);
                 if self.gate(k, model, data) && earliest.is_none_or(|(t, _)| hi < t) {
                     earliest = Some((hi, k));
                 }
@@ -229,6 +232,7 @@ impl ContactSet {
             if let Some((time, k)) = earliest {
                 angles_at(time, angles);
                 model.update_poses(angles, data);
+                model.update_corners(data);
                 return Some(self.collision(k, time, data));
             }
             gaps_start.copy_from_slice(gaps_scratch);

@@ -340,6 +340,7 @@ fn quasi_static(
     if let Some(contacts) = contacts {
         let mut angles = vec![0.0; n];
         model.update_kinematics(&angles, &mut data);
+        model.update_corners(&mut data);
         collision = contacts.touching(0.0, &data);
         if collision.is_none() {
             let mut gaps = vec![0.0; contacts.len()];
@@ -560,6 +561,7 @@ impl Driver<'_> {
         let mut gaps_scratch = Vec::new();
         if let Some(contacts) = self.contacts {
             model.update_kinematics(&angles, &mut data);
+            model.update_corners(&mut data);
             if let Some(c) = contacts.touching(0.0, &data) {
                 return Ok((samples, Some(c), 0));
             }
