@@ -1,4 +1,5 @@
-//! Command-line interface: argument definitions and the `unfold` / `check` commands.
+//! Command-line interface: argument definitions and the `unfold`, `check`, `constraints`,
+//! `simulate` and `modes` commands.
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
@@ -6,11 +7,15 @@ use nanofold::constraints::{
     default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
     Setup, Source,
 };
+use nanofold::dynamics::modes::modes;
+use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::energy::EnergyKind;
-use nanofold::output::{fold_animation, trajectory_json, write_atomic};
+use nanofold::output::{fold_animation, modes_json, response_json, response_summary, trajectory_json, write_atomic};
 use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::qp::QpMethod;
+use nanofold::scene::Scene;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldReport, UnfoldSettings};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -19,7 +24,7 @@ use std::path::{Path, PathBuf};
 #[command(
     name = "nanofold",
     version,
-    about = "Rigid origami: unfold single-vertex crease patterns to flat and extract their constraint curves"
+    about = "Rigid origami: unfold single-vertex crease patterns to flat, extract their constraint curves, simulate folding dynamics of plate chains"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -54,6 +59,61 @@ pub enum Command {
     /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
     /// (SPEC §6); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
     Constraints(ConstraintsArgs),
+    /// Response of a scene (a chain of plates) to its actuation: writes response.json,
+    /// response.svg and snapshots.svg (SPEC §7).
+    Simulate(SimulateArgs),
+    /// Natural frequencies, mode shapes and stability at the folded equilibrium of a scene.
+    Modes {
+        /// A scene file (.scene.json).
+        scene: PathBuf,
+        /// Print one JSON object on stdout instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Arguments of `nanofold simulate`.
+#[derive(Args)]
+pub struct SimulateArgs {
+    /// A scene file (.scene.json).
+    pub scene: PathBuf,
+    /// Equations to solve; `auto` compares the forcing time with the fastest natural period.
+    #[arg(long, value_enum, default_value_t = ModelArg::Auto)]
+    pub model: ModelArg,
+    /// Integrator (diffsol); `auto` is Tsit45 for short runs, ESDIRK34 for long (stiff) ones.
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    pub method: MethodArg,
+    /// Relative tolerance (the absolute tolerance is the same in rad).
+    #[arg(long, default_value_t = 1e-8, allow_negative_numbers = true)]
+    pub rtol: f64,
+    /// End time in seconds, overriding the scene's time.t_end_s.
+    #[arg(long, allow_negative_numbers = true)]
+    pub t_end: Option<f64>,
+    /// Integrate through contacts instead of stopping at the first one.
+    #[arg(long)]
+    pub ignore_collisions: bool,
+    /// Output folder (default: output/<scene name>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the summary as one JSON object on stdout (no progress bar).
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    Auto,
+    Dynamic,
+    QuasiStatic,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    Auto,
+    Bdf,
+    Esdirk34,
+    TrBdf2,
+    Tsit45,
 }
 
 /// Arguments of `nanofold constraints`. Crease indices are the file's: FOLD edge index for
@@ -428,6 +488,144 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_simulate(args: &SimulateArgs) -> Result<()> {
+    let scene = Scene::load(&args.scene)?;
+    let settings = SimulationSettings {
+        model: match args.model {
+            ModelArg::Auto => ModelChoice::Auto,
+            ModelArg::Dynamic => ModelChoice::Dynamic,
+            ModelArg::QuasiStatic => ModelChoice::QuasiStatic,
+        },
+        method: match args.method {
+            MethodArg::Auto => Method::Auto,
+            MethodArg::Bdf => Method::Bdf,
+            MethodArg::Esdirk34 => Method::Esdirk34,
+            MethodArg::TrBdf2 => Method::TrBdf2,
+            MethodArg::Tsit45 => Method::Tsit45,
+        },
+        rtol: args.rtol,
+        ignore_collisions: args.ignore_collisions,
+        t_end: args.t_end,
+        progress: !args.json,
+    };
+    let response = simulate(&scene, &settings)?;
+    // Render everything before writing anything.
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(&scene.name));
+    let files = [
+        (
+            "response.json",
+            serde_json::to_string(&response_json(&scene, &settings, &response))?,
+        ),
+        ("response.svg", response_svg(&scene, &response)?),
+        ("snapshots.svg", snapshots_svg(&scene, &response)?),
+    ];
+    for (name, contents) in &files {
+        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
+    }
+    if args.json {
+        println!("{}", response_summary(&scene, &settings, &response));
+        return Ok(());
+    }
+    let scales = &response.time_scales;
+    println!(
+        "{}: {} hinge(s), {} actuation",
+        scene.name,
+        scene.model.dof(),
+        scene.actuation_kind()
+    );
+    println!(
+        "  time scales: fastest natural period {:.3e} s, slowest {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
+        scales.fastest_period_s, scales.slowest_period_s, scales.forcing_time_s, scales.ratio
+    );
+    match response.model {
+        ModelKind::Dynamic => println!(
+            "  model: dynamic ({:?}, rtol {:.0e}): {} steps, {} right-hand sides, {:.3} s; the quasi-static path would be off by up to {:.2e} rad",
+            response.method.unwrap_or(Method::Auto),
+            response.rtol,
+            response.steps,
+            response.rhs_evaluations,
+            response.seconds,
+            response.quasi_static_error_estimate
+        ),
+        ModelKind::QuasiStatic => {
+            let (window, measured) = response.measured_quasi_static_error.unwrap_or((0.0, f64::NAN));
+            println!(
+                "  model: quasi-static (K θ = τ(t)), {:.3} s; its error: ≤ {:.2e} rad estimated, {:.2e} rad measured by a dynamic run over the first {:.2e} s",
+                response.seconds, response.quasi_static_error_estimate, measured, window
+            );
+        }
+    }
+    match &response.collision {
+        Some(c) => println!(
+            "  first contact at t = {:.6e} s: {} with {} at (x, y, z) = ({:.2}, {:.2}, {:.2}) µm",
+            c.time,
+            c.pair[0],
+            c.pair[1],
+            c.point.x * 1e6,
+            c.point.y * 1e6,
+            c.point.z * 1e6
+        ),
+        None => println!("  no contact up to t = {:.6e} s", response.t_end),
+    }
+    if let Some(last) = response.samples.last() {
+        let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
+        println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
+    }
+    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
+    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    Ok(())
+}
+
+fn run_modes(path: &Path, json: bool) -> Result<()> {
+    let scene = Scene::load(path)?;
+    let result = modes(&scene.model, scene.target_angles.as_slice())?;
+    if json {
+        println!("{}", modes_json(&scene, &result));
+        return Ok(());
+    }
+    let degrees: Vec<String> = result
+        .equilibrium
+        .iter()
+        .map(|a| format!("{:.3}°", a.to_degrees()))
+        .collect();
+    println!(
+        "{}: modes at the folded equilibrium θ* = ({})",
+        scene.name,
+        degrees.join(", ")
+    );
+    println!(
+        "  {:>4} {:>14} {:>14}  mode shape (unit max-norm)",
+        "mode", "λ (rad²/s²)", "f (Hz)"
+    );
+    for k in 0..result.eigenvalues.len() {
+        let shape: Vec<String> = result
+            .mode_shapes
+            .column(k)
+            .iter()
+            .map(|v| format!("{v:+.4}"))
+            .collect();
+        println!(
+            "  {:>4} {:>14.6e} {:>14.3} ({})",
+            k,
+            result.eigenvalues[k],
+            result.frequencies_hz[k],
+            shape.join(", ")
+        );
+    }
+    println!(
+        "  {}",
+        if result.stable {
+            "stable: K is positive definite, every eigenvalue > 0"
+        } else {
+            "NOT stable: some hinge stiffness or eigenvalue is not positive"
+        }
+    );
+    Ok(())
+}
+
 /// Runs the parsed command; Ok(false) means "finished, but exit non-zero".
 pub fn run(cli: Cli) -> Result<bool> {
     match cli.command {
@@ -439,5 +637,7 @@ pub fn run(cli: Cli) -> Result<bool> {
         } => run_unfold(&pattern, &solver, out, json).map(|_| true),
         Command::Check { patterns, solver, json } => run_check(&patterns, &solver, json),
         Command::Constraints(args) => run_constraints(&args).map(|_| true),
+        Command::Simulate(args) => run_simulate(&args).map(|_| true),
+        Command::Modes { scene, json } => run_modes(&scene, json).map(|_| true),
     }
 }

@@ -1,8 +1,11 @@
-//! Files a run writes: `trajectory.json` and the FOLD animation `unfold.fold`, each written
+//! Files a run writes: `trajectory.json`, the FOLD animation `unfold.fold`, `response.json`; each written
 //! to a temporary file and renamed, so nothing is left half-written.
 
+use crate::dynamics::modes::Modes;
+use crate::dynamics::simulate::{Response, Sample, SimulationSettings};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::{Chain, FoldMesh, Pattern, RayRole};
+use crate::scene::Scene;
 use crate::sphere::Vec3;
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
 use serde::Serialize;
@@ -279,5 +282,77 @@ pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &Un
         "recorded_steps": total,
         "steps_written": steps.len(),
         "steps": steps,
+    })
+}
+
+/// The summary of a dynamics run: the `--json` object, and the head of `response.json`.
+pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
+    let collision = response.collision.as_ref().map(|c| {
+        json!({
+            "time_s": c.time,
+            "pair": c.pair,
+            "point": [c.point.x, c.point.y, c.point.z],
+            "point_um": [c.point.x * 1e6, c.point.y * 1e6, c.point.z * 1e6],
+        })
+    });
+    let final_angles = response
+        .samples
+        .last()
+        .map(|s| s.angles.as_slice().to_vec())
+        .unwrap_or_default();
+    json!({
+        "scene": scene.name,
+        "model": response.model,
+        "method": response.method,
+        "rtol": response.rtol,
+        "time_scale_ratio": response.time_scales.ratio,
+        "time_scales": response.time_scales,
+        "quasi_static_error_estimate_rad": response.quasi_static_error_estimate,
+        "measured_quasi_static_error_rad": response.measured_quasi_static_error.map(|(_, e)| e),
+        "quasi_static_check_window_s": response.measured_quasi_static_error.map(|(w, _)| w),
+        "ignore_collisions": settings.ignore_collisions,
+        "t_end_s": response.t_end,
+        "collision": collision,
+        "final_angles_rad": final_angles,
+        "target_angles_rad": scene.target_angles.as_slice(),
+        "steps": response.steps,
+        "rhs_evaluations": response.rhs_evaluations,
+        "seconds": response.seconds,
+    })
+}
+
+/// `response.json`: the summary plus every output sample.
+pub fn response_json(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
+    let mut value = response_summary(scene, settings, response);
+    let samples = &response.samples;
+    let column = |f: &dyn Fn(&Sample) -> f64| samples.iter().map(f).collect::<Vec<f64>>();
+    value["units"] = json!({
+        "time": "s", "angles": "rad (valley positive)", "velocities": "rad/s", "energy": "J",
+        "point": "m (point_um: µm), world frame: creases along x, the chain along +y, z up",
+    });
+    value["time_s"] = json!(column(&|s| s.time));
+    value["angles_rad"] = json!(samples.iter().map(|s| s.angles.as_slice().to_vec()).collect::<Vec<_>>());
+    value["velocities_rad_s"] = json!(samples.iter().map(|s| s.rates.as_slice().to_vec()).collect::<Vec<_>>());
+    value["energy_j"] = json!({
+        "kinetic": column(&|s| s.kinetic_energy),
+        "elastic": column(&|s| s.elastic_energy),
+        "actuator_potential": column(&|s| s.actuator_potential),
+        "total": column(&|s| s.total_energy()),
+    });
+    value
+}
+
+/// `nanofold modes` output.
+pub fn modes_json(scene: &Scene, modes: &Modes) -> Value {
+    let n = modes.eigenvalues.len();
+    json!({
+        "scene": scene.name,
+        "equilibrium_rad": modes.equilibrium.as_slice(),
+        "equilibrium": "folded: K θ = K θ_target, so θ* = θ_target (passive hinges at 0)",
+        "eigenvalues": modes.eigenvalues,
+        "frequencies_hz": modes.frequencies_hz,
+        "mode_shapes": (0..n).map(|k| modes.mode_shapes.column(k).iter().copied().collect::<Vec<f64>>()).collect::<Vec<_>>(),
+        "stable": modes.stable,
+        "stiffness_n_m_per_rad": scene.model.stiffness().as_slice(),
     })
 }

@@ -1,6 +1,8 @@
 //! SVG figures drawn with plotters: the unfolding (fold angles against iteration and 3D
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
+pub mod response;
+
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
 use crate::output::{snapshot_indices, write_atomic};
@@ -9,7 +11,7 @@ use crate::unfold::UnfoldReport;
 use plotters::prelude::*;
 use std::path::Path;
 
-fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
+pub(crate) fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
     NanofoldError::Output {
         path: "SVG figure".into(),
         message: e.to_string(),

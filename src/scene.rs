@@ -393,6 +393,14 @@ impl Scene {
         }
     }
 
+    /// "step" or "ramp".
+    pub fn actuation_kind(&self) -> &'static str {
+        match self.actuation {
+            Actuation::Step => "step",
+            Actuation::Ramp { .. } => "ramp",
+        }
+    }
+
     /// The slowest forcing time scale, s: 0 for a step, the longest ramp time t_p = ρ_c θ / a.
     pub fn forcing_time(&self) -> f64 {
         match &self.actuation {

@@ -1,0 +1,343 @@
+//! Figures of a dynamics run: `response.svg` (fold angles and energies against time, like the
+//! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of the chain, figure 5-7).
+
+use super::{plot_error, series_colour};
+use crate::dynamics::simulate::{ModelKind, Response};
+use crate::dynamics::Data;
+use crate::error::Result;
+use crate::scene::Scene;
+use plotters::prelude::*;
+
+/// A time unit that keeps the axis numbers readable: (divisor, label).
+fn time_unit(t_end: f64) -> (f64, &'static str) {
+    if t_end < 1e-3 {
+        (1e-6, "µs")
+    } else if t_end < 1.0 {
+        (1e-3, "ms")
+    } else {
+        (1.0, "s")
+    }
+}
+
+fn model_label(response: &Response) -> String {
+    match response.model {
+        ModelKind::Dynamic => format!(
+            "dynamic, {}, rtol {:.0e}",
+            response
+                .method
+                .map_or("-".to_string(), |m| format!("{m:?}").to_lowercase()),
+            response.rtol
+        ),
+        ModelKind::QuasiStatic => format!("quasi-static (time-scale ratio {:.1e})", response.time_scales.ratio),
+    }
+}
+
+/// Renders `response.svg`: angles (deg) per hinge with dashed targets, and the energy terms.
+pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 760)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let (top, bottom) = root.split_vertically(470);
+        let (scale, unit) = time_unit(response.t_end.max(response.samples.last().map_or(0.0, |s| s.time)));
+        let t_max = response.samples.last().map_or(1.0, |s| s.time).max(f64::MIN_POSITIVE) / scale;
+        let mut lo: f64 = -10.0;
+        let mut hi: f64 = 10.0;
+        for s in &response.samples {
+            for a in s.angles.iter() {
+                lo = lo.min(a.to_degrees());
+                hi = hi.max(a.to_degrees());
+            }
+        }
+        for t in scene.target_angles.iter() {
+            lo = lo.min(t.to_degrees());
+            hi = hi.max(t.to_degrees());
+        }
+        let pad = 0.06 * (hi - lo);
+        let collision = response.collision.as_ref().map_or("no collision".to_string(), |c| {
+            format!("{} hits {} at t = {:.4} {unit}", c.pair[0], c.pair[1], c.time / scale)
+        });
+        let mut chart = ChartBuilder::on(&top)
+            .caption(
+                format!("{}: fold angles ({}; {collision})", scene.name, model_label(response)),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(0.0..t_max, (lo - pad)..(hi + pad))
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc(format!("time ({unit})"))
+            .y_desc("fold angle (deg)")
+            .draw()
+            .map_err(plot_error)?;
+        for i in 0..scene.model.dof() {
+            let colour = series_colour(i);
+            chart
+                .draw_series(LineSeries::new(
+                    response
+                        .samples
+                        .iter()
+                        .map(|s| (s.time / scale, s.angles[i].to_degrees())),
+                    colour.stroke_width(2),
+                ))
+                .map_err(plot_error)?
+                .label(format!(
+                    "hinge {i}{}",
+                    if scene.actuated[i] { "" } else { " (passive)" }
+                ))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+            let target = scene.target_angles[i].to_degrees();
+            let dashes = (0..40).map(|k| {
+                let a = t_max * k as f64 / 40.0;
+                PathElement::new(
+                    vec![(a, target), (a + 0.5 * t_max / 40.0, target)],
+                    colour.mix(0.6).stroke_width(1),
+                )
+            });
+            chart.draw_series(dashes).map_err(plot_error)?;
+        }
+        if let Some(c) = &response.collision {
+            let x = c.time / scale;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(x, lo - pad), (x, hi + pad)],
+                    RED.stroke_width(2),
+                )))
+                .map_err(plot_error)?
+                .label("first contact")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(plot_error)?;
+
+        // Energies in the unit that suits them.
+        let largest = response
+            .samples
+            .iter()
+            .flat_map(|s| {
+                [
+                    s.kinetic_energy.abs(),
+                    s.elastic_energy.abs(),
+                    s.actuator_potential.abs(),
+                ]
+            })
+            .fold(0.0_f64, f64::max);
+        let (e_scale, e_unit) = if largest < 1e-9 {
+            (1e-12, "pJ")
+        } else if largest < 1e-6 {
+            (1e-9, "nJ")
+        } else {
+            (1e-6, "µJ")
+        };
+        let series: [(&str, Box<dyn Fn(&crate::dynamics::simulate::Sample) -> f64>); 4] = [
+            ("kinetic ½θ̇ᵀMθ̇", Box::new(|s| s.kinetic_energy)),
+            ("elastic ½θᵀKθ", Box::new(|s| s.elastic_energy)),
+            ("actuator −τ·θ", Box::new(|s| s.actuator_potential)),
+            ("total", Box::new(|s| s.total_energy())),
+        ];
+        let (mut e_lo, mut e_hi) = (0.0_f64, 0.0_f64);
+        for s in &response.samples {
+            for (_, f) in &series {
+                e_lo = e_lo.min(f(s) / e_scale);
+                e_hi = e_hi.max(f(s) / e_scale);
+            }
+        }
+        let e_pad = 0.06 * (e_hi - e_lo).max(1e-30);
+        let mut energy = ChartBuilder::on(&bottom)
+            .caption(
+                format!(
+                    "energy (drag {})",
+                    if scene.model.drag.is_some() { "on" } else { "off" }
+                ),
+                ("sans-serif", 16),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(0.0..t_max, (e_lo - e_pad)..(e_hi + e_pad))
+            .map_err(plot_error)?;
+        energy
+            .configure_mesh()
+            .x_desc(format!("time ({unit})"))
+            .y_desc(format!("energy ({e_unit})"))
+            .draw()
+            .map_err(plot_error)?;
+        for (k, (label, f)) in series.iter().enumerate() {
+            let colour = if k == 3 { BLACK } else { series_colour(k + 5) };
+            energy
+                .draw_series(LineSeries::new(
+                    response.samples.iter().map(|s| (s.time / scale, f(s) / e_scale)),
+                    colour.stroke_width(2),
+                ))
+                .map_err(plot_error)?
+                .label(*label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+        }
+        energy
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
+
+/// Indices of `count` samples spread evenly in time, the last sample included.
+pub fn snapshot_samples(response: &Response, count: usize) -> Vec<usize> {
+    let n = response.samples.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let count = count.clamp(1, n);
+    let t_last = response.samples[n - 1].time;
+    let mut picks: Vec<usize> = (0..count)
+        .map(|k| {
+            let t = if count == 1 {
+                t_last
+            } else {
+                t_last * k as f64 / (count - 1) as f64
+            };
+            response
+                .samples
+                .iter()
+                .position(|s| s.time >= t - 1e-12 * t_last.abs())
+                .unwrap_or(n - 1)
+        })
+        .collect();
+    picks.dedup();
+    picks
+}
+
+/// Renders `snapshots.svg`: the chain seen along the creases (the y–z plane) at several
+/// times, the substrate solid where it remains and dashed where it is etched away.
+pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
+    let model = &scene.model;
+    let mut data = Data::new(model);
+    let picks = snapshot_samples(response, scene.outputs.snapshots);
+    let (scale, unit) = time_unit(response.t_end);
+    // Centre lines of the plates in µm, per snapshot.
+    let mut outlines: Vec<(f64, Vec<(f64, f64)>)> = Vec::new();
+    for &k in &picks {
+        let sample = &response.samples[k];
+        model.update_poses(sample.angles.as_slice(), &mut data);
+        model.update_corners(&mut data);
+        let mut points = Vec::new();
+        for i in 0..model.dof() {
+            let c = &data.corners[4 * i..4 * i + 4];
+            let start = (c[0] + c[1].coords) / 2.0;
+            let end = (c[2] + c[3].coords) / 2.0;
+            if i == 0 {
+                points.push((start.y * 1e6, start.z * 1e6));
+            }
+            points.push((end.y * 1e6, end.z * 1e6));
+        }
+        outlines.push((sample.time, points));
+    }
+    let (mut y_lo, mut y_hi, mut z_lo, mut z_hi) = (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64, 0.0_f64);
+    for (_, points) in &outlines {
+        for &(y, z) in points {
+            y_lo = y_lo.min(y);
+            y_hi = y_hi.max(y);
+            z_lo = z_lo.min(z);
+            z_hi = z_hi.max(z);
+        }
+    }
+    let edge = scene.substrate_edge_y * 1e6;
+    y_lo = y_lo.min(edge - 50.0);
+    let (width, height) = (1000u32, 620u32);
+    // Equal scales on both axes: widen whichever range is short.
+    let plot_w = (width - 90) as f64;
+    let plot_h = (height - 110) as f64;
+    let pad = 0.08 * (y_hi - y_lo).max(z_hi - z_lo);
+    let (mut y0, mut y1, mut z0, mut z1) = (y_lo - pad, y_hi + pad, z_lo - pad, z_hi + pad);
+    let per_px = ((y1 - y0) / plot_w).max((z1 - z0) / plot_h);
+    let (ym, zm) = (0.5 * (y0 + y1), 0.5 * (z0 + z1));
+    y0 = ym - 0.5 * per_px * plot_w;
+    y1 = ym + 0.5 * per_px * plot_w;
+    z0 = zm - 0.5 * per_px * plot_h;
+    z1 = zm + 0.5 * per_px * plot_h;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "{}: side view along the creases ({})",
+                    scene.name,
+                    model_label(response)
+                ),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(y0..y1, z0..z1)
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("y (µm)")
+            .y_desc("z (µm)")
+            .draw()
+            .map_err(plot_error)?;
+        let grey = RGBColor(90, 90, 90);
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(y0, 0.0), (edge, 0.0)],
+                grey.stroke_width(4),
+            )))
+            .map_err(plot_error)?
+            .label("substrate")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(4)));
+        let dashes = (0..60).map(|k| {
+            let a = edge + (y1 - edge) * k as f64 / 60.0;
+            PathElement::new(
+                vec![(a, 0.0), (a + 0.5 * (y1 - edge) / 60.0, 0.0)],
+                grey.stroke_width(1),
+            )
+        });
+        chart.draw_series(dashes).map_err(plot_error)?;
+        for (k, (time, points)) in outlines.iter().enumerate() {
+            let colour = series_colour(k);
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    points.clone(),
+                    colour.stroke_width(3),
+                )))
+                .map_err(plot_error)?
+                .label(format!("t = {:.4} {unit}", time / scale))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(3)));
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .map_err(plot_error)?;
+        }
+        if let Some(c) = &response.collision {
+            let p = (c.point.y * 1e6, c.point.z * 1e6);
+            chart
+                .draw_series(std::iter::once(Cross::new(p, 9, RED.stroke_width(3))))
+                .map_err(plot_error)?
+                .label(format!("contact: {} / {}", c.pair[0], c.pair[1]))
+                .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
