@@ -286,13 +286,13 @@ impl Model {
             let velocity = self.plate_velocity(i, fold_rates, data);
             let mut linear_bias = Vector3::zeros();
             let mut angular_bias = Vector3::zeros();
-            for j in 0..=i {
+            for (j, rate) in fold_rates.iter().enumerate().take(i + 1) {
                 let axis_rate = data.scratch_angular[j];
                 // ȧ_ij = ω̇'_j × (p_i − q'_j) + ω'_j × (v_i − q̇'_j).
                 let a_dot =
                     axis_rate.cross(&(com - data.points[j])) + data.axes[j].cross(&(velocity - data.scratch_linear[j]));
-                linear_bias += a_dot * fold_rates[j];
-                angular_bias += axis_rate * fold_rates[j];
+                linear_bias += a_dot * *rate;
+                angular_bias += axis_rate * *rate;
             }
             let inertia = &data.inertia_world[i];
             let force = plate.mass * linear_bias;
@@ -519,8 +519,8 @@ mod tests {
         }
         // Ṁ − 2C is skew-symmetric (passivity).
         let mut m_dot_exact = DMatrix::zeros(3, 3);
-        for k in 0..3 {
-            m_dot_exact += &data.mass_matrix_derivative[k] * rates[k];
+        for (derivative, rate) in data.mass_matrix_derivative.iter().zip(rates) {
+            m_dot_exact += derivative * rate;
         }
         let n_matrix = &m_dot_exact - 2.0 * &data.coriolis;
         let skew_error = (&n_matrix + n_matrix.transpose()).amax();

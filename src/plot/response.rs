@@ -2,11 +2,14 @@
 //! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of the chain, figure 5-7).
 
 use super::{plot_error, series_colour};
-use crate::dynamics::simulate::{ModelKind, Response};
+use crate::dynamics::simulate::{ModelKind, Response, Sample};
 use crate::dynamics::Data;
 use crate::error::Result;
 use crate::scene::Scene;
 use plotters::prelude::*;
+
+/// One energy term of a sample, J.
+type EnergyTerm = Box<dyn Fn(&Sample) -> f64>;
 
 /// A time unit that keeps the axis numbers readable: (divisor, label).
 fn time_unit(t_end: f64) -> (f64, &'static str) {
@@ -137,7 +140,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
         } else {
             (1e-6, "µJ")
         };
-        let series: [(&str, Box<dyn Fn(&crate::dynamics::simulate::Sample) -> f64>); 4] = [
+        let series: [(&str, EnergyTerm); 4] = [
             ("kinetic ½θ̇ᵀMθ̇", Box::new(|s| s.kinetic_energy)),
             ("elastic ½θᵀKθ", Box::new(|s| s.elastic_energy)),
             ("actuator −τ·θ", Box::new(|s| s.actuator_potential)),

@@ -1,0 +1,417 @@
+//! Open-chain dynamics (SPEC §7) against independent answers: closed forms for one hinged
+//! plate, kinetic energy from the plates' own motion, energy balance, the quasi-static limit,
+//! contact times from plane geometry.
+
+use nalgebra::{DVector, Vector3};
+use nanofold::dynamics::modes::modes;
+use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::Data;
+use nanofold::scene::Scene;
+use nanofold::NanofoldError;
+use proptest::prelude::*;
+use std::f64::consts::PI;
+
+/// One plate per entry of `lengths_um`, 100 µm wide, SiN 0.2 µm; hinge i gets
+/// `targets_deg[i]` (None: passive, SiN only; Some: SiN + Cr 0.1 µm).
+fn strip(lengths_um: &[f64], targets_deg: &[Option<f64>], actuation: &str, drag: bool, t_end: f64) -> Scene {
+    let plates: Vec<String> = lengths_um
+        .iter()
+        .map(|l| format!(r#"{{"length_um": {l}, "width_um": 100, "thickness_um": 0.2, "material": "SiN"}}"#))
+        .collect();
+    let hinges: Vec<String> = targets_deg
+        .iter()
+        .map(|t| match t {
+            Some(deg) => format!(
+                r#"{{"hinge_length_um": 32, "actuated": true, "target_angle_deg": {deg}, "radius_of_curvature_um": 20,
+                    "layers": [{{"material": "SiN", "thickness_um": 0.2}}, {{"material": "Cr", "thickness_um": 0.1}}]}}"#
+            ),
+            None => r#"{"hinge_length_um": 32, "actuated": false, "layers": [{"material": "SiN", "thickness_um": 0.2}]}"#
+                .to_string(),
+        })
+        .collect();
+    let json = format!(
+        r#"{{
+        "materials": {{
+            "SiN": {{"youngs_modulus_gpa": 300, "poisson_ratio": 0.28, "density_g_cm3": 3.27}},
+            "Cr": {{"youngs_modulus_gpa": 140, "poisson_ratio": 0.21, "density_g_cm3": 7.19}}
+        }},
+        "plates": [{}],
+        "hinges": [{}],
+        "actuation": {actuation},
+        "environment": {{"drag": {drag}}},
+        "time": {{"t_end_s": {t_end}}},
+        "outputs": {{"samples": 401}}
+    }}"#,
+        plates.join(","),
+        hinges.join(",")
+    );
+    Scene::from_json(&json, "test scene", "test").unwrap()
+}
+
+const STEP: &str = r#"{"kind": "step"}"#;
+
+/// Bilayer stiffness (T5.7) by hand: w t³ E / (3 l (1 − ν²)) per layer.
+fn bilayer_stiffness() -> f64 {
+    let (w, l) = (100e-6, 32e-6);
+    let sin = w * 0.2e-6_f64.powi(3) * 300e9 / (3.0 * l * (1.0 - 0.28 * 0.28));
+    let cr = w * 0.1e-6_f64.powi(3) * 140e9 / (3.0 * l * (1.0 - 0.21 * 0.21));
+    sin + cr
+}
+
+/// Moment of inertia of a 0.2 µm SiN plate of length L about its hinge: m(L² + t²)/12 + m(L/2)².
+fn hinge_inertia(length: f64) -> f64 {
+    let mass = 3270.0 * length * 100e-6 * 0.2e-6;
+    mass * (length * length + 0.2e-6 * 0.2e-6) / 12.0 + mass * (length / 2.0).powi(2)
+}
+
+#[test]
+fn one_hinged_plate_rings_at_the_closed_form_frequency() {
+    let scene = strip(&[100.0], &[Some(90.0)], STEP, false, 1e-3);
+    let k = bilayer_stiffness();
+    assert!((scene.model.joints[0].stiffness - k).abs() < 1e-12 * k);
+    let omega = (k / hinge_inertia(100e-6)).sqrt();
+    let m = modes(&scene.model, &[PI / 2.0]).unwrap();
+    let expected_hz = omega / (2.0 * PI);
+    assert!(
+        (m.frequencies_hz[0] - expected_hz).abs() < 1e-10 * expected_hz,
+        "{} vs {expected_hz}",
+        m.frequencies_hz[0]
+    );
+    assert!(m.stable);
+    assert!((m.eigenvalues[0] - omega * omega).abs() < 1e-10 * omega * omega);
+
+    // The integrated step response is θ(t) = θ_t (1 − cos ωt): check it at several times.
+    let period = 2.0 * PI / omega;
+    let settings = SimulationSettings {
+        rtol: 1e-10,
+        method: Method::Tsit45,
+        ignore_collisions: true,
+        t_end: Some(3.0 * period),
+        ..Default::default()
+    };
+    let response = simulate(&scene, &settings).unwrap();
+    assert_eq!(response.model, ModelKind::Dynamic);
+    let worst = response
+        .samples
+        .iter()
+        .map(|s| (s.angles[0] - PI / 2.0 * (1.0 - (omega * s.time).cos())).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-7, "max deviation from θ_t(1 − cos ωt): {worst:.2e} rad");
+}
+
+#[test]
+fn contact_time_of_a_swinging_plate_matches_plane_geometry() {
+    // Without drag θ(t) = θ_t (1 − cos ωt); the free edge meets the substrate (y = −L, z = 0)
+    // at θ = π, i.e. cos ωt = 1 − π/θ_t.
+    let target = 100.0_f64.to_radians();
+    let scene = strip(&[100.0], &[Some(100.0)], STEP, false, 1e-3);
+    let omega = (bilayer_stiffness() / hinge_inertia(100e-6)).sqrt();
+    let expected = (1.0 - PI / target).acos() / omega;
+    let settings = SimulationSettings {
+        rtol: 1e-11,
+        method: Method::Tsit45,
+        ..Default::default()
+    };
+    let response = simulate(&scene, &settings).unwrap();
+    let collision = response.collision.expect("the plate swings past 180°");
+    assert_eq!(collision.pair, ["plate 0".to_string(), "substrate".to_string()]);
+    assert!(
+        (collision.time - expected).abs() < 1e-7 * expected,
+        "{} vs {expected}",
+        collision.time
+    );
+    assert!((collision.point.y + 100e-6).abs() < 1e-9, "{:?}", collision.point);
+    assert!(collision.point.z.abs() < 1e-9);
+    assert_eq!(response.t_end, collision.time);
+}
+
+#[test]
+fn quasi_static_path_finds_a_plate_on_plate_contact_where_geometry_puts_it() {
+    // Plate 0 stays flat (passive); hinges 1 and 2 fold together, a = u·120°. The tip of
+    // plate 2 reaches plate 0's plane where 20 sin a + 60 sin 2a = 0: cos a = −1/6, at y = 40 µm.
+    let ramp = r#"{"kind": "ramp", "etch_rate_um_per_min": 1.5}"#;
+    let scene = strip(
+        &[100.0, 20.0, 60.0],
+        &[None, Some(120.0), Some(120.0)],
+        ramp,
+        false,
+        1e4,
+    );
+    let settings = SimulationSettings {
+        model: ModelChoice::QuasiStatic,
+        ..Default::default()
+    };
+    let response = simulate(&scene, &settings).unwrap();
+    let collision = response.collision.expect("plate 2 folds onto plate 0");
+    assert_eq!(collision.pair, ["plate 2".to_string(), "plate 0".to_string()]);
+    let a = (-1.0_f64 / 6.0).acos();
+    // θ_ramp(t) = a_etch t / ρ_c.
+    let expected_time = a * 20e-6 / (1.5e-6 / 60.0);
+    assert!(
+        (collision.time - expected_time).abs() < 1e-9 * expected_time,
+        "{} vs {expected_time}",
+        collision.time
+    );
+    assert!((collision.point.y - 40e-6).abs() < 1e-11, "{:?}", collision.point);
+}
+
+/// Kinetic energy straight from the plates: centre-of-mass velocity and angular velocity by
+/// central differences of the poses along θ + s θ̇.
+fn kinetic_energy_from_plates(scene: &Scene, angles: &[f64], rates: &[f64]) -> f64 {
+    let model = &scene.model;
+    // A step of 1e-6 rad along θ̇.
+    let h = 1e-6 / rates.iter().fold(0.0_f64, |a, r| a.max(r.abs()));
+    let shifted = |sign: f64| {
+        let mut data = Data::new(model);
+        let a: Vec<f64> = angles.iter().zip(rates).map(|(a, r)| a + sign * h * r).collect();
+        model.update_poses(&a, &mut data);
+        data.poses.clone()
+    };
+    let (plus, minus) = (shifted(1.0), shifted(-1.0));
+    let mut energy = 0.0;
+    for (i, plate) in model.plates.iter().enumerate() {
+        let v = (plus[i].translation.vector - minus[i].translation.vector) / (2.0 * h);
+        let relative = plus[i].rotation * minus[i].rotation.inverse();
+        let omega: Vector3<f64> = relative.scaled_axis() / (2.0 * h);
+        let rotation = plus[i].rotation.slerp(&minus[i].rotation, 0.5).to_rotation_matrix();
+        let inertia = rotation.matrix()
+            * nalgebra::Matrix3::from_diagonal(&plate.principal_inertia)
+            * rotation.matrix().transpose();
+        energy += 0.5 * plate.mass * v.norm_squared() + 0.5 * omega.dot(&(inertia * omega));
+    }
+    energy
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn mass_matrix_is_spd_and_gives_the_plates_kinetic_energy(
+        angles in proptest::collection::vec(-3.0..3.0f64, 4),
+        rates in proptest::collection::vec(-1.0e4..1.0e4f64, 4),
+    ) {
+        let scene = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
+        let model = &scene.model;
+        let mut data = Data::new(model);
+        model.update_kinematics(&angles, &mut data);
+        model.update_mass_matrix(&mut data);
+        let m = &data.mass_matrix;
+        prop_assert!((m - m.transpose()).amax() <= 1e-15 * m.amax());
+        let eigen = m.clone().symmetric_eigenvalues();
+        prop_assert!(eigen.min() > 0.0, "eigenvalues {}", eigen);
+        let quadratic = model.kinetic_energy(&rates, &data);
+        let direct = kinetic_energy_from_plates(&scene, &angles, &rates);
+        prop_assert!((quadratic - direct).abs() <= 1e-8 * direct.abs().max(1e-30), "½θ̇ᵀMθ̇ {} vs plates {}", quadratic, direct);
+    }
+}
+
+#[test]
+fn without_drag_the_step_conserves_energy_and_with_drag_it_only_loses_it() {
+    let slowest_period = 2.0 * PI / (bilayer_stiffness() / hinge_inertia(300e-6)).sqrt();
+    for drag in [false, true] {
+        let scene = strip(
+            &[300.0, 150.0, 100.0],
+            &[Some(60.0), Some(-45.0), Some(90.0)],
+            STEP,
+            drag,
+            1.0,
+        );
+        let settings = SimulationSettings {
+            rtol: 1e-10,
+            method: Method::Tsit45,
+            ignore_collisions: true,
+            t_end: Some(20.0 * slowest_period),
+            ..Default::default()
+        };
+        let response = simulate(&scene, &settings).unwrap();
+        let energies: Vec<f64> = response.samples.iter().map(|s| s.total_energy()).collect();
+        let scale = response.samples.iter().map(|s| s.elastic_energy).fold(0.0, f64::max);
+        if drag {
+            let rises = energies
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(f64::NEG_INFINITY, f64::max);
+            assert!(
+                rises <= 1e-9 * scale,
+                "energy rose by {rises:.2e} J with drag (scale {scale:.2e} J)"
+            );
+            assert!(
+                energies.last().unwrap() < &(energies[0] - 0.05 * scale),
+                "drag should dissipate: {energies:?}"
+            );
+        } else {
+            let drift = energies.iter().map(|e| (e - energies[0]).abs()).fold(0.0, f64::max);
+            assert!(
+                drift < 1e-7 * scale,
+                "energy drift {drift:.2e} J of {scale:.2e} J over 20 periods"
+            );
+        }
+    }
+}
+
+#[test]
+fn step_response_with_drag_settles_to_the_target_when_collisions_are_ignored() {
+    // Quadratic drag damps large swings fast and small ones slowly (amplitude ~ 1/t).
+    let scene = strip(&[300.0, 150.0], &[Some(60.0), Some(-45.0)], STEP, true, 0.1);
+    let settings = SimulationSettings {
+        rtol: 1e-8,
+        ignore_collisions: true,
+        ..Default::default()
+    };
+    let response = simulate(&scene, &settings).unwrap();
+    assert_eq!(response.method, Some(Method::Tsit45));
+    let t_end = response.t_end;
+    let swing = |from: f64, to: f64| {
+        response
+            .samples
+            .iter()
+            .filter(|s| s.time >= from * t_end && s.time <= to * t_end)
+            .map(|s| (&s.angles - &scene.target_angles).amax())
+            .fold(0.0, f64::max)
+    };
+    let (early, late) = (swing(0.0, 0.1), swing(0.9, 1.0));
+    assert!(late < 5e-3, "still {late:.2e} rad from the target after {t_end} s");
+    assert!(late < 0.02 * early, "swing {early:.2e} rad early, {late:.2e} rad late");
+}
+
+#[test]
+fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
+    // A fast etch (so the dynamic run is short), no drag (the linear bound is then tight).
+    let ramp = r#"{"kind": "ramp", "etch_rate_um_per_min": 600000}"#;
+    let mut scene = strip(&[200.0, 100.0], &[Some(90.0), Some(60.0)], ramp, false, 1.0);
+    scene.t_end = 1.2 * scene.forcing_time();
+    let run = |model| {
+        let settings = SimulationSettings {
+            model,
+            rtol: 1e-10,
+            method: Method::Esdirk34,
+            ignore_collisions: true,
+            ..Default::default()
+        };
+        simulate(&scene, &settings).unwrap()
+    };
+    let quasi = run(ModelChoice::QuasiStatic);
+    let dynamic = run(ModelChoice::Dynamic);
+    assert!(
+        quasi.time_scales.ratio > 100.0,
+        "the ramp must be slow: ratio {}",
+        quasi.time_scales.ratio
+    );
+    let mut drive = vec![0.0; 2];
+    let difference = dynamic
+        .samples
+        .iter()
+        .map(|s| {
+            scene.drive_angles(s.time, &mut drive);
+            (&s.angles - DVector::from_column_slice(&drive)).amax()
+        })
+        .fold(0.0, f64::max);
+    let estimate = quasi.quasi_static_error_estimate;
+    assert!(
+        difference <= estimate * 1.05,
+        "dynamic − quasi-static {difference:.3e} rad > estimate {estimate:.3e}"
+    );
+    assert!(
+        difference >= 0.3 * estimate,
+        "estimate {estimate:.3e} far above the difference {difference:.3e}"
+    );
+    let (_, measured) = quasi.measured_quasi_static_error.unwrap();
+    assert!(measured <= estimate * 1.05);
+}
+
+#[test]
+fn auto_model_choice_follows_the_time_scales() {
+    let step = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
+    let ramp = Scene::load(std::path::Path::new("patterns/bridge_ramp.scene.json")).unwrap();
+    let settings = SimulationSettings::default();
+    let step_response = simulate(&step, &settings).unwrap();
+    assert_eq!(step_response.model, ModelKind::Dynamic);
+    assert_eq!(step_response.time_scales.ratio, 0.0);
+    let ramp_response = simulate(&ramp, &settings).unwrap();
+    assert_eq!(ramp_response.model, ModelKind::QuasiStatic);
+    // SPEC §7: the etch ramp is ~10⁹ fastest periods long.
+    assert!(
+        (1e8..1e10).contains(&ramp_response.time_scales.ratio),
+        "{}",
+        ramp_response.time_scales.ratio
+    );
+    // The ramp lands the folded bridge on the substrate when it reaches its target: t_p = ρ_c (π/2) / a.
+    let t_p = 20e-6 * PI / 2.0 / (1.5e-6 / 60.0);
+    let collision = ramp_response.collision.unwrap();
+    assert!((collision.time - t_p).abs() < 1e-6 * t_p, "{} vs {t_p}", collision.time);
+}
+
+fn scene_error(json: &str) -> String {
+    match Scene::from_json(json, "bad.scene.json", "bad") {
+        Ok(_) => panic!("accepted a bad scene"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn bridge_text() -> String {
+    std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap()
+}
+
+#[test]
+fn bad_scenes_get_errors_that_name_the_field() {
+    let cases = [
+        (
+            bridge_text().replacen(
+                r#""thickness_um": 0.2, "material""#,
+                r#""thickness_um": -0.2, "material""#,
+                1,
+            ),
+            "plates[0].thickness_um",
+        ),
+        (
+            bridge_text().replace(r#""poisson_ratio": 0.28"#, r#""poisson_ratio": 0.5"#),
+            "materials.SiN.poisson_ratio",
+        ),
+        (
+            bridge_text().replacen(r#""width_um": 100"#, r#""width_um": 0"#, 1),
+            "plates[0].width_um",
+        ),
+        (
+            bridge_text().replace(r#""kind": "step""#, r#""kind": "pulse""#),
+            "unknown variant `pulse`",
+        ),
+        (
+            bridge_text().replacen(r#""length_um": 100"#, r#""length": 100"#, 1),
+            "unknown field `length`",
+        ),
+        (
+            bridge_text().replace(r#""t_end_s": 0.002"#, r#""t_end": 0.002"#),
+            "unknown field `t_end`",
+        ),
+        (
+            bridge_text().replacen(r#""material": "SiN" }"#, r#""material": "Si" }"#, 1),
+            "plates[0].material",
+        ),
+        (
+            bridge_text().replacen(r#""target_angle_deg": 90"#, r#""target_angle_deg": 270"#, 1),
+            "hinges[0].target_angle_deg",
+        ),
+        (
+            bridge_text().replace(r#""t_end_s": 0.002"#, r#""t_end_s": 0"#),
+            "time.t_end_s",
+        ),
+        ("{".to_string(), "malformed JSON"),
+    ];
+    for (text, expected) in cases {
+        let message = scene_error(&text);
+        assert!(message.contains(expected), "expected {expected:?} in: {message}");
+    }
+    let no_targets = bridge_text().replace(r#""target_angle_deg": 90, "#, "");
+    assert!(scene_error(&no_targets).contains("hinges[0].target_angle_deg"));
+    let ramp = std::fs::read_to_string("patterns/bridge_ramp.scene.json").unwrap();
+    let no_radius = ramp.replace(r#", "radius_of_curvature_um": 20"#, "");
+    assert!(scene_error(&no_radius).contains("hinges[0].radius_of_curvature_um"));
+    let scene = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
+    let bad_rtol = SimulationSettings {
+        rtol: -1.0,
+        ..Default::default()
+    };
+    assert!(matches!(
+        simulate(&scene, &bad_rtol),
+        Err(NanofoldError::InvalidField { .. })
+    ));
+}
