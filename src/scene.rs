@@ -401,6 +401,23 @@ impl Scene {
         }
     }
 
+    /// Times where τ(t) has a kink (a ramp reaching its target), sorted, s.
+    pub fn forcing_breakpoints(&self) -> Vec<f64> {
+        let mut times: Vec<f64> = match &self.actuation {
+            Actuation::Step => Vec::new(),
+            Actuation::Ramp {
+                etch_rate,
+                radius_of_curvature,
+            } => (0..self.model.dof())
+                .filter(|&i| self.actuated[i] && self.target_angles[i] != 0.0)
+                .map(|i| radius_of_curvature[i] * self.target_angles[i].abs() / etch_rate)
+                .collect(),
+        };
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
     /// The slowest forcing time scale, s: 0 for a step, the longest ramp time t_p = ρ_c θ / a.
     pub fn forcing_time(&self) -> f64 {
         match &self.actuation {

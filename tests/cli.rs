@@ -200,3 +200,123 @@ fn constraints_bad_arguments_fail_clearly_and_write_nothing() {
         assert!(!dir.exists(), "{args:?} wrote {}", dir.display());
     }
 }
+
+#[test]
+fn simulate_writes_response_files_and_the_documented_json_keys() {
+    let dir = temp_dir("simulate");
+    let out = nanofold()
+        .args(["simulate", "patterns/bridge_step.scene.json", "--json", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.stderr.is_empty(),
+        "--json must keep stderr quiet: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "model",
+        "time_scale_ratio",
+        "t_end_s",
+        "collision",
+        "final_angles_rad",
+        "steps",
+        "rhs_evaluations",
+        "seconds",
+    ] {
+        assert!(summary.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(summary["model"], "dynamic");
+    let collision = &summary["collision"];
+    assert_eq!(collision["pair"][1], "substrate");
+    assert_eq!(collision["time_s"], summary["t_end_s"]);
+    assert_eq!(collision["point"].as_array().unwrap().len(), 3);
+    let response: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("response.json")).unwrap()).unwrap();
+    let times = response["time_s"].as_array().unwrap();
+    assert_eq!(times.len(), response["angles_rad"].as_array().unwrap().len());
+    assert_eq!(times.len(), response["velocities_rad_s"].as_array().unwrap().len());
+    assert_eq!(times.len(), response["energy_j"]["total"].as_array().unwrap().len());
+    for (name, label) in [("response.svg", "hinge 0"), ("snapshots.svg", "substrate")] {
+        let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains(label), "{name}");
+    }
+
+    let ramp = nanofold()
+        .args(["simulate", "patterns/bridge_ramp.scene.json", "--json", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(ramp.status.success(), "{}", String::from_utf8_lossy(&ramp.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&ramp.stdout).unwrap();
+    assert_eq!(summary["model"], "quasi_static");
+    assert!(summary["time_scale_ratio"].as_f64().unwrap() > 1e8);
+    let estimate = summary["quasi_static_error_estimate_rad"].as_f64().unwrap();
+    let measured = summary["measured_quasi_static_error_rad"].as_f64().unwrap();
+    assert!(measured <= estimate, "measured {measured} > estimate {estimate}");
+}
+
+#[test]
+fn modes_prints_descending_frequencies_and_stability() {
+    let out = nanofold()
+        .args(["modes", "patterns/bridge_step.scene.json", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let modes: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let eigenvalues: Vec<f64> = modes["eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let frequencies: Vec<f64> = modes["frequencies_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(eigenvalues.len(), 4);
+    assert!(eigenvalues.windows(2).all(|w| w[0] >= w[1]));
+    for (l, f) in eigenvalues.iter().zip(&frequencies) {
+        assert!((l.sqrt() / std::f64::consts::TAU - f).abs() < 1e-9 * f);
+    }
+    assert_eq!(modes["stable"], true);
+    for shape in modes["mode_shapes"].as_array().unwrap() {
+        let max = shape
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap().abs())
+            .fold(0.0, f64::max);
+        assert!((max - 1.0).abs() < 1e-12);
+    }
+    assert_eq!(modes["equilibrium_rad"].as_array().unwrap().len(), 4);
+}
+
+#[test]
+fn a_bad_scene_fails_clearly_and_writes_nothing() {
+    let dir = temp_dir("bad-scene");
+    let scene = dir.with_extension("scene.json");
+    let text = std::fs::read_to_string("patterns/bridge_step.scene.json")
+        .unwrap()
+        .replace(r#""poisson_ratio": 0.28"#, r#""poisson_ratio": 0.7"#);
+    std::fs::write(&scene, text).unwrap();
+    let out = nanofold()
+        .arg("simulate")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("materials.SiN.poisson_ratio") && stderr.contains("0.7"),
+        "{stderr}"
+    );
+    assert!(!dir.exists(), "nothing may be written for a bad scene");
+    let _ = std::fs::remove_file(&scene);
+}

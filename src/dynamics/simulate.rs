@@ -611,7 +611,18 @@ impl Driver<'_> {
             gaps_scratch = vec![0.0; contacts.len()];
             contacts.gaps(&data, &mut gaps);
         }
-        solver.set_stop_time(self.s_end).map_err(|e| ode_error(&e))?;
+        // Stop exactly at each kink of the forcing (a ramp reaching its target), so no step
+        // straddles it, then at the end.
+        let mut stops: Vec<f64> = self
+            .scene
+            .forcing_breakpoints()
+            .into_iter()
+            .map(|t| t / self.time_unit)
+            .filter(|&s| s > 0.0 && s < self.s_end)
+            .collect();
+        stops.push(self.s_end);
+        let mut next_stop = 0;
+        solver.set_stop_time(stops[0]).map_err(|e| ode_error(&e))?;
         let mut steps = 0;
         let mut s_previous = 0.0;
         loop {
@@ -682,8 +693,15 @@ impl Driver<'_> {
             }
             self.bar.set_position((1000.0 * s_now / self.s_end) as u64);
             self.bar.set_message(format!("{:.3e} s", s_now * self.time_unit));
-            if matches!(reason, OdeSolverStopReason::TstopReached) || s_now >= self.s_end {
+            if s_now >= self.s_end {
                 break;
+            }
+            if matches!(reason, OdeSolverStopReason::TstopReached) {
+                next_stop += 1;
+                match stops.get(next_stop) {
+                    Some(&stop) => solver.set_stop_time(stop).map_err(|e| ode_error(&e))?,
+                    None => break,
+                }
             }
             s_previous = s_now;
         }
