@@ -32,7 +32,10 @@ fn bench_terms(c: &mut Criterion) {
     });
     group.bench_function("coriolis_newton_euler", |b| {
         model.update_kinematics(&angles, &mut data);
-        b.iter(|| model.coriolis_torques(black_box(&rates), &mut data, &mut out))
+        b.iter(|| {
+            model.update_velocities(black_box(&rates), &mut data);
+            model.coriolis_torques(&rates, &mut data, &mut out)
+        })
     });
     group.bench_function("coriolis_christoffel_matrix", |b| {
         model.update_kinematics(&angles, &mut data);

@@ -82,6 +82,8 @@ pub struct Data {
     pub corners: Vec<Point3<f64>>,
     /// Iᵢ ω'_j (row-major i·n + j).
     pub inertia_axes: Vec<Vector3<f64>>,
+    /// Centre-of-mass velocities, m/s.
+    pub velocities: Vec<Vector3<f64>>,
     /// a_ij = ω'_j × (p_i − q'_j): centre-of-mass velocity per unit θ̇_j (row-major i·n + j).
     pub linear_jacobian: Vec<Vector3<f64>>,
     pub mass_matrix: DMatrix<f64>,
@@ -106,6 +108,7 @@ impl Data {
             inertia_world: vec![Matrix3::zeros(); n],
             corners: vec![Point3::origin(); 4 * n],
             inertia_axes: vec![Vector3::zeros(); n * n],
+            velocities: vec![Vector3::zeros(); n],
             linear_jacobian: vec![Vector3::zeros(); n * n],
             mass_matrix: DMatrix::zeros(n, n),
             mass_matrix_derivative: vec![DMatrix::zeros(n, n); n],
@@ -261,21 +264,22 @@ impl Model {
     /// The Coriolis and centrifugal torques C(θ, θ̇) θ̇ in O(n²), for the right-hand side:
     /// Σᵢ J_vᵢᵀ mᵢ J̇_vᵢ θ̇ + J_ωᵢᵀ (Iᵢ J̇_ωᵢ θ̇ + ωᵢ × Iᵢ ωᵢ), the velocity-product part of each
     /// plate's Newton–Euler equations projected on the joints. It equals the Christoffel form
-    /// of [`Model::update_coriolis`] times θ̇ (tested); it needs only the kinematics.
+    /// of [`Model::update_coriolis`] times θ̇ (tested); it needs the kinematics and
+    /// [`Model::update_velocities`] at the same θ̇.
     pub fn coriolis_torques(&self, fold_rates: &[f64], data: &mut Data, out: &mut [f64]) {
         let n = self.dof();
         // Ω_i: angular velocity of plate i; v_i: its centre-of-mass velocity.
         let mut spin = Vector3::zeros();
-        for i in 0..n {
+        for (i, rate) in fold_rates.iter().enumerate() {
             let previous_spin = spin;
-            spin += data.axes[i] * fold_rates[i];
+            spin += data.axes[i] * *rate;
             // ω̇'_i = Ω_{i−1} × ω'_i; q̇'_i = velocity of the hinge point as a point of plate i − 1.
             data.scratch_angular[i] = previous_spin.cross(&data.axes[i]);
             data.scratch_linear[i] = if i == 0 {
                 Vector3::zeros()
             } else {
                 let com = data.poses[i - 1].translation.vector;
-                self.plate_velocity(i - 1, fold_rates, data) + previous_spin.cross(&(data.points[i] - com))
+                data.velocities[i - 1] + previous_spin.cross(&(data.points[i] - com))
             };
         }
         out.iter_mut().for_each(|o| *o = 0.0);
@@ -283,7 +287,7 @@ impl Model {
         for (i, plate) in self.plates.iter().enumerate() {
             spin += data.axes[i] * fold_rates[i];
             let com = data.poses[i].translation.vector;
-            let velocity = self.plate_velocity(i, fold_rates, data);
+            let velocity = data.velocities[i];
             let mut linear_bias = Vector3::zeros();
             let mut angular_bias = Vector3::zeros();
             for (j, rate) in fold_rates.iter().enumerate().take(i + 1) {
@@ -320,22 +324,22 @@ impl Model {
         }
     }
 
-    /// Centre-of-mass velocity of plate i, m/s (needs kinematics).
-    pub fn plate_velocity(&self, plate: usize, fold_rates: &[f64], data: &Data) -> Vector3<f64> {
+    /// Centre-of-mass velocities vᵢ = Σ_j a_ij θ̇_j, m/s, into `data.velocities` (needs kinematics).
+    pub fn update_velocities(&self, fold_rates: &[f64], data: &mut Data) {
         let n = self.dof();
-        (0..=plate)
-            .map(|j| data.linear_jacobian[plate * n + j] * fold_rates[j])
-            .sum()
+        for i in 0..n {
+            data.velocities[i] = (0..=i).map(|j| data.linear_jacobian[i * n + j] * fold_rates[j]).sum();
+        }
     }
 
     /// Generalised drag force Q_j = Σᵢ a_ijᵀ Fᵢ, N·m (T5.8); zero without drag. Its power
-    /// Q·θ̇ = Σ Fᵢ·vᵢ = −½ C_D ρ A |v|²|v·n| is never positive.
-    pub fn drag_torques(&self, fold_rates: &[f64], data: &Data, out: &mut [f64]) {
+    /// Q·θ̇ = Σ Fᵢ·vᵢ = −½ C_D ρ A |v|²|v·n| is never positive. Needs [`Model::update_velocities`].
+    pub fn drag_torques(&self, data: &Data, out: &mut [f64]) {
         out.iter_mut().for_each(|q| *q = 0.0);
         let Some(drag) = self.drag else { return };
         let n = self.dof();
         for (i, plate) in self.plates.iter().enumerate() {
-            let velocity = self.plate_velocity(i, fold_rates, data);
+            let velocity = data.velocities[i];
             let normal = data.poses[i].rotation * Vector3::z();
             let normal_speed = velocity.dot(&normal);
             if normal_speed == 0.0 {
@@ -351,8 +355,13 @@ impl Model {
 
     /// Kinetic energy ½ θ̇ᵀ M θ̇, J (needs the mass matrix).
     pub fn kinetic_energy(&self, fold_rates: &[f64], data: &Data) -> f64 {
-        let v = DVector::from_column_slice(fold_rates);
-        0.5 * v.dot(&(&data.mass_matrix * &v))
+        let mut sum = 0.0;
+        for (i, ri) in fold_rates.iter().enumerate() {
+            for (j, rj) in fold_rates.iter().enumerate() {
+                sum += data.mass_matrix[(i, j)] * ri * rj;
+            }
+        }
+        0.5 * sum
     }
 
     /// θ̈ = M⁻¹ (τ − C θ̇ − K θ + Q_drag) (T4.12, T4.15), written into `accel`.
@@ -368,10 +377,11 @@ impl Model {
         let n = self.dof();
         self.update_kinematics(fold_angles, data);
         self.update_mass_matrix(data);
+        self.update_velocities(fold_rates, data);
         let mut coriolis = std::mem::take(&mut data.coriolis_torques);
         self.coriolis_torques(fold_rates, data, &mut coriolis);
         let drag = accel.as_mut_slice();
-        self.drag_torques(fold_rates, data, drag);
+        self.drag_torques(data, drag);
         for i in 0..n {
             drag[i] += torques[i] - coriolis[i] - self.joints[i].stiffness * fold_angles[i];
         }
@@ -483,7 +493,9 @@ mod tests {
         model.update_coriolis(&rates, &mut data);
         let christoffel = &data.coriolis * DVector::from_column_slice(&rates);
         let mut newton_euler = vec![0.0; 3];
-        model.coriolis_torques(&rates, &mut data.clone(), &mut newton_euler);
+        let mut moving = data.clone();
+        model.update_velocities(&rates, &mut moving);
+        model.coriolis_torques(&rates, &mut moving, &mut newton_euler);
         // Independent: C θ̇ = Ṁ θ̇ − ½ ∂(θ̇ᵀ M θ̇)/∂θ, both by central differences of M.
         let h = 1e-5;
         let theta_dot = DVector::from_column_slice(&rates);
