@@ -415,3 +415,21 @@ fn bad_scenes_get_errors_that_name_the_field() {
         Err(NanofoldError::InvalidField { .. })
     ));
 }
+
+#[test]
+fn quasi_static_forced_on_a_step_reports_its_large_error() {
+    let scene = strip(&[300.0, 150.0], &[Some(60.0), Some(-45.0)], STEP, true, 0.01);
+    let settings = SimulationSettings {
+        model: ModelChoice::QuasiStatic,
+        ignore_collisions: true,
+        ..Default::default()
+    };
+    let response = simulate(&scene, &settings).unwrap();
+    assert_eq!(response.model, ModelKind::QuasiStatic);
+    let (_, measured) = response.measured_quasi_static_error.unwrap();
+    // The undamped step would overshoot by its own size; drag takes a little off.
+    assert!(measured > 0.5 * 60f64.to_radians(), "measured {measured}");
+    assert!(measured <= response.quasi_static_error_estimate * 1.05);
+    let last = response.samples.last().unwrap();
+    assert!((&last.angles - &scene.target_angles).amax() < 1e-15);
+}
