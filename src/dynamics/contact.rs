@@ -185,9 +185,23 @@ impl ContactSet {
         }
     }
 
-    /// The earliest contact in (t_start, t_end], scanning `subdivisions` equal sub-intervals
-    /// of the path θ(t) given by `angles_at` and bisecting each sign change. `gaps_start`
-    /// holds the gaps at t_start and is left holding those at t_end.
+    /// An upper bound on how far any corner can be from any hinge axis upstream of it, m:
+    /// the sum of the plates' diagonals. A corner moves at most this × Σ|θ̇_j|.
+    pub fn lever(model: &Model) -> f64 {
+        model
+            .plates
+            .iter()
+            .map(|p| 2.0 * p.half_extents[0].hypot(p.half_extents[1]))
+            .sum()
+    }
+
+    /// The earliest contact in (t_start, t_end], bisecting (Illinois) each sign change of a gap
+    /// along the path θ(t) given by `angles_at`. The end of the interval is checked first; only
+    /// if some gap is within `reach` (a bound on how far two corners can move towards each
+    /// other over the interval; infinite to always subdivide) of zero without changing sign
+    /// is the interval scanned in `subdivisions` parts, so a gap that dips through zero and
+    /// back within it is not missed. `gaps_start` holds the gaps at t_start and is left
+    /// holding those at t_end.
     #[allow(clippy::too_many_arguments)]
     pub fn locate(
         &self,
@@ -195,19 +209,31 @@ impl ContactSet {
         data: &mut Data,
         t_start: f64,
         t_end: f64,
+        reach: f64,
         subdivisions: usize,
         gaps_start: &mut [f64],
         gaps_scratch: &mut [f64],
         angles: &mut [f64],
         angles_at: &mut dyn FnMut(f64, &mut [f64]),
     ) -> Option<Collision> {
+        angles_at(t_end, angles);
+        model.update_poses(angles, data);
+        model.update_corners(data);
+        self.gaps(data, gaps_scratch);
+        let near = (0..self.len()).any(|k| {
+            let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
+            g0.signum() == g1.signum() && g0.abs().min(g1.abs()) < reach
+        });
+        let subdivisions = if near { subdivisions.max(1) } else { 1 };
         let mut t_left = t_start;
         for s in 1..=subdivisions {
             let t_right = t_start + (t_end - t_start) * s as f64 / subdivisions as f64;
-            angles_at(t_right, angles);
-            model.update_poses(angles, data);
-            model.update_corners(data);
-            self.gaps(data, gaps_scratch);
+            if subdivisions > 1 {
+                angles_at(t_right, angles);
+                model.update_poses(angles, data);
+                model.update_corners(data);
+                self.gaps(data, gaps_scratch);
+            }
             let mut earliest: Option<(f64, usize)> = None;
             for k in 0..self.len() {
                 let (g0, g1) = (gaps_start[k], gaps_scratch[k]);

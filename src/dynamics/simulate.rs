@@ -26,7 +26,8 @@ pub const QUASI_STATIC_RATIO: f64 = 1e3;
 /// (measured on the bridge: 4× fewer steps than ESDIRK34 at the same tolerance). BDF is
 /// offered too, but its Newton iterations fail at rtol ≤ 1e-8 on the ramp.
 pub const IMPLICIT_RATIO: f64 = 100.0;
-/// Contact scanning: sub-intervals of each solver step (catches in-and-out crossings within a step).
+/// Contact scanning: sub-intervals of a solver step in which some gap comes within reach of
+/// zero (catches in-and-out crossings within a step).
 const CONTACT_SUBDIVISIONS: usize = 4;
 /// Contact scanning of the quasi-static path: largest change of a drive angle between checks, rad.
 const QUASI_STATIC_ANGLE_STEP: f64 = 2e-3;
@@ -393,6 +394,7 @@ fn quasi_static(
                     &mut data,
                     0.0,
                     1.0,
+                    f64::INFINITY,
                     subdivisions,
                     &mut gaps,
                     &mut scratch,
@@ -626,12 +628,20 @@ impl Driver<'_> {
         solver.set_stop_time(stops[0]).map_err(|e| ode_error(&e))?;
         let mut steps = 0;
         let mut s_previous = 0.0;
+        // Σ|dθ/ds| at the previous step's end, for the contact reach bound.
+        let speed_sum = |y: &NalgebraVec<f64>| (n..2 * n).map(|i| y[i].abs()).sum::<f64>();
+        let mut previous_speed: f64 = 0.0;
+        let lever = ContactSet::lever(model);
         loop {
             let reason = solver.step().map_err(|e| ode_error(&e))?;
             steps += 1;
             let s_now = solver.state().t;
+            let current_speed = speed_sum(solver.state().y);
             let mut collision = None;
             if let Some(contacts) = self.contacts {
+                // Two corners approach each other at most 2 × lever × Σ|θ̇| (with θ̇ between its
+                // values at the step's ends, ×2 for safety as it varies within the step).
+                let reach = 4.0 * lever * (s_now - s_previous) * previous_speed.max(current_speed);
                 let mut path = |t: f64, out: &mut [f64]| {
                     if solver.interpolate_inplace(t, &mut state).is_ok() {
                         for (i, o) in out.iter_mut().enumerate() {
@@ -645,6 +655,7 @@ impl Driver<'_> {
                         &mut data,
                         s_previous,
                         s_now,
+                        reach,
                         CONTACT_SUBDIVISIONS,
                         &mut gaps,
                         &mut gaps_scratch,
@@ -705,6 +716,7 @@ impl Driver<'_> {
                 }
             }
             s_previous = s_now;
+            previous_speed = current_speed;
         }
         Ok((
             samples,
