@@ -92,6 +92,10 @@ pub struct SimulateArgs {
     /// Integrate through contacts instead of stopping at the first one.
     #[arg(long)]
     pub ignore_collisions: bool,
+    /// Stop with an error after this many integrator steps (a method unsuited to the scene
+    /// can need billions).
+    #[arg(long, default_value_t = 5_000_000)]
+    pub max_steps: usize,
     /// Output folder (default: output/<scene name>/).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -507,6 +511,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         ignore_collisions: args.ignore_collisions,
         t_end: args.t_end,
         progress: !args.json,
+        max_steps: args.max_steps,
     };
     let response = simulate(&scene, &settings)?;
     // Render everything before writing anything.

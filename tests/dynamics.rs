@@ -433,3 +433,18 @@ fn quasi_static_forced_on_a_step_reports_its_large_error() {
     let last = response.samples.last().unwrap();
     assert!((&last.angles - &scene.target_angles).amax() < 1e-15);
 }
+
+#[test]
+fn a_run_that_outgrows_its_step_budget_stops_with_advice() {
+    let scene = strip(&[300.0, 150.0], &[Some(60.0), Some(-45.0)], STEP, true, 0.01);
+    let settings = SimulationSettings {
+        max_steps: 200,
+        ignore_collisions: true,
+        ..Default::default()
+    };
+    let message = simulate(&scene, &settings).unwrap_err().to_string();
+    assert!(
+        message.contains("budget of 200 steps") && message.contains("--method"),
+        "{message}"
+    );
+}

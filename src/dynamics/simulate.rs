@@ -35,6 +35,9 @@ const QUASI_STATIC_ANGLE_STEP: f64 = 2e-3;
 const CHECK_PERIODS: f64 = 30.0;
 /// Slowest periods of that check when a fast forcing is forced onto the quasi-static model.
 const STEP_CHECK_PERIODS: f64 = 2.0;
+/// A run stops with an error once Newton has failed more than this many times and on more
+/// than every other step (diffsol's own cap counts failures over the whole run; see `integrate`).
+const NEWTON_FAILURE_FLOOR: usize = 1000;
 /// Tolerance of the check run of a slow forcing.
 const CHECK_RTOL: f64 = 1e-10;
 
@@ -78,6 +81,9 @@ pub struct SimulationSettings {
     pub t_end: Option<f64>,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// A dynamic run that needs more integrator steps stops with an error that says how many
+    /// it would still need and what to try instead.
+    pub max_steps: usize,
 }
 
 impl Default for SimulationSettings {
@@ -89,6 +95,7 @@ impl Default for SimulationSettings {
             ignore_collisions: false,
             t_end: None,
             progress: false,
+            max_steps: 5_000_000,
         }
     }
 }
@@ -259,15 +266,13 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
     match kind {
         ModelKind::Dynamic => {
             let method = resolve_method(settings.method, &scales);
-            let run = integrate(
-                scene,
-                method,
-                settings.rtol,
-                &output_times,
-                contacts.as_ref(),
-                settings.progress,
-                true,
-            )?;
+            let options = IntegrationOptions {
+                rtol: settings.rtol,
+                progress: settings.progress,
+                record_steps: true,
+                max_steps: settings.max_steps,
+            };
+            let run = integrate(scene, method, &output_times, contacts.as_ref(), options)?;
             response.method = Some(method);
             response.steps = run.steps;
             response.rhs_evaluations = run.rhs_evaluations;
@@ -289,7 +294,13 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
             };
             let window = (periods * scales.slowest_period_s).min(t_end);
             let check_times = output_times_in(window, 201);
-            let run = integrate(scene, method, rtol, &check_times, None, false, false)?;
+            let options = IntegrationOptions {
+                rtol,
+                progress: false,
+                record_steps: false,
+                max_steps: settings.max_steps,
+            };
+            let run = integrate(scene, method, &check_times, None, options)?;
             let mut drive = vec![0.0; scene.model.dof()];
             let error = run
                 .samples
@@ -435,6 +446,16 @@ fn quasi_static(
     (samples, collision, subdivisions)
 }
 
+/// How one diffsol run is driven.
+#[derive(Debug, Clone, Copy)]
+struct IntegrationOptions {
+    rtol: f64,
+    progress: bool,
+    /// Record a sample at every accepted step besides the output times.
+    record_steps: bool,
+    max_steps: usize,
+}
+
 /// Result of one diffsol run.
 struct DynamicRun {
     samples: Vec<Sample>,
@@ -447,12 +468,16 @@ struct DynamicRun {
 fn integrate(
     scene: &Scene,
     method: Method,
-    rtol: f64,
     output_times: &[f64],
     contacts: Option<&ContactSet>,
-    progress: bool,
-    record_steps: bool,
+    options: IntegrationOptions,
 ) -> Result<DynamicRun> {
+    let IntegrationOptions {
+        rtol,
+        progress,
+        record_steps,
+        max_steps,
+    } = options;
     let model = &scene.model;
     let n = model.dof();
     let flat = modes(model, &vec![0.0; n])?;
@@ -538,6 +563,8 @@ fn integrate(
         s_end,
         bar: &bar,
         record_steps,
+        method,
+        max_steps,
     };
     let result = match method {
         Method::Bdf | Method::Auto => driver.run(problem.bdf::<NalgebraLU<f64>>().map_err(|e| ode_error(&e))?),
@@ -578,6 +605,9 @@ struct Driver<'r> {
     bar: &'r ProgressBar,
     /// Record a sample at every accepted step besides the output times.
     record_steps: bool,
+    /// For error messages.
+    method: Method,
+    max_steps: usize,
 }
 
 impl Driver<'_> {
@@ -636,6 +666,33 @@ impl Driver<'_> {
             let reason = solver.step().map_err(|e| ode_error(&e))?;
             steps += 1;
             let s_now = solver.state().t;
+            let newton_failures = solver.get_statistics().number_of_nonlinear_solver_fails;
+            if steps >= self.max_steps && s_now < self.s_end {
+                return Err(NanofoldError::Numerical {
+                    stage: "ODE integration (diffsol)".into(),
+                    message: format!(
+                        "{:?} used its budget of {steps} steps by t = {:.6e} s of {:.6e} s; at this pace it needs about \
+                         {:.1e} more. Use --method esdirk34 for a slow forcing, tsit45 for a step, --model quasi-static \
+                         when the time-scale ratio is large, or a looser --rtol",
+                        self.method,
+                        s_now * self.time_unit,
+                        self.s_end * self.time_unit,
+                        steps as f64 * (self.s_end - s_now) / s_now.max(f64::MIN_POSITIVE)
+                    ),
+                });
+            }
+            if newton_failures > NEWTON_FAILURE_FLOOR && 2 * newton_failures > steps {
+                return Err(NanofoldError::Numerical {
+                    stage: "ODE integration (diffsol)".into(),
+                    message: format!(
+                        "{:?}'s Newton iterations failed {newton_failures} times in {steps} steps by t = {:.6e} s (the fast \
+                         modes make its iteration matrix ill-conditioned at this tolerance); use --method esdirk34 for a \
+                         slow forcing, tsit45 for a step, or a looser --rtol",
+                        self.method,
+                        s_now * self.time_unit
+                    ),
+                });
+            }
             let current_speed = speed_sum(solver.state().y);
             let mut collision = None;
             if let Some(contacts) = self.contacts {
