@@ -235,6 +235,15 @@ impl Pattern {
                     "sector angle must be positive",
                 ));
             }
+            // A sector of a full turn or more would overlap itself (and splitting it into
+            // quarter turns would need arbitrarily many virtual rays).
+            if *alpha >= TAU {
+                return Err(NanofoldError::invalid(
+                    field,
+                    format!("{:.6}°", alpha.to_degrees()),
+                    "sector angle must be less than 360°",
+                ));
+            }
         }
         let creases_given = raw_rays.iter().filter(|r| matches!(r, RawRay::Crease(_))).count();
         if creases_given == 0 {

@@ -267,8 +267,23 @@ impl Scene {
                 mass * (width * width + thickness * thickness) / 12.0,
                 mass * (length * length + width * width) / 12.0,
             );
+            let usable = |x: f64| x.is_finite() && x > 0.0;
+            if !(usable(mass) && principal_inertia.iter().all(|&m| usable(m))) {
+                return Err(NanofoldError::invalid(
+                    format!("plates[{i}]"),
+                    format!("mass {mass:e} kg"),
+                    "the plate's mass or inertia overflows or vanishes in double precision: check the units of its length_um, width_um, thickness_um and its material's density_g_cm3",
+                ));
+            }
             let hinge = &file.hinges[i];
             let stiffness = hinge_stiffness(&file, i, hinge, width)?;
+            if !usable(stiffness) {
+                return Err(NanofoldError::invalid(
+                    format!("hinges[{i}]"),
+                    format!("stiffness {stiffness:e} N·m/rad"),
+                    "the bending stiffness overflows or vanishes in double precision: check the units of hinge_length_um, the layers' thickness_um and youngs_modulus_gpa",
+                ));
+            }
             joints.push(Joint {
                 axis: Vector3::x_axis(),
                 point: Point3::new(0.0, y, 0.0),

@@ -123,3 +123,24 @@ fn locked_key_must_hold_one_boolean_per_edge() {
     let e = error_of(&format!(r#"{base},"edges_nanofold:locked":[true,"yes"]}}"#));
     assert!(e.contains("edges_nanofold:locked[1]"), "{e}");
 }
+
+#[test]
+fn a_sector_of_a_full_turn_or_more_is_refused() {
+    // Found by tests/fuzz.rs: a huge sector was split into that many quarter turns (out of memory).
+    let message = error_of(&native("[90, 90, 90, 1e300]", FOUR));
+    assert!(message.contains("less than 360°"), "{message}");
+}
+
+#[test]
+fn creases_on_both_sides_of_the_boundary_edges_are_refused() {
+    // Found by tests/fuzz.rs: moving the sheet corner's vertex put its creases outside the
+    // paper's wedge, and the importer dropped one (then indexed past the crease list).
+    let text = std::fs::read_to_string("patterns/sheet_corner.fold").unwrap();
+    let mut fold: serde_json::Value = serde_json::from_str(&text).unwrap();
+    fold["vertices_coords"][0] = serde_json::json!([0.0, 180.0]);
+    let message = error_of(&fold.to_string());
+    assert!(
+        message.contains("both sides") && message.contains("vertices_coords"),
+        "{message}"
+    );
+}

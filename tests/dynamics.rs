@@ -448,3 +448,17 @@ fn a_run_that_outgrows_its_step_budget_stops_with_advice() {
         "{message}"
     );
 }
+
+#[test]
+fn stiffness_and_inertia_too_far_apart_for_doubles_is_an_error_not_nan() {
+    // Found by tests/fuzz.rs: a hinge 1e-308 µm long gives K ~ 1e300 and λ = K/I overflows.
+    let text = std::fs::read_to_string("patterns/bridge_step.scene.json")
+        .unwrap()
+        .replacen(r#""hinge_length_um": 32"#, r#""hinge_length_um": 1.2e-308"#, 1);
+    let scene = Scene::from_json(&text, "tiny hinge", "tiny").unwrap();
+    let message = modes(&scene.model, scene.target_angles.as_slice())
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("overflow"), "{message}");
+    assert!(simulate(&scene, &SimulationSettings::default()).is_err());
+}

@@ -62,6 +62,11 @@ pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
         mode_shapes.set_column(column, &(shape / largest));
         eigenvalues.push(eigen.eigenvalues[k]);
     }
+    if eigenvalues.iter().any(|l| !l.is_finite()) {
+        return Err(numerical(format!(
+            "eigenvalues of M⁻¹K overflow ({eigenvalues:?}): stiffness and inertia are too far apart in double precision; check the scene's units"
+        )));
+    }
     let stable = model.joints.iter().all(|j| j.stiffness > 0.0) && eigenvalues.iter().all(|&l| l > 0.0);
     Ok(Modes {
         equilibrium: DVector::from_column_slice(equilibrium),

@@ -256,26 +256,35 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
             next - here
         }
     };
-    let (chain, start, ray_count) = match boundary_spokes.len() {
-        0 => (Chain::Closed, 0, m),
-        2 => {
-            // The paper is the angular gap between the two boundary rays that holds creases.
-            let (b0, b1) = (boundary_spokes[0], boundary_spokes[1]);
-            let creases_between = (b0 + 1..b1).count();
-            if creases_between > 0 {
-                (Chain::Open, b0, b1 - b0 + 1)
-            } else {
-                (Chain::Open, b1, m - b1 + b0 + 1)
+    let (chain, start, ray_count) =
+        match boundary_spokes.len() {
+            0 => (Chain::Closed, 0, m),
+            2 => {
+                // The paper is the angular gap between the two boundary rays that holds creases.
+                let (b0, b1) = (boundary_spokes[0], boundary_spokes[1]);
+                let creases_between = (b0 + 1..b1).count();
+                let creases_outside = m - 2 - creases_between;
+                if creases_between > 0 && creases_outside > 0 {
+                    return Err(NanofoldError::invalid(
+                    "vertices_coords",
+                    format!("boundary edges {} and {} at vertex {center}", spokes[b0].edge, spokes[b1].edge),
+                    "creases leave the vertex on both sides of its two boundary edges: the paper must lie between them",
+                ));
+                }
+                if creases_between > 0 {
+                    (Chain::Open, b0, b1 - b0 + 1)
+                } else {
+                    (Chain::Open, b1, m - b1 + b0 + 1)
+                }
             }
-        }
-        k => {
-            return Err(NanofoldError::invalid(
-                "edges_assignment",
-                format!("{k} boundary (B) edges at vertex {center}"),
-                "a vertex has 0 (interior) or 2 (on the sheet's edge) boundary edges",
-            ))
-        }
-    };
+            k => {
+                return Err(NanofoldError::invalid(
+                    "edges_assignment",
+                    format!("{k} boundary (B) edges at vertex {center}"),
+                    "a vertex has 0 (interior) or 2 (on the sheet's edge) boundary edges",
+                ))
+            }
+        };
 
     let mut rays = Vec::with_capacity(ray_count);
     let mut sector_angles = Vec::new();
