@@ -2,7 +2,9 @@
 //! each integrator and tolerance, its error against a run at a much tighter tolerance, and
 //! the etch ramp quasi-static against dynamic. `cargo run --release --example dynamics_timing`
 
-use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, Response, SimulationSettings};
+use nanofold::dynamics::simulate::{
+    quasi_static_deviation, simulate, Method, ModelChoice, Response, SimulationSettings,
+};
 use nanofold::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
@@ -89,19 +91,7 @@ fn main() {
         };
         let (seconds, dynamic) = timed(&ramp, &settings, 3);
         let contact = dynamic.collision.clone().unwrap();
-        let mut drive = vec![0.0; 4];
-        let lag = dynamic
-            .samples
-            .iter()
-            .map(|s| {
-                ramp.drive_angles(s.time, &mut drive);
-                s.angles
-                    .iter()
-                    .zip(&drive)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max)
-            })
-            .fold(0.0, f64::max);
+        let lag = quasi_static_deviation(&ramp, &dynamic.samples);
         println!(
             "  dynamic esdirk34 rtol {rtol:.0e}: {:.1} ms, {} steps; max |θ − θ_quasi-static| {lag:.2e} rad; contact at {:.6} s (Δ {:.2e} s)",
             seconds * 1e3,

@@ -18,6 +18,20 @@ pub(crate) fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
     }
 }
 
+/// The series legend every figure uses: a translucent white box at `position`.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(position)
+        .draw()
+        .map_err(plot_error)
+}
+
 /// Colour of series `i`.
 pub fn series_colour(i: usize) -> RGBColor {
     const PALETTE: [RGBColor; 10] = [
@@ -76,13 +90,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
                 .label(format!("{} ({})", crease.label, crease.assignment.letter()))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_error)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
 
         // 3D views at four moments.
         let picks = snapshot_indices(report, 11);
@@ -211,13 +219,7 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
                     .map_err(plot_error)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(plot_error)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
 
         // Fit error per dependent, at the samples.
         let errors: Vec<Vec<f64>> = poly

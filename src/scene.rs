@@ -400,6 +400,22 @@ impl Scene {
         }
     }
 
+    /// dθ_drive/dt, rad/s: a/ρ_c (with the target's sign) while a ramp releases a hinge, else 0.
+    pub fn drive_rates(&self, t: f64, out: &mut [f64]) {
+        for (i, rate) in out.iter_mut().enumerate() {
+            let target = self.target_angles[i];
+            *rate = match &self.actuation {
+                Actuation::Ramp {
+                    etch_rate,
+                    radius_of_curvature,
+                } if target != 0.0 && etch_rate * t.max(0.0) / radius_of_curvature[i] < target.abs() => {
+                    target.signum() * etch_rate / radius_of_curvature[i]
+                }
+                _ => 0.0,
+            };
+        }
+    }
+
     /// Input torques τ = K θ_drive(t), N·m.
     pub fn torques(&self, t: f64, out: &mut [f64]) {
         self.drive_angles(t, out);

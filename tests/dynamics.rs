@@ -462,3 +462,27 @@ fn stiffness_and_inertia_too_far_apart_for_doubles_is_an_error_not_nan() {
     assert!(message.contains("overflow"), "{message}");
     assert!(simulate(&scene, &SimulationSettings::default()).is_err());
 }
+
+#[test]
+fn ramp_drive_rates_are_the_derivative_of_the_drive_angles() {
+    let ramp = Scene::load(std::path::Path::new("patterns/bridge_ramp.scene.json")).unwrap();
+    let t_p = ramp.forcing_time();
+    let (mut rates, mut plus, mut minus) = (vec![0.0; 4], vec![0.0; 4], vec![0.0; 4]);
+    for (t, expected_moving) in [(0.3 * t_p, true), (0.99 * t_p, true), (1.01 * t_p, false)] {
+        ramp.drive_rates(t, &mut rates);
+        let h = 1e-4 * t_p;
+        ramp.drive_angles(t + h, &mut plus);
+        ramp.drive_angles(t - h, &mut minus);
+        for i in 0..4 {
+            let central = (plus[i] - minus[i]) / (2.0 * h);
+            assert!(
+                (rates[i] - central).abs() < 1e-9 * central.abs().max(1e-9),
+                "t = {t}: {rates:?} vs {central}"
+            );
+            assert_eq!(rates[i] != 0.0, expected_moving);
+        }
+    }
+    // a / ρ_c = (1.5 µm/min) / 20 µm.
+    ramp.drive_rates(0.0, &mut rates);
+    assert!((rates[0] - 1.5e-6 / 60.0 / 20e-6).abs() < 1e-15);
+}

@@ -2,20 +2,15 @@
 //! live beside the feature they stress: the exactly flat-folded input and sectors ≥ 360° in
 //! bad_input.rs, the locked pattern in library.rs, the 10⁹ stiffness ratio in dynamics.rs.
 
+mod common;
+use common::native_json;
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::unfold::{unfold, UnfoldSettings, Verdict};
 use std::f64::consts::TAU;
 
 /// A closed vertex with the given sectors (rad), every crease at `fold` rad.
 fn vertex(sectors: &[f64], fold: f64) -> String {
-    let creases: Vec<String> = sectors
-        .iter()
-        .map(|_| format!(r#"{{"assignment":"U","fold_angle":{fold}}}"#))
-        .collect();
-    format!(
-        r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#,
-        creases.join(",")
-    )
+    native_json(sectors, &vec![fold; sectors.len()])
 }
 
 fn load(text: &str) -> nanofold::Result<Pattern> {

@@ -1,6 +1,8 @@
 //! Numerical methods against independent answers: closed forms, finite differences and a
 //! second method (proptest over random states).
 
+mod common;
+use common::native_json;
 use nanofold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::kinematics::{closure_residual, solve_closure};
 use nanofold::pattern::{LoadOptions, Pattern};
@@ -40,17 +42,6 @@ fn random_vertex(n: usize, weights: &[f64], drive: &[f64]) -> Option<(Vec<f64>, 
         return None;
     }
     Some((sectors, rho))
-}
-
-fn native_json(sectors: &[f64], rho: &[f64]) -> String {
-    let creases: Vec<String> = rho
-        .iter()
-        .map(|r| format!(r#"{{"assignment":"U","fold_angle":{r}}}"#))
-        .collect();
-    format!(
-        r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#,
-        creases.join(",")
-    )
 }
 
 fn fd_check(f: impl Fn(&Vec3) -> f64, x: &Vec3, grad: &Vec3, tol: f64) -> Result<(), TestCaseError> {

@@ -301,20 +301,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
                 max_steps: settings.max_steps,
             };
             let run = integrate(scene, method, &check_times, None, options)?;
-            let mut drive = vec![0.0; scene.model.dof()];
-            let error = run
-                .samples
-                .iter()
-                .map(|s| {
-                    scene.drive_angles(s.time, &mut drive);
-                    s.angles
-                        .iter()
-                        .zip(&drive)
-                        .map(|(a, b)| (a - b).abs())
-                        .fold(0.0, f64::max)
-                })
-                .fold(0.0, f64::max);
-            response.measured_quasi_static_error = Some((window, error));
+            response.measured_quasi_static_error = Some((window, quasi_static_deviation(scene, &run.samples)));
         }
     }
     if let Some(c) = &response.collision {
@@ -322,6 +309,23 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
     }
     response.seconds = started.elapsed().as_secs_f64();
     Ok(response)
+}
+
+/// max over samples and hinges of |θ − θ_quasi-static(t)|, rad: how far a response strays
+/// from the quasi-static path θ_drive(t).
+pub fn quasi_static_deviation(scene: &Scene, samples: &[Sample]) -> f64 {
+    let mut drive = vec![0.0; scene.model.dof()];
+    samples
+        .iter()
+        .map(|s| {
+            scene.drive_angles(s.time, &mut drive);
+            s.angles
+                .iter()
+                .zip(&drive)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
 }
 
 fn resolve_method(method: Method, scales: &TimeScales) -> Method {
@@ -424,17 +428,7 @@ fn quasi_static(
     let mut rates = vec![0.0; n];
     let mut record = |t: f64, samples: &mut Vec<Sample>| {
         scene.drive_angles(t, &mut angles);
-        // dθ/dt of the ramp: a/ρ_c while releasing, 0 after.
-        let h = 1e-6 * scene.forcing_time().max(1e-300);
-        let mut later = vec![0.0; n];
-        scene.drive_angles(t + h, &mut later);
-        for i in 0..n {
-            rates[i] = if matches!(scene.actuation, Actuation::Step) {
-                0.0
-            } else {
-                (later[i] - angles[i]) / h
-            };
-        }
+        scene.drive_rates(t, &mut rates);
         samples.push(sample(scene, &mut data, t, &angles, &rates));
     };
     for &t in output_times.iter().filter(|&&t| t < stop) {

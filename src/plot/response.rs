@@ -1,7 +1,7 @@
 //! Figures of a dynamics run: `response.svg` (fold angles and energies against time, like the
 //! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of the chain, figure 5-7).
 
-use super::{plot_error, series_colour};
+use super::{draw_legend, plot_error, series_colour};
 use crate::dynamics::simulate::{ModelKind, Response, Sample};
 use crate::dynamics::Data;
 use crate::error::Result;
@@ -113,13 +113,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
                 .label("first contact")
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(plot_error)?;
+        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
 
         // Energies in the unit that suits them.
         let largest = response
@@ -184,13 +178,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
                 .label(*label)
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
         }
-        energy
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_error)?;
+        draw_legend(&mut energy, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
@@ -333,13 +321,7 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
                 .label(format!("contact: {} / {}", c.pair[0], c.pair[1]))
                 .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(plot_error)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
