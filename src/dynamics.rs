@@ -28,26 +28,80 @@ pub struct Joint {
 pub struct Plate {
     /// Mass from the structural layer, kg.
     pub mass: f64,
-    /// Principal moments of inertia at the centre of mass about the body axes, kg·m².
-    pub principal_inertia: Vector3<f64>,
-    /// Pose of the centre-of-mass frame at θ = 0 (body x along the crease, z the normal).
+    /// Inertia tensor at the centre of mass in the body axes, kg·m².
+    pub inertia: Matrix3<f64>,
+    /// Pose of the centre-of-mass frame at θ = 0 (body z the plate normal).
     pub reference_pose: Isometry3<f64>,
-    /// Half extents of the plate's rectangle in its body x and y directions, m.
-    pub half_extents: [f64; 2],
+    /// The plate's outline in the body frame (z = 0), a convex polygon counter-clockwise.
+    pub outline: Vec<Point3<f64>>,
     /// Area facing the air (drag), m².
     pub area: f64,
 }
 
 impl Plate {
-    /// The rectangle's corners in the body frame, counter-clockwise.
-    pub fn corners(&self) -> [Point3<f64>; 4] {
-        let [a, b] = self.half_extents;
-        [
-            Point3::new(-a, -b, 0.0),
-            Point3::new(a, -b, 0.0),
-            Point3::new(a, b, 0.0),
-            Point3::new(-a, b, 0.0),
-        ]
+    /// A uniform lamina of the given thickness (m) and density (kg/m³) whose mid-plane is the
+    /// convex polygon `outline` (m, counter-clockwise in the flat xy-plane at θ = 0). Its body
+    /// frame sits at the centroid with the world's axes, so body z is the normal. The inertia is
+    /// the thin-box tensor: in-plane second moments of the polygon plus m t²/12 about the
+    /// in-plane axes (for a rectangle exactly the box moments of SPEC §7).
+    pub fn lamina(outline: &[[f64; 2]], thickness: f64, density: f64) -> Plate {
+        let count = outline.len();
+        let (mut area2, mut cx, mut cy) = (0.0, 0.0, 0.0);
+        let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+        for k in 0..count {
+            let ([x0, y0], [x1, y1]) = (outline[k], outline[(k + 1) % count]);
+            let c = x0 * y1 - x1 * y0;
+            area2 += c;
+            cx += (x0 + x1) * c;
+            cy += (y0 + y1) * c;
+            sxx += (y0 * y0 + y0 * y1 + y1 * y1) * c;
+            syy += (x0 * x0 + x0 * x1 + x1 * x1) * c;
+            sxy += (x0 * y1 + 2.0 * x0 * y0 + 2.0 * x1 * y1 + x1 * y0) * c;
+        }
+        let area = 0.5 * area2;
+        let (cx, cy) = (cx / (3.0 * area2), cy / (3.0 * area2));
+        // ∫y², ∫x², ∫xy over the polygon, moved to the centroid.
+        let iyy_area = sxx / 12.0 - area * cy * cy;
+        let ixx_area = syy / 12.0 - area * cx * cx;
+        let ixy_area = sxy / 24.0 - area * cx * cy;
+        let areal_density = density * thickness;
+        let mass = areal_density * area;
+        let through = mass * thickness * thickness / 12.0;
+        let inertia = Matrix3::new(
+            areal_density * iyy_area + through,
+            -areal_density * ixy_area,
+            0.0,
+            -areal_density * ixy_area,
+            areal_density * ixx_area + through,
+            0.0,
+            0.0,
+            0.0,
+            areal_density * (ixx_area + iyy_area),
+        );
+        Plate {
+            mass,
+            inertia,
+            reference_pose: Isometry3::translation(cx, cy, 0.0),
+            outline: outline.iter().map(|&[x, y]| Point3::new(x - cx, y - cy, 0.0)).collect(),
+            area,
+        }
+    }
+
+    /// Largest distance of the outline from the centre of mass, m.
+    pub fn radius(&self) -> f64 {
+        self.outline.iter().map(|p| p.coords.norm()).fold(0.0, f64::max)
+    }
+
+    /// Whether a body-frame point (z ignored) lies inside the outline or within `tolerance` of it.
+    pub fn contains(&self, local: &Point3<f64>, tolerance: f64) -> bool {
+        let count = self.outline.len();
+        (0..count).all(|k| {
+            let (a, b) = (self.outline[k], self.outline[(k + 1) % count]);
+            let edge = b - a;
+            let length = edge.x.hypot(edge.y);
+            // Signed distance to the left of the edge (inside for a counter-clockwise polygon).
+            (edge.x * (local.y - a.y) - edge.y * (local.x - a.x)) / length >= -tolerance
+        })
     }
 }
 
@@ -78,7 +132,7 @@ pub struct Data {
     pub poses: Vec<Isometry3<f64>>,
     /// Rᵢ I_body Rᵢᵀ: world-frame inertia tensors at the centres of mass.
     pub inertia_world: Vec<Matrix3<f64>>,
-    /// Plate corners in the world frame, 4 per plate in [`Plate::corners`] order.
+    /// Plate outline corners in the world frame, plate after plate ([`Model::corner_index`]).
     pub corners: Vec<Point3<f64>>,
     /// Iᵢ ω'_j (row-major i·n + j).
     pub inertia_axes: Vec<Vector3<f64>>,
@@ -106,7 +160,7 @@ impl Data {
             points: vec![Vector3::zeros(); n],
             poses: vec![Isometry3::identity(); n],
             inertia_world: vec![Matrix3::zeros(); n],
-            corners: vec![Point3::origin(); 4 * n],
+            corners: vec![Point3::origin(); model.plates.iter().map(|p| p.outline.len()).sum()],
             inertia_axes: vec![Vector3::zeros(); n * n],
             velocities: vec![Vector3::zeros(); n],
             linear_jacobian: vec![Vector3::zeros(); n * n],
@@ -134,6 +188,11 @@ impl Model {
         self.joints.len()
     }
 
+    /// Index of plate `plate`'s corner `corner` in [`Data::corners`].
+    pub fn corner_index(&self, plate: usize, corner: usize) -> usize {
+        self.plates[..plate].iter().map(|p| p.outline.len()).sum::<usize>() + corner
+    }
+
     /// Diagonal hinge stiffness K, N·m/rad.
     pub fn stiffness(&self) -> DVector<f64> {
         DVector::from_iterator(self.dof(), self.joints.iter().map(|j| j.stiffness))
@@ -153,9 +212,11 @@ impl Model {
 
     /// The plates' corners in the world frame (contact detection); needs the poses.
     pub fn update_corners(&self, data: &mut Data) {
+        let mut index = 0;
         for (i, plate) in self.plates.iter().enumerate() {
-            for (c, corner) in plate.corners().iter().enumerate() {
-                data.corners[4 * i + c] = data.poses[i] * corner;
+            for corner in &plate.outline {
+                data.corners[index] = data.poses[i] * corner;
+                index += 1;
             }
         }
     }
@@ -167,7 +228,7 @@ impl Model {
         for (i, plate) in self.plates.iter().enumerate() {
             let rotation = data.poses[i].rotation.to_rotation_matrix();
             let r = rotation.matrix();
-            let inertia = r * Matrix3::from_diagonal(&plate.principal_inertia) * r.transpose();
+            let inertia = r * plate.inertia * r.transpose();
             data.inertia_world[i] = inertia;
             let com = data.poses[i].translation.vector;
             for j in 0..n {
@@ -407,9 +468,12 @@ mod tests {
     pub(crate) fn skew_chain() -> Model {
         let plate = |centre: Vector3<f64>, rotation: Rotation3<f64>| Plate {
             mass: 2.0,
-            principal_inertia: Vector3::new(0.3, 0.2, 0.45),
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.3, 0.2, 0.45)),
             reference_pose: Isometry3::from_parts(Translation3::from(centre), rotation.into()),
-            half_extents: [0.5, 0.5],
+            outline: [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]
+                .iter()
+                .map(|&[x, y]| Point3::new(x, y, 0.0))
+                .collect(),
             area: 1.0,
         };
         Model {
@@ -446,6 +510,40 @@ mod tests {
         model.update_kinematics(angles, data);
         model.update_mass_matrix(data);
         data.mass_matrix.clone()
+    }
+
+    #[test]
+    fn lamina_moments_match_closed_forms() {
+        // A 2 × 3 box of thickness 0.1: m(b² + t²)/12 about x, m(a² + t²)/12 about y, m(a² + b²)/12 about z.
+        let (a, b, t, rho) = (2.0, 3.0, 0.1, 5.0);
+        let box_plate = Plate::lamina(&[[1.0, 1.0], [3.0, 1.0], [3.0, 4.0], [1.0, 4.0]], t, rho);
+        let m = rho * a * b * t;
+        assert!((box_plate.mass - m).abs() < 1e-12);
+        let expected = Vector3::new(m * (b * b + t * t), m * (a * a + t * t), m * (a * a + b * b)) / 12.0;
+        assert!((box_plate.inertia - Matrix3::from_diagonal(&expected)).amax() < 1e-12);
+        assert!((box_plate.reference_pose.translation.vector - Vector3::new(2.0, 2.5, 0.0)).norm() < 1e-15);
+        // A right triangle with legs a (x) and b (y) at the origin: centroid (a/3, b/3),
+        // ∫y'² = a b³/36, ∫x'² = a³ b/36, ∫x'y' = −a² b²/72 (standard tables).
+        let tri = Plate::lamina(&[[0.0, 0.0], [a, 0.0], [0.0, b]], t, rho);
+        let sigma = rho * t;
+        let mass = sigma * a * b / 2.0;
+        let through = mass * t * t / 12.0;
+        assert!((tri.reference_pose.translation.vector - Vector3::new(a / 3.0, b / 3.0, 0.0)).norm() < 1e-15);
+        let want = Matrix3::new(
+            sigma * a * b.powi(3) / 36.0 + through,
+            sigma * a * a * b * b / 72.0,
+            0.0,
+            sigma * a * a * b * b / 72.0,
+            sigma * a.powi(3) * b / 36.0 + through,
+            0.0,
+            0.0,
+            0.0,
+            sigma * (a * b.powi(3) + a.powi(3) * b) / 36.0,
+        );
+        assert!((tri.inertia - want).amax() < 1e-12, "{}", tri.inertia - want);
+        assert!(tri.contains(&Point3::new(0.0, 0.0, 0.0), 1e-12));
+        assert!(!tri.contains(&Point3::new(a / 3.0, b / 3.0, 0.0), 1e-12));
+        assert!(tri.contains(&Point3::new(-a / 6.0, -b / 6.0, 0.0), 1e-12));
     }
 
     #[test]

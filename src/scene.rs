@@ -7,7 +7,7 @@
 
 use crate::dynamics::{Drag, Joint, Model, Plate};
 use crate::error::{NanofoldError, Result};
-use nalgebra::{DVector, Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{DVector, Point3, Vector3};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -259,16 +259,17 @@ impl Scene {
             let width = positive(&format!("plates[{i}].width_um"), spec.width_um)? * MICROMETRE;
             let thickness = positive(&format!("plates[{i}].thickness_um"), spec.thickness_um)? * MICROMETRE;
             let density = material(&file, &format!("plates[{i}].material"), &spec.material)?.density_g_cm3 * 1e3;
-            let mass = density * length * width * thickness;
-            // Box moments at the centre of mass; about the crease-parallel x axis the plate's
-            // length enters, not its width (SPEC §7).
-            let principal_inertia = Vector3::new(
-                mass * (length * length + thickness * thickness) / 12.0,
-                mass * (width * width + thickness * thickness) / 12.0,
-                mass * (length * length + width * width) / 12.0,
+            // The flat plate spans x ∈ [−w/2, w/2], y ∈ [y, y + L]: a box whose moment about the
+            // crease-parallel x axis involves its length, not its width (SPEC §7).
+            let half = 0.5 * width;
+            let plate = Plate::lamina(
+                &[[-half, y], [half, y], [half, y + length], [-half, y + length]],
+                thickness,
+                density,
             );
+            let mass = plate.mass;
             let usable = |x: f64| x.is_finite() && x > 0.0;
-            if !(usable(mass) && principal_inertia.iter().all(|&m| usable(m))) {
+            if !(usable(mass) && (0..3).all(|k| usable(plate.inertia[(k, k)]))) {
                 return Err(NanofoldError::invalid(
                     format!("plates[{i}]"),
                     format!("mass {mass:e} kg"),
@@ -289,16 +290,7 @@ impl Scene {
                 point: Point3::new(0.0, y, 0.0),
                 stiffness,
             });
-            plates.push(Plate {
-                mass,
-                principal_inertia,
-                reference_pose: Isometry3::from_parts(
-                    Translation3::new(0.0, y + 0.5 * length, 0.0),
-                    UnitQuaternion::identity(),
-                ),
-                half_extents: [0.5 * width, 0.5 * length],
-                area: width * length,
-            });
+            plates.push(plate);
             y += length;
         }
         let mut target_angles = DVector::zeros(n);

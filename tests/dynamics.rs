@@ -174,9 +174,7 @@ fn kinetic_energy_from_plates(scene: &Scene, angles: &[f64], rates: &[f64]) -> f
         let relative = plus[i].rotation * minus[i].rotation.inverse();
         let omega: Vector3<f64> = relative.scaled_axis() / (2.0 * h);
         let rotation = plus[i].rotation.slerp(&minus[i].rotation, 0.5).to_rotation_matrix();
-        let inertia = rotation.matrix()
-            * nalgebra::Matrix3::from_diagonal(&plate.principal_inertia)
-            * rotation.matrix().transpose();
+        let inertia = rotation.matrix() * plate.inertia * rotation.matrix().transpose();
         energy += 0.5 * plate.mass * v.norm_squared() + 0.5 * omega.dot(&(inertia * omega));
     }
     energy

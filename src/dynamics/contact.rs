@@ -35,6 +35,8 @@ pub struct Collision {
 #[derive(Debug, Clone)]
 pub struct ContactSet {
     candidates: Vec<Candidate>,
+    /// Where each plate's corners start in [`Data::corners`].
+    corner_start: Vec<usize>,
     substrate_edge_y: f64,
     /// Gaps within this distance count as touching, m (1e-9 of the chain's length).
     touch_tolerance: f64,
@@ -83,12 +85,12 @@ impl ContactSet {
     /// of every plate at least two links away.
     pub fn new(model: &Model, substrate_edge_y: f64) -> Self {
         let n = model.dof();
-        let chain_length: f64 = model.plates.iter().map(|p| 2.0 * p.half_extents[1]).sum();
+        let chain_length: f64 = model.plates.iter().map(|p| 2.0 * p.radius()).sum();
         let touch_tolerance = 1e-9 * chain_length;
         let mut candidates = Vec::new();
         let anchor = &model.joints[0];
         for (i, plate) in model.plates.iter().enumerate() {
-            for (c, corner) in plate.corners().iter().enumerate() {
+            for (c, corner) in plate.outline.iter().enumerate() {
                 let world = plate.reference_pose * corner;
                 let offset = world - anchor.point;
                 let off_axis = offset - anchor.axis.into_inner() * offset.dot(&anchor.axis);
@@ -100,7 +102,7 @@ impl ContactSet {
         for face in 0..n {
             for plate in 0..n {
                 if face.abs_diff(plate) >= 2 {
-                    for corner in 0..4 {
+                    for corner in 0..model.plates[plate].outline.len() {
                         candidates.push(Candidate::Face { face, plate, corner });
                     }
                 }
@@ -108,6 +110,7 @@ impl ContactSet {
         }
         ContactSet {
             candidates,
+            corner_start: (0..n).map(|i| model.corner_index(i, 0)).collect(),
             substrate_edge_y,
             touch_tolerance,
         }
@@ -121,22 +124,22 @@ impl ContactSet {
         self.candidates.is_empty()
     }
 
-    fn corner_world(data: &Data, plate: usize, corner: usize) -> Point3<f64> {
-        data.corners[4 * plate + corner]
+    fn corner_world(&self, data: &Data, plate: usize, corner: usize) -> Point3<f64> {
+        data.corners[self.corner_start[plate] + corner]
     }
 
     /// Signed gap of candidate k (needs kinematics): negative means penetration.
     fn gap(&self, k: usize, data: &Data) -> f64 {
         match self.candidates[k] {
             Candidate::Substrate { plate, corner } => {
-                let p = Self::corner_world(data, plate, corner);
+                let p = self.corner_world(data, plate, corner);
                 let (dy, dz) = (p.y - self.substrate_edge_y, p.z);
                 // Signed distance to the quarter-space {y ≤ edge, z ≤ 0}, minus the touch tolerance.
                 let distance = if dy > 0.0 && dz > 0.0 { dy.hypot(dz) } else { dy.max(dz) };
                 distance - self.touch_tolerance
             }
             Candidate::Face { face, plate, corner } => {
-                let p = Self::corner_world(data, plate, corner);
+                let p = self.corner_world(data, plate, corner);
                 let pose = &data.poses[face];
                 let normal = pose.rotation * Vector3::z();
                 normal.dot(&(p - pose.translation.vector).coords)
@@ -149,10 +152,9 @@ impl ContactSet {
         match self.candidates[k] {
             Candidate::Substrate { .. } => true,
             Candidate::Face { face, plate, corner } => {
-                let p = Self::corner_world(data, plate, corner);
+                let p = self.corner_world(data, plate, corner);
                 let local = data.poses[face].inverse_transform_point(&p);
-                let [a, b] = model.plates[face].half_extents;
-                local.x.abs() <= a + self.touch_tolerance && local.y.abs() <= b + self.touch_tolerance
+                model.plates[face].contains(&local, self.touch_tolerance)
             }
         }
     }
@@ -181,18 +183,14 @@ impl ContactSet {
         Collision {
             time,
             pair,
-            point: Self::corner_world(data, plate, corner).coords,
+            point: self.corner_world(data, plate, corner).coords,
         }
     }
 
     /// An upper bound on how far any corner can be from any hinge axis upstream of it, m:
     /// the sum of the plates' diagonals. A corner moves at most this × Σ|θ̇_j|.
     pub fn lever(model: &Model) -> f64 {
-        model
-            .plates
-            .iter()
-            .map(|p| 2.0 * p.half_extents[0].hypot(p.half_extents[1]))
-            .sum()
+        model.plates.iter().map(|p| 2.0 * p.radius()).sum()
     }
 
     /// The earliest contact in (t_start, t_end], bisecting (Illinois) each sign change of a gap

@@ -225,7 +225,8 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
         model.update_corners(&mut data);
         let mut points = Vec::new();
         for i in 0..model.dof() {
-            let c = &data.corners[4 * i..4 * i + 4];
+            let first = model.corner_index(i, 0);
+            let c = &data.corners[first..first + 4];
             let start = (c[0] + c[1].coords) / 2.0;
             let end = (c[2] + c[3].coords) / 2.0;
             if i == 0 {
