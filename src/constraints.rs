@@ -4,6 +4,7 @@
 //! exported report with its errors against exact loop closure.
 
 pub mod chebyshev;
+pub mod exact;
 pub mod sweep;
 
 use crate::error::{NanofoldError, Result};
@@ -137,7 +138,7 @@ impl Setup {
     }
 
     /// Ray fold angles with the held creases at their lock values and the others folded.
-    fn base_ray_angles(&self, pattern: &Pattern) -> Vec<f64> {
+    pub(crate) fn base_ray_angles(&self, pattern: &Pattern) -> Vec<f64> {
         let mut rho = pattern.folded_ray_angles();
         for &(c, value) in &self.locked {
             rho[pattern.creases[c].ray] = value;
@@ -405,6 +406,18 @@ impl ConstraintPoly {
         self.check_domain(theta)?;
         for (o, curve) in out.iter_mut().zip(&self.curves) {
             *o = curve.eval_with_derivatives(theta).2 * theta_dot;
+        }
+        Ok(())
+    }
+
+    /// f, G = f′ and f″ at θ_c in one pass (the closed-chain equations need all three).
+    pub fn evaluate(&self, theta: f64, point: &mut exact::ConstraintPoint) -> Result<()> {
+        self.check_domain(theta)?;
+        for (k, curve) in self.curves.iter().enumerate() {
+            let (value, slope, curvature) = curve.eval_with_derivatives(theta);
+            point.values[k] = value;
+            point.jacobian[k] = slope;
+            point.curvature[k] = curvature;
         }
         Ok(())
     }

@@ -192,76 +192,112 @@ impl ContactSet {
     pub fn lever(model: &Model) -> f64 {
         model.plates.iter().map(|p| 2.0 * p.radius()).sum()
     }
+}
 
-    /// The earliest contact in (t_start, t_end], bisecting (Illinois) each sign change of a gap
-    /// along the path θ(t) given by `angles_at`. The end of the interval is checked first; only
-    /// if some gap is within `reach` (a bound on how far two corners can move towards each
-    /// other over the interval; infinite to always subdivide) of zero without changing sign
-    /// is the interval scanned in `subdivisions` parts, so a gap that dips through zero and
-    /// back within it is not missed. `gaps_start` holds the gaps at t_start and is left
-    /// holding those at t_end.
-    #[allow(clippy::too_many_arguments)]
-    pub fn locate(
-        &self,
-        model: &Model,
-        data: &mut Data,
-        t_start: f64,
-        t_end: f64,
-        reach: f64,
-        subdivisions: usize,
-        gaps_start: &mut [f64],
-        gaps_scratch: &mut [f64],
-        angles: &mut [f64],
-        angles_at: &mut dyn FnMut(f64, &mut [f64]),
-    ) -> Option<Collision> {
-        angles_at(t_end, angles);
-        model.update_poses(angles, data);
-        model.update_corners(data);
-        self.gaps(data, gaps_scratch);
-        let near = (0..self.len()).any(|k| {
-            let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
-            g0.signum() == g1.signum() && g0.abs().min(g1.abs()) < reach
-        });
-        let subdivisions = if near { subdivisions.max(1) } else { 1 };
-        let mut t_left = t_start;
-        for s in 1..=subdivisions {
-            let t_right = t_start + (t_end - t_start) * s as f64 / subdivisions as f64;
-            if subdivisions > 1 {
-                angles_at(t_right, angles);
-                model.update_poses(angles, data);
-                model.update_corners(data);
-                self.gaps(data, gaps_scratch);
-            }
-            let mut earliest: Option<(f64, usize)> = None;
-            for k in 0..self.len() {
-                let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
-                let crosses = g0 != 0.0 && (g1 == 0.0 || g0.signum() != g1.signum());
-                if !crosses {
-                    continue;
-                }
-                let mut gap_at = |t: f64| {
-                    angles_at(t, angles);
-                    model.update_poses(angles, data);
-                    model.update_corners(data);
-                    self.gap(k, data)
-                };
-                let hi = illinois(&mut gap_at, (t_left, g0), (t_right, g1));
-                angles_at(hi, angles);
-                model.update_poses(angles, data);
-                model.update_corners(data);
-                if self.gate(k, model, data) && earliest.is_none_or(|(t, _)| hi < t) {
-                    earliest = Some((hi, k));
-                }
-            }
-            if let Some((time, k)) = earliest {
-                angles_at(time, angles);
-                model.update_poses(angles, data);
-                model.update_corners(data);
-                return Some(self.collision(k, time, data));
-            }
-            gaps_start.copy_from_slice(gaps_scratch);
-            t_left = t_right;
+/// What [`locate`] needs of a set of contact candidates along a path: the configuration at a
+/// path parameter, every candidate's signed gap (negative means penetration), whether a zero
+/// is a real contact, and the contact's description.
+pub trait ContactProbe {
+    fn len(&self) -> usize;
+    /// Moves to the configuration at path parameter t.
+    fn move_to(&mut self, t: f64);
+    /// Gap of candidate k at the current configuration.
+    fn gap(&self, k: usize) -> f64;
+    /// Whether a zero of candidate k's gap at the current configuration is a real contact.
+    fn gate(&self, k: usize) -> bool;
+    fn collision(&self, k: usize, t: f64) -> Collision;
+}
+
+/// The earliest contact in (t_start, t_end], bisecting (Illinois) each sign change of a gap
+/// along the probe's path. The end of the interval is checked first; only if some gap is
+/// within `reach` (a bound on how far two corners can move towards each other over the
+/// interval; infinite to always subdivide) of zero without changing sign is the interval
+/// scanned in `subdivisions` parts, so a gap that dips through zero and back within it is not
+/// missed. `gaps_start` holds the gaps at t_start and is left holding those at t_end.
+pub fn locate(
+    probe: &mut dyn ContactProbe,
+    t_start: f64,
+    t_end: f64,
+    reach: f64,
+    subdivisions: usize,
+    gaps_start: &mut [f64],
+    gaps_scratch: &mut [f64],
+) -> Option<Collision> {
+    let fill = |probe: &mut dyn ContactProbe, t: f64, gaps: &mut [f64]| {
+        probe.move_to(t);
+        for (k, gap) in gaps.iter_mut().enumerate() {
+            *gap = probe.gap(k);
         }
-        None
+    };
+    fill(probe, t_end, gaps_scratch);
+    let near = (0..probe.len()).any(|k| {
+        let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
+        g0.signum() == g1.signum() && g0.abs().min(g1.abs()) < reach
+    });
+    let subdivisions = if near { subdivisions.max(1) } else { 1 };
+    let mut t_left = t_start;
+    for s in 1..=subdivisions {
+        let t_right = t_start + (t_end - t_start) * s as f64 / subdivisions as f64;
+        if subdivisions > 1 {
+            fill(probe, t_right, gaps_scratch);
+        }
+        let mut earliest: Option<(f64, usize)> = None;
+        for k in 0..probe.len() {
+            let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
+            let crosses = g0 != 0.0 && (g1 == 0.0 || g0.signum() != g1.signum());
+            if !crosses {
+                continue;
+            }
+            let mut gap_at = |t: f64| {
+                probe.move_to(t);
+                probe.gap(k)
+            };
+            let hi = illinois(&mut gap_at, (t_left, g0), (t_right, g1));
+            probe.move_to(hi);
+            if probe.gate(k) && earliest.is_none_or(|(t, _)| hi < t) {
+                earliest = Some((hi, k));
+            }
+        }
+        if let Some((time, k)) = earliest {
+            probe.move_to(time);
+            return Some(probe.collision(k, time));
+        }
+        gaps_start.copy_from_slice(gaps_scratch);
+        t_left = t_right;
+    }
+    None
+}
+
+/// An open chain's [`ContactSet`] along a path of joint angles.
+pub struct ChainProbe<'a> {
+    pub contacts: &'a ContactSet,
+    pub model: &'a Model,
+    pub data: &'a mut Data,
+    pub angles: &'a mut [f64],
+    /// Joint angles at a path parameter.
+    pub path: &'a mut dyn FnMut(f64, &mut [f64]),
+}
+
+impl ContactProbe for ChainProbe<'_> {
+    fn len(&self) -> usize {
+        self.contacts.len()
+    }
+
+    fn move_to(&mut self, t: f64) {
+        (self.path)(t, self.angles);
+        self.model.update_poses(self.angles, self.data);
+        self.model.update_corners(self.data);
+    }
+
+    fn gap(&self, k: usize) -> f64 {
+        self.contacts.gap(k, self.data)
+    }
+
+    fn gate(&self, k: usize) -> bool {
+        self.contacts.gate(k, self.model, self.data)
+    }
+
+    fn collision(&self, k: usize, t: f64) -> Collision {
+        self.contacts.collision(k, t, self.data)
     }
 }

@@ -6,7 +6,7 @@
 //! are both O(1) and one absolute tolerance fits all components (SPEC §1: masses ~1e-12 kg,
 //! stiffnesses ~1e-9 N·m give rates ~1e4 rad/s in SI).
 
-use super::contact::{Collision, ContactSet};
+use super::contact::{locate, ChainProbe, Collision, ContactSet};
 use super::modes::modes;
 use super::Data;
 use crate::error::{NanofoldError, Result};
@@ -403,23 +403,26 @@ fn quasi_static(
                 Actuation::Ramp { .. } => scene.drive_angles(t * moving_until, out),
             };
             // Scan the path over its parameter u ∈ [0, 1].
-            collision = contacts
-                .locate(
-                    model,
-                    &mut data,
-                    0.0,
-                    1.0,
-                    f64::INFINITY,
-                    subdivisions,
-                    &mut gaps,
-                    &mut scratch,
-                    &mut angles,
-                    &mut path,
-                )
-                .map(|mut c| {
-                    c.time *= moving_until;
-                    c
-                });
+            let mut probe = ChainProbe {
+                contacts,
+                model,
+                data: &mut data,
+                angles: &mut angles,
+                path: &mut path,
+            };
+            collision = locate(
+                &mut probe,
+                0.0,
+                1.0,
+                f64::INFINITY,
+                subdivisions,
+                &mut gaps,
+                &mut scratch,
+            )
+            .map(|mut c| {
+                c.time *= moving_until;
+                c
+            });
         }
     }
     let stop = collision.as_ref().map_or(f64::INFINITY, |c| c.time);
@@ -700,23 +703,26 @@ impl Driver<'_> {
                         }
                     }
                 };
-                collision = contacts
-                    .locate(
-                        model,
-                        &mut data,
-                        s_previous,
-                        s_now,
-                        reach,
-                        CONTACT_SUBDIVISIONS,
-                        &mut gaps,
-                        &mut gaps_scratch,
-                        &mut angles,
-                        &mut path,
-                    )
-                    .map(|mut c| {
-                        c.time *= self.time_unit;
-                        c
-                    });
+                let mut probe = ChainProbe {
+                    contacts,
+                    model,
+                    data: &mut data,
+                    angles: &mut angles,
+                    path: &mut path,
+                };
+                collision = locate(
+                    &mut probe,
+                    s_previous,
+                    s_now,
+                    reach,
+                    CONTACT_SUBDIVISIONS,
+                    &mut gaps,
+                    &mut gaps_scratch,
+                )
+                .map(|mut c| {
+                    c.time *= self.time_unit;
+                    c
+                });
             }
             let s_stop = collision.as_ref().map_or(s_now, |c| c.time / self.time_unit);
             while next_output < self.output_times.len() && self.output_times[next_output] / self.time_unit <= s_stop {
