@@ -47,7 +47,7 @@ fn bench_terms(c: &mut Criterion) {
     group.bench_function("accelerations", |b| {
         b.iter(|| {
             model
-                .accelerations(black_box(&angles), &rates, &torques, &mut data, &mut accel)
+                .accelerations(black_box(&angles), &rates, &torques, &mut data, accel.as_mut_slice())
                 .unwrap()
         })
     });

@@ -10,7 +10,9 @@ pub mod modes;
 pub mod simulate;
 
 use crate::error::{NanofoldError, Result};
-use nalgebra::{Cholesky, DMatrix, DVector, Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{
+    Cholesky, DMatrix, DVector, DVectorViewMut, Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuaternion, Vector3,
+};
 
 /// A revolute hinge in the flat reference configuration: the twist ξ = (−ω × q, ω) (T4.2).
 #[derive(Debug, Clone)]
@@ -433,7 +435,7 @@ impl Model {
         fold_rates: &[f64],
         torques: &[f64],
         data: &mut Data,
-        accel: &mut DVector<f64>,
+        accel: &mut [f64],
     ) -> Result<()> {
         let n = self.dof();
         self.update_kinematics(fold_angles, data);
@@ -441,7 +443,7 @@ impl Model {
         self.update_velocities(fold_rates, data);
         let mut coriolis = std::mem::take(&mut data.coriolis_torques);
         self.coriolis_torques(fold_rates, data, &mut coriolis);
-        let drag = accel.as_mut_slice();
+        let drag = &mut *accel;
         self.drag_torques(data, drag);
         for i in 0..n {
             drag[i] += torques[i] - coriolis[i] - self.joints[i].stiffness * fold_angles[i];
@@ -453,7 +455,7 @@ impl Model {
             stage: "dynamics".into(),
             message: format!("mass matrix not positive definite at θ = {fold_angles:?}"),
         })?;
-        cholesky.solve_mut(accel);
+        cholesky.solve_mut(&mut DVectorViewMut::from_slice(accel, n));
         data.factor = cholesky.unpack_dirty();
         Ok(())
     }

@@ -198,7 +198,8 @@ impl ContactSet {
 /// path parameter, every candidate's signed gap (negative means penetration), whether a zero
 /// is a real contact, and the contact's description.
 pub trait ContactProbe {
-    fn len(&self) -> usize;
+    /// Number of candidates.
+    fn count(&self) -> usize;
     /// Moves to the configuration at path parameter t.
     fn move_to(&mut self, t: f64);
     /// Gap of candidate k at the current configuration.
@@ -230,7 +231,7 @@ pub fn locate(
         }
     };
     fill(probe, t_end, gaps_scratch);
-    let near = (0..probe.len()).any(|k| {
+    let near = (0..probe.count()).any(|k| {
         let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
         g0.signum() == g1.signum() && g0.abs().min(g1.abs()) < reach
     });
@@ -242,7 +243,7 @@ pub fn locate(
             fill(probe, t_right, gaps_scratch);
         }
         let mut earliest: Option<(f64, usize)> = None;
-        for k in 0..probe.len() {
+        for k in 0..probe.count() {
             let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
             let crosses = g0 != 0.0 && (g1 == 0.0 || g0.signum() != g1.signum());
             if !crosses {
@@ -279,7 +280,7 @@ pub struct ChainProbe<'a> {
 }
 
 impl ContactProbe for ChainProbe<'_> {
-    fn len(&self) -> usize {
+    fn count(&self) -> usize {
         self.contacts.len()
     }
 

@@ -6,7 +6,7 @@
 //! are both O(1) and one absolute tolerance fits all components (SPEC §1: masses ~1e-12 kg,
 //! stiffnesses ~1e-9 N·m give rates ~1e4 rad/s in SI).
 
-use super::contact::{locate, ChainProbe, Collision, ContactSet};
+use super::contact::{locate, ChainProbe, Collision, ContactProbe, ContactSet};
 use super::modes::modes;
 use super::Data;
 use crate::error::{NanofoldError, Result};
@@ -272,7 +272,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
                 record_steps: true,
                 max_steps: settings.max_steps,
             };
-            let run = integrate(scene, method, &output_times, contacts.as_ref(), options)?;
+            let run = integrate(&OpenChain { scene, contacts }, method, &output_times, options)?;
             response.method = Some(method);
             response.steps = run.steps;
             response.rhs_evaluations = run.rhs_evaluations;
@@ -300,7 +300,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
                 record_steps: false,
                 max_steps: settings.max_steps,
             };
-            let run = integrate(scene, method, &check_times, None, options)?;
+            let run = integrate(&OpenChain { scene, contacts: None }, method, &check_times, options)?;
             response.measured_quasi_static_error = Some((window, quasi_static_deviation(scene, &run.samples)));
         }
     }
@@ -326,6 +326,126 @@ pub fn quasi_static_deviation(scene: &Scene, samples: &[Sample]) -> f64 {
                 .fold(0.0, f64::max)
         })
         .fold(0.0, f64::max)
+}
+
+/// What the integrator needs of a mechanical system: its generalised coordinates q (the
+/// hinge angles of an open chain, the driving angle of a closed one), their accelerations,
+/// output samples and contact candidates.
+pub trait Plant {
+    /// Scratch buffers reused across evaluations.
+    type Workspace;
+    fn workspace(&self) -> Self::Workspace;
+    /// Number of generalised coordinates.
+    fn dof(&self) -> usize;
+    /// The slowest natural angular frequency at the start, rad/s: the integrator's time unit.
+    fn slowest_omega(&self) -> Result<f64>;
+    /// q at t = 0 (at rest).
+    fn initial_coordinates(&self) -> Vec<f64>;
+    /// q̈ at (t, q, q̇), written into `out`.
+    fn accelerations(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()>;
+    /// An output sample at (t, q, q̇).
+    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace) -> Result<Sample>;
+    /// Times where the forcing has a kink (no step may straddle them), s.
+    fn forcing_breakpoints(&self) -> Vec<f64>;
+    /// Number of contact candidates (0 when collisions are ignored).
+    fn contact_count(&self) -> usize;
+    /// A contact present at the configuration q (e.g. at t = 0).
+    fn touching(&self, t: f64, q: &[f64], ws: &mut Self::Workspace) -> Option<Collision>;
+    /// Two contact points approach each other at most this × Σ|q̇_j| (m per rad).
+    fn contact_lever(&self) -> f64;
+    /// The contact candidates along a path q(u) of a parameter u.
+    fn probe<'a>(
+        &'a self,
+        ws: &'a mut Self::Workspace,
+        q: &'a mut [f64],
+        path: &'a mut dyn FnMut(f64, &mut [f64]),
+    ) -> Box<dyn ContactProbe + 'a>;
+}
+
+/// An open chain of a strip scene: q = θ, the hinge angles.
+pub struct OpenChain<'s> {
+    pub scene: &'s Scene,
+    pub contacts: Option<ContactSet>,
+}
+
+/// Scratch of an [`OpenChain`]: the model's buffers and the hinge torques.
+pub struct OpenChainWorkspace {
+    data: Data,
+    torques: Vec<f64>,
+}
+
+impl Plant for OpenChain<'_> {
+    type Workspace = OpenChainWorkspace;
+
+    fn workspace(&self) -> OpenChainWorkspace {
+        OpenChainWorkspace {
+            data: Data::new(&self.scene.model),
+            torques: vec![0.0; self.dof()],
+        }
+    }
+
+    fn dof(&self) -> usize {
+        self.scene.model.dof()
+    }
+
+    fn slowest_omega(&self) -> Result<f64> {
+        let flat = modes(&self.scene.model, &vec![0.0; self.dof()])?;
+        Ok(flat.eigenvalues.last().copied().unwrap_or(1.0).sqrt())
+    }
+
+    fn initial_coordinates(&self) -> Vec<f64> {
+        vec![0.0; self.dof()]
+    }
+
+    fn accelerations(
+        &self,
+        t: f64,
+        q: &[f64],
+        q_dot: &[f64],
+        ws: &mut OpenChainWorkspace,
+        out: &mut [f64],
+    ) -> Result<()> {
+        self.scene.torques(t, &mut ws.torques);
+        self.scene.model.accelerations(q, q_dot, &ws.torques, &mut ws.data, out)
+    }
+
+    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut OpenChainWorkspace) -> Result<Sample> {
+        Ok(sample(self.scene, &mut ws.data, t, q, q_dot))
+    }
+
+    fn forcing_breakpoints(&self) -> Vec<f64> {
+        self.scene.forcing_breakpoints()
+    }
+
+    fn contact_count(&self) -> usize {
+        self.contacts.as_ref().map_or(0, ContactSet::len)
+    }
+
+    fn touching(&self, t: f64, q: &[f64], ws: &mut OpenChainWorkspace) -> Option<Collision> {
+        let contacts = self.contacts.as_ref()?;
+        self.scene.model.update_kinematics(q, &mut ws.data);
+        self.scene.model.update_corners(&mut ws.data);
+        contacts.touching(t, &ws.data)
+    }
+
+    fn contact_lever(&self) -> f64 {
+        ContactSet::lever(&self.scene.model)
+    }
+
+    fn probe<'a>(
+        &'a self,
+        ws: &'a mut OpenChainWorkspace,
+        q: &'a mut [f64],
+        path: &'a mut dyn FnMut(f64, &mut [f64]),
+    ) -> Box<dyn ContactProbe + 'a> {
+        Box::new(ChainProbe {
+            contacts: self.contacts.as_ref().expect("probe needs contacts"),
+            model: &self.scene.model,
+            data: &mut ws.data,
+            angles: q,
+            path,
+        })
+    }
 }
 
 fn resolve_method(method: Method, scales: &TimeScales) -> Method {
@@ -445,28 +565,28 @@ fn quasi_static(
 
 /// How one diffsol run is driven.
 #[derive(Debug, Clone, Copy)]
-struct IntegrationOptions {
-    rtol: f64,
-    progress: bool,
+pub struct IntegrationOptions {
+    pub rtol: f64,
+    pub progress: bool,
     /// Record a sample at every accepted step besides the output times.
-    record_steps: bool,
-    max_steps: usize,
+    pub record_steps: bool,
+    pub max_steps: usize,
 }
 
 /// Result of one diffsol run.
-struct DynamicRun {
-    samples: Vec<Sample>,
-    collision: Option<Collision>,
-    steps: usize,
-    rhs_evaluations: usize,
+pub struct DynamicRun {
+    pub samples: Vec<Sample>,
+    pub collision: Option<Collision>,
+    pub steps: usize,
+    pub rhs_evaluations: usize,
 }
 
-/// Integrates M θ̈ + C θ̇ + K θ = τ(t) + Q_drag from rest at θ = 0.
-fn integrate(
-    scene: &Scene,
+/// Integrates a plant from rest at its initial coordinates: for an open chain
+/// M θ̈ + C θ̇ + K θ = τ(t) + Q_drag.
+pub fn integrate<P: Plant>(
+    plant: &P,
     method: Method,
     output_times: &[f64],
-    contacts: Option<&ContactSet>,
     options: IntegrationOptions,
 ) -> Result<DynamicRun> {
     let IntegrationOptions {
@@ -475,24 +595,21 @@ fn integrate(
         record_steps,
         max_steps,
     } = options;
-    let model = &scene.model;
-    let n = model.dof();
-    let flat = modes(model, &vec![0.0; n])?;
-    let slowest_omega = flat.eigenvalues.last().copied().unwrap_or(1.0).sqrt();
-    let time_unit = 1.0 / slowest_omega;
+    let n = plant.dof();
+    let time_unit = 1.0 / plant.slowest_omega()?;
+    let initial = plant.initial_coordinates();
     let evaluations = Cell::new(0usize);
     let failure: RefCell<Option<NanofoldError>> = RefCell::new(None);
-    let workspace = RefCell::new((Data::new(model), vec![0.0; n], vec![0.0; n], DVector::zeros(n)));
+    let workspace = RefCell::new((plant.workspace(), vec![0.0; n], vec![0.0; n]));
     let rhs = |y: &[f64], s: f64, dy: &mut [f64]| {
         evaluations.set(evaluations.get() + 1);
         let mut guard = workspace.borrow_mut();
-        let (data, rates, torques, accel) = &mut *guard;
+        let (ws, rates, accel) = &mut *guard;
         let (angles, scaled_rates) = y.split_at(n);
         for (r, v) in rates.iter_mut().zip(scaled_rates) {
             *r = v / time_unit;
         }
-        scene.torques(s * time_unit, torques);
-        if let Err(e) = model.accelerations(angles, rates, torques, data, accel) {
+        if let Err(e) = plant.accelerations(s * time_unit, angles, rates, ws, accel) {
             failure.borrow_mut().get_or_insert(e);
             dy.iter_mut().for_each(|d| *d = f64::NAN);
             return;
@@ -532,7 +649,10 @@ fn integrate(
             |y: &[f64], _p: &[f64], s: f64, v: &[f64], jv: &mut [f64]| jacobian_times(y, s, v, jv),
         )
         .init(
-            |_p: &[f64], _t: f64, y: &mut [f64]| y.iter_mut().for_each(|x| *x = 0.0),
+            |_p: &[f64], _t: f64, y: &mut [f64]| {
+                y.iter_mut().for_each(|x| *x = 0.0);
+                y[..n].copy_from_slice(&initial);
+            },
             2 * n,
         )
         .build()
@@ -553,8 +673,7 @@ fn integrate(
         ProgressBar::hidden()
     };
     let driver = Driver {
-        scene,
-        contacts,
+        plant,
         output_times,
         time_unit,
         s_end,
@@ -593,9 +712,8 @@ fn ode_error(e: &diffsol::error::DiffsolError) -> NanofoldError {
 }
 
 /// Steps a diffsol solver to the end or the first contact, sampling the dense output.
-struct Driver<'r> {
-    scene: &'r Scene,
-    contacts: Option<&'r ContactSet>,
+struct Driver<'r, P: Plant> {
+    plant: &'r P,
     output_times: &'r [f64],
     time_unit: f64,
     s_end: f64,
@@ -607,15 +725,15 @@ struct Driver<'r> {
     max_steps: usize,
 }
 
-impl Driver<'_> {
+impl<P: Plant> Driver<'_, P> {
     fn run<'a, Eqn, S>(&self, mut solver: S) -> Result<(Vec<Sample>, Option<Collision>, usize, usize)>
     where
         Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
-        let model = &self.scene.model;
-        let n = model.dof();
-        let mut data = Data::new(model);
+        let plant = self.plant;
+        let n = plant.dof();
+        let mut ws = plant.workspace();
         let mut samples = Vec::with_capacity(self.output_times.len());
         let mut state = solver.state().y.clone();
         let mut angles = vec![0.0; n];
@@ -627,24 +745,29 @@ impl Driver<'_> {
             }
         };
         split(&state, &mut angles, &mut rates);
-        samples.push(sample(self.scene, &mut data, 0.0, &angles, &rates));
+        samples.push(plant.sample(0.0, &angles, &rates, &mut ws)?);
         let mut next_output = 1;
         let mut gaps = Vec::new();
         let mut gaps_scratch = Vec::new();
-        if let Some(contacts) = self.contacts {
-            model.update_kinematics(&angles, &mut data);
-            model.update_corners(&mut data);
-            if let Some(c) = contacts.touching(0.0, &data) {
+        let contact_count = plant.contact_count();
+        if contact_count > 0 {
+            if let Some(c) = plant.touching(0.0, &angles, &mut ws) {
                 return Ok((samples, Some(c), 0, 0));
             }
-            gaps = vec![0.0; contacts.len()];
-            gaps_scratch = vec![0.0; contacts.len()];
-            contacts.gaps(&data, &mut gaps);
+            gaps = vec![0.0; contact_count];
+            gaps_scratch = vec![0.0; contact_count];
+            let start = angles.clone();
+            let mut at_start = |_: f64, out: &mut [f64]| out.copy_from_slice(&start);
+            let mut probe = plant.probe(&mut ws, &mut angles, &mut at_start);
+            probe.move_to(0.0);
+            for (k, gap) in gaps.iter_mut().enumerate() {
+                *gap = probe.gap(k);
+            }
         }
         // Stop exactly at each kink of the forcing (a ramp reaching its target), so no step
         // straddles it, then at the end.
         let mut stops: Vec<f64> = self
-            .scene
+            .plant
             .forcing_breakpoints()
             .into_iter()
             .map(|t| t / self.time_unit)
@@ -658,7 +781,7 @@ impl Driver<'_> {
         // Σ|dθ/ds| at the previous step's end, for the contact reach bound.
         let speed_sum = |y: &NalgebraVec<f64>| (n..2 * n).map(|i| y[i].abs()).sum::<f64>();
         let mut previous_speed: f64 = 0.0;
-        let lever = ContactSet::lever(model);
+        let lever = plant.contact_lever();
         loop {
             let reason = solver.step().map_err(|e| ode_error(&e))?;
             steps += 1;
@@ -692,7 +815,7 @@ impl Driver<'_> {
             }
             let current_speed = speed_sum(solver.state().y);
             let mut collision = None;
-            if let Some(contacts) = self.contacts {
+            if contact_count > 0 {
                 // Two corners approach each other at most 2 × lever × Σ|θ̇| (with θ̇ between its
                 // values at the step's ends, ×2 for safety as it varies within the step).
                 let reach = 4.0 * lever * (s_now - s_previous) * previous_speed.max(current_speed);
@@ -703,15 +826,9 @@ impl Driver<'_> {
                         }
                     }
                 };
-                let mut probe = ChainProbe {
-                    contacts,
-                    model,
-                    data: &mut data,
-                    angles: &mut angles,
-                    path: &mut path,
-                };
+                let mut probe = plant.probe(&mut ws, &mut angles, &mut path);
                 collision = locate(
-                    &mut probe,
+                    probe.as_mut(),
                     s_previous,
                     s_now,
                     reach,
@@ -729,13 +846,7 @@ impl Driver<'_> {
                 let s = (self.output_times[next_output] / self.time_unit).min(s_now);
                 solver.interpolate_inplace(s, &mut state).map_err(|e| ode_error(&e))?;
                 split(&state, &mut angles, &mut rates);
-                samples.push(sample(
-                    self.scene,
-                    &mut data,
-                    self.output_times[next_output],
-                    &angles,
-                    &rates,
-                ));
+                samples.push(plant.sample(self.output_times[next_output], &angles, &rates, &mut ws)?);
                 next_output += 1;
             }
             if let Some(c) = collision {
@@ -743,7 +854,7 @@ impl Driver<'_> {
                     .interpolate_inplace(c.time / self.time_unit, &mut state)
                     .map_err(|e| ode_error(&e))?;
                 split(&state, &mut angles, &mut rates);
-                samples.push(sample(self.scene, &mut data, c.time, &angles, &rates));
+                samples.push(plant.sample(c.time, &angles, &rates, &mut ws)?);
                 return Ok((
                     samples,
                     Some(c),
@@ -758,7 +869,7 @@ impl Driver<'_> {
                     .interpolate_inplace(s_now, &mut state)
                     .map_err(|e| ode_error(&e))?;
                 split(&state, &mut angles, &mut rates);
-                samples.push(sample(self.scene, &mut data, s_now_time, &angles, &rates));
+                samples.push(plant.sample(s_now_time, &angles, &rates, &mut ws)?);
             }
             self.bar.set_position((1000.0 * s_now / self.s_end) as u64);
             self.bar.set_message(format!("{:.3e} s", s_now * self.time_unit));
