@@ -7,14 +7,19 @@ use nanofold::constraints::{
     default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
     Setup, Source,
 };
+use nanofold::dynamics::closed::simulate_closed;
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::energy::EnergyKind;
-use nanofold::output::{fold_animation, modes_json, response_json, response_summary, trajectory_json, write_atomic};
+use nanofold::output::{
+    closed_response_json, closed_response_summary, fold_animation, modes_json, response_json, response_summary,
+    trajectory_json, write_atomic,
+};
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::plot::response::{response_svg, snapshots_svg};
+use nanofold::plot::response::{response_svg, response_view_svg, snapshots_svg, ResponseView};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::qp::QpMethod;
+use nanofold::scene::closed::{is_closed_scene, ClosedScene};
 use nanofold::scene::Scene;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldReport, UnfoldSettings};
 use serde_json::json;
@@ -492,8 +497,100 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     Ok(())
 }
 
+/// `simulate` on a closed-chain scene: response.json and response.svg (every crease's angle).
+fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Result<()> {
+    let scene = ClosedScene::load(&args.scene)?;
+    let response = simulate_closed(&scene, settings)?;
+    let chain = &scene.chain;
+    let view = ResponseView {
+        name: scene.name.clone(),
+        labels: (0..chain.crease_stiffness.len())
+            .map(|c| {
+                let role = if c == chain.driver {
+                    "driven"
+                } else if chain.locked.iter().any(|&(l, _)| l == c) {
+                    "locked"
+                } else if c == chain.cut_crease {
+                    "cut, follows"
+                } else {
+                    "follows"
+                };
+                format!("{} ({role})", chain.crease_labels[c])
+            })
+            .collect(),
+        targets: (0..chain.crease_stiffness.len())
+            .map(|c| (c == chain.driver).then_some(chain.target))
+            .collect(),
+        drag: chain.model.drag.is_some(),
+    };
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(&scene.name));
+    let files = [
+        (
+            "response.json",
+            serde_json::to_string(&closed_response_json(&scene, settings, &response))?,
+        ),
+        ("response.svg", response_view_svg(&view, &response)?),
+    ];
+    for (name, contents) in &files {
+        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
+    }
+    let summary = closed_response_summary(&scene, settings, &response);
+    if args.json {
+        println!("{summary}");
+        return Ok(());
+    }
+    let closed = response.closed.as_ref().expect("closed-chain runs report their chain");
+    println!(
+        "{}: closed chain, {} driven, {} cut, f = {}{} (fit error {:.2e} rad)",
+        scene.name,
+        chain.crease_labels[chain.driver],
+        chain.crease_labels[chain.cut_crease],
+        closed.constraint_source,
+        closed.degree.map_or(String::new(), |d| format!(" degree {d}")),
+        closed.fit_error
+    );
+    println!(
+        "  time scales: natural period {:.3e} s, forcing {:.3e} s (ratio {:.2e}); {:?}, {} steps in {:.3} s",
+        response.time_scales.fastest_period_s,
+        response.time_scales.forcing_time_s,
+        response.time_scales.ratio,
+        response.method.unwrap_or(Method::Auto),
+        response.steps,
+        response.seconds
+    );
+    match &response.collision {
+        Some(c) => println!(
+            "  first contact at t = {:.6e} s: {} / {} at ({:.1}, {:.1}, {:.1}) µm",
+            c.time,
+            c.pair[0],
+            c.pair[1],
+            c.point.x * 1e6,
+            c.point.y * 1e6,
+            c.point.z * 1e6
+        ),
+        None => println!("  no contact up to t = {:.6e} s", response.t_end),
+    }
+    if let Some(last) = response.samples.last() {
+        let angles: Vec<String> = last.angles.iter().map(|a| format!("{:.4}", a.to_degrees())).collect();
+        println!("  final crease angles (deg): [{}]", angles.join(", "));
+    }
+    println!(
+        "  torque magnification η = {:.4}: the driving hinge ({:.1} µm wide) would need {:.1} µm to hold the target (T5.24-5.25)",
+        closed.torque_magnification, closed.driving_hinge_width_um, closed.required_hinge_width_um
+    );
+    println!(
+        "  max loop-closure residual along the run: {:.3e} rad",
+        closed.max_closure_residual
+    );
+    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
+    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    Ok(())
+}
+
 fn run_simulate(args: &SimulateArgs) -> Result<()> {
-    let scene = Scene::load(&args.scene)?;
     let settings = SimulationSettings {
         model: match args.model {
             ModelArg::Auto => ModelChoice::Auto,
@@ -513,6 +610,11 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         progress: !args.json,
         max_steps: args.max_steps,
     };
+    let text = std::fs::read_to_string(&args.scene).with_context(|| format!("reading {}", args.scene.display()))?;
+    if is_closed_scene(&text) {
+        return run_simulate_closed(args, &settings);
+    }
+    let scene = Scene::load(&args.scene)?;
     let response = simulate(&scene, &settings)?;
     // Render everything before writing anything.
     let dir = args

@@ -370,7 +370,11 @@ impl ConstraintPoly {
     }
 
     fn check_domain(&self, theta: f64) -> Result<()> {
-        let slack = 1e-12 * (1.0 + self.domain[1].abs().max(self.domain[0].abs()));
+        self.check_extended_domain(theta, 0.0)
+    }
+
+    fn check_extended_domain(&self, theta: f64, margin: f64) -> Result<()> {
+        let slack = margin + 1e-12 * (1.0 + self.domain[1].abs().max(self.domain[0].abs()));
         if theta.is_finite() && theta >= self.domain[0] - slack && theta <= self.domain[1] + slack {
             Ok(())
         } else {
@@ -412,7 +416,14 @@ impl ConstraintPoly {
 
     /// f, G = f′ and f″ at θ_c in one pass (the closed-chain equations need all three).
     pub fn evaluate(&self, theta: f64, point: &mut exact::ConstraintPoint) -> Result<()> {
-        self.check_domain(theta)?;
+        self.evaluate_extended(theta, 0.0, point)
+    }
+
+    /// [`ConstraintPoly::evaluate`] that also extrapolates up to `margin` (rad) beyond the
+    /// fitted domain (an integrator's trial stages may overshoot it; the caller checks the
+    /// accepted states).
+    pub fn evaluate_extended(&self, theta: f64, margin: f64, point: &mut exact::ConstraintPoint) -> Result<()> {
+        self.check_extended_domain(theta, margin)?;
         for (k, curve) in self.curves.iter().enumerate() {
             let (value, slope, curvature) = curve.eval_with_derivatives(theta);
             point.values[k] = value;

@@ -5,6 +5,7 @@
 //! scratch buffers reused across evaluations, so M, C and the right-hand side allocate nothing.
 //! SI units throughout (m, kg, s, N·m/rad).
 
+pub mod closed;
 pub mod contact;
 pub mod modes;
 pub mod simulate;

@@ -5,6 +5,7 @@ use crate::dynamics::modes::Modes;
 use crate::dynamics::simulate::{Response, Sample, SimulationSettings};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::{Chain, FoldMesh, Pattern, RayRole};
+use crate::scene::closed::ClosedScene;
 use crate::scene::Scene;
 use crate::sphere::Vec3;
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
@@ -287,6 +288,41 @@ pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &Un
 
 /// The summary of a dynamics run: the `--json` object, and the head of `response.json`.
 pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
+    summary_of(&scene.name, scene.target_angles.as_slice(), settings, response)
+}
+
+/// The summary of a closed-chain run: the open chain's keys (angles are every crease's, in
+/// FOLD edge order) plus `cut_crease`, `constraint_source`, `torque_magnification`,
+/// `max_closure_residual` and the fit's error.
+pub fn closed_response_summary(scene: &ClosedScene, settings: &SimulationSettings, response: &Response) -> Value {
+    let chain = &scene.chain;
+    let mut targets = vec![0.0; chain.crease_stiffness.len()];
+    targets[chain.driver] = chain.target;
+    for &(c, value) in &chain.locked {
+        targets[c] = value;
+    }
+    let mut value = summary_of(&scene.name, &targets, settings, response);
+    if let Some(closed) = &response.closed {
+        value["cut_crease"] = json!(closed.cut_crease);
+        value["driving_crease"] = json!(closed.driver);
+        value["constraint_source"] = json!(closed.constraint_source);
+        value["constraint_degree"] = json!(closed.degree);
+        value["constraint_fit_error_rad"] = json!(closed.fit_error);
+        value["torque_magnification"] = json!(closed.torque_magnification);
+        value["driving_hinge_width_um"] = json!(closed.driving_hinge_width_um);
+        value["required_hinge_width_um"] = json!(closed.required_hinge_width_um);
+        value["max_closure_residual"] = json!(closed.max_closure_residual);
+        value["crease_edges"] = json!(scene.pattern.user_indices());
+    }
+    value
+}
+
+/// `response.json` of a closed-chain run.
+pub fn closed_response_json(scene: &ClosedScene, settings: &SimulationSettings, response: &Response) -> Value {
+    with_samples(closed_response_summary(scene, settings, response), response)
+}
+
+fn summary_of(name: &str, target_angles: &[f64], settings: &SimulationSettings, response: &Response) -> Value {
     let collision = response.collision.as_ref().map(|c| {
         json!({
             "time_s": c.time,
@@ -301,7 +337,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: 
         .map(|s| s.angles.as_slice().to_vec())
         .unwrap_or_default();
     json!({
-        "scene": scene.name,
+        "scene": name,
         "model": response.model,
         "method": response.method,
         "rtol": response.rtol,
@@ -314,7 +350,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: 
         "t_end_s": response.t_end,
         "collision": collision,
         "final_angles_rad": final_angles,
-        "target_angles_rad": scene.target_angles.as_slice(),
+        "target_angles_rad": target_angles,
         "steps": response.steps,
         "rhs_evaluations": response.rhs_evaluations,
         "seconds": response.seconds,
@@ -323,7 +359,10 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: 
 
 /// `response.json`: the summary plus every output sample.
 pub fn response_json(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
-    let mut value = response_summary(scene, settings, response);
+    with_samples(response_summary(scene, settings, response), response)
+}
+
+fn with_samples(mut value: Value, response: &Response) -> Value {
     let samples = &response.samples;
     let column = |f: &dyn Fn(&Sample) -> f64| samples.iter().map(f).collect::<Vec<f64>>();
     value["units"] = json!({

@@ -12,7 +12,9 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-const MICROMETRE: f64 = 1e-6;
+pub mod closed;
+
+pub(crate) const MICROMETRE: f64 = 1e-6;
 
 /// One isotropic material.
 #[derive(Debug, Clone, Deserialize)]
@@ -175,7 +177,7 @@ pub struct Scene {
     pub outputs: OutputSpec,
 }
 
-fn positive(field: &str, value: f64) -> Result<f64> {
+pub(crate) fn positive(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
@@ -183,7 +185,7 @@ fn positive(field: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn finite(field: &str, value: f64) -> Result<f64> {
+pub(crate) fn finite(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
@@ -191,14 +193,44 @@ fn finite(field: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn material<'a>(scene: &'a SceneFile, field: &str, name: &str) -> Result<&'a MaterialSpec> {
-    scene.materials.get(name).ok_or_else(|| {
-        let known: Vec<&str> = scene.materials.keys().map(String::as_str).collect();
+pub(crate) fn material<'a>(
+    materials: &'a BTreeMap<String, MaterialSpec>,
+    field: &str,
+    name: &str,
+) -> Result<&'a MaterialSpec> {
+    materials.get(name).ok_or_else(|| {
+        let known: Vec<&str> = materials.keys().map(String::as_str).collect();
         NanofoldError::invalid(
             field,
             format!("\"{name}\""),
             format!("not in `materials` ({})", known.join(", ")),
         )
+    })
+}
+
+/// Every material's moduli and density in range.
+pub(crate) fn validate_materials(materials: &BTreeMap<String, MaterialSpec>) -> Result<()> {
+    for (name, m) in materials {
+        positive(&format!("materials.{name}.youngs_modulus_gpa"), m.youngs_modulus_gpa)?;
+        positive(&format!("materials.{name}.density_g_cm3"), m.density_g_cm3)?;
+        let field = format!("materials.{name}.poisson_ratio");
+        finite(&field, m.poisson_ratio)?;
+        if !(-1.0 < m.poisson_ratio && m.poisson_ratio < 0.5) {
+            return Err(NanofoldError::invalid(field, m.poisson_ratio, "must lie in (−1, 0.5)"));
+        }
+    }
+    Ok(())
+}
+
+/// The drag law of the environment (T5.8), or none.
+pub(crate) fn drag_law(env: &EnvironmentSpec) -> Result<Option<Drag>> {
+    Ok(if env.drag {
+        Some(Drag {
+            drag_coefficient: positive("environment.drag_coefficient", env.drag_coefficient)?,
+            air_density: positive("environment.air_density_kg_m3", env.air_density_kg_m3)?,
+        })
+    } else {
+        None
     })
 }
 
@@ -226,15 +258,7 @@ impl Scene {
     }
 
     pub fn from_file(file: SceneFile, fallback_name: &str) -> Result<Scene> {
-        for (name, m) in &file.materials {
-            positive(&format!("materials.{name}.youngs_modulus_gpa"), m.youngs_modulus_gpa)?;
-            positive(&format!("materials.{name}.density_g_cm3"), m.density_g_cm3)?;
-            let field = format!("materials.{name}.poisson_ratio");
-            finite(&field, m.poisson_ratio)?;
-            if !(-1.0 < m.poisson_ratio && m.poisson_ratio < 0.5) {
-                return Err(NanofoldError::invalid(field, m.poisson_ratio, "must lie in (−1, 0.5)"));
-            }
-        }
+        validate_materials(&file.materials)?;
         let n = file.plates.len();
         if n == 0 {
             return Err(NanofoldError::invalid(
@@ -258,7 +282,8 @@ impl Scene {
             let length = positive(&format!("plates[{i}].length_um"), spec.length_um)? * MICROMETRE;
             let width = positive(&format!("plates[{i}].width_um"), spec.width_um)? * MICROMETRE;
             let thickness = positive(&format!("plates[{i}].thickness_um"), spec.thickness_um)? * MICROMETRE;
-            let density = material(&file, &format!("plates[{i}].material"), &spec.material)?.density_g_cm3 * 1e3;
+            let density =
+                material(&file.materials, &format!("plates[{i}].material"), &spec.material)?.density_g_cm3 * 1e3;
             // The flat plate spans x ∈ [−w/2, w/2], y ∈ [y, y + L]: a box whose moment about the
             // crease-parallel x axis involves its length, not its width (SPEC §7).
             let half = 0.5 * width;
@@ -277,7 +302,7 @@ impl Scene {
                 ));
             }
             let hinge = &file.hinges[i];
-            let stiffness = hinge_stiffness(&file, i, hinge, width)?;
+            let stiffness = hinge_stiffness(&file.materials, i, hinge, width)?;
             if !usable(stiffness) {
                 return Err(NanofoldError::invalid(
                     format!("hinges[{i}]"),
@@ -346,15 +371,7 @@ impl Scene {
                 }
             }
         };
-        let env = &file.environment;
-        let drag = if env.drag {
-            Some(Drag {
-                drag_coefficient: positive("environment.drag_coefficient", env.drag_coefficient)?,
-                air_density: positive("environment.air_density_kg_m3", env.air_density_kg_m3)?,
-            })
-        } else {
-            None
-        };
+        let drag = drag_law(&file.environment)?;
         let t_end = positive("time.t_end_s", file.time.t_end_s)?;
         if file.outputs.samples < 2 {
             return Err(NanofoldError::invalid(
@@ -457,7 +474,12 @@ impl Scene {
 }
 
 /// K = Σ_layers w t³ E / (3 l (1 − ν²)) (T5.7), with w the width of the plate the hinge carries.
-fn hinge_stiffness(file: &SceneFile, i: usize, hinge: &HingeSpec, width: f64) -> Result<f64> {
+pub(crate) fn hinge_stiffness(
+    materials: &BTreeMap<String, MaterialSpec>,
+    i: usize,
+    hinge: &HingeSpec,
+    width: f64,
+) -> Result<f64> {
     let length = positive(&format!("hinges[{i}].hinge_length_um"), hinge.hinge_length_um)? * MICROMETRE;
     if hinge.layers.is_empty() {
         return Err(NanofoldError::invalid(
@@ -469,7 +491,7 @@ fn hinge_stiffness(file: &SceneFile, i: usize, hinge: &HingeSpec, width: f64) ->
     let mut stiffness = 0.0;
     for (k, layer) in hinge.layers.iter().enumerate() {
         let t = positive(&format!("hinges[{i}].layers[{k}].thickness_um"), layer.thickness_um)? * MICROMETRE;
-        let m = material(file, &format!("hinges[{i}].layers[{k}].material"), &layer.material)?;
+        let m = material(materials, &format!("hinges[{i}].layers[{k}].material"), &layer.material)?;
         let modulus = m.youngs_modulus_gpa * 1e9;
         stiffness += width * t.powi(3) * modulus / (3.0 * length * (1.0 - m.poisson_ratio * m.poisson_ratio));
     }

@@ -153,6 +153,8 @@ pub struct Response {
     pub steps: usize,
     pub rhs_evaluations: usize,
     pub seconds: f64,
+    /// What a closed chain adds (None for an open chain).
+    pub closed: Option<super::closed::ClosedReport>,
 }
 
 /// Fastest and slowest natural periods over the flat and the target configurations.
@@ -262,6 +264,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
         steps: 0,
         rhs_evaluations: 0,
         seconds: 0.0,
+        closed: None,
     };
     match kind {
         ModelKind::Dynamic => {
@@ -448,7 +451,7 @@ impl Plant for OpenChain<'_> {
     }
 }
 
-fn resolve_method(method: Method, scales: &TimeScales) -> Method {
+pub(crate) fn resolve_method(method: Method, scales: &TimeScales) -> Method {
     match method {
         Method::Auto if scales.ratio >= IMPLICIT_RATIO => Method::Esdirk34,
         Method::Auto => Method::Tsit45,
@@ -460,7 +463,7 @@ fn output_times_in(t_end: f64, samples: usize) -> Vec<f64> {
     (0..samples).map(|k| t_end * k as f64 / (samples - 1) as f64).collect()
 }
 
-fn output_times(t_end: f64, samples: usize) -> Vec<f64> {
+pub(crate) fn output_times(t_end: f64, samples: usize) -> Vec<f64> {
     output_times_in(t_end, samples.max(2))
 }
 

@@ -35,8 +35,37 @@ fn model_label(response: &Response) -> String {
     }
 }
 
-/// Renders `response.svg`: angles (deg) per hinge with dashed targets, and the energy terms.
+/// What the response figure labels: one entry per plotted angle.
+pub struct ResponseView {
+    pub name: String,
+    /// Legend label of each angle series.
+    pub labels: Vec<String>,
+    /// A dashed target line per series, if any (rad).
+    pub targets: Vec<Option<f64>>,
+    pub drag: bool,
+}
+
+impl ResponseView {
+    /// An open strip chain: hinge i, passive or with its target.
+    pub fn of_scene(scene: &Scene) -> Self {
+        ResponseView {
+            name: scene.name.clone(),
+            labels: (0..scene.model.dof())
+                .map(|i| format!("hinge {i}{}", if scene.actuated[i] { "" } else { " (passive)" }))
+                .collect(),
+            targets: scene.target_angles.iter().map(|&t| Some(t)).collect(),
+            drag: scene.model.drag.is_some(),
+        }
+    }
+}
+
+/// Renders `response.svg` of a strip scene.
 pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
+    response_view_svg(&ResponseView::of_scene(scene), response)
+}
+
+/// Renders `response.svg`: angles (deg) per series with dashed targets, and the energy terms.
+pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1000, 760)).into_drawing_area();
@@ -52,7 +81,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
                 hi = hi.max(a.to_degrees());
             }
         }
-        for t in scene.target_angles.iter() {
+        for t in view.targets.iter().flatten() {
             lo = lo.min(t.to_degrees());
             hi = hi.max(t.to_degrees());
         }
@@ -62,7 +91,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
         });
         let mut chart = ChartBuilder::on(&top)
             .caption(
-                format!("{}: fold angles ({}; {collision})", scene.name, model_label(response)),
+                format!("{}: fold angles ({}; {collision})", view.name, model_label(response)),
                 ("sans-serif", 18),
             )
             .margin(12)
@@ -76,7 +105,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
             .y_desc("fold angle (deg)")
             .draw()
             .map_err(plot_error)?;
-        for i in 0..scene.model.dof() {
+        for (i, label) in view.labels.iter().enumerate() {
             let colour = series_colour(i);
             chart
                 .draw_series(LineSeries::new(
@@ -87,12 +116,11 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
                     colour.stroke_width(2),
                 ))
                 .map_err(plot_error)?
-                .label(format!(
-                    "hinge {i}{}",
-                    if scene.actuated[i] { "" } else { " (passive)" }
-                ))
+                .label(label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
-            let target = scene.target_angles[i].to_degrees();
+            let Some(target) = view.targets[i].map(f64::to_degrees) else {
+                continue;
+            };
             let dashes = (0..40).map(|k| {
                 let a = t_max * k as f64 / 40.0;
                 PathElement::new(
@@ -150,10 +178,7 @@ pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
         let e_pad = 0.06 * (e_hi - e_lo).max(1e-30);
         let mut energy = ChartBuilder::on(&bottom)
             .caption(
-                format!(
-                    "energy (drag {})",
-                    if scene.model.drag.is_some() { "on" } else { "off" }
-                ),
+                format!("energy (drag {})", if view.drag { "on" } else { "off" }),
                 ("sans-serif", 16),
             )
             .margin(12)
