@@ -9,7 +9,7 @@ use nanofold::constraints::{
 };
 use nanofold::dynamics::closed::simulate_closed;
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, Response, SimulationSettings};
 use nanofold::energy::EnergyKind;
 use nanofold::output::{
     closed_response_json, closed_response_summary, fold_animation, modes_json, response_json, response_summary,
@@ -561,18 +561,7 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
         response.steps,
         response.seconds
     );
-    match &response.collision {
-        Some(c) => println!(
-            "  first contact at t = {:.6e} s: {} / {} at ({:.1}, {:.1}, {:.1}) µm",
-            c.time,
-            c.pair[0],
-            c.pair[1],
-            c.point.x * 1e6,
-            c.point.y * 1e6,
-            c.point.z * 1e6
-        ),
-        None => println!("  no contact up to t = {:.6e} s", response.t_end),
-    }
+    print_contact(&response);
     if let Some(last) = response.samples.last() {
         let angles: Vec<String> = last.angles.iter().map(|a| format!("{:.4}", a.to_degrees())).collect();
         println!("  final crease angles (deg): [{}]", angles.join(", "));
@@ -588,6 +577,22 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
     let names: Vec<&str> = files.iter().map(|f| f.0).collect();
     println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
     Ok(())
+}
+
+/// The first contact of a run, or that there was none, as one line.
+fn print_contact(response: &Response) {
+    match &response.collision {
+        Some(c) => println!(
+            "  first contact at t = {:.6e} s: {} with {} at (x, y, z) = ({:.2}, {:.2}, {:.2}) µm",
+            c.time,
+            c.pair[0],
+            c.pair[1],
+            c.point.x * 1e6,
+            c.point.y * 1e6,
+            c.point.z * 1e6
+        ),
+        None => println!("  no contact up to t = {:.6e} s", response.t_end),
+    }
 }
 
 fn run_simulate(args: &SimulateArgs) -> Result<()> {
@@ -665,18 +670,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
             );
         }
     }
-    match &response.collision {
-        Some(c) => println!(
-            "  first contact at t = {:.6e} s: {} with {} at (x, y, z) = ({:.2}, {:.2}, {:.2}) µm",
-            c.time,
-            c.pair[0],
-            c.pair[1],
-            c.point.x * 1e6,
-            c.point.y * 1e6,
-            c.point.z * 1e6
-        ),
-        None => println!("  no contact up to t = {:.6e} s", response.t_end),
-    }
+    print_contact(&response);
     if let Some(last) = response.samples.last() {
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));

@@ -311,6 +311,21 @@ pub fn unfold_samples(
     })
 }
 
+/// θ within `domain` (rad) widened by `margin` and a few ulps, or an `OutsideFitDomain` error.
+pub(crate) fn check_in_domain(driver_label: &str, domain: [f64; 2], theta: f64, margin: f64) -> Result<()> {
+    let slack = margin + 1e-12 * (1.0 + domain[1].abs().max(domain[0].abs()));
+    if theta.is_finite() && theta >= domain[0] - slack && theta <= domain[1] + slack {
+        Ok(())
+    } else {
+        Err(NanofoldError::OutsideFitDomain {
+            driver: driver_label.to_string(),
+            value_deg: theta.to_degrees(),
+            lower_deg: domain[0].to_degrees(),
+            upper_deg: domain[1].to_degrees(),
+        })
+    }
+}
+
 /// The fitted constraint θ_r = f(θ_c) for one driving crease: what dynamics consume.
 #[derive(Debug, Clone)]
 pub struct ConstraintPoly {
@@ -374,17 +389,7 @@ impl ConstraintPoly {
     }
 
     fn check_extended_domain(&self, theta: f64, margin: f64) -> Result<()> {
-        let slack = margin + 1e-12 * (1.0 + self.domain[1].abs().max(self.domain[0].abs()));
-        if theta.is_finite() && theta >= self.domain[0] - slack && theta <= self.domain[1] + slack {
-            Ok(())
-        } else {
-            Err(NanofoldError::OutsideFitDomain {
-                driver: self.driver_label.clone(),
-                value_deg: theta.to_degrees(),
-                lower_deg: self.domain[0].to_degrees(),
-                upper_deg: self.domain[1].to_degrees(),
-            })
-        }
+        check_in_domain(&self.driver_label, self.domain, theta, margin)
     }
 
     /// f(θ_c): the dependents' angles, written into `out` (one per dependent).

@@ -9,7 +9,7 @@
 //! so J_dep f″ = −Σ_{a before b} ρ′_a ρ′_b (x_a × x_b) with ρ′ = (1 for the driver, G, 0 held).
 
 use super::sweep::{CLOSURE_TOL, REFINE_ITERATIONS};
-use super::CurveSamples;
+use super::{check_in_domain, CurveSamples};
 use crate::error::{NanofoldError, Result};
 use crate::kinematics::{closure_jacobian, forward, refine_closure, solve_closure};
 use crate::pattern::Pattern;
@@ -91,17 +91,7 @@ impl ExactConstraint {
     }
 
     fn check_domain(&self, theta: f64, margin: f64) -> Result<()> {
-        let slack = margin + 1e-12 * (1.0 + self.domain[1].abs().max(self.domain[0].abs()));
-        if theta.is_finite() && theta >= self.domain[0] - slack && theta <= self.domain[1] + slack {
-            Ok(())
-        } else {
-            Err(NanofoldError::OutsideFitDomain {
-                driver: self.driver_label.clone(),
-                value_deg: theta.to_degrees(),
-                lower_deg: self.domain[0].to_degrees(),
-                upper_deg: self.domain[1].to_degrees(),
-            })
-        }
+        check_in_domain(&self.driver_label, self.domain, theta, margin)
     }
 
     /// Ray angles of the closed configuration at driving angle θ: Newton from the branch's
