@@ -12,8 +12,8 @@ use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, Response, SimulationSettings};
 use nanofold::energy::EnergyKind;
 use nanofold::output::{
-    closed_response_json, closed_response_summary, fold_animation, modes_json, response_json, response_summary,
-    trajectory_json, write_atomic,
+    closed_modes_json, closed_response_json, closed_response_summary, fold_animation, modes_json, response_json,
+    response_summary, trajectory_json, write_atomic,
 };
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::plot::response::{response_svg, response_view_svg, snapshots_svg, ResponseView};
@@ -477,8 +477,8 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     }
     for curve in &report.curves {
         println!(
-            "  {:<12} fit error {:.3e} rad, closure residual {:.3e} rad; coefficients (deg):",
-            curve.label, curve.max_fit_error_rad, curve.max_closure_residual
+            "  {:<12} fit error {:.3e} rad, slope error {:.3e}, closure residual {:.3e} rad; coefficients (deg):",
+            curve.label, curve.max_fit_error_rad, curve.max_slope_error, curve.max_closure_residual
         );
         let terms: Vec<String> = curve
             .coeffs_deg
@@ -544,13 +544,14 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
     }
     let closed = response.closed.as_ref().expect("closed-chain runs report their chain");
     println!(
-        "{}: closed chain, {} driven, {} cut, f = {}{} (fit error {:.2e} rad)",
+        "{}: closed chain, {} driven, {} cut, f = {}{} (fit error {:.2e} rad, slope error {:.2e})",
         scene.name,
         chain.crease_labels[chain.driver],
         chain.crease_labels[chain.cut_crease],
         closed.constraint_source,
         closed.degree.map_or(String::new(), |d| format!(" degree {d}")),
-        closed.fit_error
+        closed.fit_error,
+        closed.slope_error
     );
     println!(
         "  time scales: natural period {:.3e} s, forcing {:.3e} s (ratio {:.2e}); {:?}, {} steps in {:.3} s",
@@ -681,6 +682,10 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
 }
 
 fn run_modes(path: &Path, json: bool) -> Result<()> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    if is_closed_scene(&text) {
+        return run_modes_closed(path, json);
+    }
     let scene = Scene::load(path)?;
     let result = modes(&scene.model, scene.target_angles.as_slice())?;
     if json {
@@ -722,6 +727,80 @@ fn run_modes(path: &Path, json: bool) -> Result<()> {
             "stable: K is positive definite, every eigenvalue > 0"
         } else {
             "NOT stable: some hinge stiffness or eigenvalue is not positive"
+        }
+    );
+    Ok(())
+}
+
+fn run_modes_closed(path: &Path, json: bool) -> Result<()> {
+    let scene = ClosedScene::load(path)?;
+    let result = scene.chain.folded_modes()?;
+    let eta = scene.chain.torque_magnification()?;
+    if json {
+        println!("{}", closed_modes_json(&scene, &result, eta));
+        return Ok(());
+    }
+    let pattern = &scene.pattern;
+    let degrees = |angles: &[f64]| {
+        angles
+            .iter()
+            .map(|a| format!("{:.3}°", a.to_degrees()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let coordinates: Vec<String> = result
+        .coordinates
+        .iter()
+        .map(|&c| format!("edges[{}]", pattern.user_index(c)))
+        .collect();
+    println!(
+        "{}: modes of the closed chain (cut at edges[{}], f = {}), locks released: coordinates {}",
+        scene.name,
+        pattern.user_index(scene.chain.cut_crease),
+        scene.chain.source.name(),
+        coordinates.join(", ")
+    );
+    println!("  folded pose  θ = ({})", degrees(&result.folded_pose));
+    println!(
+        "  equilibrium  θ* = ({})  [{} Newton steps, residual torque {:.1e} N·m, closure {:.1e} rad]",
+        degrees(&result.equilibrium),
+        result.newton_iterations,
+        result.residual_torque,
+        result.closure_residual
+    );
+    for &c in &result.folded_through {
+        println!(
+            "  warning: edges[{}] is past ±180° at the free equilibrium: the plates touch before it",
+            pattern.user_index(c)
+        );
+    }
+    println!(
+        "  {:>4} {:>14} {:>12} {:>16}  shape over every crease (unit max-norm in the coordinates)",
+        "mode", "λ (rad²/s²)", "f (Hz)", "f, ΓᵀKΓ only"
+    );
+    for k in 0..result.modes.eigenvalues.len() {
+        let shape: Vec<String> = result
+            .crease_shapes
+            .column(k)
+            .iter()
+            .map(|v| format!("{v:+.4}"))
+            .collect();
+        println!(
+            "  {:>4} {:>14.6e} {:>12.3} {:>16.3}  ({})",
+            k,
+            result.modes.eigenvalues[k],
+            result.modes.frequencies_hz[k],
+            result.frequencies_without_load_hz[k],
+            shape.join(", ")
+        );
+    }
+    println!("  torque magnification η = {eta:.4}");
+    println!(
+        "  {}",
+        if result.modes.stable {
+            "stable: the reduced stiffness is positive definite, every eigenvalue > 0"
+        } else {
+            "NOT stable: some eigenvalue of the reduced stiffness is not positive"
         }
     );
     Ok(())

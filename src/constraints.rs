@@ -8,7 +8,7 @@ pub mod exact;
 pub mod sweep;
 
 use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
+use crate::kinematics::{closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, Pattern};
 use crate::unfold::{unfold, UnfoldSettings};
 use chebyshev::{eval_monomial, Chebyshev};
@@ -342,6 +342,9 @@ pub struct ConstraintPoly {
     pub curves: Vec<Chebyshev>,
     /// Largest |f − sample| per dependent, rad.
     pub max_fit_error: Vec<f64>,
+    /// Largest |f′ − G| per dependent over the regular samples, G by the implicit function
+    /// theorem on the exact closure (rad/rad).
+    pub max_slope_error: Vec<f64>,
 }
 
 impl ConstraintPoly {
@@ -354,9 +357,17 @@ impl ConstraintPoly {
                 format!("the degree must lie in 1..={MAX_DEGREE}"),
             ));
         }
+        // G by the implicit function theorem at every regular sample (the singular flat
+        // state has none): the reference for the fit's slope error.
+        let exact_slopes: Vec<Option<Vec<f64>>> = samples
+            .fold_angles
+            .iter()
+            .map(|angles| implicit_jacobian(pattern, &samples.setup, angles).ok())
+            .collect();
         let mut curves = Vec::new();
         let mut max_fit_error = Vec::new();
-        for &c in &samples.setup.dependents {
+        let mut max_slope_error = Vec::new();
+        for (k, &c) in samples.setup.dependents.iter().enumerate() {
             let values = samples.series(c);
             let series = Chebyshev::fit(&samples.drive_angles, &values, degree, samples.domain)?;
             let error = samples
@@ -365,8 +376,15 @@ impl ConstraintPoly {
                 .zip(&values)
                 .map(|(&x, &y)| (series.eval(x) - y).abs())
                 .fold(0.0, f64::max);
+            let slope_error = samples
+                .drive_angles
+                .iter()
+                .zip(&exact_slopes)
+                .filter_map(|(&x, exact)| exact.as_ref().map(|g| (series.eval_with_derivatives(x).1 - g[k]).abs()))
+                .fold(0.0, f64::max);
             curves.push(series);
             max_fit_error.push(error);
+            max_slope_error.push(slope_error);
         }
         Ok(ConstraintPoly {
             driver: samples.setup.driver,
@@ -376,6 +394,7 @@ impl ConstraintPoly {
             domain: samples.domain,
             curves,
             max_fit_error,
+            max_slope_error,
         })
     }
 
@@ -484,24 +503,18 @@ pub fn implicit_jacobian(pattern: &Pattern, setup: &Setup, crease_angles: &[f64]
     }
     let dependent_rays: Vec<usize> = setup.dependents.iter().map(|&c| pattern.creases[c].ray).collect();
     let driver_ray = pattern.creases[setup.driver].ray;
-    let (_, j_dep) = closure_jacobian(&pattern.sector_angles, &rho, &dependent_rays);
-    let (_, j_driver) = closure_jacobian(&pattern.sector_angles, &rho, &[driver_ray]);
-    let svd = j_dep.svd(true, true);
-    let (largest, smallest) = (svd.singular_values.max(), svd.singular_values.min());
-    if smallest < 1e-9 * largest {
-        return Err(NanofoldError::Numerical {
-            stage: "implicit-function Jacobian".into(),
-            message: format!(
-                "singular configuration (σ_min/σ_max = {:.1e}): the dependents are not a function of {} here",
-                smallest / largest,
-                pattern.creases[setup.driver].label
-            ),
-        });
-    }
-    let g = svd.solve(&(-j_driver), 0.0).map_err(|e| NanofoldError::Numerical {
-        stage: "implicit-function Jacobian".into(),
-        message: e.to_string(),
-    })?;
+    let g = exact::implicit_jacobian_rays(&pattern.sector_angles, &rho, &[driver_ray], &dependent_rays).map_err(
+        |e| match e {
+            NanofoldError::Numerical { stage, message } => NanofoldError::Numerical {
+                stage,
+                message: format!(
+                    "{message}: the dependents are not a function of {} here",
+                    pattern.creases[setup.driver].label
+                ),
+            },
+            other => other,
+        },
+    )?;
     Ok(g.iter().copied().collect())
 }
 
@@ -519,6 +532,8 @@ pub struct CurveReport {
     pub chebyshev_coeffs: Vec<f64>,
     /// Largest |polynomial (monomial form) − exact sample|, rad.
     pub max_fit_error_rad: f64,
+    /// Largest |f′ − G| over the regular samples, G by the implicit function theorem.
+    pub max_slope_error: f64,
     /// Loop-closure residual with this crease on its polynomial and the others exact,
     /// largest over a grid 10× finer than the samples, rad.
     pub max_closure_residual: f64,
@@ -598,6 +613,7 @@ impl ConstraintReport {
                 coeffs_deg,
                 chebyshev_coeffs: poly.curves[j].coeffs.clone(),
                 max_fit_error_rad: monomial_error.max(poly.max_fit_error[j]),
+                max_slope_error: poly.max_slope_error[j],
                 max_closure_residual: per_curve[j],
             });
         }

@@ -1,6 +1,7 @@
 //! Files a run writes: `trajectory.json`, the FOLD animation `unfold.fold`, `response.json`; each written
 //! to a temporary file and renamed, so nothing is left half-written.
 
+use crate::dynamics::closed::modes::ClosedModes;
 use crate::dynamics::modes::Modes;
 use crate::dynamics::simulate::{Response, Sample, SimulationSettings};
 use crate::error::{NanofoldError, Result};
@@ -9,6 +10,7 @@ use crate::scene::closed::ClosedScene;
 use crate::scene::Scene;
 use crate::sphere::Vec3;
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
+use nalgebra::DMatrix;
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::f64::consts::TAU;
@@ -308,6 +310,7 @@ pub fn closed_response_summary(scene: &ClosedScene, settings: &SimulationSetting
         value["constraint_source"] = json!(closed.constraint_source);
         value["constraint_degree"] = json!(closed.degree);
         value["constraint_fit_error_rad"] = json!(closed.fit_error);
+        value["constraint_slope_error"] = json!(closed.slope_error);
         value["torque_magnification"] = json!(closed.torque_magnification);
         value["driving_hinge_width_um"] = json!(closed.driving_hinge_width_um);
         value["required_hinge_width_um"] = json!(closed.required_hinge_width_um);
@@ -393,5 +396,52 @@ pub fn modes_json(scene: &Scene, modes: &Modes) -> Value {
         "mode_shapes": (0..n).map(|k| modes.mode_shapes.column(k).iter().copied().collect::<Vec<f64>>()).collect::<Vec<_>>(),
         "stable": modes.stable,
         "stiffness_n_m_per_rad": scene.model.stiffness().as_slice(),
+    })
+}
+
+/// `nanofold modes` output of a closed chain: the open chain's keys (`equilibrium_rad` and
+/// `mode_shapes` are over the released coordinates) plus every crease's angles and shapes,
+/// the reduced matrices and the closed-chain keys. Crease numbers are FOLD edge indices.
+pub fn closed_modes_json(scene: &ClosedScene, modes: &ClosedModes, torque_magnification: f64) -> Value {
+    let chain = &scene.chain;
+    let pattern = &scene.pattern;
+    let columns = |m: &DMatrix<f64>| {
+        (0..m.ncols())
+            .map(|k| m.column(k).iter().copied().collect::<Vec<f64>>())
+            .collect::<Vec<_>>()
+    };
+    let rows = |m: &DMatrix<f64>| {
+        (0..m.nrows())
+            .map(|k| m.row(k).iter().copied().collect::<Vec<f64>>())
+            .collect::<Vec<_>>()
+    };
+    let stiffness = &modes.hinge_stiffness + &modes.load_stiffness;
+    let user = |creases: &[usize]| creases.iter().map(|&c| pattern.user_index(c)).collect::<Vec<_>>();
+    json!({
+        "scene": scene.name,
+        "cut_crease": pattern.user_index(chain.cut_crease),
+        "constraint_source": chain.source.name(),
+        "torque_magnification": torque_magnification,
+        "max_closure_residual": modes.closure_residual,
+        "coordinates": user(&modes.coordinates),
+        "crease_edges": pattern.user_indices(),
+        "equilibrium_rad": modes.modes.equilibrium.as_slice(),
+        "equilibrium": "∇V = 0 with every lock released; V = Σ ½ K (θ − rest)² along the loop closure",
+        "equilibrium_crease_angles_rad": modes.equilibrium,
+        "folded_pose_rad": modes.folded_pose,
+        "rest_angles_rad": modes.rest_angles,
+        "residual_torque_n_m": modes.residual_torque,
+        "newton_iterations": modes.newton_iterations,
+        "folded_through": user(&modes.folded_through),
+        "eigenvalues": modes.modes.eigenvalues,
+        "frequencies_hz": modes.modes.frequencies_hz,
+        "frequencies_without_load_hz": modes.frequencies_without_load_hz,
+        "mode_shapes": columns(&modes.modes.mode_shapes),
+        "crease_mode_shapes": columns(&modes.crease_shapes),
+        "stable": modes.modes.stable,
+        "stiffness_n_m_per_rad": chain.crease_stiffness,
+        "reduced_mass_kg_m2": rows(&modes.reduced_mass),
+        "reduced_stiffness_n_m_per_rad": rows(&stiffness),
+        "load_stiffness_n_m_per_rad": rows(&modes.load_stiffness),
     })
 }

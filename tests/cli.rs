@@ -297,6 +297,45 @@ fn modes_prints_descending_frequencies_and_stability() {
 }
 
 #[test]
+fn modes_of_a_closed_scene_release_its_locks_and_report_the_closed_keys() {
+    let out = nanofold()
+        .args(["modes", "patterns/corner_cube_step2.scene.json", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let modes: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "eigenvalues",
+        "frequencies_hz",
+        "mode_shapes",
+        "stable",
+        "equilibrium_rad",
+        "cut_crease",
+        "constraint_source",
+        "torque_magnification",
+        "max_closure_residual",
+        "crease_mode_shapes",
+        "frequencies_without_load_hz",
+    ] {
+        assert!(modes.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(modes["coordinates"], serde_json::json!([1, 0]));
+    assert_eq!(modes["cut_crease"], 2);
+    assert_eq!(modes["stable"], true);
+    assert_eq!(modes["eigenvalues"].as_array().unwrap().len(), 2);
+    assert_eq!(modes["crease_mode_shapes"][0].as_array().unwrap().len(), 5);
+    let table = nanofold()
+        .args(["modes", "patterns/corner_cube_step2.scene.json"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        table.status.success() && text.contains("locks released") && text.contains("stable"),
+        "{text}"
+    );
+}
+
+#[test]
 fn a_bad_scene_fails_clearly_and_writes_nothing() {
     let dir = temp_dir("bad-scene");
     let scene = dir.with_extension("scene.json");

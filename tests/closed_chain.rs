@@ -4,8 +4,10 @@
 
 use nanofold::constraints::exact::{ConstraintPoint, ExactConstraint};
 use nanofold::constraints::{sweep_samples, Setup};
-use nanofold::dynamics::closed::simulate_closed;
+use nanofold::dynamics::closed::modes::ClosureState;
+use nanofold::dynamics::closed::{simulate_closed, ClosedChain, ConstraintSource};
 use nanofold::dynamics::simulate::{Method, ModelChoice, SimulationSettings};
+use nanofold::dynamics::Data;
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::scene::closed::ClosedScene;
 use std::path::Path;
@@ -191,4 +193,209 @@ fn bad_closed_scenes_name_the_problem() {
         .unwrap_err()
         .to_string();
     assert!(outside.contains("start_angle_deg"), "{outside}");
+}
+
+fn scene(name: &str, edit: impl Fn(&mut serde_json::Value)) -> ClosedScene {
+    let text = std::fs::read_to_string(format!("patterns/{name}.scene.json")).unwrap();
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut value);
+    ClosedScene::from_json(&value.to_string(), "test", "test", Path::new("patterns")).unwrap()
+}
+
+/// The fit states its error on f and on f′ = G at the sweep samples; between the samples,
+/// on the whole fitted domain, f and G of the polynomial stay within those (5% slack for the
+/// error curve's maxima falling between samples), against Newton closure and the implicit
+/// function theorem evaluated independently.
+#[test]
+fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() {
+    let reference = scene("corner_cube_step1", |v| {
+        v["constraint"] = serde_json::json!({"source": "exact", "range_deg": [-5, 180]})
+    });
+    let ConstraintSource::Exact(exact) = &reference.chain.source else {
+        panic!("exact source expected")
+    };
+    let mut slope_errors = Vec::new();
+    for degree in [2, 4, 6, 8] {
+        let fitted =
+            scene(
+                "corner_cube_step1",
+                |v| v["constraint"] = serde_json::json!({"source": "poly", "degree": degree, "range_deg": [-5, 180]}),
+            );
+        let ConstraintSource::Poly(poly) = &fitted.chain.source else {
+            panic!("poly source expected")
+        };
+        let [lo, hi] = poly.domain;
+        let (mut exact_point, mut poly_point) = (ConstraintPoint::zeros(3), ConstraintPoint::zeros(3));
+        let (mut value_error, mut slope_error): (f64, f64) = (0.0, 0.0);
+        for i in 0..=1237 {
+            let theta = lo + (hi - lo) * i as f64 / 1237.0;
+            exact.evaluate(theta, &mut exact_point).unwrap();
+            poly.evaluate(theta, &mut poly_point).unwrap();
+            for k in 0..3 {
+                value_error = value_error.max((exact_point.values[k] - poly_point.values[k]).abs());
+                slope_error = slope_error.max((exact_point.jacobian[k] - poly_point.jacobian[k]).abs());
+            }
+        }
+        assert!(fitted.slope_error > 0.0 && fitted.fit_error > 0.0);
+        assert!(
+            value_error <= 1.05 * fitted.fit_error,
+            "degree {degree}: f off by {value_error:e}, stated {:e}",
+            fitted.fit_error
+        );
+        assert!(
+            slope_error <= 1.05 * fitted.slope_error,
+            "degree {degree}: G off by {slope_error:e}, stated {:e}",
+            fitted.slope_error
+        );
+        slope_errors.push(slope_error);
+    }
+    // And the stated error means something: it falls with the degree.
+    assert!(slope_errors.windows(2).all(|w| w[1] < w[0]), "{slope_errors:?}");
+}
+
+/// Kinetic energy of the open chain after the cut moving along θ_c + s u, from the plates'
+/// poses by central differences (v and ω of every plate): independent of the mass matrix.
+fn kinetic_energy_by_differences(chain: &ClosedChain, coordinates: &[usize], state: &ClosureState, u: &[f64]) -> f64 {
+    let h = 1e-6;
+    let theta_c: Vec<f64> = coordinates.iter().map(|&c| state.angles[c]).collect();
+    let poses = |sign: f64| {
+        let shifted: Vec<f64> = theta_c.iter().zip(u).map(|(t, d)| t + sign * h * d).collect();
+        let moved = chain.closure_state(coordinates, &shifted, &state.angles).unwrap();
+        let joints: Vec<f64> = chain.joint_creases.iter().map(|&c| moved.angles[c]).collect();
+        let mut data = Data::new(&chain.model);
+        chain.model.update_kinematics(&joints, &mut data);
+        data.poses.clone()
+    };
+    let (ahead, behind) = (poses(1.0), poses(-1.0));
+    let mut energy = 0.0;
+    for (i, plate) in chain.model.plates.iter().enumerate() {
+        let velocity = (ahead[i].translation.vector - behind[i].translation.vector) / (2.0 * h);
+        let turn = ahead[i].rotation * behind[i].rotation.inverse();
+        let omega = turn.scaled_axis() / (2.0 * h);
+        let rotation = ahead[i].rotation.slerp(&behind[i].rotation, 0.5).to_rotation_matrix();
+        let inertia = rotation.matrix() * plate.inertia * rotation.matrix().transpose();
+        energy += 0.5 * plate.mass * velocity.norm_squared() + 0.5 * omega.dot(&(inertia * omega));
+    }
+    energy
+}
+
+/// ΓᵀMΓ with the locks released (2 × 2 for the corner cube), at the recorded states of both
+/// steps: positive definite (eigenvalue ratio > 1e-3), its quadratic form equal to the
+/// kinetic energy of the plates' motion (measured 7e-9 relative); the one-coordinate gᵀMg of
+/// the simulation is positive along the path too.
+#[test]
+fn reduced_mass_is_symmetric_positive_definite_along_the_path() {
+    for name in ["corner_cube_step1", "corner_cube_step2"] {
+        let scene = scene(name, |_| {});
+        let chain = &scene.chain;
+        let response = simulate_closed(&scene, &SimulationSettings::default()).unwrap();
+        let coordinates = chain.released_coordinates();
+        let mut ws = chain.workspace();
+        let mut data = Data::new(&chain.model);
+        let mut worst_energy: f64 = 0.0;
+        for (i, sample) in response.samples.iter().enumerate() {
+            let q = sample.angles[chain.driver];
+            let (mass, _) = chain.reduced_mass_and_stiffness(q, &mut ws).unwrap();
+            assert!(mass > 0.0, "{name}: gᵀMg = {mass:e} at q = {q}");
+            // Both steps start flat in the released creases (2, 3, 4 in one plane), where the
+            // closure Jacobian is singular and Γ undefined; check every 10th state after it.
+            if i == 0 || i % 10 != 0 {
+                continue;
+            }
+            let theta_c: Vec<f64> = coordinates.iter().map(|&c| sample.angles[c]).collect();
+            let state = chain
+                .closure_state(&coordinates, &theta_c, sample.angles.as_slice())
+                .unwrap();
+            let m = chain.reduced_mass_matrix(&state, &mut data);
+            let eigen = m.clone().symmetric_eigen();
+            let (smallest, largest) = (eigen.eigenvalues.min(), eigen.eigenvalues.max());
+            assert!(
+                smallest > 1e-3 * largest,
+                "{name}: ΓᵀMΓ eigenvalues {smallest:e}, {largest:e} at {:?}",
+                sample.angles
+            );
+            for u in [[1.0, 0.0], [0.0, 1.0], [0.6, -0.8]] {
+                let quadratic =
+                    0.5 * (u[0] * u[0] * m[(0, 0)] + 2.0 * u[0] * u[1] * m[(0, 1)] + u[1] * u[1] * m[(1, 1)]);
+                let by_poses = kinetic_energy_by_differences(chain, &coordinates, &state, &u);
+                worst_energy = worst_energy.max((quadratic - by_poses).abs() / quadratic);
+            }
+        }
+        assert!(
+            worst_energy < 1e-6,
+            "{name}: ½uᵀΓᵀMΓu vs plates' motion {worst_energy:e}"
+        );
+    }
+}
+
+/// The released-lock modes of the folded corner cube (SPEC §7, T5.28): the equilibrium's
+/// torque vanishes, ∇V and ∂²V match finite differences of V along the exact closure, and the
+/// eigenvalues solve det(K − λM) = 0 (closed form of the 2 × 2 pencil).
+#[test]
+fn folded_corner_cube_modes_are_a_stable_two_dof_linearisation() {
+    let scene = scene("corner_cube_step2", |_| {});
+    let chain = &scene.chain;
+    let modes = chain.folded_modes().unwrap();
+    assert_eq!(modes.coordinates, vec![1, 0]);
+    assert_eq!(modes.modes.eigenvalues.len(), 2);
+    assert!(modes.modes.stable);
+    assert!(modes.closure_residual < 1e-13, "{:e}", modes.closure_residual);
+    assert!(modes.folded_through.is_empty());
+    let rest = chain.rest_angles();
+    let scale = chain.crease_stiffness.iter().fold(0.0, |a: f64, &k| a.max(k)) * std::f64::consts::PI;
+    assert!(modes.residual_torque < 1e-12 * scale, "{:e}", modes.residual_torque);
+
+    // Derivatives of V at a point off the equilibrium (where the load term is larger).
+    let theta_c = [modes.equilibrium[1] - 0.2, modes.equilibrium[0] - 0.1];
+    let state = chain
+        .closure_state(&modes.coordinates, &theta_c, &modes.equilibrium)
+        .unwrap();
+    let (_, gradient, hinge, load) = chain.hinge_energy(&state, &rest);
+    let hessian = &hinge + &load;
+    let h = 1e-5;
+    let energy_and_gradient = |a: usize, sign: f64| {
+        let mut shifted = theta_c;
+        shifted[a] += sign * h;
+        let moved = chain
+            .closure_state(&modes.coordinates, &shifted, &state.angles)
+            .unwrap();
+        let (v, g, _, _) = chain.hinge_energy(&moved, &rest);
+        (v, g)
+    };
+    for a in 0..2 {
+        let ((v_plus, g_plus), (v_minus, g_minus)) = (energy_and_gradient(a, 1.0), energy_and_gradient(a, -1.0));
+        let slope = (v_plus - v_minus) / (2.0 * h);
+        assert!(
+            (slope - gradient[a]).abs() < 1e-7 * gradient.amax(),
+            "∂V/∂θ_{a}: {slope:e} vs {:e}",
+            gradient[a]
+        );
+        for b in 0..2 {
+            let second = (g_plus[b] - g_minus[b]) / (2.0 * h);
+            assert!(
+                (second - hessian[(b, a)]).abs() < 1e-6 * hessian.amax(),
+                "∂²V/∂θ_{a}∂θ_{b}: {second:e} vs {:e}",
+                hessian[(b, a)]
+            );
+        }
+    }
+    // The load term is not negligible there: without it the Hessian would be off.
+    assert!(load.amax() > 1e-3 * hinge.amax());
+
+    // det(K − λM) = 0: λ² det M − λ (k11 m22 + k22 m11 − 2 k12 m12) + det K = 0.
+    let (m, k) = (&modes.reduced_mass, &modes.hinge_stiffness + &modes.load_stiffness);
+    let a = m.determinant();
+    let b = -(k[(0, 0)] * m[(1, 1)] + k[(1, 1)] * m[(0, 0)] - 2.0 * k[(0, 1)] * m[(0, 1)]);
+    let c = k.determinant();
+    let root = (b * b - 4.0 * a * c).sqrt();
+    let closed_form = [(-b + root) / (2.0 * a), (-b - root) / (2.0 * a)];
+    for (lambda, want) in modes.modes.eigenvalues.iter().zip(closed_form) {
+        assert!((lambda - want).abs() < 1e-10 * want, "λ {lambda:e} vs {want:e}");
+    }
+    // Each crease shape is Γ φ: the coordinates' rows are the shapes themselves.
+    for k in 0..2 {
+        for (row, &c) in modes.coordinates.iter().enumerate() {
+            assert_eq!(modes.crease_shapes[(c, k)], modes.modes.mode_shapes[(row, k)]);
+        }
+    }
 }

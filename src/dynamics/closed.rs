@@ -7,6 +7,8 @@
 //! the reduced equation Gᵀ[M(G θ̈_c + Ġ θ̇_c) + C G θ̇_c + N] = τ_c written for one coordinate.
 //! The elastic sum runs over every crease, the cut one included: it is a hinge too.
 
+pub mod modes;
+
 use super::contact::{Collision, ContactProbe};
 use super::simulate::{
     integrate, output_times, resolve_method, IntegrationOptions, ModelChoice, ModelKind, Plant, Response, Sample,
@@ -40,7 +42,7 @@ impl ConstraintSource {
         }
     }
 
-    fn evaluate(&self, theta: f64, point: &mut ConstraintPoint) -> Result<()> {
+    pub(crate) fn evaluate(&self, theta: f64, point: &mut ConstraintPoint) -> Result<()> {
         match self {
             ConstraintSource::Poly(poly) => poly.evaluate_extended(theta, DOMAIN_MARGIN, point),
             ConstraintSource::Exact(exact) => exact.evaluate_extended(theta, DOMAIN_MARGIN, point),
@@ -236,6 +238,21 @@ impl ClosedChain {
             });
         }
         Ok(force / reduced_mass)
+    }
+
+    /// T5.24–5.25 at the target: the torque the driving hinge must supply to hold it against
+    /// every hinge of the loop, Σ K ρ g, over what its own stressed layer gives, K θ_target.
+    pub fn torque_magnification(&self) -> Result<f64> {
+        let mut ws = self.workspace();
+        let [lo, hi] = self.source.domain();
+        self.update_creases(self.target.clamp(lo, hi), &mut ws)?;
+        let drive = self.crease_stiffness[self.driver] * self.target;
+        let holding: f64 = (0..self.crease_stiffness.len())
+            .filter(|&c| c != self.driver)
+            .map(|c| self.crease_stiffness[c] * ws.crease_angles[c] * ws.crease_g[c])
+            .sum::<f64>()
+            + drive;
+        Ok(holding / drive)
     }
 
     /// Loop-closure residual of the crease angles in `ws`, rad.
@@ -592,6 +609,8 @@ pub struct ClosedReport {
     pub degree: Option<usize>,
     /// Largest |f − exact| over the sweep samples, rad (0 for exact).
     pub fit_error: f64,
+    /// Largest |f′ − G| over the regular sweep samples (0 for exact).
+    pub slope_error: f64,
     /// T5.24–5.25: the torque the driving hinge must supply to hold the target against every
     /// hinge of the loop, Σ K ρ g, over the torque its own stressed layer gives, K θ_target;
     /// and the driving hinge width that would supply it (stiffness ∝ width).
@@ -660,14 +679,7 @@ pub fn simulate_closed(scene: &ClosedScene, settings: &SimulationSettings) -> Re
         ws.crease_angles.copy_from_slice(sample.angles.as_slice());
         max_closure_residual = max_closure_residual.max(chain.closure_residual(&ws));
     }
-    // Torque magnification at the target (T5.24–5.25).
-    chain.update_creases(chain.target.clamp(lo, hi), &mut ws)?;
-    let holding: f64 = (0..chain.crease_stiffness.len())
-        .filter(|&c| c != chain.driver)
-        .map(|c| chain.crease_stiffness[c] * ws.crease_angles[c] * ws.crease_g[c])
-        .sum::<f64>()
-        + chain.crease_stiffness[chain.driver] * chain.target;
-    let eta = holding / (chain.crease_stiffness[chain.driver] * chain.target);
+    let eta = chain.torque_magnification()?;
     let width = chain.crease_ends[chain.driver].coords.norm() * 1e6;
     let collision = run.collision;
     Ok(Response {
@@ -692,6 +704,7 @@ pub fn simulate_closed(scene: &ClosedScene, settings: &SimulationSettings) -> Re
                 ConstraintSource::Exact(_) => None,
             },
             fit_error: scene.fit_error,
+            slope_error: scene.slope_error,
             torque_magnification: eta,
             driving_hinge_width_um: width,
             required_hinge_width_um: width * eta,

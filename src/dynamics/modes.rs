@@ -20,25 +20,32 @@ pub struct Modes {
     pub stable: bool,
 }
 
-/// Solves K φ = λ M φ through the Cholesky factor M = L Lᵀ: (L⁻¹ K L⁻ᵀ) v = λ v, φ = L⁻ᵀ v.
+/// Solves K φ = λ M φ at the equilibrium of an open chain (K the diagonal hinge stiffness).
 pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
-    let n = model.dof();
     let mut data = Data::new(model);
     model.update_kinematics(equilibrium, &mut data);
     model.update_mass_matrix(&mut data);
+    let stiffness = DMatrix::from_diagonal(&model.stiffness());
+    let mut result = generalized_modes(&data.mass_matrix, &stiffness, DVector::from_column_slice(equilibrium))?;
+    result.stable &= model.joints.iter().all(|j| j.stiffness > 0.0);
+    Ok(result)
+}
+
+/// K φ = λ M φ for a symmetric positive definite M and a symmetric K, through the Cholesky
+/// factor M = L Lᵀ: (L⁻¹ K L⁻ᵀ) v = λ v, φ = L⁻ᵀ v. Stable when every λ > 0.
+pub fn generalized_modes(mass: &DMatrix<f64>, stiffness: &DMatrix<f64>, equilibrium: DVector<f64>) -> Result<Modes> {
+    let n = mass.nrows();
     let numerical = |message: String| NanofoldError::Numerical {
         stage: "modes".into(),
         message,
     };
-    let cholesky = data
-        .mass_matrix
+    let cholesky = mass
         .clone()
         .cholesky()
         .ok_or_else(|| numerical("mass matrix is not positive definite".into()))?;
     let l = cholesky.l();
-    let stiffness = DMatrix::from_diagonal(&model.stiffness());
     let l_inv_k = l
-        .solve_lower_triangular(&stiffness)
+        .solve_lower_triangular(stiffness)
         .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
     let a = l
         .solve_lower_triangular(&l_inv_k.transpose())
@@ -67,9 +74,9 @@ pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
             "eigenvalues of M⁻¹K overflow ({eigenvalues:?}): stiffness and inertia are too far apart in double precision; check the scene's units"
         )));
     }
-    let stable = model.joints.iter().all(|j| j.stiffness > 0.0) && eigenvalues.iter().all(|&l| l > 0.0);
+    let stable = eigenvalues.iter().all(|&l| l > 0.0);
     Ok(Modes {
-        equilibrium: DVector::from_column_slice(equilibrium),
+        equilibrium,
         frequencies_hz: eigenvalues
             .iter()
             .map(|&l| l.max(0.0).sqrt() / std::f64::consts::TAU)

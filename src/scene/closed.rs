@@ -131,6 +131,9 @@ pub struct ClosedScene {
     pub outputs: OutputSpec,
     /// Largest |f − exact| of the fit over the sweep samples, rad (0 for `exact`).
     pub fit_error: f64,
+    /// Largest |f′ − G| of the fit over the regular sweep samples, G by the implicit function
+    /// theorem (0 for `exact`).
+    pub slope_error: f64,
 }
 
 /// Whether a scene file's text describes a closed chain (it names a `pattern`).
@@ -333,11 +336,12 @@ impl ClosedScene {
             None => [start.min(target), start.max(target)],
         };
         let samples = sweep_samples(&pattern, &setup, domain, file.constraint.samples)?;
-        let (source, fit_error) = match (file.constraint.source, file.constraint.degree) {
+        let (source, fit_error, slope_error) = match (file.constraint.source, file.constraint.degree) {
             (SourceKind::Poly, Some(degree)) => {
                 let poly = ConstraintPoly::fit(&pattern, &samples, degree)?;
-                let error = poly.max_fit_error.iter().copied().fold(0.0, f64::max);
-                (ConstraintSource::Poly(poly), error)
+                let largest = |errors: &[f64]| errors.iter().copied().fold(0.0, f64::max);
+                let (error, slope) = (largest(&poly.max_fit_error), largest(&poly.max_slope_error));
+                (ConstraintSource::Poly(poly), error, slope)
             }
             (SourceKind::Poly, None) => {
                 return Err(NanofoldError::MissingField {
@@ -351,7 +355,11 @@ impl ClosedScene {
                     "only the \"poly\" source has a degree",
                 ))
             }
-            (SourceKind::Exact, None) => (ConstraintSource::Exact(ExactConstraint::new(&pattern, &samples)), 0.0),
+            (SourceKind::Exact, None) => (
+                ConstraintSource::Exact(ExactConstraint::new(&pattern, &samples)),
+                0.0,
+                0.0,
+            ),
         };
         if start < domain[0] - 1e-12 || start > domain[1] + 1e-12 {
             return Err(NanofoldError::invalid(
@@ -450,6 +458,7 @@ impl ClosedScene {
             t_end,
             outputs: file.outputs.clone(),
             fit_error,
+            slope_error,
         })
     }
 }
