@@ -554,14 +554,10 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
         closed.slope_error
     );
     println!(
-        "  time scales: natural period {:.3e} s, forcing {:.3e} s (ratio {:.2e}); {:?}, {} steps in {:.3} s",
-        response.time_scales.fastest_period_s,
-        response.time_scales.forcing_time_s,
-        response.time_scales.ratio,
-        response.method.unwrap_or(Method::Auto),
-        response.steps,
-        response.seconds
+        "  time scales: natural period {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
+        response.time_scales.fastest_period_s, response.time_scales.forcing_time_s, response.time_scales.ratio,
     );
+    print_model(&response);
     print_contact(&response);
     if let Some(last) = response.samples.last() {
         let angles: Vec<String> = last.angles.iter().map(|a| format!("{:.4}", a.to_degrees())).collect();
@@ -581,6 +577,33 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
 }
 
 /// The first contact of a run, or that there was none, as one line.
+/// The model line of `simulate`: which equations, their cost and their error against the other.
+fn print_model(response: &Response) {
+    match response.model {
+        ModelKind::Dynamic => {
+            println!(
+                "  model: dynamic ({:?}, rtol {:.0e}): {} steps, {} right-hand sides, {:.3} s; the quasi-static path would be off by up to {:.2e} rad",
+                response.method.unwrap_or(Method::Auto),
+                response.rtol,
+                response.steps,
+                response.rhs_evaluations,
+                response.seconds,
+                response.quasi_static_error_estimate
+            );
+            if let Some((_, measured)) = response.measured_quasi_static_error {
+                println!("  measured against the quasi-static path: {measured:.2e} rad");
+            }
+        }
+        ModelKind::QuasiStatic => {
+            let (window, measured) = response.measured_quasi_static_error.unwrap_or((0.0, f64::NAN));
+            println!(
+                "  model: quasi-static (K θ = τ(t)), {:.3} s; its error: ≤ {:.2e} rad estimated, {:.2e} rad measured by a dynamic run over the first {:.2e} s",
+                response.seconds, response.quasi_static_error_estimate, measured, window
+            );
+        }
+    }
+}
+
 fn print_contact(response: &Response) {
     match &response.collision {
         Some(c) => println!(
@@ -653,24 +676,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         "  time scales: fastest natural period {:.3e} s, slowest {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
         scales.fastest_period_s, scales.slowest_period_s, scales.forcing_time_s, scales.ratio
     );
-    match response.model {
-        ModelKind::Dynamic => println!(
-            "  model: dynamic ({:?}, rtol {:.0e}): {} steps, {} right-hand sides, {:.3} s; the quasi-static path would be off by up to {:.2e} rad",
-            response.method.unwrap_or(Method::Auto),
-            response.rtol,
-            response.steps,
-            response.rhs_evaluations,
-            response.seconds,
-            response.quasi_static_error_estimate
-        ),
-        ModelKind::QuasiStatic => {
-            let (window, measured) = response.measured_quasi_static_error.unwrap_or((0.0, f64::NAN));
-            println!(
-                "  model: quasi-static (K θ = τ(t)), {:.3} s; its error: ≤ {:.2e} rad estimated, {:.2e} rad measured by a dynamic run over the first {:.2e} s",
-                response.seconds, response.quasi_static_error_estimate, measured, window
-            );
-        }
-    }
+    print_model(&response);
     print_contact(&response);
     if let Some(last) = response.samples.last() {
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();

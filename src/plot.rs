@@ -2,6 +2,7 @@
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
 pub mod response;
+pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};

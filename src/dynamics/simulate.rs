@@ -231,6 +231,49 @@ fn quasi_static_error_estimate(scene: &Scene) -> Result<f64> {
     Ok(bound.amax())
 }
 
+impl ModelChoice {
+    /// The model to run: `Auto` is quasi-static from a time-scale ratio of 10³ up.
+    pub fn resolve(self, scales: &TimeScales) -> ModelKind {
+        match self {
+            ModelChoice::Dynamic => ModelKind::Dynamic,
+            ModelChoice::QuasiStatic => ModelKind::QuasiStatic,
+            ModelChoice::Auto if scales.ratio >= QUASI_STATIC_RATIO => ModelKind::QuasiStatic,
+            ModelChoice::Auto => ModelKind::Dynamic,
+        }
+    }
+}
+
+impl SimulationSettings {
+    /// Integration options of the main dynamic run.
+    pub(crate) fn run_options(&self) -> IntegrationOptions {
+        IntegrationOptions {
+            rtol: self.rtol,
+            progress: self.progress,
+            record_steps: true,
+            max_steps: self.max_steps,
+        }
+    }
+
+    /// The dynamic run that measures a quasi-static model's error: its window (s), method and
+    /// options. Slow forcing: a smooth response, ESDIRK34 at a tolerance well below the model's
+    /// error. A step forced onto the quasi-static model rings at O(1) rad: a few periods with
+    /// Tsit45 at the run's tolerance show it (an implicit method would crawl).
+    pub(crate) fn check_run(&self, scales: &TimeScales, t_end: f64) -> (f64, Method, IntegrationOptions) {
+        let (periods, method, rtol) = if scales.ratio >= IMPLICIT_RATIO {
+            (CHECK_PERIODS, Method::Esdirk34, CHECK_RTOL.min(self.rtol))
+        } else {
+            (STEP_CHECK_PERIODS, Method::Tsit45, self.rtol)
+        };
+        let options = IntegrationOptions {
+            rtol,
+            progress: false,
+            record_steps: false,
+            max_steps: self.max_steps,
+        };
+        ((periods * scales.slowest_period_s).min(t_end), method, options)
+    }
+}
+
 /// Runs a scene.
 pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response> {
     let started = Instant::now();
@@ -243,12 +286,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
     }
     let scales = time_scales(scene)?;
     let estimate = quasi_static_error_estimate(scene)?;
-    let kind = match settings.model {
-        ModelChoice::Dynamic => ModelKind::Dynamic,
-        ModelChoice::QuasiStatic => ModelKind::QuasiStatic,
-        ModelChoice::Auto if scales.ratio >= QUASI_STATIC_RATIO => ModelKind::QuasiStatic,
-        ModelChoice::Auto => ModelKind::Dynamic,
-    };
+    let kind = settings.model.resolve(&scales);
     let contacts = (!settings.ignore_collisions).then(|| ContactSet::new(&scene.model, scene.substrate_edge_y));
     let output_times = output_times(t_end, scene.outputs.samples);
     let mut response = Response {
@@ -269,13 +307,12 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
     match kind {
         ModelKind::Dynamic => {
             let method = resolve_method(settings.method, &scales);
-            let options = IntegrationOptions {
-                rtol: settings.rtol,
-                progress: settings.progress,
-                record_steps: true,
-                max_steps: settings.max_steps,
-            };
-            let run = integrate(&OpenChain { scene, contacts }, method, &output_times, options)?;
+            let run = integrate(
+                &OpenChain { scene, contacts },
+                method,
+                &output_times,
+                settings.run_options(),
+            )?;
             response.method = Some(method);
             response.steps = run.steps;
             response.rhs_evaluations = run.rhs_evaluations;
@@ -287,22 +324,8 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Response
             response.samples = samples;
             response.collision = collision;
             response.steps = steps;
-            // Slow forcing: a smooth response, ESDIRK34 at a tolerance well below the model's
-            // error. A step forced onto the quasi-static model rings at O(1) rad: a few periods
-            // with Tsit45 at the run's tolerance show it (an implicit method would crawl).
-            let (periods, method, rtol) = if scales.ratio >= IMPLICIT_RATIO {
-                (CHECK_PERIODS, Method::Esdirk34, CHECK_RTOL.min(settings.rtol))
-            } else {
-                (STEP_CHECK_PERIODS, Method::Tsit45, settings.rtol)
-            };
-            let window = (periods * scales.slowest_period_s).min(t_end);
+            let (window, method, options) = settings.check_run(&scales, t_end);
             let check_times = output_times_in(window, 201);
-            let options = IntegrationOptions {
-                rtol,
-                progress: false,
-                record_steps: false,
-                max_steps: settings.max_steps,
-            };
             let run = integrate(&OpenChain { scene, contacts: None }, method, &check_times, options)?;
             response.measured_quasi_static_error = Some((window, quasi_static_deviation(scene, &run.samples)));
         }
@@ -459,7 +482,7 @@ pub(crate) fn resolve_method(method: Method, scales: &TimeScales) -> Method {
     }
 }
 
-fn output_times_in(t_end: f64, samples: usize) -> Vec<f64> {
+pub(crate) fn output_times_in(t_end: f64, samples: usize) -> Vec<f64> {
     (0..samples).map(|k| t_end * k as f64 / (samples - 1) as f64).collect()
 }
 

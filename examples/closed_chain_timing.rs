@@ -1,0 +1,240 @@
+//! Speed against error for the closed chain (issue 5): the corner cube's step 1 with
+//! f = poly (degrees 2…8) and f = exact, each against the exact run (contact time, angles at
+//! contact, loop-closure drift); and the etch ramp quasi-static against dynamic.
+//! `cargo run --release --example closed_chain_timing` writes
+//! `output/closed_chain_timing/{report.json, poly_vs_exact.svg, ramp.svg}`.
+
+use nanofold::dynamics::closed::simulate_closed;
+use nanofold::dynamics::simulate::{Method, ModelChoice, Response, SimulationSettings};
+use nanofold::output::write_atomic;
+use nanofold::plot::work_precision::{work_precision_svg, WorkPoint, WorkSeries};
+use nanofold::scene::closed::ClosedScene;
+use serde_json::json;
+use std::path::Path;
+use std::time::Instant;
+
+const RUNS: usize = 5;
+
+fn scene(name: &str, constraint: serde_json::Value) -> ClosedScene {
+    let path = format!("patterns/{name}.scene.json");
+    let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    value["constraint"] = constraint;
+    ClosedScene::from_json(&value.to_string(), &path, name, Path::new("patterns")).unwrap()
+}
+
+/// Median wall time of RUNS runs (scene set-up excluded), and the last response.
+fn timed(scene: &ClosedScene, settings: &SimulationSettings) -> (f64, Response) {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..RUNS {
+        let start = Instant::now();
+        let response = simulate_closed(scene, settings).expect("run");
+        times.push(start.elapsed().as_secs_f64());
+        last = Some(response);
+    }
+    times.sort_by(f64::total_cmp);
+    (times[RUNS / 2], last.unwrap())
+}
+
+fn machine() -> serde_json::Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let commit = std::process::Command::new("git")
+        .args(["rev-parse", "--short", "HEAD"])
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default();
+    json!({
+        "cores": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        "cpu": cpu,
+        "commit": commit,
+    })
+}
+
+fn main() {
+    let out = Path::new("output/closed_chain_timing");
+    std::fs::create_dir_all(out).unwrap();
+    let settings = SimulationSettings {
+        model: ModelChoice::Dynamic,
+        method: Method::Tsit45,
+        rtol: 1e-10,
+        progress: false,
+        ..SimulationSettings::default()
+    };
+    let range = json!([-5, 180]);
+    let exact_scene = scene("corner_cube_step1", json!({"source": "exact", "range_deg": range}));
+    let (exact_seconds, exact) = timed(&exact_scene, &settings);
+    let exact_contact = exact.collision.clone().expect("exact run reaches contact");
+    let exact_end = exact.samples.last().unwrap().angles.clone();
+    println!("corner cube step 1, Tsit45 rtol 1e-10, median of {RUNS} runs");
+    println!(
+        "{:>7} {:>10} {:>10} {:>10} {:>12} {:>12} {:>12}",
+        "f", "ms", "fit err", "slope err", "closure", "Δt contact", "Δθ contact"
+    );
+    let closure = |r: &Response| r.closed.as_ref().unwrap().max_closure_residual;
+    println!(
+        "{:>7} {:>10.3} {:>10} {:>10} {:>12.1e} {:>12} {:>12}",
+        "exact",
+        exact_seconds * 1e3,
+        "0",
+        "0",
+        closure(&exact),
+        "0",
+        "0"
+    );
+    let mut rows = vec![json!({
+        "source": "exact", "seconds": exact_seconds, "fit_error_rad": 0.0, "slope_error": 0.0,
+        "max_closure_residual": closure(&exact), "contact_time_s": exact_contact.time,
+        "contact_time_error_s": 0.0, "contact_angle_error_rad": 0.0,
+    })];
+    let (mut drift, mut timing, mut angles) = (Vec::new(), Vec::new(), Vec::new());
+    for degree in 2..=8 {
+        let poly_scene = scene(
+            "corner_cube_step1",
+            json!({"source": "poly", "degree": degree, "range_deg": range}),
+        );
+        let (seconds, response) = timed(&poly_scene, &settings);
+        let contact = response.collision.clone().expect("poly run reaches contact");
+        let dt = contact.time - exact_contact.time;
+        let dtheta = (&response.samples.last().unwrap().angles - &exact_end).amax();
+        let report = response.closed.as_ref().unwrap();
+        println!(
+            "{:>7} {:>10.3} {:>10.1e} {:>10.1e} {:>12.1e} {:>12.1e} {:>12.1e}",
+            format!("poly {degree}"),
+            seconds * 1e3,
+            report.fit_error,
+            report.slope_error,
+            report.max_closure_residual,
+            dt,
+            dtheta
+        );
+        rows.push(json!({
+            "source": "poly", "degree": degree, "seconds": seconds, "fit_error_rad": report.fit_error,
+            "slope_error": report.slope_error, "max_closure_residual": report.max_closure_residual,
+            "contact_time_s": contact.time, "contact_time_error_s": dt, "contact_angle_error_rad": dtheta,
+        }));
+        let label = format!("{degree}");
+        drift.push(WorkPoint {
+            label: label.clone(),
+            seconds,
+            error: report.max_closure_residual,
+        });
+        timing.push(WorkPoint {
+            label: label.clone(),
+            seconds,
+            error: dt.abs() / exact_contact.time,
+        });
+        angles.push(WorkPoint {
+            label,
+            seconds,
+            error: dtheta,
+        });
+    }
+    // Exact last: the line runs from the cheapest fit to the reference.
+    drift.push(WorkPoint {
+        label: "exact".into(),
+        seconds: exact_seconds,
+        error: closure(&exact),
+    });
+    let figure = work_precision_svg(
+        "corner cube step 1: f = poly (degree beside each point) against f = exact",
+        "error against the exact run",
+        &[
+            WorkSeries {
+                name: "max loop-closure residual (rad; exact at its own)".into(),
+                points: drift,
+            },
+            WorkSeries {
+                name: "angles at contact − exact (rad)".into(),
+                points: angles,
+            },
+            WorkSeries {
+                name: "|contact time − exact| / contact time".into(),
+                points: timing,
+            },
+        ],
+    )
+    .unwrap();
+    write_atomic(&out.join("poly_vs_exact.svg"), figure.as_bytes()).unwrap();
+
+    // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
+    let ramp = ClosedScene::load(Path::new("patterns/corner_cube_step1_ramp.scene.json")).unwrap();
+    let auto = SimulationSettings {
+        progress: false,
+        ..SimulationSettings::default()
+    };
+    let (qs_seconds, qs) = timed(&ramp, &auto);
+    let (_, qs_measured) = qs.measured_quasi_static_error.unwrap();
+    println!(
+        "\ncorner cube step 1 ramp ({:.0} s of etch): quasi-static {:.2} ms, error ≤ {:.1e} rad (bound), {:.1e} rad measured",
+        qs.time_scales.forcing_time_s,
+        qs_seconds * 1e3,
+        qs.quasi_static_error_estimate,
+        qs_measured
+    );
+    let mut ramp_rows = vec![json!({
+        "model": "quasi_static", "seconds": qs_seconds, "error_bound_rad": qs.quasi_static_error_estimate,
+        "measured_error_rad": qs_measured,
+    })];
+    let mut ramp_points = vec![WorkPoint {
+        label: "quasi-static".into(),
+        seconds: qs_seconds,
+        error: qs.quasi_static_error_estimate,
+    }];
+    for rtol in [1e-10, 1e-11] {
+        let dynamic = SimulationSettings {
+            model: ModelChoice::Dynamic,
+            method: Method::Esdirk34,
+            rtol,
+            progress: false,
+            ..SimulationSettings::default()
+        };
+        let (seconds, run) = timed(&ramp, &dynamic);
+        let deviation = ramp.chain.quasi_static_deviation(&run.samples).unwrap();
+        println!(
+            "  dynamic ESDIRK34 rtol {rtol:.0e}: {:.2} ms, {} steps, max |θ − θ_quasi-static| {:.1e} rad",
+            seconds * 1e3,
+            run.steps,
+            deviation
+        );
+        ramp_rows.push(json!({
+            "model": "dynamic", "method": "esdirk34", "rtol": rtol, "seconds": seconds, "steps": run.steps,
+            "deviation_from_quasi_static_rad": deviation,
+        }));
+        ramp_points.push(WorkPoint {
+            label: format!("ESDIRK34 {rtol:.0e}"),
+            seconds,
+            error: deviation,
+        });
+    }
+    let figure = work_precision_svg(
+        "corner cube step 1 etch ramp: quasi-static (its error bound) against dynamic (its distance from it)",
+        "error (rad)",
+        &[WorkSeries {
+            name: "ramp models".into(),
+            points: ramp_points,
+        }],
+    )
+    .unwrap();
+    write_atomic(&out.join("ramp.svg"), figure.as_bytes()).unwrap();
+    let report = json!({
+        "machine": machine(),
+        "runs_per_point": RUNS,
+        "step": {"scene": "corner_cube_step1", "method": "tsit45", "rtol": 1e-10, "rows": rows},
+        "ramp": {"scene": "corner_cube_step1_ramp", "rows": ramp_rows},
+    });
+    write_atomic(
+        &out.join("report.json"),
+        serde_json::to_string_pretty(&report).unwrap().as_bytes(),
+    )
+    .unwrap();
+    println!("wrote {}/{{report.json, poly_vs_exact.svg, ramp.svg}}", out.display());
+}
