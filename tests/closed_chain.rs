@@ -451,3 +451,61 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
         }
     }
 }
+
+/// The closed-scene fields added for plates and constraints, each refused with its name.
+#[test]
+fn bad_closed_scene_geometry_names_the_field() {
+    let message = |edit: &dyn Fn(&mut serde_json::Value)| step1_scene(edit).unwrap_err().to_string();
+    for unit in [0.0, -300.0] {
+        let text = message(&|v| v["length_unit_um"] = serde_json::json!(unit));
+        assert!(text.contains("length_unit_um"), "{text}");
+    }
+    let reversed = message(&|v| v["constraint"]["range_deg"] = serde_json::json!([180, -5]));
+    assert!(reversed.contains("constraint.range_deg"), "{reversed}");
+    let beyond = message(&|v| v["constraint"]["range_deg"] = serde_json::json!([-5, 400]));
+    assert!(
+        beyond.contains("constraint.range_deg") && beyond.contains("180"),
+        "{beyond}"
+    );
+    let twice = message(&|v| {
+        let first = v["hinges"][0].clone();
+        v["hinges"].as_array_mut().unwrap().push(first);
+    });
+    assert!(
+        twice.contains("hinges[5].crease") && twice.contains("already has a hinge"),
+        "{twice}"
+    );
+
+    // Pattern files edited: no faces, a face that is not convex (two corners swapped).
+    let dir = std::env::temp_dir().join(format!("nanofold-closed-geometry-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/corner_cube_plates.fold").unwrap()).unwrap();
+    let scene_text = std::fs::read_to_string("patterns/corner_cube_step1.scene.json").unwrap();
+    let with_pattern = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut pattern = fold.clone();
+        edit(&mut pattern);
+        std::fs::write(dir.join("edited.fold"), pattern.to_string()).unwrap();
+        let mut scene: serde_json::Value = serde_json::from_str(&scene_text).unwrap();
+        scene["pattern"] = serde_json::json!("edited.fold");
+        ClosedScene::from_json(&scene.to_string(), "test", "test", &dir)
+            .unwrap_err()
+            .to_string()
+    };
+    let no_faces = with_pattern(&|p| {
+        p.as_object_mut().unwrap().remove("faces_vertices");
+    });
+    assert!(no_faces.contains("faces_vertices"), "{no_faces}");
+    let square = (0..)
+        .find(|&i| fold["faces_vertices"][i].as_array().unwrap().len() == 4)
+        .unwrap();
+    let bow_tie = with_pattern(&|p| {
+        let face = p["faces_vertices"][square].as_array_mut().unwrap();
+        face.swap(1, 2);
+    });
+    assert!(
+        bow_tie.contains(&format!("faces_vertices[{square}]")) && bow_tie.contains("convex"),
+        "{bow_tie}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -332,7 +332,24 @@ impl ClosedScene {
         let start = finite("start_angle_deg", file.start_angle_deg)?.to_radians();
         let target = target_deg.to_radians();
         let domain = match file.constraint.range_deg {
-            Some([a, b]) => [a.to_radians(), b.to_radians()],
+            Some([a, b]) => {
+                let field = "constraint.range_deg";
+                if !(a.is_finite() && b.is_finite() && a < b) {
+                    return Err(NanofoldError::invalid(
+                        field,
+                        format!("[{a}, {b}]"),
+                        "needs finite [A, B] with A < B",
+                    ));
+                }
+                if a < -180.0 || b > 180.0 {
+                    return Err(NanofoldError::invalid(
+                        field,
+                        format!("[{a}, {b}]"),
+                        "fold angles lie in [−180°, 180°]",
+                    ));
+                }
+                [a.to_radians(), b.to_radians()]
+            }
             None => [start.min(target), start.max(target)],
         };
         let samples = sweep_samples(&pattern, &setup, domain, file.constraint.samples)?;
