@@ -16,7 +16,7 @@ use nanofold::output::{
     response_summary, trajectory_json, write_atomic,
 };
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::plot::response::{response_svg, response_view_svg, snapshots_svg, ResponseView};
+use nanofold::plot::response::{closed_snapshots_svg, response_svg, response_view_svg, snapshots_svg, ResponseView};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::qp::QpMethod;
 use nanofold::scene::closed::{is_closed_scene, ClosedScene};
@@ -533,6 +533,7 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
             serde_json::to_string(&closed_response_json(&scene, settings, &response))?,
         ),
         ("response.svg", response_view_svg(&view, &response)?),
+        ("snapshots.svg", closed_snapshots_svg(&scene, &response, 5)?),
     ];
     for (name, contents) in &files {
         write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;

@@ -297,6 +297,36 @@ fn modes_prints_descending_frequencies_and_stability() {
 }
 
 #[test]
+fn simulate_of_a_closed_scene_writes_its_figures_and_the_closed_keys() {
+    let dir = temp_dir("simulate-closed");
+    let out = nanofold()
+        .args(["simulate", "patterns/corner_cube_step1.scene.json", "--json", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "model",
+        "collision",
+        "final_angles_rad",
+        "cut_crease",
+        "constraint_source",
+        "torque_magnification",
+        "max_closure_residual",
+        "constraint_slope_error",
+    ] {
+        assert!(summary.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(summary["final_angles_rad"].as_array().unwrap().len(), 5);
+    for (name, label) in [("response.svg", "edges[0]"), ("snapshots.svg", "anchored sector")] {
+        let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains(label), "{name}");
+    }
+    assert!(dir.join("response.json").exists());
+}
+
+#[test]
 fn modes_of_a_closed_scene_release_its_locks_and_report_the_closed_keys() {
     let out = nanofold()
         .args(["modes", "patterns/corner_cube_step2.scene.json", "--json"])

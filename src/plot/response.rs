@@ -1,11 +1,14 @@
 //! Figures of a dynamics run: `response.svg` (fold angles and energies against time, like the
-//! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of the chain, figure 5-7).
+//! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of a strip, figure 5-7; the
+//! plates in 3D for a closed chain, figures 5-10 to 5-12).
 
 use super::{draw_legend, plot_error, series_colour};
 use crate::dynamics::simulate::{ModelKind, Response, Sample};
 use crate::dynamics::Data;
 use crate::error::Result;
+use crate::scene::closed::ClosedScene;
 use crate::scene::Scene;
+use nalgebra::Point3;
 use plotters::prelude::*;
 
 /// One energy term of a sample, J.
@@ -348,6 +351,86 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
                 .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
         }
         draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
+
+/// Renders a closed chain's `snapshots.svg`: the sector plates in 3D (the anchored one grey)
+/// at `count` moments of the response, like the thesis's figures 5-10 to 5-12.
+pub fn closed_snapshots_svg(scene: &ClosedScene, response: &Response, count: usize) -> Result<String> {
+    let chain = &scene.chain;
+    let model = &chain.model;
+    let mut data = Data::new(model);
+    let reach = chain
+        .ground
+        .iter()
+        .chain(model.plates.iter().flat_map(|p| p.outline.iter()))
+        .map(|c| c.coords.norm())
+        .chain(
+            model
+                .plates
+                .iter()
+                .map(|p| p.radius() + p.reference_pose.translation.vector.norm()),
+        )
+        .fold(0.0, f64::max)
+        * 1e6;
+    let picks = snapshot_samples(response, count);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1100, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let (title, body) = root.split_vertically(34);
+        title
+            .titled(
+                &format!(
+                    "{}: the plates in 3D (grey: anchored sector; µm){}",
+                    scene.name,
+                    response
+                        .collision
+                        .as_ref()
+                        .map_or(String::new(), |c| format!(", first contact at t = {:.4e} s", c.time))
+                ),
+                ("sans-serif", 18),
+            )
+            .map_err(plot_error)?;
+        let panels = body.split_evenly((1, picks.len().max(1)));
+        // plotters' 3D y axis is vertical: plot (x, z, y) so the pattern's z is up.
+        let to_plot = |p: &Point3<f64>| (p.x * 1e6, p.z * 1e6, p.y * 1e6);
+        for (panel, &index) in panels.iter().zip(&picks) {
+            let sample = &response.samples[index];
+            let joint_angles: Vec<f64> = chain.joint_creases.iter().map(|&c| sample.angles[c]).collect();
+            model.update_poses(&joint_angles, &mut data);
+            model.update_corners(&mut data);
+            let mut view = ChartBuilder::on(panel)
+                .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
+                .margin(4)
+                .build_cartesian_3d(-reach..reach, -reach..reach, -reach..reach)
+                .map_err(plot_error)?;
+            view.with_projection(|mut p| {
+                p.yaw = -0.9;
+                p.pitch = 0.45;
+                p.scale = 1.25;
+                p.into_matrix()
+            });
+            let mut polygons = vec![(
+                chain.ground.iter().map(to_plot).collect::<Vec<_>>(),
+                RGBColor(150, 150, 150),
+            )];
+            for (j, plate) in model.plates.iter().enumerate() {
+                let corners = (0..plate.outline.len())
+                    .map(|k| to_plot(&data.corners[model.corner_index(j, k)]))
+                    .collect();
+                polygons.push((corners, series_colour(chain.joint_creases[j])));
+            }
+            for (mut outline, colour) in polygons {
+                view.draw_series(std::iter::once(Polygon::new(outline.clone(), colour.mix(0.4).filled())))
+                    .map_err(plot_error)?;
+                outline.push(outline[0]);
+                view.draw_series(std::iter::once(PathElement::new(outline, BLACK.stroke_width(1))))
+                    .map_err(plot_error)?;
+            }
+        }
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
