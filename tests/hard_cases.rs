@@ -1,6 +1,8 @@
-//! Hard cases of SPEC §9, each with its stated expectation (issue 6; more to come). Others
-//! live beside the feature they stress: the exactly flat-folded input and sectors ≥ 360° in
-//! bad_input.rs, the locked pattern in library.rs, the 10⁹ stiffness ratio in dynamics.rs.
+//! Hard cases of SPEC §9, each with its stated expectation (issue 6; more to come): Σα near
+//! 2π, tiny sectors, n = 64 and 256, a degree-12 fit exported in degrees, plates touching at
+//! the first step. Others live beside the feature they stress: the exactly flat-folded input
+//! and sectors ≥ 360° in bad_input.rs, the locked pattern in library.rs, the 10⁹ stiffness
+//! ratio in dynamics.rs and closed_chain.rs (the etch ramps).
 
 mod common;
 use common::native_json;
@@ -62,5 +64,68 @@ fn tiny_sectors_and_many_creases_load_and_stay_finite() {
             .final_fold_angles_rad
             .iter()
             .all(|r| r.is_finite() && r.abs() <= 1e-12));
+    }
+}
+
+#[test]
+fn a_degree_twelve_fit_exported_in_degrees_on_0_to_180_stays_accurate() {
+    // Expectation: the fit itself is Chebyshev (well conditioned), and the exported monomial
+    // coefficients in degrees, where t¹² reaches 180¹² ≈ 1.2e27, are finite and reproduce
+    // the exact samples in degrees to within the stated fit error plus 1e-12 rad of rounding
+    // (measured: the same as the radian form to 3e-16 rad; fit error 6e-8 rad).
+    use nanofold::constraints::chebyshev::eval_monomial;
+    use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
+    let pattern = Pattern::load(
+        std::path::Path::new("patterns/corner_cube.fold"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
+    let samples = sweep_samples(&pattern, &setup, [0.0, std::f64::consts::PI], 181).unwrap();
+    let poly = ConstraintPoly::fit(&pattern, &samples, 12).unwrap();
+    let report = ConstraintReport::new(&pattern, &samples, &poly).unwrap();
+    for (curve, &c) in report.curves.iter().zip(&setup.dependents) {
+        assert!(curve.coeffs_deg.iter().all(|k| k.is_finite()));
+        let mut worst: f64 = 0.0;
+        for (theta, angles) in samples.drive_angles.iter().zip(&samples.fold_angles) {
+            let in_degrees = eval_monomial(&curve.coeffs_deg, theta.to_degrees());
+            worst = worst.max((in_degrees - angles[c].to_degrees()).abs().to_radians());
+        }
+        assert!(
+            worst <= curve.max_fit_error_rad + 1e-12,
+            "{}: {worst:e} rad in degrees vs stated {:e}",
+            curve.label,
+            curve.max_fit_error_rad
+        );
+    }
+}
+
+#[test]
+fn plates_touching_at_the_first_step_stop_the_run_at_once() {
+    // Expectation: corner cube step 2 started at its end (crease 1 at 90°, so the doubled flap
+    // already lies folded flat on the third square, crease 4 at −180°) reports that contact at
+    // t = 0 with zero steps and finite angles, for the dynamic and the quasi-static model.
+    use nanofold::dynamics::closed::simulate_closed;
+    use nanofold::dynamics::simulate::{ModelChoice, SimulationSettings};
+    use nanofold::scene::closed::ClosedScene;
+    let text = std::fs::read_to_string("patterns/corner_cube_step2.scene.json").unwrap();
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value["start_angle_deg"] = serde_json::json!(90);
+    value["hinges"][1]["target_angle_deg"] = serde_json::json!(60);
+    value["constraint"]["range_deg"] = serde_json::json!([0, 90]);
+    let scene = ClosedScene::from_json(&value.to_string(), "test", "test", std::path::Path::new("patterns")).unwrap();
+    for model in [ModelChoice::Dynamic, ModelChoice::QuasiStatic] {
+        let settings = SimulationSettings {
+            model,
+            ..SimulationSettings::default()
+        };
+        let response = simulate_closed(&scene, &settings).unwrap();
+        let contact = response.collision.as_ref().expect("touching at t = 0");
+        assert_eq!(contact.time, 0.0, "{model:?}");
+        assert!(contact.pair[0].starts_with("edges[4]"), "{model:?}: {:?}", contact.pair);
+        assert!(response.samples.iter().all(|s| s.angles.iter().all(|a| a.is_finite())));
+        if model == ModelChoice::Dynamic {
+            assert_eq!(response.steps, 0);
+        }
     }
 }

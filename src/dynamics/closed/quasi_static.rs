@@ -127,8 +127,15 @@ pub(crate) fn quasi_static_path(
         Actuation::Step => 0.0,
         Actuation::Ramp { .. } => u * chain.forcing_time().min(t_last),
     };
-    let start = chain.quasi_static_angle(0.0, chain.start, &mut ws)?;
     let subdivisions = ((drive_end.abs() / DRIVE_STEP).ceil() as usize).max(1);
+    // A contact in the scene's start configuration stops the run at once.
+    if let Some(c) = plant.touching(0.0, &[chain.start], &mut ws) {
+        let sample = chain.sample(0.0, chain.start, 0.0, &mut ws)?;
+        return Ok((vec![sample], Some(c), 0));
+    }
+    // From there the chain settles at once to the balance with no drive (a start its passive
+    // hinges do not hold moves; that jump is not scanned for contacts).
+    let start = chain.quasi_static_angle(0.0, chain.start, &mut ws)?;
     // The first contact and the fraction u of the drive where it happens.
     let mut contact: Option<(f64, Collision)> = None;
     if plant.contact_count() > 0 {
