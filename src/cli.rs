@@ -453,9 +453,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     if args.format == ExportFormat::Mujoco {
         files.push(("constraints.xml", mujoco_snippet(&report)?));
     }
-    for (name, contents) in &files {
-        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
-    }
+    write_outputs(&dir, &files)?;
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
         return Ok(());
@@ -492,8 +490,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         "  all curves together: loop-closure residual {:.3e} rad",
         report.max_closure_residual
     );
-    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
-    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    print_written(&dir, &files);
     Ok(())
 }
 
@@ -535,9 +532,7 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
         ("response.svg", response_view_svg(&view, &response)?),
         ("snapshots.svg", closed_snapshots_svg(&scene, &response, 5)?),
     ];
-    for (name, contents) in &files {
-        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
-    }
+    write_outputs(&dir, &files)?;
     let summary = closed_response_summary(&scene, settings, &response);
     if args.json {
         println!("{summary}");
@@ -572,12 +567,25 @@ fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Re
         "  max loop-closure residual along the run: {:.3e} rad",
         closed.max_closure_residual
     );
-    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
-    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    print_written(&dir, &files);
     Ok(())
 }
 
 /// The first contact of a run, or that there was none, as one line.
+/// Writes each (file name, contents) into `dir`, each atomically; everything is rendered first.
+fn write_outputs(dir: &Path, files: &[(&str, String)]) -> Result<()> {
+    for (name, contents) in files {
+        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
+    }
+    Ok(())
+}
+
+/// The "wrote DIR/{a, b}" line.
+fn print_written(dir: &Path, files: &[(&str, String)]) {
+    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
+    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+}
+
 /// The model line of `simulate`: which equations, their cost and their error against the other.
 fn print_model(response: &Response) {
     match response.model {
@@ -659,9 +667,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         ("response.svg", response_svg(&scene, &response)?),
         ("snapshots.svg", snapshots_svg(&scene, &response)?),
     ];
-    for (name, contents) in &files {
-        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
-    }
+    write_outputs(&dir, &files)?;
     if args.json {
         println!("{}", response_summary(&scene, &settings, &response));
         return Ok(());
@@ -683,8 +689,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
     }
-    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
-    println!("  wrote {}/{{{}}}", dir.display(), names.join(", "));
+    print_written(&dir, &files);
     Ok(())
 }
 

@@ -12,16 +12,22 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
+/// Runs a command that must succeed and print one JSON value; returns its output and the value.
+fn json_run(command: &mut Command) -> (std::process::Output, serde_json::Value) {
+    let out = command.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let value = serde_json::from_slice(&out.stdout).unwrap();
+    (out, value)
+}
+
 #[test]
 fn unfold_writes_outputs_and_json_summary() {
     let dir = temp_dir("unfold");
-    let out = nanofold()
-        .args(["unfold", "patterns/corner_cube.fold", "--json", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (_, summary) = json_run(
+        nanofold()
+            .args(["unfold", "patterns/corner_cube.fold", "--json", "--out"])
+            .arg(&dir),
+    );
     for key in [
         "verdict",
         "iterations",
@@ -244,13 +250,11 @@ fn simulate_writes_response_files_and_the_documented_json_keys() {
         assert!(svg.starts_with("<svg") && svg.contains(label), "{name}");
     }
 
-    let ramp = nanofold()
-        .args(["simulate", "patterns/bridge_ramp.scene.json", "--json", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(ramp.status.success(), "{}", String::from_utf8_lossy(&ramp.stderr));
-    let summary: serde_json::Value = serde_json::from_slice(&ramp.stdout).unwrap();
+    let (_, summary) = json_run(
+        nanofold()
+            .args(["simulate", "patterns/bridge_ramp.scene.json", "--json", "--out"])
+            .arg(&dir),
+    );
     assert_eq!(summary["model"], "quasi_static");
     assert!(summary["time_scale_ratio"].as_f64().unwrap() > 1e8);
     let estimate = summary["quasi_static_error_estimate_rad"].as_f64().unwrap();
@@ -260,12 +264,7 @@ fn simulate_writes_response_files_and_the_documented_json_keys() {
 
 #[test]
 fn modes_prints_descending_frequencies_and_stability() {
-    let out = nanofold()
-        .args(["modes", "patterns/bridge_step.scene.json", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let modes: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (_, modes) = json_run(nanofold().args(["modes", "patterns/bridge_step.scene.json", "--json"]));
     let eigenvalues: Vec<f64> = modes["eigenvalues"]
         .as_array()
         .unwrap()
@@ -299,13 +298,11 @@ fn modes_prints_descending_frequencies_and_stability() {
 #[test]
 fn simulate_of_a_closed_scene_writes_its_figures_and_the_closed_keys() {
     let dir = temp_dir("simulate-closed");
-    let out = nanofold()
-        .args(["simulate", "patterns/corner_cube_step1.scene.json", "--json", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (_, summary) = json_run(
+        nanofold()
+            .args(["simulate", "patterns/corner_cube_step1.scene.json", "--json", "--out"])
+            .arg(&dir),
+    );
     for key in [
         "model",
         "collision",
@@ -328,12 +325,7 @@ fn simulate_of_a_closed_scene_writes_its_figures_and_the_closed_keys() {
 
 #[test]
 fn modes_of_a_closed_scene_release_its_locks_and_report_the_closed_keys() {
-    let out = nanofold()
-        .args(["modes", "patterns/corner_cube_step2.scene.json", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let modes: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (_, modes) = json_run(nanofold().args(["modes", "patterns/corner_cube_step2.scene.json", "--json"]));
     for key in [
         "eigenvalues",
         "frequencies_hz",

@@ -209,6 +209,14 @@ pub trait ContactProbe {
     fn collision(&self, k: usize, t: f64) -> Collision;
 }
 
+/// Moves the probe to path parameter t and fills every candidate's gap there.
+pub fn gaps_at(probe: &mut dyn ContactProbe, t: f64, gaps: &mut [f64]) {
+    probe.move_to(t);
+    for (k, gap) in gaps.iter_mut().enumerate() {
+        *gap = probe.gap(k);
+    }
+}
+
 /// The earliest contact in (t_start, t_end], bisecting (Illinois) each sign change of a gap
 /// along the probe's path. The end of the interval is checked first; only if some gap is
 /// within `reach` (a bound on how far two corners can move towards each other over the
@@ -224,13 +232,7 @@ pub fn locate(
     gaps_start: &mut [f64],
     gaps_scratch: &mut [f64],
 ) -> Option<Collision> {
-    let fill = |probe: &mut dyn ContactProbe, t: f64, gaps: &mut [f64]| {
-        probe.move_to(t);
-        for (k, gap) in gaps.iter_mut().enumerate() {
-            *gap = probe.gap(k);
-        }
-    };
-    fill(probe, t_end, gaps_scratch);
+    gaps_at(probe, t_end, gaps_scratch);
     let near = (0..probe.count()).any(|k| {
         let (g0, g1) = (gaps_start[k], gaps_scratch[k]);
         g0.signum() == g1.signum() && g0.abs().min(g1.abs()) < reach
@@ -240,7 +242,7 @@ pub fn locate(
     for s in 1..=subdivisions {
         let t_right = t_start + (t_end - t_start) * s as f64 / subdivisions as f64;
         if subdivisions > 1 {
-            fill(probe, t_right, gaps_scratch);
+            gaps_at(probe, t_right, gaps_scratch);
         }
         let mut earliest: Option<(f64, usize)> = None;
         for k in 0..probe.count() {

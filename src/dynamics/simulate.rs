@@ -6,7 +6,7 @@
 //! are both O(1) and one absolute tolerance fits all components (SPEC §1: masses ~1e-12 kg,
 //! stiffnesses ~1e-9 N·m give rates ~1e4 rad/s in SI).
 
-use super::contact::{locate, ChainProbe, Collision, ContactProbe, ContactSet};
+use super::contact::{gaps_at, locate, ChainProbe, Collision, ContactProbe, ContactSet};
 use super::modes::modes;
 use super::Data;
 use crate::error::{NanofoldError, Result};
@@ -785,10 +785,7 @@ impl<P: Plant> Driver<'_, P> {
             let start = angles.clone();
             let mut at_start = |_: f64, out: &mut [f64]| out.copy_from_slice(&start);
             let mut probe = plant.probe(&mut ws, &mut angles, &mut at_start);
-            probe.move_to(0.0);
-            for (k, gap) in gaps.iter_mut().enumerate() {
-                *gap = probe.gap(k);
-            }
+            gaps_at(probe.as_mut(), 0.0, &mut gaps);
         }
         // Stop exactly at each kink of the forcing (a ramp reaching its target), so no step
         // straddles it, then at the end.

@@ -217,11 +217,11 @@ impl ClosedChain {
         let mut guess = folded_pose.clone();
         let mut iterations = 0;
         let mut state = self.closure_state(&coordinates, &theta_c, &guess)?;
-        loop {
+        let (gradient, hinge, load) = loop {
             let (_, gradient, hinge, load) = self.hinge_energy(&state, &rest);
-            let step = (hinge + load)
+            let step = (&hinge + &load)
                 .lu()
-                .solve(&(-gradient))
+                .solve(&(-&gradient))
                 .filter(|s| s.iter().all(|v| v.is_finite()))
                 .ok_or_else(|| NanofoldError::Numerical {
                     stage: "closed-chain equilibrium".into(),
@@ -232,7 +232,7 @@ impl ClosedChain {
                 })?;
             let size = step.amax();
             if size <= NEWTON_STEP_TOL {
-                break;
+                break (gradient, hinge, load);
             }
             if iterations == NEWTON_ITERATIONS {
                 return Err(NanofoldError::Numerical {
@@ -247,8 +247,7 @@ impl ClosedChain {
             guess.clone_from(&state.angles);
             state = self.closure_state(&coordinates, &theta_c, &guess)?;
             iterations += 1;
-        }
-        let (_, gradient, hinge, load) = self.hinge_energy(&state, &rest);
+        };
         let jacobian = state.jacobian.clone();
         let reduced_mass = self.reduced_mass_matrix(&state, &mut Data::new(&self.model));
         let stiffness = &hinge + &load;

@@ -6,7 +6,7 @@
 //! are located along the drive angle and mapped back to time.
 
 use super::{ClosedChain, ClosedData, ClosedPlant};
-use crate::dynamics::contact::{locate, Collision};
+use crate::dynamics::contact::{gaps_at, locate, Collision};
 use crate::dynamics::simulate::{Plant, Sample};
 use crate::error::{NanofoldError, Result};
 use crate::scene::Actuation;
@@ -155,10 +155,7 @@ pub(crate) fn quasi_static_path(
             let count = plant.contact_count();
             let (mut gaps, mut scratch) = (vec![0.0; count], vec![0.0; count]);
             let mut probe = plant.probe(&mut ws, &mut q, &mut path);
-            probe.move_to(0.0);
-            for (k, gap) in gaps.iter_mut().enumerate() {
-                *gap = probe.gap(k);
-            }
+            gaps_at(probe.as_mut(), 0.0, &mut gaps);
             contact = locate(
                 probe.as_mut(),
                 0.0,
