@@ -38,21 +38,27 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Unfold one pattern; write trajectory.json, unfold.svg and unfold.fold.
+    /// Unfold patterns; write trajectory.json, unfold.svg and unfold.fold for each.
     Unfold {
-        /// A FOLD file (.fold) or a native vertex (.json).
-        pattern: PathBuf,
+        /// FOLD files (.fold), native vertices (.json) or directories of them (searched
+        /// recursively; scene files are skipped). Several run in parallel.
+        #[arg(required = true)]
+        patterns: Vec<PathBuf>,
         #[command(flatten)]
         solver: SolverArgs,
-        /// Output folder (default: output/<pattern name>/).
+        /// Output folder for one pattern (default: output/<pattern name>/); with several,
+        /// the parent of their <pattern name>/ folders (default: output/).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Print one JSON object on stdout instead of a summary.
+        /// Print one JSON object per pattern on stdout instead of a summary.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        parallel: ParallelArgs,
     },
     /// Verdict of each pattern, one line each; writes no files.
     Check {
+        /// Pattern files or directories of them (searched recursively; scene files skipped).
         #[arg(required = true)]
         patterns: Vec<PathBuf>,
         #[command(flatten)]
@@ -60,6 +66,8 @@ pub enum Command {
         /// One JSON object per line.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        parallel: ParallelArgs,
     },
     /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
     /// (SPEC §6); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
@@ -237,6 +245,71 @@ impl SolverArgs {
     }
 }
 
+/// How many patterns run at once.
+#[derive(Args, Debug, Clone)]
+pub struct ParallelArgs {
+    /// Patterns run at once (0: one per core). Lines come out as patterns finish, each
+    /// naming its file.
+    #[arg(long, default_value_t = 0)]
+    pub jobs: usize,
+}
+
+impl ParallelArgs {
+    /// Runs `work` on every path in a pool of `--jobs` threads; `work` prints its own lines.
+    fn for_each(&self, paths: &[PathBuf], work: impl Fn(&Path) + Sync) -> Result<()> {
+        use rayon::prelude::*;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.jobs)
+            .build()
+            .context("starting the worker threads")?;
+        pool.install(|| paths.par_iter().for_each(|path| work(path)));
+        Ok(())
+    }
+}
+
+/// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
+fn is_pattern_file(path: &Path) -> bool {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
+}
+
+/// The pattern files named on the command line: files as given, directories searched
+/// recursively for `.fold` and `.json` files (scene files skipped), each directory's in
+/// name order. A directory without any is an error naming it.
+fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    fn walk(dir: &Path, found: &mut Vec<PathBuf>) -> Result<()> {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+            .with_context(|| format!("cannot read directory {}", dir.display()))?
+            .map(|entry| entry.map(|e| e.path()))
+            .collect::<std::io::Result<_>>()
+            .with_context(|| format!("cannot read directory {}", dir.display()))?;
+        entries.sort();
+        for path in entries {
+            if path.is_dir() {
+                walk(&path, found)?;
+            } else if is_pattern_file(&path) {
+                found.push(path);
+            }
+        }
+        Ok(())
+    }
+    let mut found = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            let before = found.len();
+            walk(path, &mut found)?;
+            anyhow::ensure!(
+                found.len() > before,
+                "no pattern files (.fold or .json, scene files aside) in directory {}",
+                path.display()
+            );
+        } else {
+            found.push(path.clone());
+        }
+    }
+    Ok(found)
+}
+
 /// The `--json` summary of one run.
 fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json::Value {
     json!({
@@ -260,12 +333,14 @@ fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json:
     })
 }
 
-fn run_unfold(pattern_path: &Path, solver: &SolverArgs, out: Option<PathBuf>, as_json: bool) -> Result<()> {
+/// Unfolds one pattern into `dir`; returns its JSON summary and its human-readable lines.
+fn unfold_one(pattern_path: &Path, solver: &SolverArgs, dir: Option<&Path>) -> Result<(serde_json::Value, String)> {
+    use std::fmt::Write as _;
     let settings = solver.settings()?;
     let pattern = Pattern::load(pattern_path, &solver.load_options())?;
     let report = unfold(&pattern, &settings)?;
     let model = UnfoldModel::new(&pattern);
-    let dir = out.unwrap_or_else(|| PathBuf::from("output").join(&pattern.name));
+    let dir = dir.map_or_else(|| PathBuf::from("output").join(&pattern.name), Path::to_path_buf);
     // Render everything before writing anything.
     let trajectory = serde_json::to_string(&trajectory_json(&pattern, &settings, &report, 1000))?;
     let fold = serde_json::to_string_pretty(&fold_animation(&pattern, &model, &report))?;
@@ -279,71 +354,130 @@ fn run_unfold(pattern_path: &Path, solver: &SolverArgs, out: Option<PathBuf>, as
     }
     let mut summary = summary(&pattern, pattern_path, &report);
     summary["out"] = json!(dir.display().to_string());
-    if as_json {
-        println!("{summary}");
-    } else {
-        println!("{}: {} ({})", pattern.name, report.verdict.as_str(), report.evidence);
-        println!(
-            "  {} iterations in {:.3} ms; energy {:.6e} -> {:.6e}",
-            report.iterations,
-            report.seconds * 1e3,
-            report.energy_initial,
-            report.energy_final
-        );
-        println!(
-            "  max arc residual {:.2e} rad, planarity residual {:.2e}, restarts {}",
-            report.max_arc_residual, report.planarity_residual, report.restarts_used
-        );
-        for (c, rho) in pattern.creases.iter().zip(&report.final_fold_angles_rad) {
-            println!(
-                "  {:<12} {:>11.6}° -> {:>12.3e} rad",
-                c.label,
-                c.folded_angle.to_degrees(),
-                rho
-            );
-        }
-        for note in &report.adjustments {
-            println!("  note: {note}");
-        }
-        println!("  wrote {}/{{trajectory.json, unfold.svg, unfold.fold}}", dir.display());
+    let mut text = String::new();
+    writeln!(
+        text,
+        "{}: {} ({})",
+        pattern.name,
+        report.verdict.as_str(),
+        report.evidence
+    )?;
+    writeln!(
+        text,
+        "  {} iterations in {:.3} ms; energy {:.6e} -> {:.6e}",
+        report.iterations,
+        report.seconds * 1e3,
+        report.energy_initial,
+        report.energy_final
+    )?;
+    writeln!(
+        text,
+        "  max arc residual {:.2e} rad, planarity residual {:.2e}, flat layout error {:.2e}, restarts {}",
+        report.max_arc_residual, report.planarity_residual, report.flat_layout_error, report.restarts_used
+    )?;
+    for (c, rho) in pattern.creases.iter().zip(&report.final_fold_angles_rad) {
+        writeln!(
+            text,
+            "  {:<12} {:>11.6}° -> {:>12.3e} rad",
+            c.label,
+            c.folded_angle.to_degrees(),
+            rho
+        )?;
     }
-    Ok(())
+    for note in &report.adjustments {
+        writeln!(text, "  note: {note}")?;
+    }
+    write!(
+        text,
+        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold}}",
+        dir.display()
+    )?;
+    Ok((summary, text))
 }
 
-fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool) -> Result<bool> {
-    let settings = solver.settings()?;
-    let mut all_readable = true;
-    for path in patterns {
-        let outcome = Pattern::load(path, &solver.load_options()).and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
-        match outcome {
-            Ok((pattern, report)) => {
-                if as_json {
-                    println!("{}", summary(&pattern, path, &report));
-                } else {
-                    println!(
-                        "{}: {} ({} iterations, {:.3} ms) {}",
-                        path.display(),
-                        report.verdict.as_str(),
-                        report.iterations,
-                        report.seconds * 1e3,
-                        report.evidence
-                    );
-                }
-            }
+/// One pattern: errors end the command. Several: each runs in parallel into
+/// `<out>/<pattern name>/`, a failure is reported on its own line and the exit status is
+/// non-zero at the end.
+fn run_unfold(
+    patterns: &[PathBuf],
+    solver: &SolverArgs,
+    out: Option<PathBuf>,
+    as_json: bool,
+    parallel: &ParallelArgs,
+) -> Result<bool> {
+    solver.settings()?;
+    let single = patterns.len() == 1 && !patterns[0].is_dir();
+    if single {
+        let (summary, text) = unfold_one(&patterns[0], solver, out.as_deref())?;
+        println!("{}", if as_json { summary.to_string() } else { text });
+        return Ok(true);
+    }
+    let files = expand_patterns(patterns)?;
+    // Output folders by pattern name, refused up front if two patterns would share one.
+    let parent = out.unwrap_or_else(|| PathBuf::from("output"));
+    let mut dirs = Vec::with_capacity(files.len());
+    let mut seen: std::collections::HashMap<PathBuf, &Path> = std::collections::HashMap::new();
+    for path in &files {
+        let dir = parent.join(nanofold::pattern::pattern_name(path));
+        if let Some(other) = seen.insert(dir.clone(), path) {
+            anyhow::bail!(
+                "{} and {} would both write {}: unfold them separately with --out",
+                other.display(),
+                path.display(),
+                dir.display()
+            );
+        }
+        dirs.push(dir);
+    }
+    let all_ok = std::sync::atomic::AtomicBool::new(true);
+    parallel.for_each(&files, |path| {
+        let index = files.iter().position(|f| f == path).unwrap_or(0);
+        match unfold_one(path, solver, Some(&dirs[index])) {
+            Ok((summary, text)) => println!("{}", if as_json { summary.to_string() } else { text }),
             Err(e) => {
-                all_readable = false;
-                if as_json {
-                    println!(
-                        "{}",
-                        json!({"file": path.display().to_string(), "error": e.to_string()})
-                    );
-                } else {
-                    println!("{}: error: {e}", path.display());
-                }
+                all_ok.store(false, std::sync::atomic::Ordering::Relaxed);
+                print_failure(path, &e, as_json);
             }
         }
+    })?;
+    Ok(all_ok.into_inner())
+}
+
+/// One line for a pattern that could not be read or run.
+fn print_failure(path: &Path, error: &anyhow::Error, as_json: bool) {
+    if as_json {
+        println!(
+            "{}",
+            json!({"file": path.display().to_string(), "error": format!("{error:#}")})
+        );
+    } else {
+        println!("{}: error: {error:#}", path.display());
     }
-    Ok(all_readable)
+}
+
+fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel: &ParallelArgs) -> Result<bool> {
+    let settings = solver.settings()?;
+    let files = expand_patterns(patterns)?;
+    let all_readable = std::sync::atomic::AtomicBool::new(true);
+    parallel.for_each(&files, |path| {
+        let outcome = Pattern::load(path, &solver.load_options()).and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
+        match outcome {
+            Ok((pattern, report)) if as_json => println!("{}", summary(&pattern, path, &report)),
+            Ok((_, report)) => println!(
+                "{}: {} ({} iterations, {:.3} ms) {}",
+                path.display(),
+                report.verdict.as_str(),
+                report.iterations,
+                report.seconds * 1e3,
+                report.evidence
+            ),
+            Err(e) => {
+                all_readable.store(false, std::sync::atomic::Ordering::Relaxed);
+                print_failure(path, &anyhow::Error::new(e), as_json);
+            }
+        }
+    })?;
+    Ok(all_readable.into_inner())
 }
 
 /// Parses "J=DEG" into (crease index, rad).
@@ -822,12 +956,18 @@ fn run_modes_closed(path: &Path, json: bool) -> Result<()> {
 pub fn run(cli: Cli) -> Result<bool> {
     match cli.command {
         Command::Unfold {
-            pattern,
+            patterns,
             solver,
             out,
             json,
-        } => run_unfold(&pattern, &solver, out, json).map(|_| true),
-        Command::Check { patterns, solver, json } => run_check(&patterns, &solver, json),
+            parallel,
+        } => run_unfold(&patterns, &solver, out, json, &parallel),
+        Command::Check {
+            patterns,
+            solver,
+            json,
+            parallel,
+        } => run_check(&patterns, &solver, json, &parallel),
         Command::Constraints(args) => run_constraints(&args).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
         Command::Modes { scene, json } => run_modes(&scene, json).map(|_| true),

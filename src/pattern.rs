@@ -173,6 +173,14 @@ pub(crate) struct RawVertex {
     pub mesh: Option<FoldMesh>,
 }
 
+/// A pattern's name: its file name without `.fold` or `.json` (names output folders).
+pub fn pattern_name(path: &Path) -> String {
+    path.file_name()
+        .and_then(|s| s.to_str())
+        .map(|s| s.trim_end_matches(".json").trim_end_matches(".fold").to_string())
+        .unwrap_or_else(|| "pattern".to_string())
+}
+
 impl Pattern {
     /// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
     /// `vertices_coords`).
@@ -181,11 +189,7 @@ impl Pattern {
             path: path.display().to_string(),
             error,
         })?;
-        let name = path
-            .file_name()
-            .and_then(|s| s.to_str())
-            .map(|s| s.trim_end_matches(".json").trim_end_matches(".fold").to_string())
-            .unwrap_or_else(|| "pattern".to_string());
+        let name = pattern_name(path);
         Self::from_str(&text, &name, &path.display().to_string(), options)
     }
 

@@ -194,12 +194,16 @@ impl RowSpace {
 
 /// The direct path: y = −(I − A⁺A) q.
 pub fn solve_direct(problem: &DirectionProblem) -> Result<DirectionSolution> {
-    let row_space = RowSpace::new(&problem.a)?;
-    Ok(DirectionSolution {
+    Ok(solve_direct_with(problem, &RowSpace::new(&problem.a)?))
+}
+
+/// The direct path with A already factorised (the unfolder reuses it for the restoration).
+pub fn solve_direct_with(problem: &DirectionProblem, row_space: &RowSpace) -> DirectionSolution {
+    DirectionSolution {
         y: -row_space.project_to_null(&problem.q),
         status: QpStatus::Solved,
         iterations: 0,
-    })
+    }
 }
 
 #[cfg(test)]

@@ -39,6 +39,9 @@ pub struct UnfoldSettings {
     pub armijo: f64,
     /// Largest node displacement per step, radians (keeps trial steps off barriers).
     pub max_step_rad: f64,
+    /// Finish with [`Unfolder::flatten`] (Newton onto ρ = 0) once within `flat_tol`, or when
+    /// stalled within 1e-4 rad of flat; off, the line search polishes as far as it can.
+    pub newton_flatten: bool,
     /// Restarts from perturbed states when stuck, before a verdict.
     pub restarts: usize,
     /// Size of the restart perturbation, radians.
@@ -58,6 +61,7 @@ impl Default for UnfoldSettings {
             restore_tol: 1e-13,
             armijo: 1e-4,
             max_step_rad: 0.2,
+            newton_flatten: true,
             restarts: 3,
             restart_kick_rad: 0.05,
             seed: 1,
@@ -97,6 +101,8 @@ pub struct UnfoldModel {
 enum ConstraintRow {
     Arc(usize),
     Held(usize),
+    /// The fold angle at this ray is zero (only while [`Unfolder::flatten`] runs).
+    Flat(usize),
     /// Component `k` (of the tangent plane at x_v) of x_v + x_w = 0: an antipodal pair held
     /// at its kink (see [`Unfolder::pin_antipodal_pairs`]).
     Antipodal {
@@ -278,6 +284,7 @@ fn fill_residuals(model: &UnfoldModel, rows: &[ConstraintRow], nodes: &[Vec3], o
                 let held = model.held[h];
                 wrap(model.fold_angle_at(nodes, held.ray) - held.target)
             }
+            ConstraintRow::Flat(ray) => wrap(model.fold_angle_at(nodes, ray)),
             ConstraintRow::Antipodal { v, w, k } => tangent_basis(&nodes[v])[k].dot(&(nodes[v] + nodes[w])),
         };
     }
@@ -299,6 +306,13 @@ fn fill_jacobian(
             out[(r, col + 1)] += basis[node][1].dot(g);
         }
     };
+    let put_fold_angle = |out: &mut DMatrix<f64>, r: usize, ray: usize| {
+        let (prev, next) = model.neighbours(ray);
+        let (_, [gp, ga, gn]) = fold_angle_with_gradient(&nodes[prev], &nodes[ray], &nodes[next]);
+        put(out, r, prev, &gp);
+        put(out, r, ray, &ga);
+        put(out, r, next, &gn);
+    };
     for (r, row) in rows.iter().enumerate() {
         match *row {
             ConstraintRow::Arc(e) => {
@@ -307,14 +321,8 @@ fn fill_jacobian(
                 put(out, r, arc.a, &ga);
                 put(out, r, arc.b, &gb);
             }
-            ConstraintRow::Held(h) => {
-                let ray = model.held[h].ray;
-                let (prev, next) = model.neighbours(ray);
-                let (_, [gp, ga, gn]) = fold_angle_with_gradient(&nodes[prev], &nodes[ray], &nodes[next]);
-                put(out, r, prev, &gp);
-                put(out, r, ray, &ga);
-                put(out, r, next, &gn);
-            }
+            ConstraintRow::Held(h) => put_fold_angle(out, r, model.held[h].ray),
+            ConstraintRow::Flat(ray) => put_fold_angle(out, r, ray),
             ConstraintRow::Antipodal { v, w, k } => {
                 let e = tangent_basis(&nodes[v])[k];
                 put(out, r, v, &e);
@@ -516,7 +524,7 @@ impl<'a> Unfolder<'a> {
         let model = self.model;
         let (problem, row_space) = self.direction_problem()?;
         let solution = match self.settings.qp {
-            QpMethod::Direct => qp::solve_direct(&problem)?,
+            QpMethod::Direct => qp::solve_direct_with(&problem, &row_space),
             QpMethod::Clarabel => qp::solve_clarabel(&problem)?,
         };
         if solution.status == qp::QpStatus::AlmostSolved {
@@ -669,6 +677,49 @@ impl<'a> Unfolder<'a> {
             self.ws.resize_rows(self.model);
             false
         }
+    }
+
+    /// Newton to the flat state (SPEC §5). Near flat U varies as ρ², so its values resolve ρ
+    /// only to about √ε and the line search stalls around 1e-7; the fold angles themselves
+    /// are well-conditioned there. So the last stretch is a Newton projection onto {arc
+    /// lengths, every fold angle = 0}, accepted only if the energy does not rise (beyond
+    /// rounding) and no node passes through an arc. Returns whether it was accepted.
+    pub fn flatten(&mut self) -> Result<bool> {
+        let model = self.model;
+        self.unpin();
+        let rows_before = self.ws.rows.len();
+        let held: Vec<usize> = model.held.iter().map(|h| h.ray).collect();
+        for &ray in &model.fold_rays {
+            if !held.contains(&ray) {
+                self.ws.rows.push(ConstraintRow::Flat(ray));
+            }
+        }
+        self.ws.resize_rows(model);
+        let mut flattened = self.nodes.clone();
+        let restored = restore(model, &mut self.ws, &mut flattened, self.settings.restore_tol, None);
+        self.ws.rows.truncate(rows_before);
+        self.ws.resize_rows(model);
+        if restored.is_err() || find_crossing(model, &self.nodes, &flattened).is_some() {
+            return Ok(false);
+        }
+        let mut gradient = vec![Vec3::zeros(); model.node_count];
+        let value = self
+            .energy
+            .value_and_gradient(&flattened, &model.arcs, &mut self.ws.energy, &mut gradient);
+        if !(value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs()) {
+            return Ok(false);
+        }
+        self.last_direction_norm = self
+            .nodes
+            .iter()
+            .zip(&flattened)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        self.nodes = flattened;
+        self.energy_value = value;
+        self.ws.gradient = gradient;
+        self.step_scale = None;
+        Ok(true)
     }
 
     /// Drops every antipodal pin.
@@ -825,6 +876,9 @@ fn record(model: &UnfoldModel, solver: &Unfolder, iteration: usize) -> StepRecor
 /// Largest fold angle at which a stall counts as "near flat" rather than a local minimum.
 const NEAR_FLAT: f64 = 1e-4;
 
+/// Fold angles this small are flat to rounding.
+const ROUNDING_FLAT: f64 = 1e-14;
+
 /// Backs a flat-folded (|ρ| = π, coincident charges) start off the singularity: every fold
 /// angle is scaled by (1 − 10⁻³) and the constraints restored (documented in README).
 const FLAT_FOLDED_BACKOFF: f64 = 1e-3;
@@ -908,6 +962,7 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
     let mut iteration = 0;
     let mut rng = SplitMix64(settings.seed);
     let mut restarts_used = 0;
+    let mut flattened_from: Option<f64> = None;
     let is_flat = |s: &Unfolder| model.max_fold_angle(&s.nodes) <= settings.flat_tol;
 
     let verdict;
@@ -921,8 +976,20 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
             // the line search is stationary or the polish budget is spent.
             let mut stationary = false;
             let mut polish_left = settings.polish_iterations;
+            let mut flatten_tried = false;
             while iteration < settings.max_iterations {
                 if is_flat(&solver) {
+                    let from = model.max_fold_angle(&solver.nodes);
+                    // Nothing for Newton to gain once the fold angles are at rounding level.
+                    if settings.newton_flatten && !flatten_tried && from > ROUNDING_FLAT {
+                        flatten_tried = true;
+                        if solver.flatten()? {
+                            iteration += 1;
+                            trajectory.push(record(&model, &solver, iteration));
+                            flattened_from = Some(from);
+                            break;
+                        }
+                    }
                     if polish_left == 0 {
                         break;
                     }
@@ -939,16 +1006,27 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
                     }
                 }
             }
+            // A stall this close to flat is the √ε limit of U, not a minimum: Newton decides.
+            let left = model.max_fold_angle(&solver.nodes);
+            let stalled_near_flat = stationary && left < NEAR_FLAT && left > ROUNDING_FLAT;
+            if settings.newton_flatten && flattened_from.is_none() && stalled_near_flat && solver.flatten()? {
+                iteration += 1;
+                trajectory.push(record(&model, &solver, iteration));
+                flattened_from = Some(left);
+            }
             if is_flat(&solver) {
                 verdict = Verdict::Flat;
-                evidence = if restarts_used == 0 {
-                    format!("every fold angle ≤ {:.0e} rad", settings.flat_tol)
-                } else {
-                    format!(
-                        "every fold angle ≤ {:.0e} rad after {restarts_used} restart(s) from perturbed states",
-                        settings.flat_tol
-                    )
-                };
+                let mut words = format!("every fold angle ≤ {:.0e} rad", settings.flat_tol);
+                if let Some(from) = flattened_from {
+                    words += &format!(
+                        " (max |ρ| = {:.1e} rad after Newton onto ρ = 0 from {from:.1e} rad)",
+                        model.max_fold_angle(&solver.nodes)
+                    );
+                }
+                if restarts_used > 0 {
+                    words += &format!(" after {restarts_used} restart(s) from perturbed states");
+                }
+                evidence = words;
                 break;
             }
             let why = if stationary { "stationary" } else { "iteration limit" };

@@ -112,15 +112,131 @@ fn check_prints_one_line_per_pattern_and_fails_only_on_unreadable_input() {
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
+    // Lines come out as patterns finish: match them by file.
+    let verdict_of = |file: &str| {
+        lines
+            .iter()
+            .find(|l| l["file"] == file)
+            .map(|l| l["verdict"].clone())
+            .unwrap()
+    };
     assert_eq!(lines.len(), 2);
-    assert_eq!(lines[0]["verdict"], "locked");
-    assert_eq!(lines[1]["verdict"], "not_flat_foldable");
+    assert_eq!(verdict_of("patterns/degree4_locked.fold"), "locked");
+    assert_eq!(verdict_of("patterns/cone.json"), "not_flat_foldable");
     let out = nanofold()
         .args(["check", "patterns/half_paper.fold", "Cargo.toml"])
         .output()
         .unwrap();
     assert!(!out.status.success());
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 2);
+}
+
+/// JSON lines of a command, keyed by their "file".
+fn json_lines(out: &std::process::Output) -> std::collections::BTreeMap<String, serde_json::Value> {
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let value: serde_json::Value = serde_json::from_str(l).unwrap();
+            (value["file"].as_str().unwrap().to_string(), value)
+        })
+        .collect()
+}
+
+#[test]
+fn check_of_a_directory_runs_every_pattern_in_parallel_one_line_each() {
+    let out = nanofold()
+        .args(["check", "--json", "--jobs", "2", "patterns"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines = json_lines(&out);
+    // Every pattern file of the library, scene files skipped, each once.
+    let mut expected: Vec<String> = std::fs::read_dir("patterns")
+        .unwrap()
+        .map(|e| e.unwrap().path().display().to_string())
+        .filter(|p| (p.ends_with(".fold") || p.ends_with(".json")) && !p.ends_with(".scene.json"))
+        .collect();
+    expected.sort();
+    assert_eq!(lines.keys().cloned().collect::<Vec<_>>(), expected);
+    assert_eq!(lines["patterns/degree4_locked.fold"]["verdict"], "locked");
+    assert_eq!(lines["patterns/cone.json"]["verdict"], "not_flat_foldable");
+    assert_eq!(lines["patterns/symmetric16.fold"]["verdict"], "flat");
+    // The same answers one at a time: parallel runs do not disturb each other.
+    let serial = nanofold()
+        .args(["check", "--json", "--jobs", "1", "patterns"])
+        .output()
+        .unwrap();
+    for (file, line) in json_lines(&serial) {
+        assert_eq!(line["verdict"], lines[&file]["verdict"], "{file}");
+        assert_eq!(
+            line["final_fold_angles_rad"], lines[&file]["final_fold_angles_rad"],
+            "{file}"
+        );
+    }
+}
+
+#[test]
+fn unfold_of_several_patterns_writes_a_folder_each_and_refuses_name_clashes() {
+    let dir = temp_dir("unfold-many");
+    let out = nanofold()
+        .args([
+            "unfold",
+            "--json",
+            "patterns/half_paper.fold",
+            "patterns/degree4_generic.fold",
+            "patterns/cone.json",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines = json_lines(&out);
+    assert_eq!(lines.len(), 3);
+    for name in ["half_paper", "degree4_generic", "cone"] {
+        for file in ["trajectory.json", "unfold.svg", "unfold.fold"] {
+            assert!(dir.join(name).join(file).is_file(), "{name}/{file}");
+        }
+    }
+    assert_eq!(lines["patterns/degree4_generic.fold"]["verdict"], "flat");
+    assert_eq!(
+        lines["patterns/degree4_generic.fold"]["out"],
+        dir.join("degree4_generic").display().to_string()
+    );
+
+    // Two files with one name would share a folder: refused before anything runs.
+    let other = temp_dir("unfold-clash");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::copy("patterns/half_paper.fold", other.join("half_paper.fold")).unwrap();
+    let clash_out = temp_dir("unfold-clash-out");
+    let out = nanofold()
+        .args(["unfold", "patterns/half_paper.fold"])
+        .arg(other.join("half_paper.fold"))
+        .arg("--out")
+        .arg(&clash_out)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("would both write"));
+    assert!(!clash_out.exists());
+
+    // A directory without patterns is an error naming it.
+    let empty = temp_dir("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = nanofold().arg("check").arg(&empty).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no pattern files"));
+
+    // One unreadable file among several: the others still run, the exit status says so.
+    let out = nanofold()
+        .args(["unfold", "--json", "patterns/half_paper.fold", "Cargo.toml", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let lines = json_lines(&out);
+    assert_eq!(lines["patterns/half_paper.fold"]["verdict"], "flat");
+    assert!(lines["Cargo.toml"]["error"].as_str().unwrap().contains("Cargo.toml"));
 }
 
 #[test]

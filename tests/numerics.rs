@@ -177,6 +177,7 @@ proptest! {
         }
         if report.verdict == Verdict::Flat {
             prop_assert!(report.final_fold_angles_rad.iter().all(|r| r.abs() <= 1e-6));
+            prop_assert!(report.flat_layout_error <= 1e-8, "layout error {:e}", report.flat_layout_error);
         }
         prop_assert!(report.verdict != Verdict::LocalMinimum && report.verdict != Verdict::Locked, "{:?}: {}", report.verdict, report.evidence);
     }
