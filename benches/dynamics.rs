@@ -1,6 +1,6 @@
 //! Criterion benches for the bridge (SPEC §8): M(θ), C(θ, θ̇)θ̇, the whole right-hand side,
 //! and the step response to first collision at two tolerances. The example
-//! `dynamics_timing` prints each run's error beside its time.
+//! `work_precision` prints each run's error beside its time.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;

@@ -4,6 +4,9 @@
 //! `cargo run --release --example closed_chain_timing` writes
 //! `output/closed_chain_timing/{report.json, poly_vs_exact.svg, ramp.svg}`.
 
+mod common;
+
+use common::machine;
 use nanofold::dynamics::closed::simulate_closed;
 use nanofold::dynamics::simulate::{Method, ModelChoice, Response, SimulationSettings};
 use nanofold::output::write_atomic;
@@ -11,7 +14,6 @@ use nanofold::plot::work_precision::{work_precision_svg, WorkPoint, WorkSeries};
 use nanofold::scene::closed::ClosedScene;
 use serde_json::json;
 use std::path::Path;
-use std::time::Instant;
 
 const RUNS: usize = 5;
 
@@ -24,39 +26,7 @@ fn scene(name: &str, constraint: serde_json::Value) -> ClosedScene {
 
 /// Median wall time of RUNS runs (scene set-up excluded), and the last response.
 fn timed(scene: &ClosedScene, settings: &SimulationSettings) -> (f64, Response) {
-    let mut times = Vec::new();
-    let mut last = None;
-    for _ in 0..RUNS {
-        let start = Instant::now();
-        let response = simulate_closed(scene, settings).expect("run");
-        times.push(start.elapsed().as_secs_f64());
-        last = Some(response);
-    }
-    times.sort_by(f64::total_cmp);
-    (times[RUNS / 2], last.unwrap())
-}
-
-fn machine() -> serde_json::Value {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|s| s.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".into());
-    let commit = std::process::Command::new("git")
-        .args(["rev-parse", "--short", "HEAD"])
-        .output()
-        .ok()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .unwrap_or_default();
-    json!({
-        "cores": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
-        "cpu": cpu,
-        "commit": commit,
-    })
+    common::timed(RUNS, || simulate_closed(scene, settings).expect("run"))
 }
 
 fn main() {

@@ -1,5 +1,6 @@
 //! Work–precision figures: wall time against error on log–log axes, one labelled point per
-//! setting, one line per series (a method, or one kind of error).
+//! setting, one line per series (a method, or one kind of error); and cost-against-size
+//! figures for scaling, with the fitted power law.
 
 use super::{draw_legend, plot_error, series_colour};
 use crate::error::Result;
@@ -22,14 +23,30 @@ pub struct WorkSeries {
     pub points: Vec<WorkPoint>,
 }
 
-/// Log–log SVG of error against wall time (ms). Points with a zero or non-finite error or time
-/// are left out (a log axis cannot show them); say so in the caption if it matters.
+/// The unit that shows times best: (name, seconds per unit), chosen so the largest time is
+/// at least 1.
+fn time_unit(largest_seconds: f64) -> (&'static str, f64) {
+    [("s", 1.0), ("ms", 1e-3), ("µs", 1e-6), ("ns", 1e-9)]
+        .into_iter()
+        .find(|&(_, unit)| largest_seconds >= unit)
+        .unwrap_or(("ns", 1e-9))
+}
+
+/// Log–log SVG of error against wall time (in s, ms, µs or ns, whichever shows the times
+/// best). Points with a zero or non-finite error or time are left out (a log axis cannot
+/// show them); say so in the caption if it matters.
 pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries]) -> Result<String> {
     let shown = |p: &WorkPoint| p.seconds > 0.0 && p.error > 0.0 && p.seconds.is_finite() && p.error.is_finite();
+    let largest = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| shown(p))
+        .fold(0.0_f64, |m, p| m.max(p.seconds));
+    let (unit_name, unit) = time_unit(largest);
     let (mut t_lo, mut t_hi, mut e_lo, mut e_hi) = (f64::INFINITY, 0.0_f64, f64::INFINITY, 0.0_f64);
     for p in series.iter().flat_map(|s| s.points.iter()).filter(|p| shown(p)) {
-        t_lo = t_lo.min(p.seconds * 1e3);
-        t_hi = t_hi.max(p.seconds * 1e3);
+        t_lo = t_lo.min(p.seconds / unit);
+        t_hi = t_hi.max(p.seconds / unit);
         e_lo = e_lo.min(p.error);
         e_hi = e_hi.max(p.error);
     }
@@ -41,10 +58,12 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
     let (e_lo, e_hi) = (e_lo / 10.0, e_hi * 10.0);
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (1100, 600)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
+        let root = root.titled(title, ("sans-serif", 18)).map_err(plot_error)?;
+        // The legend gets its own column: with a dozen series it would hide points.
+        let (plot_area, legend_area) = root.split_horizontally(760);
+        let mut chart = ChartBuilder::on(&plot_area)
             .margin(14)
             .x_label_area_size(40)
             .y_label_area_size(70)
@@ -52,10 +71,10 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
             .map_err(plot_error)?;
         chart
             .configure_mesh()
-            .x_desc("wall time (ms)")
+            .x_desc(format!("wall time ({unit_name})"))
             .y_desc(error_label)
             .y_label_formatter(&|v| format!("{v:.0e}"))
-            .x_label_formatter(&|v| format!("{v:.2}"))
+            .x_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(plot_error)?;
         for (i, line) in series.iter().enumerate() {
@@ -64,27 +83,181 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 .points
                 .iter()
                 .filter(|p| shown(p))
-                .map(|p| (p.seconds * 1e3, p.error))
+                .map(|p| (p.seconds / unit, p.error))
                 .collect();
             chart
                 .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(plot_error)?
-                .label(line.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
                 .map_err(plot_error)?;
+            if triangles(i) {
+                chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 6, colour.filled())))
+            } else {
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+            }
+            .map_err(plot_error)?;
             chart
                 .draw_series(
                     line.points
                         .iter()
                         .filter(|p| shown(p))
-                        .map(|p| Text::new(p.label.clone(), (p.seconds * 1e3, p.error), ("sans-serif", 12))),
+                        .map(|p| Text::new(p.label.clone(), (p.seconds / unit, p.error), ("sans-serif", 12))),
                 )
                 .map_err(plot_error)?;
+            let y = 30 + 20 * i as i32;
+            legend_area
+                .draw(&PathElement::new(vec![(4, y), (26, y)], colour.stroke_width(2)))
+                .map_err(plot_error)?;
+            if triangles(i) {
+                legend_area.draw(&TriangleMarker::new((15, y), 6, colour.filled()))
+            } else {
+                legend_area.draw(&Circle::new((15, y), 4, colour.filled()))
+            }
+            .map_err(plot_error)?;
+            legend_area
+                .draw(&Text::new(line.name.clone(), (32, y - 7), ("sans-serif", 13)))
+                .map_err(plot_error)?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
+}
+
+/// Series past the palette's ten colours get triangles instead of circles.
+fn triangles(i: usize) -> bool {
+    (i / 10) % 2 == 1
+}
+
+/// An axis number without trailing zeros ("10", "0.25", "3e-4").
+fn tick(v: f64) -> String {
+    if v != 0.0 && v.abs() < 1e-2 {
+        return format!("{v:.0e}");
+    }
+    let text = format!("{v:.3}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// A least-squares power law c·nᵏ through (n, cost) points: returns (k, c). None with fewer
+/// than two distinct sizes.
+pub fn power_law_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let logs: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(n, c)| *n > 0.0 && *c > 0.0)
+        .map(|(n, c)| (n.ln(), c.ln()))
+        .collect();
+    let count = logs.len() as f64;
+    let mean_x = logs.iter().map(|p| p.0).sum::<f64>() / count;
+    let mean_y = logs.iter().map(|p| p.1).sum::<f64>() / count;
+    let sxx: f64 = logs.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
+    if logs.len() < 2 || sxx <= 0.0 {
+        return None;
+    }
+    let sxy: f64 = logs.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
+    let k = sxy / sxx;
+    Some((k, (mean_y - k * mean_x).exp()))
+}
+
+/// The three largest sizes of a series (sorted by size), where the leading term shows.
+pub fn largest_sizes(points: &[(f64, f64)]) -> &[(f64, f64)] {
+    &points[points.len().saturating_sub(3)..]
+}
+
+/// One line of a scaling figure: cost (s) against size.
+#[derive(Debug, Clone)]
+pub struct ScalingSeries {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Log–log SVG of cost (in the unit that shows it best) against size (points sorted by
+/// size), each series with its points joined and, in the legend, the exponent fitted over
+/// its three largest sizes.
+pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> Result<String> {
+    let all = || {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|(n, c)| *n > 0.0 && *c > 0.0)
+    };
+    let largest = all().fold(0.0_f64, |m, p| m.max(p.1));
+    let (unit_name, unit) = time_unit(largest);
+    let (mut n_lo, mut n_hi, mut c_lo, mut c_hi) = (f64::INFINITY, 0.0_f64, f64::INFINITY, 0.0_f64);
+    for &(n, c) in all() {
+        n_lo = n_lo.min(n);
+        n_hi = n_hi.max(n);
+        c_lo = c_lo.min(c / unit);
+        c_hi = c_hi.max(c / unit);
+    }
+    if n_hi == 0.0 {
+        (n_lo, n_hi, c_lo, c_hi) = (1.0, 10.0, 0.1, 1.0);
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(14)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(
+                (n_lo / 1.3..n_hi * 1.3).log_scale(),
+                (c_lo / 3.0..c_hi * 3.0).log_scale(),
+            )
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc(size_label)
+            .y_desc(format!("time ({unit_name})"))
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| tick(*v))
+            .draw()
+            .map_err(plot_error)?;
+        for (i, line) in series.iter().enumerate() {
+            let colour = series_colour(i);
+            let points: Vec<(f64, f64)> = line
+                .points
+                .iter()
+                .filter(|(n, c)| *n > 0.0 && *c > 0.0)
+                .map(|&(n, c)| (n, c / unit))
+                .collect();
+            let name = match power_law_fit(largest_sizes(&line.points)) {
+                Some((k, _)) => format!("{} (n^{k:.2} over the three largest n)", line.name),
+                None => line.name.clone(),
+            };
+            chart
+                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                .map_err(plot_error)?
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .map_err(plot_error)?;
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn power_law_fit_recovers_an_exact_power_law() {
+        let points: Vec<(f64, f64)> = [4.0, 16.0, 64.0, 256.0]
+            .iter()
+            .map(|&n: &f64| (n, 3e-7 * n.powf(2.5)))
+            .collect();
+        let (k, c) = power_law_fit(&points).unwrap();
+        assert!((k - 2.5).abs() < 1e-12 && (c / 3e-7 - 1.0).abs() < 1e-10);
+        assert!(power_law_fit(&[(8.0, 1.0)]).is_none());
+    }
+
+    #[test]
+    fn times_are_shown_in_a_readable_unit() {
+        assert_eq!(time_unit(2.0).0, "s");
+        assert_eq!(time_unit(0.5).0, "ms");
+        assert_eq!(time_unit(3e-6).0, "µs");
+        assert_eq!(time_unit(5e-8).0, "ns");
+    }
 }

@@ -1,0 +1,558 @@
+//! Speed against error, in one report (issue 6): unfolding every library pattern over a
+//! sweep of solver settings, the constraint fits by degree, the bridge's step response per
+//! integrator and tolerance against a much tighter reference, the bridge's etch ramp
+//! quasi-static against dynamic, and the cost of one unfold iteration against the number of
+//! creases. Each time is the median of several runs.
+//!
+//! `cargo run --release --example work_precision` prints the tables and writes
+//! `output/work_precision/{report.json, unfold_*.svg, fits.svg, bridge_step.svg,
+//! bridge_ramp.svg, scaling.svg}` (about two minutes on two cores).
+
+mod common;
+
+use common::{library_patterns, machine, many_creases, median, timed};
+use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
+use nanofold::dynamics::simulate::{quasi_static_deviation, simulate, Method, ModelChoice, SimulationSettings};
+use nanofold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::output::write_atomic;
+use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::plot::work_precision::{
+    largest_sizes, power_law_fit, scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries,
+};
+use nanofold::qp::QpMethod;
+use nanofold::scene::Scene;
+use nanofold::sphere::Vec3;
+use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
+use serde_json::{json, Value};
+use std::f64::consts::PI;
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+/// Runs per point (the median is reported).
+const RUNS: usize = 5;
+/// Runs per dynamics point (the implicit methods take up to half a second a run).
+const DYNAMIC_RUNS: usize = 3;
+
+fn write(out: &Path, name: &str, contents: &str) {
+    write_atomic(&out.join(name), contents.as_bytes()).expect("writing the report");
+}
+
+/// One unfolding configuration of the sweep.
+#[derive(Clone, Copy)]
+struct UnfoldConfig {
+    qp: QpMethod,
+    newton_flatten: bool,
+    flat_tol: f64,
+    max_step_rad: f64,
+}
+
+impl UnfoldConfig {
+    fn settings(self) -> UnfoldSettings {
+        UnfoldSettings {
+            qp: self.qp,
+            newton_flatten: self.newton_flatten,
+            flat_tol: self.flat_tol,
+            max_step_rad: self.max_step_rad,
+            ..UnfoldSettings::default()
+        }
+    }
+    fn series(self) -> String {
+        let qp = match self.qp {
+            QpMethod::Direct => "direct",
+            QpMethod::Clarabel => "clarabel",
+        };
+        let finish = if self.newton_flatten {
+            "newton finish"
+        } else {
+            "line search only"
+        };
+        format!("{qp}, {finish}")
+    }
+}
+
+/// A configuration with its median seconds and its distance from the flat layout.
+type MeasuredConfig = (UnfoldConfig, f64, f64);
+
+/// The unfolding sweep: every pattern that unfolds × direction solver × finish × flat
+/// tolerance, plus the step cap of the line search at the default setting.
+fn unfold_part(out: &Path) -> Value {
+    let defaults = UnfoldSettings::default();
+    let mut configs = Vec::new();
+    for qp in [QpMethod::Direct, QpMethod::Clarabel] {
+        for newton_flatten in [true, false] {
+            for flat_tol in [1e-2, 1e-4, 1e-6] {
+                configs.push(UnfoldConfig {
+                    qp,
+                    newton_flatten,
+                    flat_tol,
+                    max_step_rad: defaults.max_step_rad,
+                });
+            }
+        }
+    }
+    let step_caps = [0.05, 0.8];
+    for max_step_rad in step_caps {
+        configs.push(UnfoldConfig {
+            qp: QpMethod::Direct,
+            newton_flatten: true,
+            flat_tol: defaults.flat_tol,
+            max_step_rad,
+        });
+    }
+
+    println!("== unfolding: wall time against error (median of {RUNS}) ==");
+    println!(
+        "{:<20} {:<28} {:>8} {:>9} {:<14} {:>6} {:>10} {:>10} {:>10}",
+        "pattern", "direction, finish", "flat tol", "step cap", "verdict", "iters", "ms", "layout err", "arc resid"
+    );
+    let mut rows = Vec::new();
+    let mut by_pattern: Vec<(String, Vec<MeasuredConfig>)> = Vec::new();
+    for pattern in library_patterns() {
+        let probe = unfold(&pattern, &defaults).expect("library pattern unfolds without error");
+        if probe.verdict != Verdict::Flat {
+            println!(
+                "{:<20} verdict {} at the default settings: no flat layout to measure against",
+                pattern.name,
+                probe.verdict.as_str()
+            );
+            rows.push(json!({"pattern": pattern.name, "verdict": probe.verdict.as_str()}));
+            continue;
+        }
+        let mut points = Vec::new();
+        for config in &configs {
+            let settings = config.settings();
+            let (seconds, report) = timed(RUNS, || unfold(&pattern, &settings).expect("unfold"));
+            println!(
+                "{:<20} {:<28} {:>8.0e} {:>9} {:<14} {:>6} {:>10.3} {:>10.1e} {:>10.1e}",
+                pattern.name,
+                config.series(),
+                config.flat_tol,
+                config.max_step_rad,
+                report.verdict.as_str(),
+                report.iterations,
+                seconds * 1e3,
+                report.flat_layout_error,
+                report.max_arc_residual
+            );
+            rows.push(json!({
+                "pattern": pattern.name, "creases": pattern.creases.len(),
+                "qp": config.qp, "newton_flatten": config.newton_flatten, "flat_tol": config.flat_tol,
+                "max_step_rad": config.max_step_rad, "verdict": report.verdict.as_str(),
+                "iterations": report.iterations, "seconds": seconds,
+                "flat_layout_error": report.flat_layout_error, "max_arc_residual": report.max_arc_residual,
+            }));
+            if config.max_step_rad == defaults.max_step_rad {
+                points.push((*config, seconds, report.flat_layout_error));
+            }
+        }
+        by_pattern.push((pattern.name.clone(), points));
+    }
+
+    // One figure per family; a line per pattern and (direction, finish), a point per tolerance.
+    let families: [(&str, &str, &[&str]); 4] = [
+        ("unfold_two_creases.svg", "two creases", &["half_paper", "sheet_corner"]),
+        (
+            "unfold_degree4.svg",
+            "degree 4",
+            &["degree4_generic", "degree4_native", "miura_vertex"],
+        ),
+        ("unfold_corner_cube.svg", "corner cube", &["corner_cube"]),
+        (
+            "unfold_degree6_to_16.svg",
+            "degree 6 to 16",
+            &["degree6_asymmetric", "waterbomb", "symmetric16"],
+        ),
+    ];
+    for (file, family, members) in families {
+        let mut series = Vec::new();
+        for (name, points) in by_pattern.iter().filter(|(name, _)| members.contains(&name.as_str())) {
+            let mut lines: Vec<String> = points.iter().map(|(c, _, _)| c.series()).collect();
+            lines.dedup();
+            for line in lines {
+                series.push(WorkSeries {
+                    name: format!("{name}: {line}"),
+                    points: points
+                        .iter()
+                        .filter(|(c, _, _)| c.series() == line)
+                        .map(|(c, seconds, error)| WorkPoint {
+                            label: format!("{:.0e}", c.flat_tol),
+                            seconds: *seconds,
+                            // Exactly on the layout cannot be drawn on a log axis.
+                            error: error.max(1e-17),
+                        })
+                        .collect(),
+                });
+            }
+        }
+        let svg = work_precision_svg(
+            &format!("unfolding, {family}: distance from the exact flat layout (points: --flat-tol)"),
+            "max node distance from the flat layout",
+            &series,
+        )
+        .expect("figure");
+        write(out, file, &svg);
+    }
+    json!({"runs_per_point": RUNS, "rows": rows})
+}
+
+/// Degree against error and evaluation time of f and G for the corner cube's step-1 curves.
+fn fits_part(out: &Path) -> Value {
+    let pattern = Pattern::load(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
+    let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).expect("setup");
+    let (sweep_seconds, samples) = timed(RUNS, || sweep_samples(&pattern, &setup, [0.0, PI], 201).expect("sweep"));
+    println!(
+        "\n== constraint fits: corner cube step 1, driver crease 0 on [0, π], crease 1 held flat ==\nexact sweep of 201 samples: {:.3} ms, closure residual {:.1e} rad",
+        sweep_seconds * 1e3,
+        samples.max_closure_residual
+    );
+    println!(
+        "{:>6} {:>13} {:>14} {:>14} {:>10} {:>10}",
+        "degree", "fit err rad", "slope err", "closure rad", "f ns", "G ns"
+    );
+    let thetas: Vec<f64> = (0..1000).map(|i| PI * i as f64 / 999.0).collect();
+    let mut buffer = vec![0.0; setup.dependents.len()];
+    let (mut rows, mut f_points, mut g_points) = (Vec::new(), Vec::new(), Vec::new());
+    for degree in [1, 2, 3, 4, 6, 8, 10, 12, 14, 16, 20] {
+        let poly = ConstraintPoly::fit(&pattern, &samples, degree).expect("fit");
+        let report = ConstraintReport::new(&pattern, &samples, &poly).expect("report");
+        let slope_error = report.curves.iter().map(|c| c.max_slope_error).fold(0.0, f64::max);
+        let mut per_eval = |jacobian: bool| {
+            let times: Vec<f64> = (0..RUNS)
+                .map(|_| {
+                    let start = Instant::now();
+                    for &theta in &thetas {
+                        if jacobian {
+                            poly.jacobian_into(black_box(theta), &mut buffer).expect("G");
+                        } else {
+                            poly.eval_into(black_box(theta), &mut buffer).expect("f");
+                        }
+                        black_box(&buffer);
+                    }
+                    start.elapsed().as_secs_f64() / thetas.len() as f64
+                })
+                .collect();
+            median(times)
+        };
+        let (f_seconds, g_seconds) = (per_eval(false), per_eval(true));
+        println!(
+            "{degree:>6} {:>13.2e} {:>14.2e} {:>14.2e} {:>10.1} {:>10.1}",
+            report.max_fit_error(),
+            slope_error,
+            report.max_closure_residual,
+            f_seconds * 1e9,
+            g_seconds * 1e9
+        );
+        rows.push(json!({
+            "degree": degree, "max_fit_error_rad": report.max_fit_error(), "max_slope_error": slope_error,
+            "max_closure_residual_rad": report.max_closure_residual,
+            "f_seconds_per_eval": f_seconds, "g_seconds_per_eval": g_seconds,
+        }));
+        f_points.push(WorkPoint {
+            label: format!("{degree}"),
+            seconds: f_seconds,
+            error: report.max_fit_error(),
+        });
+        g_points.push(WorkPoint {
+            label: format!("{degree}"),
+            seconds: g_seconds,
+            error: slope_error,
+        });
+    }
+    let svg = work_precision_svg(
+        "constraint fits, corner cube step 1: error against one evaluation (points: degree)",
+        "max error (rad; slope: rad/rad)",
+        &[
+            WorkSeries {
+                name: "f: fit error vs the exact sweep".into(),
+                points: f_points,
+            },
+            WorkSeries {
+                name: "G = f′: slope error vs the implicit function theorem".into(),
+                points: g_points,
+            },
+        ],
+    )
+    .expect("figure");
+    write(out, "fits.svg", &svg);
+    json!({
+        "pattern": "corner_cube", "driver": 0, "held": {"1": 0.0}, "domain_rad": [0.0, PI], "samples": 201,
+        "sweep_seconds": sweep_seconds, "rows": rows,
+    })
+}
+
+/// The bridge's step response per integrator and tolerance against a reference, and its
+/// etch ramp quasi-static against dynamic.
+fn dynamics_part(out: &Path) -> Value {
+    let step = Scene::load(Path::new("patterns/bridge_step.scene.json")).expect("scene");
+    let reference_settings = SimulationSettings {
+        rtol: 1e-13,
+        method: Method::Tsit45,
+        progress: false,
+        ..Default::default()
+    };
+    let (reference_seconds, reference) = timed(1, || simulate(&step, &reference_settings).expect("reference"));
+    let reference_contact = reference.collision.clone().expect("the bridge step collides");
+    let reference_angles = reference.samples.last().expect("samples").angles.clone();
+    println!(
+        "\n== bridge step response: error against Tsit45 at rtol 1e-13 ({:.2} s), median of {DYNAMIC_RUNS} ==\nreference first contact {} / {} at t = {:.9e} s",
+        reference_seconds, reference_contact.pair[0], reference_contact.pair[1], reference_contact.time
+    );
+    println!(
+        "{:<10} {:>7} {:>10} {:>8} {:>10} {:>14} {:>14}",
+        "method", "rtol", "ms", "steps", "rhs", "|Δt contact| s", "max|Δθ| rad"
+    );
+    let mut rows = Vec::new();
+    let (mut angle_series, mut time_series) = (Vec::new(), Vec::new());
+    for method in [Method::Tsit45, Method::Bdf, Method::Esdirk34, Method::TrBdf2] {
+        let name = format!("{method:?}").to_lowercase();
+        let (mut angle_points, mut time_points) = (Vec::new(), Vec::new());
+        for rtol in [1e-6, 1e-8, 1e-10] {
+            // The implicit methods take seconds at 1e-10 on this ringing response.
+            if method != Method::Tsit45 && rtol < 1e-8 {
+                continue;
+            }
+            let settings = SimulationSettings {
+                rtol,
+                method,
+                progress: false,
+                ..Default::default()
+            };
+            let (seconds, response) = timed(DYNAMIC_RUNS, || simulate(&step, &settings).expect("run"));
+            let contact = response.collision.clone().expect("collides");
+            let angle_error = (&response.samples.last().expect("samples").angles - &reference_angles).amax();
+            let time_error = (contact.time - reference_contact.time).abs();
+            println!(
+                "{name:<10} {rtol:>7.0e} {:>10.2} {:>8} {:>10} {time_error:>14.2e} {angle_error:>14.2e}",
+                seconds * 1e3,
+                response.steps,
+                response.rhs_evaluations
+            );
+            rows.push(json!({
+                "method": name, "rtol": rtol, "seconds": seconds, "steps": response.steps,
+                "rhs_evaluations": response.rhs_evaluations, "contact_time_error_s": time_error,
+                "angle_error_at_contact_rad": angle_error,
+            }));
+            let label = format!("{rtol:.0e}");
+            angle_points.push(WorkPoint {
+                label: label.clone(),
+                seconds,
+                error: angle_error,
+            });
+            time_points.push(WorkPoint {
+                label,
+                seconds,
+                // Relative to the contact time, so both errors share one axis.
+                error: time_error / reference_contact.time,
+            });
+        }
+        angle_series.push(WorkSeries {
+            name: format!("{name}: max |Δθ| at contact (rad)"),
+            points: angle_points,
+        });
+        time_series.push(WorkSeries {
+            name: format!("{name}: |Δt contact| / t contact"),
+            points: time_points,
+        });
+    }
+    angle_series.extend(time_series);
+    let svg = work_precision_svg(
+        "bridge step response to first contact: error against Tsit45 at rtol 1e-13 (points: rtol)",
+        "error",
+        &angle_series,
+    )
+    .expect("figure");
+    write(out, "bridge_step.svg", &svg);
+
+    let ramp = Scene::load(Path::new("patterns/bridge_ramp.scene.json")).expect("scene");
+    let quasi_settings = SimulationSettings {
+        progress: false,
+        ..Default::default()
+    };
+    let (quasi_seconds, quasi) = timed(RUNS, || simulate(&ramp, &quasi_settings).expect("quasi-static"));
+    let (window, measured) = quasi.measured_quasi_static_error.expect("auto measures its error");
+    let quasi_contact = quasi.collision.clone().expect("the ramp lands");
+    println!(
+        "\n== bridge etch ramp (time-scale ratio {:.2e}) ==\nquasi-static: {:.2} ms (with its {:.0e} s dynamic check); error bound {:.2e} rad, measured {:.2e} rad; contact at {:.6} s",
+        quasi.time_scales.ratio,
+        quasi_seconds * 1e3,
+        window,
+        quasi.quasi_static_error_estimate,
+        measured,
+        quasi_contact.time
+    );
+    let mut ramp_rows = vec![json!({
+        "model": "quasi_static", "seconds": quasi_seconds, "error_bound_rad": quasi.quasi_static_error_estimate,
+        "measured_error_rad": measured, "contact_time_s": quasi_contact.time,
+    })];
+    let mut ramp_points = vec![WorkPoint {
+        label: "quasi-static (measured error)".into(),
+        seconds: quasi_seconds,
+        error: measured,
+    }];
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        let settings = SimulationSettings {
+            model: ModelChoice::Dynamic,
+            method: Method::Esdirk34,
+            rtol,
+            progress: false,
+            ..Default::default()
+        };
+        let (seconds, dynamic) = timed(DYNAMIC_RUNS, || simulate(&ramp, &settings).expect("dynamic ramp"));
+        let contact = dynamic.collision.clone().expect("the ramp lands");
+        let deviation = quasi_static_deviation(&ramp, &dynamic.samples);
+        println!(
+            "dynamic ESDIRK34 rtol {rtol:.0e}: {:.2} ms, {} steps; max |θ − θ_quasi-static| {deviation:.2e} rad; contact Δ {:.2e} s",
+            seconds * 1e3,
+            dynamic.steps,
+            contact.time - quasi_contact.time
+        );
+        ramp_rows.push(json!({
+            "model": "dynamic", "method": "esdirk34", "rtol": rtol, "seconds": seconds, "steps": dynamic.steps,
+            "deviation_from_quasi_static_rad": deviation, "contact_time_s": contact.time,
+        }));
+        ramp_points.push(WorkPoint {
+            label: format!("ESDIRK34 {rtol:.0e}"),
+            seconds,
+            error: deviation,
+        });
+    }
+    let svg = work_precision_svg(
+        "bridge etch ramp: quasi-static (its measured error) and dynamic (its distance from quasi-static)",
+        "error (rad)",
+        &[WorkSeries {
+            name: "ramp models".into(),
+            points: ramp_points,
+        }],
+    )
+    .expect("figure");
+    write(out, "bridge_ramp.svg", &svg);
+    json!({
+        "step": {"scene": "bridge_step", "reference": {"method": "tsit45", "rtol": 1e-13, "seconds": reference_seconds,
+                 "contact_time_s": reference_contact.time}, "runs_per_point": DYNAMIC_RUNS, "rows": rows},
+        "ramp": {"scene": "bridge_ramp", "time_scale_ratio": quasi.time_scales.ratio, "rows": ramp_rows},
+    })
+}
+
+/// Median seconds per call of `work`, repeated until about 20 ms have passed (at least 5).
+fn per_call(mut work: impl FnMut()) -> f64 {
+    let mut times = Vec::new();
+    let started = Instant::now();
+    while times.len() < 5 || (started.elapsed().as_secs_f64() < 0.02 && times.len() < 10_000) {
+        let start = Instant::now();
+        work();
+        times.push(start.elapsed().as_secs_f64());
+    }
+    median(times)
+}
+
+/// The cost of one unfold iteration against n, split into its parts.
+fn scaling_part(out: &Path) -> Value {
+    println!("\n== one unfold iteration against the number of creases (random vertices, median) ==");
+    println!(
+        "{:>5} {:>14} {:>14} {:>16} {:>10}",
+        "n", "iteration µs", "U+∇U µs", "A and its SVD µs", "SVD share"
+    );
+    let sizes = [4usize, 8, 16, 32, 64, 128, 256];
+    let (mut iteration, mut energy, mut direction) = (Vec::new(), Vec::new(), Vec::new());
+    let mut rows = Vec::new();
+    for &n in &sizes {
+        let pattern = many_creases(n);
+        let model = UnfoldModel::new(&pattern);
+        let settings = UnfoldSettings::default();
+        let mut solver = Unfolder::new(&model, &settings, model.folded_nodes()).expect("start");
+        let kind = EnergyKind::Separable.build(None);
+        let mut ws = EnergyWorkspace::default();
+        let mut gradient = vec![Vec3::zeros(); model.node_count];
+        let nodes = solver.nodes.clone();
+        let energy_seconds = per_call(|| {
+            black_box(kind.value_and_gradient(&nodes, &model.arcs, &mut ws, &mut gradient));
+        });
+        let direction_seconds = per_call(|| {
+            black_box(solver.direction_problem().expect("direction"));
+        });
+        // Steps change the state: time a fixed number from the folded start.
+        let step_times: Vec<f64> = (0..15)
+            .map(|_| {
+                let start = Instant::now();
+                solver.step().expect("step");
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        let step_seconds = median(step_times);
+        println!(
+            "{n:>5} {:>14.1} {:>14.2} {:>16.1} {:>9.0}%",
+            step_seconds * 1e6,
+            energy_seconds * 1e6,
+            direction_seconds * 1e6,
+            100.0 * direction_seconds / step_seconds
+        );
+        rows.push(json!({
+            "creases": n, "iteration_seconds": step_seconds, "energy_and_gradient_seconds": energy_seconds,
+            "jacobian_and_svd_seconds": direction_seconds,
+        }));
+        iteration.push((n as f64, step_seconds));
+        energy.push((n as f64, energy_seconds));
+        direction.push((n as f64, direction_seconds));
+    }
+    // Exponents from the large sizes, where the leading term dominates.
+    let tail = |points: &[(f64, f64)]| power_law_fit(largest_sizes(points)).map(|(k, _)| k);
+    let exponents = json!({
+        "iteration": tail(&iteration), "energy_and_gradient": tail(&energy), "jacobian_and_svd": tail(&direction),
+    });
+    println!(
+        "exponents over n = 64…256: iteration n^{:.2}, U+∇U n^{:.2}, A and its SVD n^{:.2}",
+        tail(&iteration).unwrap_or(f64::NAN),
+        tail(&energy).unwrap_or(f64::NAN),
+        tail(&direction).unwrap_or(f64::NAN)
+    );
+    let svg = scaling_svg(
+        "cost of one unfold iteration against the number of creases (random vertices)",
+        "creases n",
+        &[
+            ScalingSeries {
+                name: "one iteration".into(),
+                points: iteration,
+            },
+            ScalingSeries {
+                name: "A and its SVD".into(),
+                points: direction,
+            },
+            ScalingSeries {
+                name: "U + ∇U".into(),
+                points: energy,
+            },
+        ],
+    )
+    .expect("figure");
+    write(out, "scaling.svg", &svg);
+    json!({"rows": rows, "exponents_over_64_to_256": exponents})
+}
+
+fn main() {
+    let out = Path::new("output/work_precision");
+    std::fs::create_dir_all(out).expect("output folder");
+    let started = Instant::now();
+    let unfolding = unfold_part(out);
+    let fits = fits_part(out);
+    let dynamics = dynamics_part(out);
+    let scaling = scaling_part(out);
+    let report = json!({
+        "machine": machine(),
+        "seconds_total": started.elapsed().as_secs_f64(),
+        "unfolding": unfolding,
+        "constraint_fits": fits,
+        "dynamics": dynamics,
+        "scaling": scaling,
+    });
+    write(
+        out,
+        "report.json",
+        &serde_json::to_string_pretty(&report).expect("json"),
+    );
+    println!(
+        "\nwrote {}/{{report.json, unfold_*.svg, fits.svg, bridge_step.svg, bridge_ramp.svg, scaling.svg}} in {:.0} s",
+        out.display(),
+        started.elapsed().as_secs_f64()
+    );
+}
