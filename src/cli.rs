@@ -255,22 +255,24 @@ pub struct ParallelArgs {
 }
 
 impl ParallelArgs {
-    /// Runs `work` on every path in a pool of `--jobs` threads; `work` prints its own lines.
-    fn for_each(&self, paths: &[PathBuf], work: impl Fn(&Path) + Sync) -> Result<()> {
+    /// Runs `work` on every item in a pool of `--jobs` threads; `work` prints its own lines
+    /// and says whether its item succeeded. Returns whether all did.
+    fn all<T: Sync>(&self, items: &[T], work: impl Fn(&T) -> bool + Sync) -> Result<bool> {
         use rayon::prelude::*;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.jobs)
             .build()
             .context("starting the worker threads")?;
-        pool.install(|| paths.par_iter().for_each(|path| work(path)));
-        Ok(())
+        // `map` then `all`, not `all` alone: every item runs even after a failure.
+        Ok(pool.install(|| {
+            items
+                .par_iter()
+                .map(&work)
+                .collect::<Vec<bool>>()
+                .into_iter()
+                .all(|ok| ok)
+        }))
     }
-}
-
-/// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
-fn is_pattern_file(path: &Path) -> bool {
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-    (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
 }
 
 /// The pattern files named on the command line: files as given, directories searched
@@ -287,7 +289,7 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         for path in entries {
             if path.is_dir() {
                 walk(&path, found)?;
-            } else if is_pattern_file(&path) {
+            } else if nanofold::pattern::is_pattern_file(&path) {
                 found.push(path);
             }
         }
@@ -415,11 +417,11 @@ fn run_unfold(
     let files = expand_patterns(patterns)?;
     // Output folders by pattern name, refused up front if two patterns would share one.
     let parent = out.unwrap_or_else(|| PathBuf::from("output"));
-    let mut dirs = Vec::with_capacity(files.len());
-    let mut seen: std::collections::HashMap<PathBuf, &Path> = std::collections::HashMap::new();
-    for path in &files {
-        let dir = parent.join(nanofold::pattern::pattern_name(path));
-        if let Some(other) = seen.insert(dir.clone(), path) {
+    let mut jobs: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
+    let mut writer_of: std::collections::HashMap<PathBuf, PathBuf> = std::collections::HashMap::new();
+    for path in files {
+        let dir = parent.join(nanofold::pattern::pattern_name(&path));
+        if let Some(other) = writer_of.insert(dir.clone(), path.clone()) {
             anyhow::bail!(
                 "{} and {} would both write {}: unfold them separately with --out",
                 other.display(),
@@ -427,20 +429,18 @@ fn run_unfold(
                 dir.display()
             );
         }
-        dirs.push(dir);
+        jobs.push((path, dir));
     }
-    let all_ok = std::sync::atomic::AtomicBool::new(true);
-    parallel.for_each(&files, |path| {
-        let index = files.iter().position(|f| f == path).unwrap_or(0);
-        match unfold_one(path, solver, Some(&dirs[index])) {
-            Ok((summary, text)) => println!("{}", if as_json { summary.to_string() } else { text }),
-            Err(e) => {
-                all_ok.store(false, std::sync::atomic::Ordering::Relaxed);
-                print_failure(path, &e, as_json);
-            }
+    parallel.all(&jobs, |(path, dir)| match unfold_one(path, solver, Some(dir)) {
+        Ok((summary, text)) => {
+            println!("{}", if as_json { summary.to_string() } else { text });
+            true
         }
-    })?;
-    Ok(all_ok.into_inner())
+        Err(e) => {
+            print_failure(path, &e, as_json);
+            false
+        }
+    })
 }
 
 /// One line for a pattern that could not be read or run.
@@ -458,8 +458,7 @@ fn print_failure(path: &Path, error: &anyhow::Error, as_json: bool) {
 fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel: &ParallelArgs) -> Result<bool> {
     let settings = solver.settings()?;
     let files = expand_patterns(patterns)?;
-    let all_readable = std::sync::atomic::AtomicBool::new(true);
-    parallel.for_each(&files, |path| {
+    parallel.all(&files, |path| {
         let outcome = Pattern::load(path, &solver.load_options()).and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
         match outcome {
             Ok((pattern, report)) if as_json => println!("{}", summary(&pattern, path, &report)),
@@ -472,12 +471,12 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
                 report.evidence
             ),
             Err(e) => {
-                all_readable.store(false, std::sync::atomic::Ordering::Relaxed);
                 print_failure(path, &anyhow::Error::new(e), as_json);
+                return false;
             }
         }
-    })?;
-    Ok(all_readable.into_inner())
+        true
+    })
 }
 
 /// Parses "J=DEG" into (crease index, rad).

@@ -173,6 +173,12 @@ pub(crate) struct RawVertex {
     pub mesh: Option<FoldMesh>,
 }
 
+/// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
+pub fn is_pattern_file(path: &Path) -> bool {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
+}
+
 /// A pattern's name: its file name without `.fold` or `.json` (names output folders).
 pub fn pattern_name(path: &Path) -> String {
     path.file_name()

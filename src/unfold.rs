@@ -647,30 +647,8 @@ impl<'a> Unfolder<'a> {
         self.ws.resize_rows(self.model);
         // Project onto the pinned set at once; keep the pins only if that does not cost
         // energy beyond rounding.
-        let mut projected = self.nodes.clone();
-        let restored = restore(
-            self.model,
-            &mut self.ws,
-            &mut projected,
-            self.settings.restore_tol,
-            None,
-        );
-        let mut gradient = vec![Vec3::zeros(); self.model.node_count];
-        let value = if restored.is_ok() {
-            self.energy
-                .value_and_gradient(&projected, &self.model.arcs, &mut self.ws.energy, &mut gradient)
-        } else {
-            f64::INFINITY
-        };
-        if value.is_finite()
-            && value <= self.energy_value + 1e-12 * self.energy_value.abs()
-            && find_crossing(self.model, &self.nodes, &projected).is_none()
-        {
-            self.nodes = projected;
-            self.energy_value = value;
-            self.ws.gradient = gradient;
+        if self.project_if_no_worse().is_some() {
             self.pins += 1;
-            self.step_scale = None;
             true
         } else {
             self.ws.rows.truncate(rows_before);
@@ -679,12 +657,43 @@ impl<'a> Unfolder<'a> {
         }
     }
 
+    /// Newton projection of the current state onto the workspace's constraint rows, taken
+    /// only if it converges, the energy does not rise beyond rounding and no node passes
+    /// through an arc on the way. Returns the largest node displacement when it moved.
+    fn project_if_no_worse(&mut self) -> Option<f64> {
+        let model = self.model;
+        let mut projected = self.nodes.clone();
+        if restore(model, &mut self.ws, &mut projected, self.settings.restore_tol, None).is_err()
+            || find_crossing(model, &self.nodes, &projected).is_some()
+        {
+            return None;
+        }
+        let mut gradient = vec![Vec3::zeros(); model.node_count];
+        let value = self
+            .energy
+            .value_and_gradient(&projected, &model.arcs, &mut self.ws.energy, &mut gradient);
+        if !(value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs()) {
+            return None;
+        }
+        let displacement = self
+            .nodes
+            .iter()
+            .zip(&projected)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        self.nodes = projected;
+        self.energy_value = value;
+        self.ws.gradient = gradient;
+        self.step_scale = None;
+        Some(displacement)
+    }
+
     /// Newton to the flat state (SPEC §5). Near flat U varies as ρ², so its values resolve ρ
     /// only to about √ε and the line search stalls around 1e-7; the fold angles themselves
     /// are well-conditioned there. So the last stretch is a Newton projection onto {arc
     /// lengths, every fold angle = 0}, accepted only if the energy does not rise (beyond
     /// rounding) and no node passes through an arc. Returns whether it was accepted.
-    pub fn flatten(&mut self) -> Result<bool> {
+    pub fn flatten(&mut self) -> bool {
         let model = self.model;
         self.unpin();
         let rows_before = self.ws.rows.len();
@@ -695,31 +704,13 @@ impl<'a> Unfolder<'a> {
             }
         }
         self.ws.resize_rows(model);
-        let mut flattened = self.nodes.clone();
-        let restored = restore(model, &mut self.ws, &mut flattened, self.settings.restore_tol, None);
+        let moved = self.project_if_no_worse();
         self.ws.rows.truncate(rows_before);
         self.ws.resize_rows(model);
-        if restored.is_err() || find_crossing(model, &self.nodes, &flattened).is_some() {
-            return Ok(false);
+        if let Some(displacement) = moved {
+            self.last_direction_norm = displacement;
         }
-        let mut gradient = vec![Vec3::zeros(); model.node_count];
-        let value = self
-            .energy
-            .value_and_gradient(&flattened, &model.arcs, &mut self.ws.energy, &mut gradient);
-        if !(value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs()) {
-            return Ok(false);
-        }
-        self.last_direction_norm = self
-            .nodes
-            .iter()
-            .zip(&flattened)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
-        self.nodes = flattened;
-        self.energy_value = value;
-        self.ws.gradient = gradient;
-        self.step_scale = None;
-        Ok(true)
+        moved.is_some()
     }
 
     /// Drops every antipodal pin.
@@ -1016,15 +1007,15 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
             let mut polish_left = settings.polish_iterations;
             let mut flatten_tried = false;
             while iteration < settings.max_iterations {
-                if is_flat(&solver) {
-                    let from = model.max_fold_angle(&solver.nodes);
+                let largest = model.max_fold_angle(&solver.nodes);
+                if largest <= settings.flat_tol {
                     // Nothing for Newton to gain once the fold angles are at rounding level.
-                    if settings.newton_flatten && !flatten_tried && from > ROUNDING_FLAT {
+                    if settings.newton_flatten && !flatten_tried && largest > ROUNDING_FLAT {
                         flatten_tried = true;
-                        if solver.flatten()? {
+                        if solver.flatten() {
                             iteration += 1;
                             trajectory.push(record(&model, &solver, iteration));
-                            flattened_from = Some(from);
+                            flattened_from = Some(largest);
                             break;
                         }
                     }
@@ -1047,7 +1038,7 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
             // A stall this close to flat is the √ε limit of U, not a minimum: Newton decides.
             let left = model.max_fold_angle(&solver.nodes);
             let stalled_near_flat = stationary && left < NEAR_FLAT && left > ROUNDING_FLAT;
-            if settings.newton_flatten && flattened_from.is_none() && stalled_near_flat && solver.flatten()? {
+            if settings.newton_flatten && flattened_from.is_none() && stalled_near_flat && solver.flatten() {
                 iteration += 1;
                 trajectory.push(record(&model, &solver, iteration));
                 flattened_from = Some(left);

@@ -220,6 +220,14 @@ fn unfold_of_several_patterns_writes_a_folder_each_and_refuses_name_clashes() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("would both write"));
     assert!(!clash_out.exists());
 
+    // A bad --jobs is refused by name.
+    let out = nanofold()
+        .args(["check", "patterns", "--jobs", "two"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--jobs"));
+
     // A directory without patterns is an error naming it.
     let empty = temp_dir("empty");
     std::fs::create_dir_all(&empty).unwrap();

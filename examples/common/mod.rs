@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use nanofold::kinematics::solve_closure;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{is_pattern_file, LoadOptions, Pattern};
 use nanofold::unfold::SplitMix64;
 use serde_json::json;
 
@@ -89,10 +89,7 @@ pub fn library_patterns() -> Vec<Pattern> {
     let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir("patterns")
         .expect("run from the repository root")
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            let name = p.to_string_lossy();
-            (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
-        })
+        .filter(|p| is_pattern_file(p))
         .collect();
     paths.sort();
     paths
