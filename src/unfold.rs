@@ -11,11 +11,11 @@ use crate::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
 use crate::error::{NanofoldError, Result};
 use crate::kinematics;
 use crate::pattern::{Assignment, Chain, Pattern, RayRole};
-use crate::qp::{self, DirectionProblem, QpMethod, RowSpace};
+use crate::qp::{self, ConstraintJacobian, DirectionProblem, QpMethod, RowSpace};
 use crate::sphere::{
     fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc, side_of_arc, Vec3,
 };
-use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
+use nalgebra::{DVector, Matrix3, SymmetricEigen};
 use serde::Serialize;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -191,6 +191,23 @@ impl UnfoldModel {
             .fold(0.0, f64::max)
     }
 
+    /// Whether a row closes the loop (see [`crate::qp::JacobianRow::closing`]). The open
+    /// chain is: arc (i−1, i) and the fold angle at ray i−1 for every free node i, both of
+    /// which move x_i (along and across the arc) and nothing later. The arc back to node 0,
+    /// fold angles at rays n−1 and 0, and antipodal pins close it.
+    fn is_closing(&self, row: ConstraintRow) -> bool {
+        match row {
+            ConstraintRow::Arc(e) => self.arcs[e].b < self.arcs[e].a,
+            ConstraintRow::Held(h) => self.closes_at_ray(self.held[h].ray),
+            ConstraintRow::Flat(ray) => self.closes_at_ray(ray),
+            ConstraintRow::Antipodal { .. } => true,
+        }
+    }
+
+    fn closes_at_ray(&self, ray: usize) -> bool {
+        ray == 0 || ray + 1 >= self.node_count
+    }
+
     fn constraint_rows(&self) -> Vec<ConstraintRow> {
         let mut rows: Vec<ConstraintRow> = (0..self.arcs.len())
             .filter(|&e| self.arcs[e].a >= 2 || self.arcs[e].b >= 2)
@@ -238,15 +255,17 @@ pub struct Workspace {
     trial_gradient: Vec<Vec3>,
     basis: Vec<[Vec3; 2]>,
     rows: Vec<ConstraintRow>,
-    jacobian: DMatrix<f64>,
+    jacobian: ConstraintJacobian,
     residual: DVector<f64>,
+    trial_residual: DVector<f64>,
     trial: Vec<Vec3>,
 }
 
 impl Workspace {
     fn resize_rows(&mut self, model: &UnfoldModel) {
-        self.jacobian = DMatrix::zeros(self.rows.len(), 2 * model.free.len());
+        self.jacobian = ConstraintJacobian::new(self.rows.len(), 2 * model.free.len());
         self.residual = DVector::zeros(self.rows.len());
+        self.trial_residual = DVector::zeros(self.rows.len());
     }
 
     fn new(model: &UnfoldModel) -> Workspace {
@@ -257,8 +276,9 @@ impl Workspace {
             gradient: vec![Vec3::zeros(); model.node_count],
             trial_gradient: vec![Vec3::zeros(); model.node_count],
             basis: vec![[Vec3::zeros(); 2]; model.node_count],
-            jacobian: DMatrix::zeros(rows.len(), 2 * m),
+            jacobian: ConstraintJacobian::new(rows.len(), 2 * m),
             residual: DVector::zeros(rows.len()),
+            trial_residual: DVector::zeros(rows.len()),
             rows,
             trial: vec![Vec3::zeros(); model.node_count],
         }
@@ -296,37 +316,35 @@ fn fill_jacobian(
     rows: &[ConstraintRow],
     nodes: &[Vec3],
     basis: &[[Vec3; 2]],
-    out: &mut DMatrix<f64>,
+    out: &mut ConstraintJacobian,
 ) {
-    out.fill(0.0);
-    let put = |out: &mut DMatrix<f64>, r: usize, node: usize, g: &Vec3| {
+    let put = |out: &mut qp::JacobianRow, node: usize, g: &Vec3| {
         if node >= 2 {
-            let col = 2 * (node - 2);
-            out[(r, col)] += basis[node][0].dot(g);
-            out[(r, col + 1)] += basis[node][1].dot(g);
+            out.add(node - 2, [basis[node][0].dot(g), basis[node][1].dot(g)]);
         }
     };
-    let put_fold_angle = |out: &mut DMatrix<f64>, r: usize, ray: usize| {
+    let put_fold_angle = |out: &mut qp::JacobianRow, ray: usize| {
         let (prev, next) = model.neighbours(ray);
         let (_, [gp, ga, gn]) = fold_angle_with_gradient(&nodes[prev], &nodes[ray], &nodes[next]);
-        put(out, r, prev, &gp);
-        put(out, r, ray, &ga);
-        put(out, r, next, &gn);
+        put(out, prev, &gp);
+        put(out, ray, &ga);
+        put(out, next, &gn);
     };
-    for (r, row) in rows.iter().enumerate() {
+    for (row, out) in rows.iter().zip(out.rows.iter_mut()) {
+        out.clear(model.is_closing(*row));
         match *row {
             ConstraintRow::Arc(e) => {
                 let arc = model.arcs[e];
                 let (_, ga, gb) = geodesic_with_gradient(&nodes[arc.a], &nodes[arc.b]);
-                put(out, r, arc.a, &ga);
-                put(out, r, arc.b, &gb);
+                put(out, arc.a, &ga);
+                put(out, arc.b, &gb);
             }
-            ConstraintRow::Held(h) => put_fold_angle(out, r, model.held[h].ray),
-            ConstraintRow::Flat(ray) => put_fold_angle(out, r, ray),
+            ConstraintRow::Held(h) => put_fold_angle(out, model.held[h].ray),
+            ConstraintRow::Flat(ray) => put_fold_angle(out, ray),
             ConstraintRow::Antipodal { v, w, k } => {
                 let e = tangent_basis(&nodes[v])[k];
-                put(out, r, v, &e);
-                put(out, r, w, &e);
+                put(out, v, &e);
+                put(out, w, &e);
             }
         }
     }
@@ -343,7 +361,10 @@ pub fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVe
 
 /// Newton projection onto the constraints (SPEC §5 "restore"): minimum-norm steps in the
 /// tangent space, the factorisation reused while it converges (chord Newton) and refreshed
-/// when it stalls. Returns the final max residual; Err when it does not reach `tol`.
+/// when it stalls. Each step is halved until the residual norm falls: near the flat state
+/// A has singular values ~ρ and a full minimum-norm step can overshoot the region where
+/// the linearisation holds (a 1e-6 rad fold with a 1e-12 closing error diverged without
+/// it). Returns the final max residual; Err when it does not reach `tol`.
 pub fn restore(
     model: &UnfoldModel,
     ws: &mut Workspace,
@@ -354,9 +375,10 @@ pub fn restore(
     let mut basis = ws.basis.clone();
     let mut owned: Option<RowSpace> = None;
     let mut previous = f64::INFINITY;
+    let mut stale = false;
     let mut moved = nodes.to_vec();
+    fill_residuals(model, &ws.rows, nodes, &mut ws.residual);
     for iteration in 0..40 {
-        fill_residuals(model, &ws.rows, nodes, &mut ws.residual);
         let worst = ws.residual.amax();
         if !worst.is_finite() {
             return Err(NanofoldError::Numerical {
@@ -367,7 +389,7 @@ pub fn restore(
         if worst <= tol {
             return Ok(worst);
         }
-        let refresh = owned.is_none() && (row_space.is_none() || worst > 0.5 * previous || iteration >= 10);
+        let refresh = stale || (owned.is_none() && (row_space.is_none() || worst > 0.5 * previous || iteration >= 10));
         if refresh {
             fill_bases(model, nodes, &mut basis);
             fill_jacobian(model, &ws.rows, nodes, &basis, &mut ws.jacobian);
@@ -378,18 +400,37 @@ pub fn restore(
         previous = worst;
         let rs = owned.as_ref().or(row_space).expect("a factorisation");
         let mut z = rs.solve_min_norm(&ws.residual);
-        // Trust region: near the flat state A has singular values ~ρ, so a minimum-norm
-        // step can be far larger than the residual; allow up to 10·√residual (what the
-        // ill-conditioning legitimately needs) and no more.
+        // Trust region: a minimum-norm step near flat can be far larger than the residual;
+        // allow up to 10·√residual (what the ill-conditioning legitimately needs).
         let cap = 10.0 * worst.sqrt();
         let largest = z.amax();
         if largest > cap {
             z *= cap / largest;
         }
-        retract(model, nodes, &basis, &z, -1.0, &mut moved);
+        let norm = ws.residual.norm();
+        let mut fraction = 1.0;
+        let mut accepted = false;
+        for _ in 0..30 {
+            retract(model, nodes, &basis, &z, -fraction, &mut moved);
+            fill_residuals(model, &ws.rows, &moved, &mut ws.trial_residual);
+            if ws.trial_residual.norm() < norm {
+                accepted = true;
+                break;
+            }
+            fraction *= 0.5;
+        }
+        if !accepted {
+            if refresh {
+                break;
+            }
+            // The chord factorisation is too old for this point: refresh and retry.
+            stale = true;
+            continue;
+        }
+        stale = false;
         nodes.copy_from_slice(&moved);
+        std::mem::swap(&mut ws.residual, &mut ws.trial_residual);
     }
-    fill_residuals(model, &ws.rows, nodes, &mut ws.residual);
     let worst = ws.residual.amax();
     if worst <= tol {
         Ok(worst)

@@ -6,7 +6,7 @@ use common::native_json;
 use nanofold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::kinematics::{closure_residual, solve_closure};
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::qp::{solve_clarabel, solve_direct};
+use nanofold::qp::{solve_clarabel, solve_direct, RowSpace};
 use nanofold::sphere::{
     fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3,
 };
@@ -151,9 +151,55 @@ proptest! {
         let clarabel = solve_clarabel(&problem).unwrap();
         let scale = 1.0 + problem.q.amax();
         prop_assert!((&direct.y - &clarabel.y).amax() <= 1e-10 * scale, "differ by {:e} (scale {scale:e})", (&direct.y - &clarabel.y).amax());
-        prop_assert!((&problem.a * &direct.y).amax() <= 1e-12 * scale);
+        prop_assert!((problem.a.mul(&direct.y)).amax() <= 1e-12 * scale);
     }
 
+}
+
+proptest! {
+    // Cheap (n < 40, one SVD each); about four in five draws restore onto the loop.
+    #![proptest_config(ProptestConfig::with_cases(160))]
+
+    #[test]
+    fn chain_factorisation_agrees_with_the_dense_svd_from_folded_to_exactly_flat(
+        n in 4usize..40,
+        weights in proptest::collection::vec(1.0..2.0f64, 40),
+        rho_seed in proptest::collection::vec(-1.0..1.0f64, 40),
+        scale_index in 0usize..4,
+        g_seed in proptest::collection::vec(-1.0..1.0f64, 80),
+    ) {
+        // Folded, near flat (where A's smallest singular value is ~ρ) and exactly flat (where
+        // it loses rank): the banded chain + Schur projector against the dense SVD. The state
+        // is forward kinematics of random fold angles, put back on the loop by the
+        // solver's own restoration.
+        let total: f64 = weights[..n].iter().sum();
+        let sectors: Vec<f64> = weights[..n].iter().map(|w| w / total * TAU).collect();
+        let scale = [0.1, 1e-3, 1e-6, 0.0][scale_index];
+        let rho: Vec<f64> = rho_seed[..n].iter().map(|r| r * scale).collect();
+        let pattern = Pattern::from_str(&native_json(&sectors, &vec![0.0; n]), "r", "r", &LoadOptions::default()).unwrap();
+        let model = UnfoldModel::new(&pattern);
+        let nodes = nanofold::kinematics::forward(&model.sector_angles, &rho);
+        // Restoration can fail from a random fold (the loop gap is ~ρ²/ρ away along a
+        // direction of singular value ~ρ); those draws are skipped.
+        let Ok(mut solver) = Unfolder::new(&model, &UnfoldSettings::default(), nodes) else { return Ok(()) };
+        let (problem, _) = solver.direction_problem().unwrap();
+        let chain = RowSpace::new(&problem.a).unwrap();
+        let dense = RowSpace::dense(&problem.a).unwrap();
+        prop_assert!(chain.is_banded());
+        prop_assert_eq!(chain.rank(), dense.rank(), "rank at scale {}", scale);
+        if scale == 0.0 {
+            // The flat state: the closing arc depends on the others (SPEC §9).
+            prop_assert_eq!(chain.rank(), problem.a.rows.len() - 1);
+        }
+        let g = nalgebra::DVector::from_iterator(problem.a.columns, g_seed.iter().copied().cycle().take(problem.a.columns));
+        let projected = chain.project_to_null(&g);
+        let reference = dense.project_to_null(&g);
+        // Near flat both are accurate only to about ε/σ_min ≈ 1e-16/ρ.
+        let tol = if scale == 1e-6 { 1e-8 } else { 1e-11 };
+        let difference = (&projected - &reference).amax();
+        prop_assert!(difference <= tol, "differ by {:e} at scale {}", difference, scale);
+        prop_assert!(problem.a.mul(&projected).amax() <= 1e-12, "A P g = {:e}", problem.a.mul(&projected).amax());
+    }
 }
 
 proptest! {
