@@ -255,6 +255,18 @@ pub fn unfold_samples(
         .iter()
         .map(|step| (step.fold_angles[driver], step.fold_angles.clone()))
         .collect();
+    // A step may pass through the flat state, where the branches of the constraint curve
+    // meet; points past the driver's first change of sign lie on another branch. The flat
+    // end itself (every angle 0) is on all of them and stays.
+    let start_sign = points.first().map_or(1.0, |p| p.0.signum());
+    if let Some(first_past) = points.iter().position(|p| p.0 * start_sign < -1e-12) {
+        let flat_end = points
+            .last()
+            .filter(|p| p.1.iter().all(|a| a.abs() <= settings.flat_tol))
+            .cloned();
+        points.truncate(first_past);
+        points.extend(flat_end);
+    }
     let covered = points.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |r, p| {
         [r[0].min(p.0), r[1].max(p.0)]
     });

@@ -1,6 +1,7 @@
 //! The direction subproblem of the projected gradient step (SPEC §5):
-//! min_y ½‖y‖² + qᵀy  s.t.  A y = 0, solved by Clarabel (the general path) or by a direct
-//! projection onto the null space of A (the equality-only closed form).
+//! min_y ½ yᵀMy + qᵀy  s.t.  A y = 0, with M = I (SPEC's QP) or the bending metric
+//! M = I + SᵀS, solved by Clarabel (the general path) or by a direct projection onto the
+//! null space of A (the equality-only closed form).
 
 mod row_space;
 
@@ -9,7 +10,7 @@ pub use row_space::{ConstraintJacobian, JacobianRow, RowSpace, RANK_TOL};
 use crate::error::{NanofoldError, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 /// Which solver computes the direction.
@@ -24,11 +25,23 @@ pub enum QpMethod {
 }
 
 /// Problem data: the linearised constraints A (rows) and the energy gradient q, both in the
-/// tangent coordinates of the free nodes.
+/// tangent coordinates of the free nodes, and the rows of S when the metric is
+/// M = I + SᵀS (None: M = I).
 #[derive(Debug, Clone)]
 pub struct DirectionProblem {
     pub q: DVector<f64>,
     pub a: ConstraintJacobian,
+    pub metric: Option<ConstraintJacobian>,
+}
+
+impl DirectionProblem {
+    /// ½ yᵀMy's gradient My.
+    pub fn metric_times(&self, y: &DVector<f64>) -> DVector<f64> {
+        match &self.metric {
+            None => y.clone(),
+            Some(s) => y + s.mul_transpose(&s.mul(y)),
+        }
+    }
 }
 
 /// Outcome of a direction solve, Clarabel-style.
@@ -54,7 +67,10 @@ pub struct DirectionSolution {
 pub fn solve_clarabel(problem: &DirectionProblem) -> Result<DirectionSolution> {
     let n = problem.q.len();
     let rows = problem.a.rows.len();
-    let p = CscMatrix::identity(n);
+    let p = match &problem.metric {
+        None => CscMatrix::identity(n),
+        Some(s) => upper_triangle_csc(&(DMatrix::identity(n, n) + s.to_dense().transpose() * s.to_dense())),
+    };
     let q: Vec<f64> = problem.q.iter().copied().collect();
     let a = problem.a.to_csc();
     let b = vec![0.0; rows];
@@ -92,18 +108,98 @@ pub fn solve_clarabel(problem: &DirectionProblem) -> Result<DirectionSolution> {
     })
 }
 
-/// The direct path: y = −(I − A⁺A) q.
+/// The upper triangle of a symmetric matrix (what Clarabel reads of P).
+fn upper_triangle_csc(p: &DMatrix<f64>) -> CscMatrix<f64> {
+    let n = p.ncols();
+    let (mut colptr, mut rowval, mut nzval) = (vec![0], Vec::new(), Vec::new());
+    for j in 0..n {
+        for i in 0..=j {
+            if p[(i, j)] != 0.0 {
+                rowval.push(i);
+                nzval.push(p[(i, j)]);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    CscMatrix::new(n, n, colptr, rowval, nzval)
+}
+
+/// The direct path: y = −(I − A⁺A) q, or with the metric M = I + SᵀS the same projection
+/// in the variables (y, e) under A y = 0, S y − e = 0 (so ½‖y‖² + ½‖e‖² = ½ yᵀMy).
 pub fn solve_direct(problem: &DirectionProblem) -> Result<DirectionSolution> {
-    Ok(solve_direct_with(problem, &RowSpace::new(&problem.a)?))
+    match &problem.metric {
+        None => solve_direct_with(problem, &RowSpace::new(&problem.a)?),
+        Some(s) => solve_with_metric(problem, s),
+    }
 }
 
 /// The direct path with A already factorised (the unfolder reuses it for the restoration).
-pub fn solve_direct_with(problem: &DirectionProblem, row_space: &RowSpace) -> DirectionSolution {
-    DirectionSolution {
-        y: -row_space.project_to_null(&problem.q),
+pub fn solve_direct_with(problem: &DirectionProblem, row_space: &RowSpace) -> Result<DirectionSolution> {
+    match &problem.metric {
+        None => Ok(DirectionSolution {
+            y: -row_space.project_to_null(&problem.q),
+            status: QpStatus::Solved,
+            iterations: 0,
+        }),
+        Some(s) => solve_with_metric(problem, s),
+    }
+}
+
+/// Each row of S gets its own variable e, placed right after the last node the row
+/// touches so the augmented rows keep the chain's band (and pivot on e: independent).
+fn solve_with_metric(problem: &DirectionProblem, s: &ConstraintJacobian) -> Result<DirectionSolution> {
+    let nodes = problem.a.columns / 2;
+    let mut rows_at = vec![0usize; nodes];
+    for row in &s.rows {
+        if let Some(pivot) = row.entries().iter().map(|e| e.0).max() {
+            rows_at[pivot] += 1;
+        }
+    }
+    let mut node_slot = vec![0; nodes];
+    let mut extra_first = vec![0; nodes];
+    let mut cursor = 0;
+    for k in 0..nodes {
+        node_slot[k] = cursor;
+        extra_first[k] = cursor + 1;
+        cursor += 1 + rows_at[k].div_ceil(2);
+    }
+    let mut augmented = ConstraintJacobian::new(problem.a.rows.len(), 2 * cursor);
+    for (out, row) in augmented.rows.iter_mut().zip(&problem.a.rows) {
+        out.clear(row.closing);
+        for (slot, g) in row.entries() {
+            out.add(node_slot[*slot], *g);
+        }
+    }
+    let mut used = vec![0usize; nodes];
+    for row in &s.rows {
+        let Some(pivot) = row.entries().iter().map(|e| e.0).max() else {
+            continue;
+        };
+        let mut out = JacobianRow::default();
+        out.clear(false);
+        for (slot, g) in row.entries() {
+            out.add(node_slot[*slot], *g);
+        }
+        let k = used[pivot];
+        used[pivot] += 1;
+        out.add(
+            extra_first[pivot] + k / 2,
+            if k.is_multiple_of(2) { [-1.0, 0.0] } else { [0.0, -1.0] },
+        );
+        augmented.rows.push(out);
+    }
+    let mut q = DVector::zeros(2 * cursor);
+    for k in 0..nodes {
+        q[2 * node_slot[k]] = problem.q[2 * k];
+        q[2 * node_slot[k] + 1] = problem.q[2 * k + 1];
+    }
+    let projected = RowSpace::new(&augmented)?.project_to_null(&q);
+    let y = DVector::from_fn(2 * nodes, |c, _| -projected[2 * node_slot[c / 2] + c % 2]);
+    Ok(DirectionSolution {
+        y,
         status: QpStatus::Solved,
         iterations: 0,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -116,7 +212,11 @@ mod tests {
         let dense = DMatrix::from_row_slice(2, 4, &[1.0, 2.0, 0.0, -1.0, 0.0, 1.0, 1.0, 3.0]);
         let a = ConstraintJacobian::from_dense(&dense, &[false, true]);
         let q = DVector::from_vec(vec![0.3, -1.0, 2.0, 0.5]);
-        let problem = DirectionProblem { q, a: a.clone() };
+        let problem = DirectionProblem {
+            q,
+            a: a.clone(),
+            metric: None,
+        };
         let direct = solve_direct(&problem).unwrap();
         let clarabel = solve_clarabel(&problem).unwrap();
         assert!((&direct.y - &clarabel.y).amax() < 1e-10);
@@ -132,7 +232,7 @@ mod tests {
         let dense = DMatrix::from_row_slice(3, 4, &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0]);
         let a = ConstraintJacobian::from_dense(&dense, &[false, false, true]);
         let q = DVector::from_vec(vec![1.0, 2.0, 3.0, -1.0]);
-        let problem = DirectionProblem { q, a };
+        let problem = DirectionProblem { q, a, metric: None };
         let expected = DVector::from_vec(vec![0.0, 0.0, -3.0, 1.0]);
         let direct = solve_direct(&problem).unwrap();
         assert!((direct.y - &expected).amax() < 1e-14);

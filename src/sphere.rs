@@ -113,6 +113,17 @@ pub fn projects_onto_arc(a: &Vec3, b: &Vec3, p: &Vec3) -> bool {
     normal.dot(&a.cross(&q)) >= 0.0 && normal.dot(&q.cross(b)) >= 0.0 && q.dot(&(a + b)) > 0.0
 }
 
+/// Geodesic distance from p to the arc from a to b (α < π): to the arc's great circle
+/// when p projects inside the arc, else to the nearer end.
+pub fn distance_to_arc(a: &Vec3, b: &Vec3, p: &Vec3) -> f64 {
+    if projects_onto_arc(a, b, p) {
+        let normal = a.cross(b).normalize();
+        normal.dot(p).abs().min(1.0).asin()
+    } else {
+        geodesic(p, a).min(geodesic(p, b))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,5 +176,30 @@ mod tests {
         let m = arc_midpoint(&a, &b);
         assert!((geodesic(&a, &m) - geodesic(&m, &b)).abs() < 1e-14);
         assert!((2.0 * geodesic(&a, &m) - geodesic(&a, &b)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn distance_to_arc_matches_sampling_the_arc() {
+        let a = unit(1.2, 0.1);
+        let b = unit(1.6, 1.3);
+        let alpha = geodesic(&a, &b);
+        let axis = a.cross(&b).normalize();
+        let tangent = axis.cross(&a);
+        for (theta, phi) in [(0.3, 0.4), (1.5, 0.7), (2.8, -1.0), (1.4, 2.5), (1.0, 0.9), (2.0, 4.0)] {
+            let p = unit(theta, phi);
+            // Sample the arc finely; the closest sample is within half a sample spacing.
+            let samples = 20_000;
+            let sampled = (0..=samples)
+                .map(|k| {
+                    let t = alpha * k as f64 / samples as f64;
+                    geodesic(&p, &(a * t.cos() + tangent * t.sin()))
+                })
+                .fold(f64::INFINITY, f64::min);
+            let exact = distance_to_arc(&a, &b, &p);
+            assert!(
+                exact <= sampled + 1e-12 && sampled - exact < alpha / samples as f64,
+                "{exact} vs {sampled}"
+            );
+        }
     }
 }

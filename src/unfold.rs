@@ -13,7 +13,8 @@ use crate::kinematics;
 use crate::pattern::{Assignment, Chain, Pattern, RayRole};
 use crate::qp::{self, ConstraintJacobian, DirectionProblem, QpMethod, RowSpace};
 use crate::sphere::{
-    fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc, side_of_arc, Vec3,
+    distance_to_arc, fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc,
+    side_of_arc, Vec3,
 };
 use nalgebra::{DVector, Matrix3, SymmetricEigen};
 use serde::Serialize;
@@ -42,6 +43,12 @@ pub struct UnfoldSettings {
     /// Finish with [`Unfolder::flatten`] (Newton onto ρ = 0) once within `flat_tol`, or when
     /// stalled within 1e-4 rad of flat; off, the line search polishes as far as it can.
     pub newton_flatten: bool,
+    /// Weight κ of the bending metric: the direction minimises ½ yᵀ(I + SᵀS)y + ∇U·y where
+    /// S takes second differences of the node displacements along the chain, scaled by
+    /// √κ/ᾱ² (ᾱ the mean sector). The energy is stiff against short-wavelength bending
+    /// (stiffness ~k⁴ for mode k) and soft against long-wavelength; this preconditions that
+    /// spread. 0 is SPEC §5's plain QP (M = I).
+    pub bending_metric: f64,
     /// Restarts from perturbed states when stuck, before a verdict.
     pub restarts: usize,
     /// Size of the restart perturbation, radians.
@@ -62,6 +69,7 @@ impl Default for UnfoldSettings {
             armijo: 1e-4,
             max_step_rad: 0.2,
             newton_flatten: true,
+            bending_metric: 0.01,
             restarts: 3,
             restart_kick_rad: 0.05,
             seed: 1,
@@ -350,6 +358,37 @@ fn fill_jacobian(
     }
 }
 
+/// Rows of S in the bending metric M = I + SᵀS (see [`UnfoldSettings::bending_metric`]):
+/// for every ray with two neighbours, the three components of the second difference
+/// x_prev − 2 x_ray + x_next of the node displacements, scaled by √(κ / ᾱ⁴).
+pub fn bending_rows(model: &UnfoldModel, basis: &[[Vec3; 2]], kappa: f64) -> ConstraintJacobian {
+    let n = model.node_count;
+    let mean_sector = model.sector_angles.iter().sum::<f64>() / model.sector_angles.len() as f64;
+    let weight = (kappa / mean_sector.powi(4)).sqrt();
+    let mut rows = ConstraintJacobian::new(0, 2 * model.free.len());
+    for centre in 0..n {
+        let (prev, next) = model.neighbours(centre);
+        let open_end = model.chain == Chain::Open && (centre == 0 || centre + 1 == n);
+        if open_end {
+            continue;
+        }
+        for axis in [Vec3::x(), Vec3::y(), Vec3::z()] {
+            let mut row = qp::JacobianRow::default();
+            row.clear(false);
+            for (node, coefficient) in [(prev, 1.0), (centre, -2.0), (next, 1.0)] {
+                if node >= 2 {
+                    let c = weight * coefficient;
+                    row.add(node - 2, [c * basis[node][0].dot(&axis), c * basis[node][1].dot(&axis)]);
+                }
+            }
+            if !row.entries().is_empty() {
+                rows.rows.push(row);
+            }
+        }
+    }
+    rows
+}
+
 /// Moves the free nodes by the tangent coordinates `y` (scaled by `t`) and renormalises.
 pub fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVector<f64>, t: f64, out: &mut [Vec3]) {
     out.copy_from_slice(nodes);
@@ -358,6 +397,9 @@ pub fn retract(model: &UnfoldModel, nodes: &[Vec3], basis: &[[Vec3; 2]], y: &DVe
         out[i] = (nodes[i] + t * d).normalize();
     }
 }
+
+/// Residual below which [`restore`] halves a Newton step that does not reduce it.
+const DAMPED_RESTORE_BELOW: f64 = 1e-8;
 
 /// Newton projection onto the constraints (SPEC §5 "restore"): minimum-norm steps in the
 /// tangent space, the factorisation reused while it converges (chord Newton) and refreshed
@@ -410,7 +452,10 @@ pub fn restore(
         let norm = ws.residual.norm();
         let mut fraction = 1.0;
         let mut accepted = false;
-        for _ in 0..30 {
+        // Damping is for the small residuals near flat; a large one means the trial step
+        // was too long, which the line search's own halving fixes more cheaply.
+        let halvings = if worst <= DAMPED_RESTORE_BELOW { 8 } else { 0 };
+        for _ in 0..=halvings {
             retract(model, nodes, &basis, &z, -fraction, &mut moved);
             fill_residuals(model, &ws.rows, &moved, &mut ws.trial_residual);
             if ws.trial_residual.norm() < norm {
@@ -440,6 +485,28 @@ pub fn restore(
             message: format!("residual {worst:.3e} after Newton projection"),
         })
     }
+}
+
+/// Largest distance a node moved (chord, radians to first order).
+fn largest_move(before: &[Vec3], after: &[Vec3]) -> f64 {
+    before
+        .iter()
+        .zip(after)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max)
+}
+
+/// Smallest geodesic distance from a node to an arc it is not an end of.
+pub fn node_arc_clearance(model: &UnfoldModel, nodes: &[Vec3]) -> f64 {
+    let mut clearance = f64::INFINITY;
+    for arc in &model.arcs {
+        for (v, node) in nodes.iter().enumerate() {
+            if v != arc.a && v != arc.b {
+                clearance = clearance.min(distance_to_arc(&nodes[arc.a], &nodes[arc.b], node));
+            }
+        }
+    }
+    clearance
 }
 
 /// Does the straight-line motion from `before` to `after` carry a node through an arc
@@ -545,10 +612,13 @@ impl<'a> Unfolder<'a> {
             q[2 * slot + 1] = self.ws.basis[i][1].dot(&self.ws.gradient[i]);
         }
         let row_space = RowSpace::new(&self.ws.jacobian)?;
+        let metric = (self.settings.bending_metric > 0.0)
+            .then(|| bending_rows(model, &self.ws.basis, self.settings.bending_metric));
         Ok((
             DirectionProblem {
                 q,
                 a: self.ws.jacobian.clone(),
+                metric,
             },
             row_space,
         ))
@@ -565,7 +635,7 @@ impl<'a> Unfolder<'a> {
         let model = self.model;
         let (problem, row_space) = self.direction_problem()?;
         let solution = match self.settings.qp {
-            QpMethod::Direct => qp::solve_direct_with(&problem, &row_space),
+            QpMethod::Direct => qp::solve_direct_with(&problem, &row_space)?,
             QpMethod::Clarabel => qp::solve_clarabel(&problem)?,
         };
         if solution.status == qp::QpStatus::AlmostSolved {
@@ -576,7 +646,8 @@ impl<'a> Unfolder<'a> {
             .map(|s| (y[2 * s].powi(2) + y[2 * s + 1].powi(2)).sqrt())
             .fold(0.0, f64::max);
         self.last_direction_norm = largest;
-        let slope = y.norm_squared();
+        // −∇U·y = yᵀMy: the decrease rate along y in the problem's metric.
+        let slope = -problem.q.dot(&y);
         if largest <= 1e-14 * (1.0 + problem.q.amax()) || !largest.is_finite() {
             if self.pin_antipodal_pairs() {
                 return Ok(StepOutcome::Moved { displacement: 0.0 });
@@ -688,7 +759,7 @@ impl<'a> Unfolder<'a> {
         self.ws.resize_rows(self.model);
         // Project onto the pinned set at once; keep the pins only if that does not cost
         // energy beyond rounding.
-        if self.project_if_no_worse().is_some() {
+        if self.project_if_no_worse(f64::INFINITY).is_some() {
             self.pins += 1;
             true
         } else {
@@ -701,10 +772,12 @@ impl<'a> Unfolder<'a> {
     /// Newton projection of the current state onto the workspace's constraint rows, taken
     /// only if it converges, the energy does not rise beyond rounding and no node passes
     /// through an arc on the way. Returns the largest node displacement when it moved.
-    fn project_if_no_worse(&mut self) -> Option<f64> {
+    /// No node may move more than `max_displacement` (radians).
+    fn project_if_no_worse(&mut self, max_displacement: f64) -> Option<f64> {
         let model = self.model;
         let mut projected = self.nodes.clone();
         if restore(model, &mut self.ws, &mut projected, self.settings.restore_tol, None).is_err()
+            || largest_move(&self.nodes, &projected) > max_displacement
             || find_crossing(model, &self.nodes, &projected).is_some()
         {
             return None;
@@ -716,12 +789,7 @@ impl<'a> Unfolder<'a> {
         if !(value.is_finite() && value <= self.energy_value + 1e-12 * self.energy_value.abs()) {
             return None;
         }
-        let displacement = self
-            .nodes
-            .iter()
-            .zip(&projected)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
+        let displacement = largest_move(&self.nodes, &projected);
         self.nodes = projected;
         self.energy_value = value;
         self.ws.gradient = gradient;
@@ -731,11 +799,15 @@ impl<'a> Unfolder<'a> {
 
     /// Newton to the flat state (SPEC §5). Near flat U varies as ρ², so its values resolve ρ
     /// only to about √ε and the line search stalls around 1e-7; the fold angles themselves
-    /// are well-conditioned there. So the last stretch is a Newton projection onto {arc
-    /// lengths, every fold angle = 0}, accepted only if the energy does not rise (beyond
-    /// rounding) and no node passes through an arc. Returns whether it was accepted.
+    /// are well-conditioned there, and the descent towards the singular flat state is slow.
+    /// So the last stretch is a Newton projection onto {arc lengths, every fold angle = 0},
+    /// accepted only if the energy does not rise (beyond rounding), no node passes through
+    /// an arc on the straight way there, and no node moves more than a quarter of the
+    /// smallest node–arc clearance (so no sector can reach another on the way, whatever
+    /// the path within that distance). Returns whether it was accepted.
     pub fn flatten(&mut self) -> bool {
         let model = self.model;
+        let clearance = node_arc_clearance(model, &self.nodes);
         self.unpin();
         let rows_before = self.ws.rows.len();
         let held: Vec<usize> = model.held.iter().map(|h| h.ray).collect();
@@ -745,7 +817,7 @@ impl<'a> Unfolder<'a> {
             }
         }
         self.ws.resize_rows(model);
-        let moved = self.project_if_no_worse();
+        let moved = self.project_if_no_worse(0.25 * clearance);
         self.ws.rows.truncate(rows_before);
         self.ws.resize_rows(model);
         if let Some(displacement) = moved {
@@ -905,6 +977,9 @@ fn record(model: &UnfoldModel, solver: &Unfolder, iteration: usize) -> StepRecor
     }
 }
 
+/// Largest fold angle at which the driver first tries [`Unfolder::flatten`].
+const FLATTEN_FROM: f64 = 1e-2;
+
 /// Largest fold angle at which a stall counts as "near flat" rather than a local minimum.
 const NEAR_FLAT: f64 = 1e-4;
 
@@ -1047,8 +1122,21 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
             let mut stationary = false;
             let mut polish_left = settings.polish_iterations;
             let mut flatten_tried = false;
+            let mut next_flatten = FLATTEN_FROM;
             while iteration < settings.max_iterations {
                 let largest = model.max_fold_angle(&solver.nodes);
+                // Near flat the descent is linear at best; try Newton onto ρ = 0 once per
+                // decade of max |ρ| below FLATTEN_FROM (it checks energy, crossings, clearance).
+                let decade = largest <= next_flatten && largest > settings.flat_tol;
+                if settings.newton_flatten && flattened_from.is_none() && decade {
+                    next_flatten = largest / 10.0;
+                    if solver.flatten() {
+                        iteration += 1;
+                        trajectory.push(record(&model, &solver, iteration));
+                        flattened_from = Some(largest);
+                        break;
+                    }
+                }
                 if largest <= settings.flat_tol {
                     // Nothing for Newton to gain once the fold angles are at rounding level.
                     if settings.newton_flatten && !flatten_tried && largest > ROUNDING_FLAT {

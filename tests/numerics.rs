@@ -6,7 +6,7 @@ use common::native_json;
 use nanofold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::kinematics::{closure_residual, solve_closure};
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::qp::{solve_clarabel, solve_direct, RowSpace};
+use nanofold::qp::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
 use nanofold::sphere::{
     fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3,
 };
@@ -146,12 +146,19 @@ proptest! {
         let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let mut solver = Unfolder::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
-        let (problem, _) = solver.direction_problem().unwrap();
-        let direct = solve_direct(&problem).unwrap();
-        let clarabel = solve_clarabel(&problem).unwrap();
-        let scale = 1.0 + problem.q.amax();
-        prop_assert!((&direct.y - &clarabel.y).amax() <= 1e-10 * scale, "differ by {:e} (scale {scale:e})", (&direct.y - &clarabel.y).amax());
-        prop_assert!((problem.a.mul(&direct.y)).amax() <= 1e-12 * scale);
+        let (bending, _) = solver.direction_problem().unwrap();
+        prop_assert!(bending.metric.is_some(), "the default direction uses the bending metric");
+        let euclidean = DirectionProblem { metric: None, ..bending.clone() };
+        for problem in [euclidean, bending] {
+            let direct = solve_direct(&problem).unwrap();
+            let clarabel = solve_clarabel(&problem).unwrap();
+            let scale = 1.0 + problem.q.amax();
+            prop_assert!((&direct.y - &clarabel.y).amax() <= 1e-10 * scale, "differ by {:e} (scale {scale:e})", (&direct.y - &clarabel.y).amax());
+            prop_assert!((problem.a.mul(&direct.y)).amax() <= 1e-12 * scale);
+            // Optimality: M y + q lies in the row space of A.
+            let stationarity = RowSpace::dense(&problem.a).unwrap().project_to_null(&(problem.metric_times(&direct.y) + &problem.q));
+            prop_assert!(stationarity.amax() <= 1e-10 * scale, "KKT residual {:e}", stationarity.amax());
+        }
     }
 
 }

@@ -161,6 +161,15 @@ impl ConstraintJacobian {
         DVector::from_iterator(self.rows.len(), self.rows.iter().map(|row| row.dot(y)))
     }
 
+    /// Aᵀ v.
+    pub fn mul_transpose(&self, v: &DVector<f64>) -> DVector<f64> {
+        let mut out = DVector::zeros(self.columns);
+        for (row, value) in self.rows.iter().zip(v.iter()) {
+            row.axpy(*value, &mut out);
+        }
+        out
+    }
+
     fn largest_row_norm(&self) -> f64 {
         self.rows.iter().map(|r| r.norm_squared()).fold(0.0, f64::max).sqrt()
     }
