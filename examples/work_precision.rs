@@ -19,7 +19,7 @@ use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::plot::work_precision::{
     largest_sizes, power_law_fit, scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries,
 };
-use nanofold::qp::QpMethod;
+use nanofold::qp::{self, QpMethod};
 use nanofold::scene::Scene;
 use nanofold::sphere::Vec3;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
@@ -45,6 +45,7 @@ struct UnfoldConfig {
     newton_flatten: bool,
     flat_tol: f64,
     max_step_rad: f64,
+    bending_metric: f64,
 }
 
 impl UnfoldConfig {
@@ -54,6 +55,7 @@ impl UnfoldConfig {
             newton_flatten: self.newton_flatten,
             flat_tol: self.flat_tol,
             max_step_rad: self.max_step_rad,
+            bending_metric: self.bending_metric,
             ..UnfoldSettings::default()
         }
     }
@@ -67,7 +69,11 @@ impl UnfoldConfig {
         } else {
             "line search only"
         };
-        format!("{qp}, {finish}")
+        if self.bending_metric == 0.0 {
+            format!("{qp}, plain QP, {finish}")
+        } else {
+            format!("{qp}, {finish}")
+        }
     }
 }
 
@@ -87,9 +93,20 @@ fn unfold_part(out: &Path) -> Value {
                     newton_flatten,
                     flat_tol,
                     max_step_rad: defaults.max_step_rad,
+                    bending_metric: defaults.bending_metric,
                 });
             }
         }
+    }
+    // SPEC §5's plain QP (M = I) beside the default bending metric.
+    for flat_tol in [1e-2, 1e-4, 1e-6] {
+        configs.push(UnfoldConfig {
+            qp: QpMethod::Direct,
+            newton_flatten: true,
+            flat_tol,
+            max_step_rad: defaults.max_step_rad,
+            bending_metric: 0.0,
+        });
     }
     let step_caps = [0.05, 0.8];
     for max_step_rad in step_caps {
@@ -98,12 +115,13 @@ fn unfold_part(out: &Path) -> Value {
             newton_flatten: true,
             flat_tol: defaults.flat_tol,
             max_step_rad,
+            bending_metric: defaults.bending_metric,
         });
     }
 
     println!("== unfolding: wall time against error (median of {RUNS}) ==");
     println!(
-        "{:<20} {:<28} {:>8} {:>9} {:<14} {:>6} {:>10} {:>10} {:>10}",
+        "{:<20} {:<40} {:>8} {:>9} {:<14} {:>6} {:>10} {:>10} {:>10}",
         "pattern", "direction, finish", "flat tol", "step cap", "verdict", "iters", "ms", "layout err", "arc resid"
     );
     let mut rows = Vec::new();
@@ -124,7 +142,7 @@ fn unfold_part(out: &Path) -> Value {
             let settings = config.settings();
             let (seconds, report) = timed(RUNS, || unfold(&pattern, &settings).expect("unfold"));
             println!(
-                "{:<20} {:<28} {:>8.0e} {:>9} {:<14} {:>6} {:>10.3} {:>10.1e} {:>10.1e}",
+                "{:<20} {:<40} {:>8.0e} {:>9} {:<14} {:>6} {:>10.3} {:>10.1e} {:>10.1e}",
                 pattern.name,
                 config.series(),
                 config.flat_tol,
@@ -137,7 +155,7 @@ fn unfold_part(out: &Path) -> Value {
             );
             rows.push(json!({
                 "pattern": pattern.name, "creases": pattern.creases.len(),
-                "qp": config.qp, "newton_flatten": config.newton_flatten, "flat_tol": config.flat_tol,
+                "qp": config.qp, "bending_metric": config.bending_metric, "newton_flatten": config.newton_flatten, "flat_tol": config.flat_tol,
                 "max_step_rad": config.max_step_rad, "verdict": report.verdict.as_str(),
                 "iterations": report.iterations, "seconds": seconds,
                 "flat_layout_error": report.flat_layout_error, "max_arc_residual": report.max_arc_residual,
@@ -450,8 +468,8 @@ fn per_call(mut work: impl FnMut()) -> f64 {
 fn scaling_part(out: &Path) -> Value {
     println!("\n== one unfold iteration against the number of creases (random vertices, median) ==");
     println!(
-        "{:>5} {:>14} {:>14} {:>16} {:>10}",
-        "n", "iteration µs", "U+∇U µs", "A and its SVD µs", "SVD share"
+        "{:>5} {:>14} {:>14} {:>20} {:>10} {:>13} {:>6} {:>10} {:>10}",
+        "n", "iteration µs", "U+∇U µs", "direction µs", "share", "unfold", "iters", "ms", "layout err"
     );
     let sizes = [4usize, 8, 16, 32, 64, 128, 256];
     let (mut iteration, mut energy, mut direction) = (Vec::new(), Vec::new(), Vec::new());
@@ -469,7 +487,8 @@ fn scaling_part(out: &Path) -> Value {
             black_box(kind.value_and_gradient(&nodes, &model.arcs, &mut ws, &mut gradient));
         });
         let direction_seconds = per_call(|| {
-            black_box(solver.direction_problem().expect("direction"));
+            let (problem, row_space) = solver.direction_problem().expect("direction");
+            black_box(qp::solve_direct_with(&problem, &row_space).expect("direction solve"));
         });
         // Steps change the state: time a fixed number from the folded start.
         let step_times: Vec<f64> = (0..15)
@@ -480,16 +499,26 @@ fn scaling_part(out: &Path) -> Value {
             })
             .collect();
         let step_seconds = median(step_times);
+        // The whole unfold from the folded state, once.
+        let start = Instant::now();
+        let report = unfold(&pattern, &settings).expect("unfold");
+        let unfold_seconds = start.elapsed().as_secs_f64();
         println!(
-            "{n:>5} {:>14.1} {:>14.2} {:>16.1} {:>9.0}%",
+            "{n:>5} {:>14.1} {:>14.2} {:>20.1} {:>9.0}% {:>13} {:>6} {:>10.1} {:>10.1e}",
             step_seconds * 1e6,
             energy_seconds * 1e6,
             direction_seconds * 1e6,
-            100.0 * direction_seconds / step_seconds
+            100.0 * direction_seconds / step_seconds,
+            report.verdict.as_str(),
+            report.iterations,
+            unfold_seconds * 1e3,
+            report.flat_layout_error
         );
         rows.push(json!({
             "creases": n, "iteration_seconds": step_seconds, "energy_and_gradient_seconds": energy_seconds,
-            "jacobian_and_svd_seconds": direction_seconds,
+            "direction_seconds": direction_seconds, "unfold_verdict": report.verdict.as_str(),
+            "unfold_iterations": report.iterations, "unfold_seconds": unfold_seconds,
+            "flat_layout_error": report.flat_layout_error,
         }));
         iteration.push((n as f64, step_seconds));
         energy.push((n as f64, energy_seconds));
@@ -498,10 +527,10 @@ fn scaling_part(out: &Path) -> Value {
     // Exponents from the large sizes, where the leading term dominates.
     let tail = |points: &[(f64, f64)]| power_law_fit(largest_sizes(points)).map(|(k, _)| k);
     let exponents = json!({
-        "iteration": tail(&iteration), "energy_and_gradient": tail(&energy), "jacobian_and_svd": tail(&direction),
+        "iteration": tail(&iteration), "energy_and_gradient": tail(&energy), "direction": tail(&direction),
     });
     println!(
-        "exponents over n = 64…256: iteration n^{:.2}, U+∇U n^{:.2}, A and its SVD n^{:.2}",
+        "exponents over n = 64…256: iteration n^{:.2}, U+∇U n^{:.2}, direction (A, factorisations, solve) n^{:.2}",
         tail(&iteration).unwrap_or(f64::NAN),
         tail(&energy).unwrap_or(f64::NAN),
         tail(&direction).unwrap_or(f64::NAN)
@@ -515,7 +544,7 @@ fn scaling_part(out: &Path) -> Value {
                 points: iteration,
             },
             ScalingSeries {
-                name: "A and its SVD".into(),
+                name: "direction (A, factorisations, solve)".into(),
                 points: direction,
             },
             ScalingSeries {

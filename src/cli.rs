@@ -197,6 +197,9 @@ pub struct SolverArgs {
     /// Flat when every |fold angle| ≤ this (rad).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub flat_tol: f64,
+    /// Weight κ of the bending metric of the direction (0: SPEC's plain QP, M = I).
+    #[arg(long, default_value_t = UnfoldSettings::default().bending_metric, allow_negative_numbers = true)]
+    pub bending_metric: f64,
     /// Iteration limit.
     #[arg(long, default_value_t = 20_000)]
     pub max_iter: usize,
@@ -222,6 +225,11 @@ impl SolverArgs {
             self.flat_tol
         );
         anyhow::ensure!(
+            self.bending_metric.is_finite() && self.bending_metric >= 0.0,
+            "invalid --bending-metric {}: must be a number ≥ 0 (0 is the plain QP)",
+            self.bending_metric
+        );
+        anyhow::ensure!(
             self.closure_tol.is_finite() && self.closure_tol > 0.0,
             "invalid --closure-tol {}: must be a positive number",
             self.closure_tol
@@ -231,6 +239,7 @@ impl SolverArgs {
             p: self.p,
             qp: self.qp,
             flat_tol: self.flat_tol,
+            bending_metric: self.bending_metric,
             max_iterations: self.max_iter,
             restarts: self.restarts,
             ..UnfoldSettings::default()

@@ -228,6 +228,14 @@ fn unfold_of_several_patterns_writes_a_folder_each_and_refuses_name_clashes() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--jobs"));
 
+    // So is a negative bending metric, with its value.
+    let out = nanofold()
+        .args(["check", "patterns/corner_cube.fold", "--bending-metric", "-1"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--bending-metric -1"));
+
     // A directory without patterns is an error naming it.
     let empty = temp_dir("empty");
     std::fs::create_dir_all(&empty).unwrap();
