@@ -36,7 +36,7 @@ fn main() {
         model: ModelChoice::Dynamic,
         method: Method::Tsit45,
         rtol: 1e-10,
-        progress: false,
+        progress: None,
         ..SimulationSettings::default()
     };
     let range = json!([-5, 180]);
@@ -138,7 +138,7 @@ fn main() {
     // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
     let ramp = ClosedScene::load(Path::new("patterns/corner_cube_step1_ramp.scene.json")).unwrap();
     let auto = SimulationSettings {
-        progress: false,
+        progress: None,
         ..SimulationSettings::default()
     };
     let (qs_seconds, qs) = timed(&ramp, &auto);
@@ -164,7 +164,7 @@ fn main() {
             model: ModelChoice::Dynamic,
             method: Method::Esdirk34,
             rtol,
-            progress: false,
+            progress: None,
             ..SimulationSettings::default()
         };
         let (seconds, run) = timed(&ramp, &dynamic);

@@ -306,7 +306,7 @@ fn dynamics_part(out: &Path) -> Value {
     let reference_settings = SimulationSettings {
         rtol: 1e-13,
         method: Method::Tsit45,
-        progress: false,
+        progress: None,
         ..Default::default()
     };
     let (reference_seconds, reference) = timed(1, || simulate(&step, &reference_settings).expect("reference"));
@@ -333,7 +333,7 @@ fn dynamics_part(out: &Path) -> Value {
             let settings = SimulationSettings {
                 rtol,
                 method,
-                progress: false,
+                progress: None,
                 ..Default::default()
             };
             let (seconds, response) = timed(DYNAMIC_RUNS, || simulate(&step, &settings).expect("run"));
@@ -384,7 +384,7 @@ fn dynamics_part(out: &Path) -> Value {
 
     let ramp = Scene::load(Path::new("patterns/bridge_ramp.scene.json")).expect("scene");
     let quasi_settings = SimulationSettings {
-        progress: false,
+        progress: None,
         ..Default::default()
     };
     let (quasi_seconds, quasi) = timed(RUNS, || simulate(&ramp, &quasi_settings).expect("quasi-static"));
@@ -413,7 +413,7 @@ fn dynamics_part(out: &Path) -> Value {
             model: ModelChoice::Dynamic,
             method: Method::Esdirk34,
             rtol,
-            progress: false,
+            progress: None,
             ..Default::default()
         };
         let (seconds, dynamic) = timed(DYNAMIC_RUNS, || simulate(&ramp, &settings).expect("dynamic ramp"));

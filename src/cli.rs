@@ -5,11 +5,13 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{
     default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
-    Setup, Source,
+    Setup,
 };
 use nanofold::dynamics::closed::simulate_closed;
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, Response, SimulationSettings};
+use nanofold::dynamics::simulate::{
+    simulate, Method, ModelChoice, ModelKind, ProgressObserver, Response, SimulationSettings,
+};
 use nanofold::energy::EnergyKind;
 use nanofold::output::{
     closed_modes_json, closed_response_json, closed_response_summary, fold_animation, modes_json, response_json,
@@ -152,8 +154,8 @@ pub struct ConstraintsArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub tol: Option<f64>,
     /// Where the samples come from: an exact sweep or an unfolding trajectory.
-    #[arg(long, value_enum, default_value_t = Source::Sweep)]
-    pub source: Source,
+    #[arg(long, value_enum, default_value_t = SourceArg::Sweep)]
+    pub source: SourceArg,
     /// Driving-angle range A:B in degrees (default: flat to the folded angle).
     #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
     pub range: Option<String>,
@@ -174,6 +176,51 @@ pub struct ConstraintsArgs {
     pub closure_tol: f64,
 }
 
+/// `--source`: where constraint samples come from.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SourceArg {
+    /// Newton loop closure along a kinematic sweep: the exact reference.
+    Sweep,
+    /// The fold angles along an unfolding trajectory.
+    Unfold,
+}
+
+/// `--energy`: the repulsive energy (SPEC §4).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EnergyArg {
+    /// Σ (γ(v,a) + γ(v,b) − α)^(−p), default p = 2: a barrier wherever a node touches an arc.
+    Separable,
+    /// Σ γ(v, m_e)^(−p), default p = 4: no barrier away from arc midpoints.
+    NonSeparable,
+}
+
+impl From<EnergyArg> for EnergyKind {
+    fn from(arg: EnergyArg) -> Self {
+        match arg {
+            EnergyArg::Separable => EnergyKind::Separable,
+            EnergyArg::NonSeparable => EnergyKind::NonSeparable,
+        }
+    }
+}
+
+/// `--qp`: the direction solver.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum QpArg {
+    /// Clarabel interior-point QP (the reference path).
+    Clarabel,
+    /// Closed-form projection onto the null space of the constraint rows.
+    Direct,
+}
+
+impl From<QpArg> for QpMethod {
+    fn from(arg: QpArg) -> Self {
+        match arg {
+            QpArg::Clarabel => QpMethod::Clarabel,
+            QpArg::Direct => QpMethod::Direct,
+        }
+    }
+}
+
 /// Export format of `nanofold constraints`.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ExportFormat {
@@ -186,14 +233,14 @@ pub enum ExportFormat {
 #[derive(Args, Clone)]
 pub struct SolverArgs {
     /// Repulsive energy (SPEC §4).
-    #[arg(long, value_enum, default_value_t = EnergyKind::Separable)]
-    pub energy: EnergyKind,
+    #[arg(long, value_enum, default_value_t = EnergyArg::Separable)]
+    pub energy: EnergyArg,
     /// Exponent p (default 2 separable, 4 non-separable).
     #[arg(long, allow_negative_numbers = true)]
     pub p: Option<f64>,
     /// Direction solver: the direct null-space projection or the Clarabel QP.
-    #[arg(long, value_enum, default_value_t = QpMethod::Direct)]
-    pub qp: QpMethod,
+    #[arg(long, value_enum, default_value_t = QpArg::Direct)]
+    pub qp: QpArg,
     /// Flat when every |fold angle| ≤ this (rad).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub flat_tol: f64,
@@ -235,9 +282,9 @@ impl SolverArgs {
             self.closure_tol
         );
         Ok(UnfoldSettings {
-            energy: self.energy,
+            energy: self.energy.into(),
             p: self.p,
-            qp: self.qp,
+            qp: self.qp.into(),
             flat_tol: self.flat_tol,
             bending_metric: self.bending_metric,
             max_iterations: self.max_iter,
@@ -567,14 +614,14 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     let range = args.range.as_deref().map(parse_range).transpose()?;
     let setup = Setup::new(&pattern, driver, &locks)?;
     let samples = match args.source {
-        Source::Sweep => {
+        SourceArg::Sweep => {
             let domain = match range {
                 Some(d) => d,
                 None => default_domain(&pattern, driver)?,
             };
             sweep_samples(&pattern, &setup, domain, args.samples)?
         }
-        Source::Unfold => unfold_samples(&pattern, &setup, range, &UnfoldSettings::default())?,
+        SourceArg::Unfold => unfold_samples(&pattern, &setup, range, &UnfoldSettings::default())?,
     };
     let (poly, report) = match degree {
         Some(d) => {
@@ -770,7 +817,34 @@ fn print_contact(response: &Response) {
     }
 }
 
+/// A progress bar on stderr for a long simulation (hidden when `show` is false), and the
+/// observer that moves it. The caller clears the bar when the run ends.
+fn progress_bar(show: bool) -> (indicatif::ProgressBar, ProgressObserver) {
+    let bar = if show {
+        indicatif::ProgressBar::new(1000)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% t = {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let moved = bar.clone();
+    let observer = ProgressObserver(std::sync::Arc::new(move |fraction, time| {
+        moved.set_position((1000.0 * fraction) as u64);
+        moved.set_message(format!("{time:.3e} s"));
+    }));
+    (bar, observer)
+}
+
 fn run_simulate(args: &SimulateArgs) -> Result<()> {
+    let (bar, observer) = progress_bar(!args.json);
+    let result = run_simulate_with(args, observer);
+    bar.finish_and_clear();
+    result
+}
+
+fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<()> {
     let settings = SimulationSettings {
         model: match args.model {
             ModelArg::Auto => ModelChoice::Auto,
@@ -787,7 +861,7 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
         rtol: args.rtol,
         ignore_collisions: args.ignore_collisions,
         t_end: args.t_end,
-        progress: !args.json,
+        progress: Some(progress),
         max_steps: args.max_steps,
     };
     let text = std::fs::read_to_string(&args.scene).with_context(|| format!("reading {}", args.scene.display()))?;

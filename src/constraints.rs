@@ -148,7 +148,7 @@ impl Setup {
 }
 
 /// Where the samples of a curve come from (SPEC §6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Source {
     /// Newton loop closure along a kinematic sweep: the exact reference.

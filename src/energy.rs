@@ -37,7 +37,7 @@ pub trait Energy: Send + Sync {
 }
 
 /// Which energy to use, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EnergyKind {
     /// U_s = Σ_e Σ_{v∉e} (γ(v,a_e) + γ(v,b_e) − α_e)^(−p), default p = 2: a barrier

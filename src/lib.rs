@@ -8,6 +8,7 @@ pub mod error;
 pub mod kinematics;
 pub mod output;
 pub mod pattern;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod qp;
 pub mod scene;

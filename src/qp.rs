@@ -14,7 +14,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 /// Which solver computes the direction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum QpMethod {
     /// Clarabel interior-point QP (handles inequalities; the reference path).

@@ -324,6 +324,7 @@ fn every_closed_library_pattern_yields_curves_once_locked_to_one_degree_of_freed
         let report = ConstraintReport::new(&pattern, &samples, &poly).unwrap();
         assert!(report.max_fit_error() < 1e-3, "{name}: {:e}", report.max_fit_error());
         assert!(mujoco_snippet(&report).is_ok());
+        #[cfg(feature = "plot")]
         assert!(nanofold::plot::constraints_svg(&pattern, &samples, &poly).is_ok());
     }
 }

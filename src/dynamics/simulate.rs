@@ -12,7 +12,6 @@ use super::Data;
 use crate::error::{NanofoldError, Result};
 use crate::scene::{Actuation, Scene};
 use diffsol::{NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason};
-use indicatif::{ProgressBar, ProgressStyle};
 use nalgebra::DVector;
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
@@ -79,8 +78,8 @@ pub struct SimulationSettings {
     pub ignore_collisions: bool,
     /// Overrides the scene's `time.t_end_s`.
     pub t_end: Option<f64>,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
+    /// Called as the main run advances (a progress bar, a log); None for silence.
+    pub progress: Option<ProgressObserver>,
     /// A dynamic run that needs more integrator steps stops with an error that says how many
     /// it would still need and what to try instead.
     pub max_steps: usize,
@@ -94,7 +93,7 @@ impl Default for SimulationSettings {
             rtol: 1e-8,
             ignore_collisions: false,
             t_end: None,
-            progress: false,
+            progress: None,
             max_steps: 5_000_000,
         }
     }
@@ -248,7 +247,7 @@ impl SimulationSettings {
     pub(crate) fn run_options(&self) -> IntegrationOptions {
         IntegrationOptions {
             rtol: self.rtol,
-            progress: self.progress,
+            progress: self.progress.clone(),
             record_steps: true,
             max_steps: self.max_steps,
         }
@@ -266,7 +265,7 @@ impl SimulationSettings {
         };
         let options = IntegrationOptions {
             rtol,
-            progress: false,
+            progress: None,
             record_steps: false,
             max_steps: self.max_steps,
         };
@@ -589,11 +588,22 @@ fn quasi_static(
     (samples, collision, subdivisions)
 }
 
+/// Receives the progress of a run: the fraction of its time span done (0..=1) and the time
+/// reached, s. Called once per accepted integrator step.
+#[derive(Clone)]
+pub struct ProgressObserver(pub std::sync::Arc<dyn Fn(f64, f64) + Send + Sync>);
+
+impl std::fmt::Debug for ProgressObserver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressObserver")
+    }
+}
+
 /// How one diffsol run is driven.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct IntegrationOptions {
     pub rtol: f64,
-    pub progress: bool,
+    pub progress: Option<ProgressObserver>,
     /// Record a sample at every accepted step besides the output times.
     pub record_steps: bool,
     pub max_steps: usize,
@@ -688,22 +698,12 @@ pub fn integrate<P: Plant>(
     // The minimum step size still stops a run that genuinely cannot proceed.
     problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
     let s_end = output_times.last().copied().unwrap_or(0.0) / time_unit;
-    let bar = if progress {
-        let bar = ProgressBar::new(1000);
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% t = {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
     let driver = Driver {
         plant,
         output_times,
         time_unit,
         s_end,
-        bar: &bar,
+        progress: progress.as_ref(),
         record_steps,
         method,
         max_steps,
@@ -714,14 +714,10 @@ pub fn integrate<P: Plant>(
         Method::TrBdf2 => driver.run(problem.tr_bdf2::<NalgebraLU<f64>>().map_err(|e| ode_error(&e))?),
         Method::Tsit45 => driver.run(problem.tsit45().map_err(|e| ode_error(&e))?),
     };
-    bar.finish_and_clear();
     if let Some(e) = failure.borrow_mut().take() {
         return Err(e);
     }
-    let (samples, collision, steps, newton_failures) = result?;
-    if std::env::var_os("NANOFOLD_DEBUG").is_some() {
-        eprintln!("newton failures {newton_failures}");
-    }
+    let (samples, collision, steps, _) = result?;
     Ok(DynamicRun {
         samples,
         collision,
@@ -743,7 +739,7 @@ struct Driver<'r, P: Plant> {
     output_times: &'r [f64],
     time_unit: f64,
     s_end: f64,
-    bar: &'r ProgressBar,
+    progress: Option<&'r ProgressObserver>,
     /// Record a sample at every accepted step besides the output times.
     record_steps: bool,
     /// For error messages.
@@ -894,8 +890,9 @@ impl<P: Plant> Driver<'_, P> {
                 split(&state, &mut angles, &mut rates);
                 samples.push(plant.sample(s_now_time, &angles, &rates, &mut ws)?);
             }
-            self.bar.set_position((1000.0 * s_now / self.s_end) as u64);
-            self.bar.set_message(format!("{:.3e} s", s_now * self.time_unit));
+            if let Some(progress) = self.progress {
+                (progress.0)(s_now / self.s_end, s_now * self.time_unit);
+            }
             if s_now >= self.s_end {
                 break;
             }
