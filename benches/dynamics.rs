@@ -4,19 +4,26 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;
-use nanofold::dynamics::simulate::{simulate, Method, SimulationSettings};
+use nanofold::dynamics::algorithms::{
+    coriolis_torques, forward_dynamics, update_coriolis_matrix, update_kinematics, update_mass_matrix,
+    update_mass_matrix_derivative, update_velocities,
+};
+use nanofold::dynamics::integrate::Method;
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, SimulationSettings};
 use nanofold::dynamics::Data;
-use nanofold::scene::Scene;
 use std::hint::black_box;
 use std::path::Path;
 
 fn bridge() -> Scene {
-    Scene::load(Path::new("patterns/bridge_step.scene.json")).unwrap()
+    nanofold::io::load_scene(Path::new("patterns/bridge_step.scene.json"))
+        .and_then(|spec| spec.build())
+        .unwrap()
 }
 
 fn bench_terms(c: &mut Criterion) {
     let scene = bridge();
-    let model = &scene.model;
+    let model = &scene.strip().unwrap().model;
     let mut data = Data::new(model);
     let angles = [0.7, 1.1, -0.4, 1.9];
     let rates = [1.0e3, -2.0e3, 5.0e3, 1.0e4];
@@ -26,29 +33,35 @@ fn bench_terms(c: &mut Criterion) {
     let mut group = c.benchmark_group("bridge");
     group.bench_function("mass_matrix", |b| {
         b.iter(|| {
-            model.update_kinematics(black_box(&angles), &mut data);
-            model.update_mass_matrix(&mut data);
+            update_kinematics(model, black_box(&angles), &mut data);
+            update_mass_matrix(model, &mut data);
         })
     });
     group.bench_function("coriolis_newton_euler", |b| {
-        model.update_kinematics(&angles, &mut data);
+        update_kinematics(model, &angles, &mut data);
         b.iter(|| {
-            model.update_velocities(black_box(&rates), &mut data);
-            model.coriolis_torques(&rates, &mut data, &mut out)
+            update_velocities(model, black_box(&rates), &mut data);
+            coriolis_torques(model, &rates, &mut data, &mut out)
         })
     });
     group.bench_function("coriolis_christoffel_matrix", |b| {
-        model.update_kinematics(&angles, &mut data);
+        update_kinematics(model, &angles, &mut data);
         b.iter(|| {
-            model.update_mass_matrix_derivative(&mut data);
-            model.update_coriolis(black_box(&rates), &mut data);
+            update_mass_matrix_derivative(model, &mut data);
+            update_coriolis_matrix(model, black_box(&rates), &mut data);
         })
     });
     group.bench_function("accelerations", |b| {
         b.iter(|| {
-            model
-                .accelerations(black_box(&angles), &rates, &torques, &mut data, accel.as_mut_slice())
-                .unwrap()
+            forward_dynamics(
+                model,
+                black_box(&angles),
+                &rates,
+                &torques,
+                &mut data,
+                accel.as_mut_slice(),
+            )
+            .unwrap()
         })
     });
     group.finish();

@@ -1,9 +1,9 @@
 //! Criterion benches: unfolding each library pattern, and one energy + gradient evaluation.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use nanofold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::geometry::sphere::Vec3;
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::sphere::Vec3;
+use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};
 
 fn library() -> Vec<Pattern> {
@@ -15,7 +15,7 @@ fn library() -> Vec<Pattern> {
     paths.sort();
     paths
         .iter()
-        .map(|p| Pattern::load(p, &LoadOptions::default()).unwrap())
+        .map(|p| nanofold::io::load_pattern(p, &LoadOptions::default()).unwrap())
         .collect()
 }
 
@@ -30,7 +30,7 @@ fn bench_unfold(c: &mut Criterion) {
 }
 
 fn bench_energy(c: &mut Criterion) {
-    let pattern = Pattern::load(
+    let pattern = nanofold::io::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
         &LoadOptions::default(),
     )

@@ -7,26 +7,30 @@
 mod common;
 
 use common::machine;
-use nanofold::dynamics::closed::simulate_closed;
-use nanofold::dynamics::simulate::{Method, ModelChoice, Response, SimulationSettings};
-use nanofold::output::write_atomic;
+use nanofold::dynamics::closed::ClosedPlant;
+use nanofold::dynamics::integrate::Method;
+use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, ModelChoice, Simulation, SimulationSettings};
+use nanofold::io::output::write_atomic;
 use nanofold::plot::work_precision::{work_precision_svg, WorkPoint, WorkSeries};
-use nanofold::scene::closed::ClosedScene;
 use serde_json::json;
 use std::path::Path;
 
 const RUNS: usize = 5;
 
-fn scene(name: &str, constraint: serde_json::Value) -> ClosedScene {
+fn scene(name: &str, constraint: serde_json::Value) -> Scene {
     let path = format!("patterns/{name}.scene.json");
     let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     value["constraint"] = constraint;
-    ClosedScene::from_json(&value.to_string(), &path, name, Path::new("patterns")).unwrap()
+    nanofold::io::parse_scene(&value.to_string(), &path, name, Path::new("patterns"))
+        .and_then(|spec| spec.build())
+        .unwrap()
 }
 
-/// Median wall time of RUNS runs (scene set-up excluded), and the last response.
-fn timed(scene: &ClosedScene, settings: &SimulationSettings) -> (f64, Response) {
-    common::timed(RUNS, || simulate_closed(scene, settings).expect("run"))
+/// Median wall time of RUNS runs (scene set-up excluded), and the last run.
+fn timed(scene: &Scene, settings: &SimulationSettings) -> (f64, Simulation) {
+    common::timed(RUNS, || simulate(scene, settings).expect("run"))
 }
 
 fn main() {
@@ -42,14 +46,14 @@ fn main() {
     let range = json!([-5, 180]);
     let exact_scene = scene("corner_cube_step1", json!({"source": "exact", "range_deg": range}));
     let (exact_seconds, exact) = timed(&exact_scene, &settings);
-    let exact_contact = exact.collision.clone().expect("exact run reaches contact");
-    let exact_end = exact.samples.last().unwrap().angles.clone();
+    let exact_contact = exact.response.collision.clone().expect("exact run reaches contact");
+    let exact_end = exact.response.samples.last().unwrap().angles.clone();
     println!("corner cube step 1, Tsit45 rtol 1e-10, median of {RUNS} runs");
     println!(
         "{:>7} {:>10} {:>10} {:>10} {:>12} {:>12} {:>12}",
         "f", "ms", "fit err", "slope err", "closure", "Δt contact", "Δθ contact"
     );
-    let closure = |r: &Response| r.closed.as_ref().unwrap().max_closure_residual;
+    let closure = |r: &Simulation| r.closed.as_ref().unwrap().max_closure_residual;
     println!(
         "{:>7} {:>10.3} {:>10} {:>10} {:>12.1e} {:>12} {:>12}",
         "exact",
@@ -71,11 +75,11 @@ fn main() {
             "corner_cube_step1",
             json!({"source": "poly", "degree": degree, "range_deg": range}),
         );
-        let (seconds, response) = timed(&poly_scene, &settings);
-        let contact = response.collision.clone().expect("poly run reaches contact");
+        let (seconds, run) = timed(&poly_scene, &settings);
+        let contact = run.response.collision.clone().expect("poly run reaches contact");
         let dt = contact.time - exact_contact.time;
-        let dtheta = (&response.samples.last().unwrap().angles - &exact_end).amax();
-        let report = response.closed.as_ref().unwrap();
+        let dtheta = (&run.response.samples.last().unwrap().angles - &exact_end).amax();
+        let report = run.closed.as_ref().unwrap();
         println!(
             "{:>7} {:>10.3} {:>10.1e} {:>10.1e} {:>12.1e} {:>12.1e} {:>12.1e}",
             format!("poly {degree}"),
@@ -136,12 +140,15 @@ fn main() {
     write_atomic(&out.join("poly_vs_exact.svg"), figure.as_bytes()).unwrap();
 
     // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
-    let ramp = ClosedScene::load(Path::new("patterns/corner_cube_step1_ramp.scene.json")).unwrap();
+    let ramp = nanofold::io::load_scene(Path::new("patterns/corner_cube_step1_ramp.scene.json"))
+        .and_then(|spec| spec.build())
+        .unwrap();
     let auto = SimulationSettings {
         progress: None,
         ..SimulationSettings::default()
     };
     let (qs_seconds, qs) = timed(&ramp, &auto);
+    let qs = qs.response;
     let (_, qs_measured) = qs.measured_quasi_static_error.unwrap();
     println!(
         "\ncorner cube step 1 ramp ({:.0} s of etch): quasi-static {:.2} ms, error ≤ {:.1e} rad (bound), {:.1e} rad measured",
@@ -168,7 +175,9 @@ fn main() {
             ..SimulationSettings::default()
         };
         let (seconds, run) = timed(&ramp, &dynamic);
-        let deviation = ramp.chain.quasi_static_deviation(&run.samples).unwrap();
+        let run = run.response;
+        let plant = ClosedPlant::new(ramp.closed().unwrap(), false);
+        let deviation = quasi_static_deviation(&plant, &run.samples).unwrap();
         println!(
             "  dynamic ESDIRK34 rtol {rtol:.0e}: {:.2} ms, {} steps, max |θ − θ_quasi-static| {:.1e} rad",
             seconds * 1e3,

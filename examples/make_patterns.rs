@@ -4,7 +4,7 @@
 //!
 //! Run: `cargo run --release --example make_patterns`
 
-use nanofold::kinematics::solve_closure;
+use nanofold::geometry::kinematics::solve_closure;
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 

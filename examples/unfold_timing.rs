@@ -5,9 +5,9 @@
 mod common;
 
 use common::{library_patterns, many_creases, timed};
-use nanofold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::qp::QpMethod;
-use nanofold::sphere::Vec3;
+use nanofold::geometry::sphere::Vec3;
+use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::unfold::qp::QpMethod;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};
 use std::time::Instant;
 

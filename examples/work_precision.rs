@@ -12,16 +12,19 @@ mod common;
 
 use common::{library_patterns, machine, many_creases, median, timed};
 use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
-use nanofold::dynamics::simulate::{quasi_static_deviation, simulate, Method, ModelChoice, SimulationSettings};
-use nanofold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::output::write_atomic;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::dynamics::integrate::Method;
+use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, ModelChoice, SimulationSettings};
+use nanofold::dynamics::strip::StripPlant;
+use nanofold::geometry::sphere::Vec3;
+use nanofold::io::output::write_atomic;
+use nanofold::pattern::LoadOptions;
 use nanofold::plot::work_precision::{
     largest_sizes, power_law_fit, scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries,
 };
-use nanofold::qp::{self, QpMethod};
-use nanofold::scene::Scene;
-use nanofold::sphere::Vec3;
+use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::unfold::qp::{self, QpMethod};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
@@ -216,7 +219,8 @@ fn unfold_part(out: &Path) -> Value {
 
 /// Degree against error and evaluation time of f and G for the corner cube's step-1 curves.
 fn fits_part(out: &Path) -> Value {
-    let pattern = Pattern::load(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
+    let pattern =
+        nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
     let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).expect("setup");
     let (sweep_seconds, samples) = timed(RUNS, || sweep_samples(&pattern, &setup, [0.0, PI], 201).expect("sweep"));
     println!(
@@ -302,14 +306,14 @@ fn fits_part(out: &Path) -> Value {
 /// The bridge's step response per integrator and tolerance against a reference, and its
 /// etch ramp quasi-static against dynamic.
 fn dynamics_part(out: &Path) -> Value {
-    let step = Scene::load(Path::new("patterns/bridge_step.scene.json")).expect("scene");
+    let step = load_scene(Path::new("patterns/bridge_step.scene.json"));
     let reference_settings = SimulationSettings {
         rtol: 1e-13,
         method: Method::Tsit45,
         progress: None,
         ..Default::default()
     };
-    let (reference_seconds, reference) = timed(1, || simulate(&step, &reference_settings).expect("reference"));
+    let (reference_seconds, reference) = timed(1, || simulate(&step, &reference_settings).expect("reference").response);
     let reference_contact = reference.collision.clone().expect("the bridge step collides");
     let reference_angles = reference.samples.last().expect("samples").angles.clone();
     println!(
@@ -336,7 +340,7 @@ fn dynamics_part(out: &Path) -> Value {
                 progress: None,
                 ..Default::default()
             };
-            let (seconds, response) = timed(DYNAMIC_RUNS, || simulate(&step, &settings).expect("run"));
+            let (seconds, response) = timed(DYNAMIC_RUNS, || simulate(&step, &settings).expect("run").response);
             let contact = response.collision.clone().expect("collides");
             let angle_error = (&response.samples.last().expect("samples").angles - &reference_angles).amax();
             let time_error = (contact.time - reference_contact.time).abs();
@@ -382,12 +386,14 @@ fn dynamics_part(out: &Path) -> Value {
     .expect("figure");
     write(out, "bridge_step.svg", &svg);
 
-    let ramp = Scene::load(Path::new("patterns/bridge_ramp.scene.json")).expect("scene");
+    let ramp = load_scene(Path::new("patterns/bridge_ramp.scene.json"));
     let quasi_settings = SimulationSettings {
         progress: None,
         ..Default::default()
     };
-    let (quasi_seconds, quasi) = timed(RUNS, || simulate(&ramp, &quasi_settings).expect("quasi-static"));
+    let (quasi_seconds, quasi) = timed(RUNS, || {
+        simulate(&ramp, &quasi_settings).expect("quasi-static").response
+    });
     let (window, measured) = quasi.measured_quasi_static_error.expect("auto measures its error");
     let quasi_contact = quasi.collision.clone().expect("the ramp lands");
     println!(
@@ -416,9 +422,15 @@ fn dynamics_part(out: &Path) -> Value {
             progress: None,
             ..Default::default()
         };
-        let (seconds, dynamic) = timed(DYNAMIC_RUNS, || simulate(&ramp, &settings).expect("dynamic ramp"));
+        let (seconds, dynamic) = timed(DYNAMIC_RUNS, || {
+            simulate(&ramp, &settings).expect("dynamic ramp").response
+        });
         let contact = dynamic.collision.clone().expect("the ramp lands");
-        let deviation = quasi_static_deviation(&ramp, &dynamic.samples);
+        let deviation = quasi_static_deviation(
+            &StripPlant::new(ramp.strip().expect("a strip"), false),
+            &dynamic.samples,
+        )
+        .expect("deviation");
         println!(
             "dynamic ESDIRK34 rtol {rtol:.0e}: {:.2} ms, {} steps; max |θ − θ_quasi-static| {deviation:.2e} rad; contact Δ {:.2e} s",
             seconds * 1e3,
@@ -584,4 +596,11 @@ fn main() {
         out.display(),
         started.elapsed().as_secs_f64()
     );
+}
+
+/// A bundled scene, loaded and built.
+fn load_scene(path: &Path) -> Scene {
+    nanofold::io::load_scene(path)
+        .and_then(|spec| spec.build())
+        .expect("scene")
 }

@@ -7,22 +7,18 @@ use nanofold::constraints::{
     default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
     Setup,
 };
-use nanofold::dynamics::closed::simulate_closed;
+use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::simulate::{
-    simulate, Method, ModelChoice, ModelKind, ProgressObserver, Response, SimulationSettings,
-};
-use nanofold::energy::EnergyKind;
-use nanofold::output::{
-    closed_modes_json, closed_response_json, closed_response_summary, fold_animation, modes_json, response_json,
-    response_summary, trajectory_json, write_atomic,
+use nanofold::dynamics::scene::{Scene, System};
+use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, SimulationSettings};
+use nanofold::io::output::{
+    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json, write_atomic,
 };
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::plot::response::{closed_snapshots_svg, response_svg, response_view_svg, snapshots_svg, ResponseView};
+use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
-use nanofold::qp::QpMethod;
-use nanofold::scene::closed::{is_closed_scene, ClosedScene};
-use nanofold::scene::Scene;
+use nanofold::unfold::energy::EnergyKind;
+use nanofold::unfold::qp::QpMethod;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldReport, UnfoldSettings};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -345,7 +341,7 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         for path in entries {
             if path.is_dir() {
                 walk(&path, found)?;
-            } else if nanofold::pattern::is_pattern_file(&path) {
+            } else if nanofold::io::is_pattern_file(&path) {
                 found.push(path);
             }
         }
@@ -395,7 +391,7 @@ fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json:
 fn unfold_one(pattern_path: &Path, solver: &SolverArgs, dir: Option<&Path>) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
-    let pattern = Pattern::load(pattern_path, &solver.load_options())?;
+    let pattern = nanofold::io::load_pattern(pattern_path, &solver.load_options())?;
     let report = unfold(&pattern, &settings)?;
     let model = UnfoldModel::new(&pattern);
     let dir = dir.map_or_else(|| PathBuf::from("output").join(&pattern.name), Path::to_path_buf);
@@ -476,7 +472,7 @@ fn run_unfold(
     let mut jobs: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
     let mut writer_of: std::collections::HashMap<PathBuf, PathBuf> = std::collections::HashMap::new();
     for path in files {
-        let dir = parent.join(nanofold::pattern::pattern_name(&path));
+        let dir = parent.join(nanofold::io::pattern_name(&path));
         if let Some(other) = writer_of.insert(dir.clone(), path.clone()) {
             anyhow::bail!(
                 "{} and {} would both write {}: unfold them separately with --out",
@@ -515,7 +511,8 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
     let settings = solver.settings()?;
     let files = expand_patterns(patterns)?;
     parallel.all(&files, |path| {
-        let outcome = Pattern::load(path, &solver.load_options()).and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
+        let outcome = nanofold::io::load_pattern(path, &solver.load_options())
+            .and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
         match outcome {
             Ok((pattern, report)) if as_json => println!("{}", summary(&pattern, path, &report)),
             Ok((_, report)) => println!(
@@ -604,7 +601,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         closure_tol: args.closure_tol,
         ..LoadOptions::default()
     };
-    let pattern = Pattern::load(&args.pattern, &options)?;
+    let pattern = nanofold::io::load_pattern(&args.pattern, &options)?;
     let driver = crease_index(&pattern, args.drive, "--drive")?;
     let locks = args
         .locks
@@ -678,83 +675,6 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     println!(
         "  all curves together: loop-closure residual {:.3e} rad",
         report.max_closure_residual
-    );
-    print_written(&dir, &files);
-    Ok(())
-}
-
-/// `simulate` on a closed-chain scene: response.json and response.svg (every crease's angle).
-fn run_simulate_closed(args: &SimulateArgs, settings: &SimulationSettings) -> Result<()> {
-    let scene = ClosedScene::load(&args.scene)?;
-    let response = simulate_closed(&scene, settings)?;
-    let chain = &scene.chain;
-    let view = ResponseView {
-        name: scene.name.clone(),
-        labels: (0..chain.crease_stiffness.len())
-            .map(|c| {
-                let role = if c == chain.driver {
-                    "driven"
-                } else if chain.locked.iter().any(|&(l, _)| l == c) {
-                    "locked"
-                } else if c == chain.cut_crease {
-                    "cut, follows"
-                } else {
-                    "follows"
-                };
-                format!("{} ({role})", chain.crease_labels[c])
-            })
-            .collect(),
-        targets: (0..chain.crease_stiffness.len())
-            .map(|c| (c == chain.driver).then_some(chain.target))
-            .collect(),
-        drag: chain.model.drag.is_some(),
-    };
-    let dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("output").join(&scene.name));
-    let files = [
-        (
-            "response.json",
-            serde_json::to_string(&closed_response_json(&scene, settings, &response))?,
-        ),
-        ("response.svg", response_view_svg(&view, &response)?),
-        ("snapshots.svg", closed_snapshots_svg(&scene, &response, 5)?),
-    ];
-    write_outputs(&dir, &files)?;
-    let summary = closed_response_summary(&scene, settings, &response);
-    if args.json {
-        println!("{summary}");
-        return Ok(());
-    }
-    let closed = response.closed.as_ref().expect("closed-chain runs report their chain");
-    println!(
-        "{}: closed chain, {} driven, {} cut, f = {}{} (fit error {:.2e} rad, slope error {:.2e})",
-        scene.name,
-        chain.crease_labels[chain.driver],
-        chain.crease_labels[chain.cut_crease],
-        closed.constraint_source,
-        closed.degree.map_or(String::new(), |d| format!(" degree {d}")),
-        closed.fit_error,
-        closed.slope_error
-    );
-    println!(
-        "  time scales: natural period {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
-        response.time_scales.fastest_period_s, response.time_scales.forcing_time_s, response.time_scales.ratio,
-    );
-    print_model(&response);
-    print_contact(&response);
-    if let Some(last) = response.samples.last() {
-        let angles: Vec<String> = last.angles.iter().map(|a| format!("{:.4}", a.to_degrees())).collect();
-        println!("  final crease angles (deg): [{}]", angles.join(", "));
-    }
-    println!(
-        "  torque magnification η = {:.4}: the driving hinge ({:.1} µm wide) would need {:.1} µm to hold the target (T5.24-5.25)",
-        closed.torque_magnification, closed.driving_hinge_width_um, closed.required_hinge_width_um
-    );
-    println!(
-        "  max loop-closure residual along the run: {:.3e} rad",
-        closed.max_closure_residual
     );
     print_written(&dir, &files);
     Ok(())
@@ -844,6 +764,13 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
     result
 }
 
+/// Loads a scene file and builds it (the closed chain's sweep and fit run here).
+fn load_scene(path: &Path) -> Result<Scene> {
+    let spec = nanofold::io::load_scene(path)?;
+    spec.build()
+        .with_context(|| format!("building the scene of {}", path.display()))
+}
+
 fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<()> {
     let settings = SimulationSettings {
         model: match args.model {
@@ -864,12 +791,10 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         progress: Some(progress),
         max_steps: args.max_steps,
     };
-    let text = std::fs::read_to_string(&args.scene).with_context(|| format!("reading {}", args.scene.display()))?;
-    if is_closed_scene(&text) {
-        return run_simulate_closed(args, &settings);
-    }
-    let scene = Scene::load(&args.scene)?;
-    let response = simulate(&scene, &settings)?;
+    settings.validate().map_err(simulate_flags)?;
+    let scene = load_scene(&args.scene)?;
+    let simulation = simulate(&scene, &settings).map_err(simulate_flags)?;
+    let response = &simulation.response;
     // Render everything before writing anything.
     let dir = args
         .out
@@ -878,44 +803,94 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     let files = [
         (
             "response.json",
-            serde_json::to_string(&response_json(&scene, &settings, &response))?,
+            serde_json::to_string(&response_json(&scene, &settings, &simulation))?,
         ),
-        ("response.svg", response_svg(&scene, &response)?),
-        ("snapshots.svg", snapshots_svg(&scene, &response)?),
+        ("response.svg", response_svg(&scene, response)?),
+        ("snapshots.svg", snapshots_svg(&scene, response)?),
     ];
     write_outputs(&dir, &files)?;
     if args.json {
-        println!("{}", response_summary(&scene, &settings, &response));
+        println!("{}", response_summary(&scene, &settings, &simulation));
         return Ok(());
     }
     let scales = &response.time_scales;
-    println!(
-        "{}: {} hinge(s), {} actuation",
-        scene.name,
-        scene.model.dof(),
-        scene.actuation_kind()
-    );
+    match &scene.system {
+        System::Strip(chain) => println!(
+            "{}: {} hinge(s), {} actuation",
+            scene.name,
+            chain.model.dof(),
+            chain.forcing.kind()
+        ),
+        System::Closed(chain) => {
+            let closed = simulation
+                .closed
+                .as_ref()
+                .expect("closed-chain runs report their chain");
+            println!(
+                "{}: closed chain, {} driven, {} cut, face {} anchored, f = {}{} (fit error {:.2e} rad, slope error {:.2e})",
+                scene.name,
+                chain.crease_labels[chain.driver],
+                chain.crease_labels[chain.cut_crease],
+                closed.anchored_face,
+                closed.constraint_source,
+                closed.degree.map_or(String::new(), |d| format!(" degree {d}")),
+                closed.fit_error,
+                closed.slope_error
+            );
+        }
+    }
     println!(
         "  time scales: fastest natural period {:.3e} s, slowest {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
         scales.fastest_period_s, scales.slowest_period_s, scales.forcing_time_s, scales.ratio
     );
-    print_model(&response);
-    print_contact(&response);
+    print_model(response);
+    print_contact(response);
     if let Some(last) = response.samples.last() {
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
+    }
+    if let Some(closed) = &simulation.closed {
+        println!(
+            "  torque magnification η = {:.4}: the driving hinge ({:.1} µm wide) would need {:.1} µm to hold the target (T5.24-5.25)",
+            closed.torque_magnification, closed.driving_hinge_width_um, closed.required_hinge_width_um
+        );
+        println!(
+            "  max loop-closure residual along the run: {:.3e} rad",
+            closed.max_closure_residual
+        );
     }
     print_written(&dir, &files);
     Ok(())
 }
 
-fn run_modes(path: &Path, json: bool) -> Result<()> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    if is_closed_scene(&text) {
-        return run_modes_closed(path, json);
+/// Library errors name library settings; say which flags set them.
+fn simulate_flags(error: nanofold::NanofoldError) -> anyhow::Error {
+    use nanofold::error::NumericalError;
+    let flags = match &error {
+        nanofold::NanofoldError::InvalidField { field, .. } => match field.as_str() {
+            "rtol" => Some("--rtol"),
+            "t_end" => Some("--t-end"),
+            "max_steps" => Some("--max-steps"),
+            _ => None,
+        },
+        nanofold::NanofoldError::Numerical(
+            NumericalError::StepBudget { .. } | NumericalError::NewtonFailures { .. } | NumericalError::Strayed { .. },
+        ) => Some("--method, --model, --rtol, --max-steps"),
+        _ => None,
+    };
+    match flags {
+        Some(flags) => anyhow::Error::new(error).context(format!("simulate (set by {flags})")),
+        None => anyhow::Error::new(error),
     }
-    let scene = Scene::load(path)?;
-    let result = modes(&scene.model, scene.target_angles.as_slice())?;
+}
+
+fn run_modes(path: &Path, json: bool) -> Result<()> {
+    let scene = load_scene(path)?;
+    let chain = match &scene.system {
+        System::Closed(chain) => return run_modes_closed(&scene.name, chain, json),
+        System::Strip(chain) => chain,
+    };
+    let result = modes(&chain.model, chain.target_angles().as_slice())?;
     if json {
         println!("{}", modes_json(&scene, &result));
         return Ok(());
@@ -960,15 +935,13 @@ fn run_modes(path: &Path, json: bool) -> Result<()> {
     Ok(())
 }
 
-fn run_modes_closed(path: &Path, json: bool) -> Result<()> {
-    let scene = ClosedScene::load(path)?;
-    let result = scene.chain.folded_modes()?;
-    let eta = scene.chain.torque_magnification()?;
+fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain, json: bool) -> Result<()> {
+    let result = chain.folded_modes()?;
+    let eta = chain.torque_magnification()?;
     if json {
-        println!("{}", closed_modes_json(&scene, &result, eta));
+        println!("{}", closed_modes_json(name, chain, &result, eta));
         return Ok(());
     }
-    let pattern = &scene.pattern;
     let degrees = |angles: &[f64]| {
         angles
             .iter()
@@ -979,13 +952,14 @@ fn run_modes_closed(path: &Path, json: bool) -> Result<()> {
     let coordinates: Vec<String> = result
         .coordinates
         .iter()
-        .map(|&c| format!("edges[{}]", pattern.user_index(c)))
+        .map(|&c| format!("edges[{}]", chain.crease_user_indices[c]))
         .collect();
     println!(
-        "{}: modes of the closed chain (cut at edges[{}], f = {}), locks released: coordinates {}",
-        scene.name,
-        pattern.user_index(scene.chain.cut_crease),
-        scene.chain.source.name(),
+        "{}: modes of the closed chain (cut at edges[{}], face {} anchored, f = {}), locks released: coordinates {}",
+        name,
+        chain.crease_user_indices[chain.cut_crease],
+        chain.anchored_face,
+        chain.source.name(),
         coordinates.join(", ")
     );
     println!("  folded pose  θ = ({})", degrees(&result.folded_pose));
@@ -999,7 +973,7 @@ fn run_modes_closed(path: &Path, json: bool) -> Result<()> {
     for &c in &result.folded_through {
         println!(
             "  warning: edges[{}] is past ±180° at the free equilibrium: the plates touch before it",
-            pattern.user_index(c)
+            chain.crease_user_indices[c]
         );
     }
     println!(

@@ -7,8 +7,8 @@ pub mod chebyshev;
 pub mod exact;
 pub mod sweep;
 
-use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_residual, refine_closure, solve_closure};
+use crate::error::{NanofoldError, NumericalError, Result};
+use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, Pattern};
 use crate::unfold::{unfold, UnfoldSettings};
 use chebyshev::{eval_monomial, Chebyshev};
@@ -517,13 +517,14 @@ pub fn implicit_jacobian(pattern: &Pattern, setup: &Setup, crease_angles: &[f64]
     let driver_ray = pattern.creases[setup.driver].ray;
     let g = exact::implicit_jacobian_rays(&pattern.sector_angles, &rho, &[driver_ray], &dependent_rays).map_err(
         |e| match e {
-            NanofoldError::Numerical { stage, message } => NanofoldError::Numerical {
-                stage,
-                message: format!(
-                    "{message}: the dependents are not a function of {} here",
+            NanofoldError::Numerical(NumericalError::Singular { what, detail }) => NumericalError::Singular {
+                what,
+                detail: format!(
+                    "{detail}: the dependents are not a function of {} here",
                     pattern.creases[setup.driver].label
                 ),
-            },
+            }
+            .into(),
             other => other,
         },
     )?;

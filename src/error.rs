@@ -1,57 +1,248 @@
-//! The crate's one error type: every bad input names the field and the value.
+//! The crate's error types: [`NanofoldError`] for everything a caller can get back, with
+//! [`NumericalError`] for the failures of the numerics. Bad input names the field and the
+//! value; sources (io, JSON, Clarabel, diffsol) are kept, not flattened into strings.
 
 use thiserror::Error;
 
 /// Everything that can go wrong in nanofold's library code.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum NanofoldError {
     /// The input file could not be read.
-    #[error("cannot read {path}: {error}")]
-    Io { path: String, error: std::io::Error },
-    /// The input is not valid JSON.
-    #[error("{path}: malformed JSON: {message}")]
-    Json { path: String, message: String },
+    #[error("cannot read {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The input is not valid JSON, or not of the expected shape.
+    #[error("{path}: malformed JSON")]
+    Json {
+        /// The file (or another name of the input).
+        path: String,
+        /// serde_json's account, with line and column.
+        #[source]
+        source: serde_json::Error,
+    },
     /// A required key is absent.
-    #[error("missing key `{field}`")]
-    MissingField { field: String },
+    #[error("missing key `{field}`{}", hint.as_deref().map(|h| format!(" ({h})")).unwrap_or_default())]
+    MissingField {
+        /// The key, as the input names it.
+        field: String,
+        /// What the key holds, when the name alone does not say.
+        hint: Option<String>,
+    },
     /// A field holds a value that is out of range or of the wrong kind.
     #[error("invalid `{field}`: {value} ({reason})")]
     InvalidField {
+        /// The field, as the input or the settings name it.
         field: String,
+        /// The value found.
         value: String,
+        /// What is wrong with it.
         reason: String,
     },
-    /// The folded state does not close up (SPEC §2).
+    /// The folded state does not close up (`docs/model.md#loop-closure`).
     #[error("folded state violates loop closure: residual {residual:.3e} rad > tolerance {tolerance:.1e} rad (check `{field}`)")]
     ClosureViolated {
+        /// The field holding the fold angles.
         field: String,
+        /// Rotation angle of the holonomy, rad.
         residual: f64,
+        /// Largest accepted residual, rad.
         tolerance: f64,
     },
     /// The pattern has more than one vertex where creases meet.
     #[error("{count} vertices with creases; only single-vertex patterns are supported")]
-    MultipleVertices { count: usize },
+    MultipleVertices {
+        /// How many.
+        count: usize,
+    },
     /// A numerical routine failed in a way the caller should hear about.
-    #[error("numerical failure in {stage}: {message}")]
-    Numerical { stage: String, message: String },
+    #[error(transparent)]
+    Numerical(#[from] NumericalError),
     /// A sweep cannot reach the requested configuration; says where it stopped and why.
     #[error("cannot reach {what}: stopped at {reached}: {reason}")]
     Unreachable {
+        /// The configuration asked for.
         what: String,
+        /// Where the sweep stopped.
         reached: String,
+        /// Why it could go no further.
         reason: String,
     },
     /// A fitted constraint was evaluated outside the interval it was fitted on.
     #[error("{driver} = {value_deg:.6}° is outside the fitted domain [{lower_deg:.6}°, {upper_deg:.6}°] of the constraint polynomial")]
     OutsideFitDomain {
+        /// The driving crease (and when, for a run).
         driver: String,
+        /// The driving angle asked for, degrees.
         value_deg: f64,
+        /// The fitted interval, degrees.
         lower_deg: f64,
+        /// The fitted interval, degrees.
         upper_deg: f64,
     },
+    /// Drawing a figure failed.
+    #[error("cannot draw {figure}: {message}")]
+    Plot {
+        /// Which figure.
+        figure: String,
+        /// The plotting library's account.
+        message: String,
+    },
     /// Writing an output file failed.
-    #[error("cannot write {path}: {message}")]
-    Output { path: String, message: String },
+    #[error("cannot write {path}")]
+    Output {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// How a numerical method failed.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum NumericalError {
+    /// Newton projection back onto the constraints did not reach its tolerance.
+    #[error(
+        "constraint restoration failed: residual {residual:.3e} after Newton projection (tolerance {tolerance:.1e})"
+    )]
+    RestorationFailed {
+        /// Largest constraint residual left (rad).
+        residual: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// Newton on the loop closure did not converge.
+    #[error("loop closure: Newton did not converge: residual {residual:.3e} rad after {iterations} iterations")]
+    ClosureNotConverged {
+        /// Rotation angle of the holonomy left, rad.
+        residual: f64,
+        /// Iterations spent.
+        iterations: usize,
+    },
+    /// Clarabel stopped with a status other than solved.
+    #[error("direction QP (Clarabel): status {status}")]
+    QpStatus {
+        /// Clarabel's status, as it names it.
+        status: String,
+    },
+    /// Clarabel refused the problem or its settings.
+    #[error("direction QP (Clarabel): the solver refused the problem: {message}")]
+    QpSetup {
+        /// Clarabel's account.
+        message: String,
+    },
+    /// A matrix that must be symmetric positive definite is not.
+    #[error("{matrix} is not positive definite at {at}")]
+    NotPositiveDefinite {
+        /// Which matrix.
+        matrix: &'static str,
+        /// Where it was evaluated.
+        at: String,
+    },
+    /// A linear system that must be regular is singular (or too ill-conditioned).
+    #[error("{what}: singular ({detail})")]
+    Singular {
+        /// Which system.
+        what: &'static str,
+        /// How singular, where.
+        detail: String,
+    },
+    /// A computation produced NaN or infinity.
+    #[error("{what}: non-finite value ({detail})")]
+    NonFinite {
+        /// Which computation.
+        what: &'static str,
+        /// Which value.
+        detail: String,
+    },
+    /// diffsol failed.
+    #[error("ODE integration (diffsol) failed")]
+    Ode {
+        /// diffsol's own error.
+        #[source]
+        source: diffsol::error::DiffsolError,
+    },
+    /// A dynamic run used its step budget before the end of its time span.
+    #[error(
+        "{method} used its budget of {steps} steps by t = {reached_s:.6e} s of {end_s:.6e} s; at this pace it needs \
+         about {projected:.1e} more. Use the esdirk34 method for a slow forcing, tsit45 for a step, the quasi-static \
+         model when the time-scale ratio is large, or a looser rtol"
+    )]
+    StepBudget {
+        /// The integrator.
+        method: String,
+        /// Steps taken.
+        steps: usize,
+        /// Time reached, s.
+        reached_s: f64,
+        /// End of the span, s.
+        end_s: f64,
+        /// Steps it would still need at this pace.
+        projected: f64,
+    },
+    /// An implicit integrator's Newton iterations keep failing.
+    #[error(
+        "{method}'s Newton iterations failed {failures} times in {steps} steps by t = {reached_s:.6e} s (the fast modes \
+         make its iteration matrix ill-conditioned at this tolerance); use the esdirk34 method for a slow forcing, \
+         tsit45 for a step, or a looser rtol"
+    )]
+    NewtonFailures {
+        /// The integrator.
+        method: String,
+        /// Failed Newton iterations so far.
+        failures: usize,
+        /// Steps taken.
+        steps: usize,
+        /// Time reached, s.
+        reached_s: f64,
+    },
+    /// A dynamic run of a slow forcing strayed from the quasi-static path it should follow.
+    #[error(
+        "the {method} run strays {deviation_deg:.3}° from the quasi-static path, whose linear error bound is \
+         {bound:.1e} rad: its error control failed on this stiff forcing; use a tighter rtol (1e-10) or the \
+         quasi-static model"
+    )]
+    Strayed {
+        /// The integrator.
+        method: String,
+        /// Largest distance from the quasi-static path, degrees.
+        deviation_deg: f64,
+        /// The linear bound on that distance, rad.
+        bound: f64,
+    },
+    /// No equilibrium (or balance) was found where one was sought.
+    #[error("{what}: {detail}")]
+    NoEquilibrium {
+        /// Which equilibrium.
+        what: &'static str,
+        /// Where the search looked and what to change.
+        detail: String,
+    },
+    /// A least-squares fit failed.
+    #[error("polynomial fit: {detail}")]
+    Fit {
+        /// Why.
+        detail: String,
+    },
+}
+
+impl From<diffsol::error::DiffsolError> for NumericalError {
+    fn from(source: diffsol::error::DiffsolError) -> Self {
+        NumericalError::Ode { source }
+    }
+}
+
+impl From<diffsol::error::DiffsolError> for NanofoldError {
+    fn from(source: diffsol::error::DiffsolError) -> Self {
+        NumericalError::Ode { source }.into()
+    }
 }
 
 impl NanofoldError {
@@ -61,6 +252,22 @@ impl NanofoldError {
             field: field.into(),
             value: value.to_string(),
             reason: reason.into(),
+        }
+    }
+
+    /// Shorthand for [`NanofoldError::MissingField`] without a hint.
+    pub fn missing(field: impl Into<String>) -> Self {
+        NanofoldError::MissingField {
+            field: field.into(),
+            hint: None,
+        }
+    }
+
+    /// Shorthand for [`NanofoldError::MissingField`] with what the key holds.
+    pub fn missing_with(field: impl Into<String>, hint: impl Into<String>) -> Self {
+        NanofoldError::MissingField {
+            field: field.into(),
+            hint: Some(hint.into()),
         }
     }
 }

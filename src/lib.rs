@@ -3,16 +3,13 @@
 
 pub mod constraints;
 pub mod dynamics;
-pub mod energy;
 pub mod error;
-pub mod kinematics;
-pub mod output;
+pub mod geometry;
+pub mod io;
 pub mod pattern;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod qp;
-pub mod scene;
-pub mod sphere;
+pub mod prelude;
 pub mod unfold;
 
 pub use error::{NanofoldError, Result};

@@ -1,14 +1,11 @@
-//! Single-vertex crease patterns (SPEC §2): the validated description every other module
-//! reads, built from a FOLD file ([`fold`]) or the native JSON schema ([`native`]).
-
-pub mod fold;
-pub mod native;
+//! The crease-pattern model (SPEC §2): a validated single vertex — its rays, sectors and
+//! creases — that every algorithm reads. Built from numbers with [`VertexBuilder`], or from
+//! files by the io layer ([`crate::io`]).
 
 use crate::error::{NanofoldError, Result};
-use crate::kinematics;
+use crate::geometry::kinematics;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
-use std::path::Path;
 
 /// Mountain / valley / flat / unassigned assignment of a crease (FOLD's letters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -90,7 +87,7 @@ pub struct Crease {
 
 /// The original FOLD geometry, kept so outputs can be written back on the same mesh.
 #[derive(Debug, Clone)]
-pub struct FoldMesh {
+pub struct FlatMesh {
     pub vertices_coords: Vec<[f64; 2]>,
     pub edges_vertices: Vec<[usize; 2]>,
     pub edges_assignment: Vec<String>,
@@ -120,7 +117,7 @@ pub struct Pattern {
     /// Loop-closure residual of the given folded state (0 for an open chain).
     pub closure_residual: f64,
     /// The FOLD mesh when the input was a FOLD file.
-    pub mesh: Option<FoldMesh>,
+    pub mesh: Option<FlatMesh>,
 }
 
 /// Tolerances applied while loading.
@@ -141,81 +138,148 @@ impl Default for LoadOptions {
     }
 }
 
-/// A ray as an importer sees it, before validation and splitting.
+/// One ray handed to a [`VertexBuilder`], counter-clockwise.
 #[derive(Debug, Clone)]
-pub(crate) enum RawRay {
-    Crease(RawCrease),
+pub enum RaySpec {
+    /// A crease.
+    Crease(CreaseSpec),
+    /// An edge of the sheet (the first and last ray of an open chain).
     Boundary,
 }
 
+/// A crease as given, before validation.
 #[derive(Debug, Clone)]
-pub(crate) struct RawCrease {
+pub struct CreaseSpec {
+    /// How errors and outputs name it ("edges[3]", "creases[1]").
     pub label: String,
+    /// Mountain, valley, flat or unassigned.
     pub assignment: Assignment,
-    pub folded_angle: f64,
+    /// Fold angle of the given folded state, radians, valley positive.
+    pub fold_angle: f64,
+    /// Held at `fold_angle` while unfolding.
     pub locked: bool,
+    /// FOLD edge index, for FOLD input.
     pub fold_edge: Option<usize>,
-    /// Position in the file's crease order.
+    /// Position in the caller's crease order (the order of [`Pattern::creases`]).
     pub order: usize,
     /// Name of the fold-angle field, for errors.
     pub angle_field: String,
 }
 
-/// What an importer hands to [`Pattern::build`].
-pub(crate) struct RawVertex {
+/// Builds a [`Pattern`] from numbers: sector angles and creases counter-clockwise.
+///
+/// ```
+/// use nanofold::pattern::{Assignment, VertexBuilder};
+/// use std::f64::consts::FRAC_PI_2;
+/// // A plus-shaped vertex folded along one straight crease line.
+/// let pattern = VertexBuilder::closed("plus")
+///     .sector_angles([FRAC_PI_2; 4])
+///     .crease(Assignment::Valley, 1.0)
+///     .crease(Assignment::Flat, 0.0)
+///     .crease(Assignment::Valley, 1.0)
+///     .crease(Assignment::Flat, 0.0)
+///     .build()?;
+/// assert_eq!(pattern.creases.len(), 4);
+/// assert!(pattern.closure_residual < 1e-14);
+/// # Ok::<(), nanofold::NanofoldError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct VertexBuilder {
+    /// Names the pattern (and its output folder).
     pub name: String,
+    /// Interior (closed) or boundary (open) vertex.
     pub chain: Chain,
-    /// Rays CCW; for an open chain the first and last are `Boundary`.
-    pub rays: Vec<RawRay>,
-    /// Sector k between ray k and k+1; `sector_fields[k]` names it in errors.
+    /// Rays counter-clockwise; for an open chain the first and last are [`RaySpec::Boundary`].
+    pub rays: Vec<RaySpec>,
+    /// Sector k lies between ray k and ray k+1, radians.
     pub sector_angles: Vec<f64>,
+    /// `sector_fields[k]` names sector k in errors (defaults to `sector_angles[k]`).
     pub sector_fields: Vec<String>,
-    pub mesh: Option<FoldMesh>,
+    /// The flat mesh the pattern came from, if any (outputs are written on it).
+    pub mesh: Option<FlatMesh>,
 }
 
-/// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
-pub fn is_pattern_file(path: &Path) -> bool {
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-    (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
-}
+impl VertexBuilder {
+    fn new(name: &str, chain: Chain) -> Self {
+        VertexBuilder {
+            name: name.to_string(),
+            chain,
+            rays: Vec::new(),
+            sector_angles: Vec::new(),
+            sector_fields: Vec::new(),
+            mesh: None,
+        }
+    }
 
-/// A pattern's name: its file name without `.fold` or `.json` (names output folders).
-pub fn pattern_name(path: &Path) -> String {
-    path.file_name()
-        .and_then(|s| s.to_str())
-        .map(|s| s.trim_end_matches(".json").trim_end_matches(".fold").to_string())
-        .unwrap_or_else(|| "pattern".to_string())
+    /// An interior vertex: one sector after each crease, summing to 2π.
+    pub fn closed(name: &str) -> Self {
+        Self::new(name, Chain::Closed)
+    }
+
+    /// A boundary vertex: the sheet's edge, the creases, the other edge; one sector more
+    /// than creases.
+    pub fn open(name: &str) -> Self {
+        Self::new(name, Chain::Open)
+    }
+
+    /// Sets the sector angles (radians), counter-clockwise from the first ray.
+    pub fn sector_angles(mut self, angles: impl IntoIterator<Item = f64>) -> Self {
+        self.sector_angles = angles.into_iter().collect();
+        self.sector_fields = (0..self.sector_angles.len())
+            .map(|k| format!("sector_angles[{k}]"))
+            .collect();
+        self
+    }
+
+    /// Adds the next crease counter-clockwise with its folded angle (radians).
+    pub fn crease(self, assignment: Assignment, fold_angle: f64) -> Self {
+        self.push_crease(assignment, fold_angle, false)
+    }
+
+    /// Adds the next crease, held at its folded angle while unfolding.
+    pub fn locked_crease(self, assignment: Assignment, fold_angle: f64) -> Self {
+        self.push_crease(assignment, fold_angle, true)
+    }
+
+    fn push_crease(mut self, assignment: Assignment, fold_angle: f64, locked: bool) -> Self {
+        let order = self.rays.iter().filter(|r| matches!(r, RaySpec::Crease(_))).count();
+        self.rays.push(RaySpec::Crease(CreaseSpec {
+            label: format!("creases[{order}]"),
+            assignment,
+            fold_angle,
+            locked,
+            fold_edge: None,
+            order,
+            angle_field: format!("creases[{order}].fold_angle"),
+        }));
+        self
+    }
+
+    /// Validates with the default [`LoadOptions`] (SPEC §2, §3).
+    pub fn build(self) -> Result<Pattern> {
+        self.build_with(&LoadOptions::default())
+    }
+
+    /// Validates and splits sectors of π or more (SPEC §2, §3). An open chain built with
+    /// [`VertexBuilder::crease`] gets its two boundary rays here.
+    pub fn build_with(mut self, options: &LoadOptions) -> Result<Pattern> {
+        if self.chain == Chain::Open && !matches!(self.rays.first(), Some(RaySpec::Boundary)) {
+            self.rays.insert(0, RaySpec::Boundary);
+            self.rays.push(RaySpec::Boundary);
+        }
+        if self.sector_fields.len() != self.sector_angles.len() {
+            self.sector_fields = (0..self.sector_angles.len())
+                .map(|k| format!("sector_angles[{k}]"))
+                .collect();
+        }
+        Pattern::build(self, options)
+    }
 }
 
 impl Pattern {
-    /// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
-    /// `vertices_coords`).
-    pub fn load(path: &Path, options: &LoadOptions) -> Result<Pattern> {
-        let text = std::fs::read_to_string(path).map_err(|error| NanofoldError::Io {
-            path: path.display().to_string(),
-            error,
-        })?;
-        let name = pattern_name(path);
-        Self::from_str(&text, &name, &path.display().to_string(), options)
-    }
-
-    /// Parses pattern text; `origin` names it in error messages.
-    pub fn from_str(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| NanofoldError::Json {
-            path: origin.to_string(),
-            message: e.to_string(),
-        })?;
-        let raw = if value.get("vertices_coords").is_some() {
-            fold::read_fold(&value, name)?
-        } else {
-            native::read_native(&value, name)?
-        };
-        Pattern::build(raw, options)
-    }
-
-    /// Validates and splits an importer's vertex (SPEC §2, §3).
-    pub(crate) fn build(raw: RawVertex, options: &LoadOptions) -> Result<Pattern> {
-        let RawVertex {
+    /// Validates and splits a builder's vertex (SPEC §2, §3).
+    fn build(raw: VertexBuilder, options: &LoadOptions) -> Result<Pattern> {
+        let VertexBuilder {
             name,
             chain,
             rays: raw_rays,
@@ -223,6 +287,9 @@ impl Pattern {
             sector_fields,
             mesh,
         } = raw;
+        if raw_rays.is_empty() {
+            return Err(NanofoldError::invalid("creases", 0, "the vertex has no crease"));
+        }
         let expected_sectors = match chain {
             Chain::Closed => raw_rays.len(),
             Chain::Open => raw_rays.len() - 1,
@@ -255,12 +322,12 @@ impl Pattern {
                 ));
             }
         }
-        let creases_given = raw_rays.iter().filter(|r| matches!(r, RawRay::Crease(_))).count();
+        let creases_given = raw_rays.iter().filter(|r| matches!(r, RaySpec::Crease(_))).count();
         if creases_given == 0 {
             return Err(NanofoldError::invalid("creases", 0, "the vertex has no crease"));
         }
         for ray in &raw_rays {
-            if let RawRay::Crease(c) = ray {
+            if let RaySpec::Crease(c) = ray {
                 check_crease_angle(c)?;
             }
         }
@@ -300,13 +367,13 @@ impl Pattern {
         for (k, raw_ray) in raw_rays.iter().enumerate() {
             let ray_index = rays.len();
             match raw_ray {
-                RawRay::Boundary => rays.push(RayRole::Boundary),
-                RawRay::Crease(c) => {
+                RaySpec::Boundary => rays.push(RayRole::Boundary),
+                RaySpec::Crease(c) => {
                     rays.push(RayRole::Crease(c.order));
                     creases[c.order] = Some(Crease {
                         label: c.label.clone(),
                         assignment: c.assignment,
-                        folded_angle: c.folded_angle,
+                        folded_angle: c.fold_angle,
                         locked: c.locked,
                         ray: ray_index,
                         fold_edge: c.fold_edge,
@@ -437,8 +504,8 @@ impl Pattern {
 }
 
 /// Range and sign checks of one crease's folded angle (SPEC §1).
-fn check_crease_angle(c: &RawCrease) -> Result<()> {
-    let rho = c.folded_angle;
+fn check_crease_angle(c: &CreaseSpec) -> Result<()> {
+    let rho = c.fold_angle;
     let shown = format!("{:.6}°", rho.to_degrees());
     if !rho.is_finite() {
         return Err(NanofoldError::invalid(&c.angle_field, rho, "fold angle must be finite"));

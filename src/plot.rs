@@ -6,15 +6,15 @@ pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
-use crate::output::{snapshot_indices, write_atomic};
+use crate::io::output::{snapshot_indices, write_atomic};
 use crate::pattern::Pattern;
 use crate::unfold::UnfoldReport;
 use plotters::prelude::*;
 use std::path::Path;
 
 pub(crate) fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
-    NanofoldError::Output {
-        path: "SVG figure".into(),
+    NanofoldError::Plot {
+        figure: "an SVG figure".into(),
         message: e.to_string(),
     }
 }
@@ -115,7 +115,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
                 p.into_matrix()
             });
             // plotters' 3D y axis is vertical: plot (x, z, y) so the pattern's z is up.
-            let to_plot = |v: &crate::sphere::Vec3| (v.x, v.z, v.y);
+            let to_plot = |v: &crate::geometry::sphere::Vec3| (v.x, v.z, v.y);
             let n = step.nodes.len();
             for (k, _) in pattern.sector_angles.iter().enumerate() {
                 let a = step.nodes[k];

@@ -1,5 +1,5 @@
 //! The unfolding engine (SPEC §5): projected-gradient steps on the sphere. The direction
-//! is the QP of [`crate::qp`] in tangent coordinates of the free nodes; a backtracking line
+//! is the QP of [`crate::unfold::qp`] in tangent coordinates of the free nodes; a backtracking line
 //! search on U refuses steps that carry a node through an arc; Newton projection restores
 //! the arc-length, unit-norm and held-crease constraints; the driver decides the verdict.
 //!
@@ -7,16 +7,19 @@
 //! [`Workspace`] the scratch reused by every step, [`Unfolder::step`] one iteration and
 //! [`unfold`] the loop with restarts that records the trajectory.
 
-use crate::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
-use crate::error::{NanofoldError, Result};
-use crate::kinematics;
-use crate::pattern::{Assignment, Chain, Pattern, RayRole};
-use crate::qp::{self, ConstraintJacobian, DirectionProblem, QpMethod, RowSpace};
-use crate::sphere::{
+pub mod energy;
+pub mod qp;
+
+use crate::error::{NumericalError, Result};
+use crate::geometry::kinematics;
+use crate::geometry::sphere::{
     distance_to_arc, fold_angle, fold_angle_with_gradient, geodesic, geodesic_with_gradient, projects_onto_arc,
     side_of_arc, Vec3,
 };
+use crate::pattern::{Assignment, Chain, Pattern, RayRole};
+use energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
 use nalgebra::{DVector, Matrix3, SymmetricEigen};
+use qp::{ConstraintJacobian, DirectionProblem, QpMethod, RowSpace};
 use serde::Serialize;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -199,7 +202,7 @@ impl UnfoldModel {
             .fold(0.0, f64::max)
     }
 
-    /// Whether a row closes the loop (see [`crate::qp::JacobianRow::closing`]). The open
+    /// Whether a row closes the loop (see [`crate::unfold::qp::JacobianRow::closing`]). The open
     /// chain is: arc (i−1, i) and the fold angle at ray i−1 for every free node i, both of
     /// which move x_i (along and across the arc) and nothing later. The arc back to node 0,
     /// fold angles at rays n−1 and 0, and antipodal pins close it.
@@ -423,10 +426,11 @@ pub fn restore(
     for iteration in 0..40 {
         let worst = ws.residual.amax();
         if !worst.is_finite() {
-            return Err(NanofoldError::Numerical {
-                stage: "constraint restoration".into(),
-                message: "non-finite residual".into(),
-            });
+            return Err(NumericalError::NonFinite {
+                what: "constraint restoration",
+                detail: "a constraint residual".into(),
+            }
+            .into());
         }
         if worst <= tol {
             return Ok(worst);
@@ -480,10 +484,11 @@ pub fn restore(
     if worst <= tol {
         Ok(worst)
     } else {
-        Err(NanofoldError::Numerical {
-            stage: "constraint restoration".into(),
-            message: format!("residual {worst:.3e} after Newton projection"),
-        })
+        Err(NumericalError::RestorationFailed {
+            residual: worst,
+            tolerance: tol,
+        }
+        .into())
     }
 }
 
@@ -1097,10 +1102,11 @@ pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldRepo
     }
     let mut solver = Unfolder::new(&model, settings, start)?;
     if !solver.energy_value.is_finite() {
-        return Err(NanofoldError::Numerical {
-            stage: "initial energy".into(),
-            message: "charges still touch after backing off the flat-folded state".into(),
-        });
+        return Err(NumericalError::NonFinite {
+            what: "initial energy",
+            detail: "charges still touch after backing off the flat-folded state".into(),
+        }
+        .into());
     }
     let energy_initial = solver.energy_value;
     let mut trajectory = vec![record(&model, &solver, 0)];

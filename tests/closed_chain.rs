@@ -2,18 +2,23 @@
 //! derivatives against finite differences, energy conservation of the reduced equations, and
 //! bad closed-chain scenes.
 
+mod common;
+
 use nanofold::constraints::exact::{ConstraintPoint, ExactConstraint};
 use nanofold::constraints::{sweep_samples, Setup};
+use nanofold::dynamics::algorithms::update_kinematics;
 use nanofold::dynamics::closed::modes::ClosureState;
-use nanofold::dynamics::closed::{simulate_closed, ClosedChain, ConstraintSource};
-use nanofold::dynamics::simulate::{Method, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::closed::{ClosedChain, ClosedPlant, ConstraintSource};
+use nanofold::dynamics::integrate::Method;
+use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
 use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::scene::closed::ClosedScene;
 use std::path::Path;
 
 fn degree4() -> Pattern {
-    Pattern::load(Path::new("patterns/degree4_generic.fold"), &LoadOptions::default()).unwrap()
+    nanofold::io::load_pattern(Path::new("patterns/degree4_generic.fold"), &LoadOptions::default()).unwrap()
 }
 
 /// A 4R spherical linkage (degree-4 vertex): the diagonal between the driver's neighbours
@@ -98,11 +103,11 @@ fn exact_derivatives_match_finite_differences() {
     }
 }
 
-fn step1_scene(edit: impl Fn(&mut serde_json::Value)) -> nanofold::error::Result<ClosedScene> {
+fn step1_scene(edit: impl Fn(&mut serde_json::Value)) -> nanofold::error::Result<Scene> {
     let text = std::fs::read_to_string("patterns/corner_cube_step1.scene.json").unwrap();
     let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
     edit(&mut value);
-    ClosedScene::from_json(&value.to_string(), "test", "test", Path::new("patterns"))
+    common::scene_text(&value.to_string())
 }
 
 /// Without drag a step's total energy (kinetic + elastic + −τθ) is conserved by the reduced
@@ -125,7 +130,7 @@ fn reduced_dynamics_conserve_energy_without_drag() {
             t_end: Some(2.5e-5),
             ..SimulationSettings::default()
         };
-        let response = simulate_closed(&scene, &settings).unwrap();
+        let response = simulate(&scene, &settings).unwrap().response;
         assert!(response.collision.is_none(), "{:?}", response.collision);
         let scale = response.samples.iter().map(|s| s.kinetic_energy).fold(0.0, f64::max);
         assert!(scale > 0.0);
@@ -146,8 +151,8 @@ fn reduced_dynamics_conserve_energy_without_drag() {
 #[test]
 fn the_corner_cube_folds_in_two_steps() {
     let settings = SimulationSettings::default();
-    let one = ClosedScene::load(Path::new("patterns/corner_cube_step1.scene.json")).unwrap();
-    let first = simulate_closed(&one, &settings).unwrap();
+    let one = common::scene_file("patterns/corner_cube_step1.scene.json");
+    let first = simulate(&one, &settings).unwrap().response;
     let c = first.collision.as_ref().expect("the flap halves close");
     assert!(c.pair[0].starts_with("edges[0]"), "{:?}", c.pair);
     let end = first.samples.last().unwrap();
@@ -159,8 +164,8 @@ fn the_corner_cube_folds_in_two_steps() {
             end.angles[k].to_degrees()
         );
     }
-    let two = ClosedScene::load(Path::new("patterns/corner_cube_step2.scene.json")).unwrap();
-    let second = simulate_closed(&two, &settings).unwrap();
+    let two = common::scene_file("patterns/corner_cube_step2.scene.json");
+    let second = simulate(&two, &settings).unwrap().response;
     let c = second.collision.as_ref().expect("the flap lands on the third square");
     assert!(c.pair[0].starts_with("edges[4]"), "{:?}", c.pair);
     let end = second.samples.last().unwrap();
@@ -193,13 +198,17 @@ fn bad_closed_scenes_name_the_problem() {
         .unwrap_err()
         .to_string();
     assert!(outside.contains("start_angle_deg"), "{outside}");
+    let no_face = step1_scene(|v| v["anchored_face"] = serde_json::json!(9))
+        .unwrap_err()
+        .to_string();
+    assert!(no_face.contains("anchored_face") && no_face.contains('9'), "{no_face}");
 }
 
-fn scene(name: &str, edit: impl Fn(&mut serde_json::Value)) -> ClosedScene {
+fn scene(name: &str, edit: impl Fn(&mut serde_json::Value)) -> Scene {
     let text = std::fs::read_to_string(format!("patterns/{name}.scene.json")).unwrap();
     let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
     edit(&mut value);
-    ClosedScene::from_json(&value.to_string(), "test", "test", Path::new("patterns")).unwrap()
+    common::scene_text(&value.to_string()).unwrap()
 }
 
 /// The fit states its error on f and on f′ = G at the sweep samples; between the samples,
@@ -211,7 +220,7 @@ fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() 
     let reference = scene("corner_cube_step1", |v| {
         v["constraint"] = serde_json::json!({"source": "exact", "range_deg": [-5, 180]})
     });
-    let ConstraintSource::Exact(exact) = &reference.chain.source else {
+    let ConstraintSource::Exact(exact) = &reference.closed().unwrap().source else {
         panic!("exact source expected")
     };
     let mut slope_errors = Vec::new();
@@ -221,7 +230,7 @@ fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() 
                 "corner_cube_step1",
                 |v| v["constraint"] = serde_json::json!({"source": "poly", "degree": degree, "range_deg": [-5, 180]}),
             );
-        let ConstraintSource::Poly(poly) = &fitted.chain.source else {
+        let ConstraintSource::Poly(poly) = &fitted.closed().unwrap().source else {
             panic!("poly source expected")
         };
         let [lo, hi] = poly.domain;
@@ -236,16 +245,16 @@ fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() 
                 slope_error = slope_error.max((exact_point.jacobian[k] - poly_point.jacobian[k]).abs());
             }
         }
-        assert!(fitted.slope_error > 0.0 && fitted.fit_error > 0.0);
+        assert!(fitted.closed().unwrap().source.errors().1 > 0.0 && fitted.closed().unwrap().source.errors().0 > 0.0);
         assert!(
-            value_error <= 1.05 * fitted.fit_error,
+            value_error <= 1.05 * fitted.closed().unwrap().source.errors().0,
             "degree {degree}: f off by {value_error:e}, stated {:e}",
-            fitted.fit_error
+            fitted.closed().unwrap().source.errors().0
         );
         assert!(
-            slope_error <= 1.05 * fitted.slope_error,
+            slope_error <= 1.05 * fitted.closed().unwrap().source.errors().1,
             "degree {degree}: G off by {slope_error:e}, stated {:e}",
-            fitted.slope_error
+            fitted.closed().unwrap().source.errors().1
         );
         slope_errors.push(slope_error);
     }
@@ -263,12 +272,12 @@ fn kinetic_energy_by_differences(chain: &ClosedChain, coordinates: &[usize], sta
         let moved = chain.closure_state(coordinates, &shifted, &state.angles).unwrap();
         let joints: Vec<f64> = chain.joint_creases.iter().map(|&c| moved.angles[c]).collect();
         let mut data = Data::new(&chain.model);
-        chain.model.update_kinematics(&joints, &mut data);
+        update_kinematics(&chain.model, &joints, &mut data);
         data.poses.clone()
     };
     let (ahead, behind) = (poses(1.0), poses(-1.0));
     let mut energy = 0.0;
-    for (i, plate) in chain.model.plates.iter().enumerate() {
+    for (i, plate) in chain.model.plates().iter().enumerate() {
         let velocity = (ahead[i].translation.vector - behind[i].translation.vector) / (2.0 * h);
         let turn = ahead[i].rotation * behind[i].rotation.inverse();
         let omega = turn.scaled_axis() / (2.0 * h);
@@ -287,8 +296,8 @@ fn kinetic_energy_by_differences(chain: &ClosedChain, coordinates: &[usize], sta
 fn reduced_mass_is_symmetric_positive_definite_along_the_path() {
     for name in ["corner_cube_step1", "corner_cube_step2"] {
         let scene = scene(name, |_| {});
-        let chain = &scene.chain;
-        let response = simulate_closed(&scene, &SimulationSettings::default()).unwrap();
+        let chain = scene.closed().unwrap();
+        let response = simulate(&scene, &SimulationSettings::default()).unwrap().response;
         let coordinates = chain.released_coordinates();
         let mut ws = chain.workspace();
         let mut data = Data::new(&chain.model);
@@ -334,7 +343,7 @@ fn reduced_mass_is_symmetric_positive_definite_along_the_path() {
 #[test]
 fn folded_corner_cube_modes_are_a_stable_two_dof_linearisation() {
     let scene = scene("corner_cube_step2", |_| {});
-    let chain = &scene.chain;
+    let chain = scene.closed().unwrap();
     let modes = chain.folded_modes().unwrap();
     assert_eq!(modes.coordinates, vec![1, 0]);
     assert_eq!(modes.modes.eigenvalues.len(), 2);
@@ -408,7 +417,7 @@ fn folded_corner_cube_modes_are_a_stable_two_dof_linearisation() {
 fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
     for name in ["corner_cube_step1_ramp", "corner_cube_step2_ramp"] {
         let scene = scene(name, |_| {});
-        let auto = simulate_closed(&scene, &SimulationSettings::default()).unwrap();
+        let auto = simulate(&scene, &SimulationSettings::default()).unwrap().response;
         assert_eq!(auto.model, ModelKind::QuasiStatic, "{name}");
         let (_, measured) = auto.measured_quasi_static_error.unwrap();
         assert!(
@@ -418,10 +427,10 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
         );
         // The hinges cannot hold the target against the passive ones (η > 1): the drive
         // stops short of it and no plates touch.
-        let chain = &scene.chain;
+        let chain = scene.closed().unwrap();
         let end = auto.samples.last().unwrap();
         assert!(auto.collision.is_none());
-        assert!(end.angles[chain.driver].abs() < chain.target.abs());
+        assert!(end.angles[chain.driver].abs() < chain.target().abs());
         if name == "corner_cube_step1_ramp" {
             let tight = SimulationSettings {
                 model: ModelChoice::Dynamic,
@@ -429,25 +438,22 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
                 rtol: 1e-10,
                 ..SimulationSettings::default()
             };
-            let dynamic = simulate_closed(&scene, &tight).unwrap();
+            let dynamic = simulate(&scene, &tight).unwrap().response;
             // Along the ramp ESDIRK34 lags the balance by 1.2e-4 rad (measured; steps of ~1 s,
             // 10⁴ periods: the stiff mode's error escapes the error estimate, and rtol 1e-12
             // still leaves 1.1e-5) while the physical lag is below the 7.6e-8 rad bound: the
             // quasi-static path is the more accurate answer here, and 4× faster.
-            let along = chain.quasi_static_deviation(&dynamic.samples).unwrap();
+            let along = quasi_static_deviation(&ClosedPlant::new(chain, false), &dynamic.samples).unwrap();
             assert!(
                 along < 5e-4,
                 "{name}: dynamic vs quasi-static along the path {along:e} rad"
             );
             let last = dynamic.samples.last().unwrap();
             assert!((&last.angles - &end.angles).amax() < 1e-9);
-            let loose = simulate_closed(&scene, &SimulationSettings { rtol: 1e-6, ..tight })
+            let loose = simulate(&scene, &SimulationSettings { rtol: 1e-6, ..tight })
                 .unwrap_err()
                 .to_string();
-            assert!(
-                loose.contains("quasi-static path") && loose.contains("--rtol"),
-                "{loose}"
-            );
+            assert!(loose.contains("quasi-static path") && loose.contains("rtol"), "{loose}");
         }
     }
 }
@@ -488,7 +494,8 @@ fn bad_closed_scene_geometry_names_the_field() {
         std::fs::write(dir.join("edited.fold"), pattern.to_string()).unwrap();
         let mut scene: serde_json::Value = serde_json::from_str(&scene_text).unwrap();
         scene["pattern"] = serde_json::json!("edited.fold");
-        ClosedScene::from_json(&scene.to_string(), "test", "test", &dir)
+        nanofold::io::parse_scene(&scene.to_string(), "test", "test", &dir)
+            .and_then(|spec| spec.build())
             .unwrap_err()
             .to_string()
     };
@@ -508,4 +515,54 @@ fn bad_closed_scene_geometry_names_the_field() {
         "{bow_tie}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The face on the substrate is physics, the cut crease numerics: with the anchored face
+/// fixed, cutting the loop at any of the three follower creases must give the same motion
+/// (here the same first-contact time and final pose, exact constraint, rtol 1e-11), while a
+/// different anchored face gives a different one (the substrate holds a different plate).
+#[test]
+fn the_anchored_face_not_the_cut_decides_the_motion() {
+    let settings = SimulationSettings {
+        model: ModelChoice::Dynamic,
+        rtol: 1e-11,
+        ..SimulationSettings::default()
+    };
+    let mut by_face = Vec::new();
+    for face in [0, 2] {
+        let runs: Vec<(f64, Vec<f64>)> = [2, 3, 4]
+            .iter()
+            .map(|&cut| {
+                let scene = step1_scene(|v| {
+                    v["cut_crease"] = serde_json::json!(cut);
+                    v["anchored_face"] = serde_json::json!(face);
+                    v["constraint"] = serde_json::json!({"source": "exact", "range_deg": [-5, 180]});
+                })
+                .unwrap();
+                let run = simulate(&scene, &settings).unwrap();
+                assert_eq!(run.closed.unwrap().anchored_face, face);
+                let contact = run.response.collision.expect("the flap halves close");
+                let last = run.response.samples.last().unwrap().angles.as_slice().to_vec();
+                (contact.time, last)
+            })
+            .collect();
+        for (time, angles) in &runs[1..] {
+            assert!(
+                (time - runs[0].0).abs() < 1e-8 * runs[0].0,
+                "face {face}: contact at {time:e} vs {:e} s",
+                runs[0].0
+            );
+            let spread = angles
+                .iter()
+                .zip(&runs[0].1)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(spread < 1e-8, "face {face}: final angles differ by {spread:e} rad");
+        }
+        by_face.push(runs[0].0);
+    }
+    assert!(
+        (by_face[0] - by_face[1]).abs() > 1e-3 * by_face[0],
+        "anchoring faces 0 and 2 gave the same contact time {by_face:?}"
+    );
 }

@@ -3,10 +3,15 @@
 //! contact times from plane geometry.
 
 use nalgebra::{DVector, Vector3};
+mod common;
+
+use common::{scene_file, scene_text};
+use nanofold::dynamics::algorithms::{kinetic_energy, update_kinematics, update_mass_matrix, update_poses};
+use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::simulate::{simulate, Method, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
-use nanofold::scene::Scene;
 use nanofold::NanofoldError;
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -45,7 +50,7 @@ fn strip(lengths_um: &[f64], targets_deg: &[Option<f64>], actuation: &str, drag:
         plates.join(","),
         hinges.join(",")
     );
-    Scene::from_json(&json, "test scene", "test").unwrap()
+    scene_text(&json).unwrap()
 }
 
 const STEP: &str = r#"{"kind": "step"}"#;
@@ -68,9 +73,9 @@ fn hinge_inertia(length: f64) -> f64 {
 fn one_hinged_plate_rings_at_the_closed_form_frequency() {
     let scene = strip(&[100.0], &[Some(90.0)], STEP, false, 1e-3);
     let k = bilayer_stiffness();
-    assert!((scene.model.joints[0].stiffness - k).abs() < 1e-12 * k);
+    assert!((scene.strip().unwrap().model.joints()[0].stiffness - k).abs() < 1e-12 * k);
     let omega = (k / hinge_inertia(100e-6)).sqrt();
-    let m = modes(&scene.model, &[PI / 2.0]).unwrap();
+    let m = modes(&scene.strip().unwrap().model, &[PI / 2.0]).unwrap();
     let expected_hz = omega / (2.0 * PI);
     assert!(
         (m.frequencies_hz[0] - expected_hz).abs() < 1e-10 * expected_hz,
@@ -89,7 +94,7 @@ fn one_hinged_plate_rings_at_the_closed_form_frequency() {
         t_end: Some(3.0 * period),
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap();
+    let response = simulate(&scene, &settings).unwrap().response;
     assert_eq!(response.model, ModelKind::Dynamic);
     let worst = response
         .samples
@@ -112,7 +117,7 @@ fn contact_time_of_a_swinging_plate_matches_plane_geometry() {
         method: Method::Tsit45,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap();
+    let response = simulate(&scene, &settings).unwrap().response;
     let collision = response.collision.expect("the plate swings past 180°");
     assert_eq!(collision.pair, ["plate 0".to_string(), "substrate".to_string()]);
     assert!(
@@ -141,7 +146,7 @@ fn quasi_static_path_finds_a_plate_on_plate_contact_where_geometry_puts_it() {
         model: ModelChoice::QuasiStatic,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap();
+    let response = simulate(&scene, &settings).unwrap().response;
     let collision = response.collision.expect("plate 2 folds onto plate 0");
     assert_eq!(collision.pair, ["plate 2".to_string(), "plate 0".to_string()]);
     let a = (-1.0_f64 / 6.0).acos();
@@ -159,18 +164,18 @@ fn quasi_static_path_finds_a_plate_on_plate_contact_where_geometry_puts_it() {
 /// central differences of the poses along θ + s θ̇, Richardson-extrapolated from steps h and 2h
 /// (error O(h⁴)) so that h can be large enough (1e-4 rad) for rounding to stay near 1e-12.
 fn kinetic_energy_from_plates(scene: &Scene, angles: &[f64], rates: &[f64]) -> f64 {
-    let model = &scene.model;
+    let model = &scene.strip().unwrap().model;
     let h = 1e-4 / rates.iter().fold(0.0_f64, |a, r| a.max(r.abs()));
     let poses_at = |s: f64| {
         let mut data = Data::new(model);
         let a: Vec<f64> = angles.iter().zip(rates).map(|(a, r)| a + s * r).collect();
-        model.update_poses(&a, &mut data);
+        update_poses(model, &a, &mut data);
         data.poses.clone()
     };
     let centre = poses_at(0.0);
     let (plus, minus, plus2, minus2) = (poses_at(h), poses_at(-h), poses_at(2.0 * h), poses_at(-2.0 * h));
     let mut energy = 0.0;
-    for (i, plate) in model.plates.iter().enumerate() {
+    for (i, plate) in model.plates().iter().enumerate() {
         let velocity = |p: &nalgebra::Isometry3<f64>, m: &nalgebra::Isometry3<f64>, step: f64| {
             (p.translation.vector - m.translation.vector) / (2.0 * step)
         };
@@ -193,16 +198,16 @@ proptest! {
         angles in proptest::collection::vec(-3.0..3.0f64, 4),
         rates in proptest::collection::vec(-1.0e4..1.0e4f64, 4),
     ) {
-        let scene = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
-        let model = &scene.model;
+        let scene = scene_file("patterns/bridge_step.scene.json");
+        let model = &scene.strip().unwrap().model;
         let mut data = Data::new(model);
-        model.update_kinematics(&angles, &mut data);
-        model.update_mass_matrix(&mut data);
+        update_kinematics(model, &angles, &mut data);
+        update_mass_matrix(model, &mut data);
         let m = &data.mass_matrix;
         prop_assert!((m - m.transpose()).amax() <= 1e-15 * m.amax());
         let eigen = m.clone().symmetric_eigenvalues();
         prop_assert!(eigen.min() > 0.0, "eigenvalues {}", eigen);
-        let quadratic = model.kinetic_energy(&rates, &data);
+        let quadratic = kinetic_energy(&rates, &data);
         let direct = kinetic_energy_from_plates(&scene, &angles, &rates);
         prop_assert!((quadratic - direct).abs() <= 1e-8 * direct.abs().max(1e-30), "½θ̇ᵀMθ̇ {} vs plates {}", quadratic, direct);
     }
@@ -226,7 +231,7 @@ fn without_drag_the_step_conserves_energy_and_with_drag_it_only_loses_it() {
             t_end: Some(20.0 * slowest_period),
             ..Default::default()
         };
-        let response = simulate(&scene, &settings).unwrap();
+        let response = simulate(&scene, &settings).unwrap().response;
         let energies: Vec<f64> = response.samples.iter().map(|s| s.total_energy()).collect();
         let scale = response.samples.iter().map(|s| s.elastic_energy).fold(0.0, f64::max);
         if drag {
@@ -261,7 +266,7 @@ fn step_response_with_drag_settles_to_the_target_when_collisions_are_ignored() {
         ignore_collisions: true,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap();
+    let response = simulate(&scene, &settings).unwrap().response;
     assert_eq!(response.method, Some(Method::Tsit45));
     let t_end = response.t_end;
     let swing = |from: f64, to: f64| {
@@ -269,7 +274,7 @@ fn step_response_with_drag_settles_to_the_target_when_collisions_are_ignored() {
             .samples
             .iter()
             .filter(|s| s.time >= from * t_end && s.time <= to * t_end)
-            .map(|s| (&s.angles - &scene.target_angles).amax())
+            .map(|s| (&s.angles - &scene.strip().unwrap().target_angles()).amax())
             .fold(0.0, f64::max)
     };
     let (early, late) = (swing(0.0, 0.1), swing(0.9, 1.0));
@@ -282,7 +287,7 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
     // A fast etch (so the dynamic run is short), no drag (the linear bound is then tight).
     let ramp = r#"{"kind": "ramp", "etch_rate_um_per_min": 600000}"#;
     let mut scene = strip(&[200.0, 100.0], &[Some(90.0), Some(60.0)], ramp, false, 1.0);
-    scene.t_end = 1.2 * scene.forcing_time();
+    scene.t_end = 1.2 * scene.forcing().duration();
     let run = |model| {
         let settings = SimulationSettings {
             model,
@@ -291,7 +296,7 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
             ignore_collisions: true,
             ..Default::default()
         };
-        simulate(&scene, &settings).unwrap()
+        simulate(&scene, &settings).unwrap().response
     };
     let quasi = run(ModelChoice::QuasiStatic);
     let dynamic = run(ModelChoice::Dynamic);
@@ -305,7 +310,7 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
         .samples
         .iter()
         .map(|s| {
-            scene.drive_angles(s.time, &mut drive);
+            scene.forcing().drive_angles(s.time, &mut drive);
             (&s.angles - DVector::from_column_slice(&drive)).amax()
         })
         .fold(0.0, f64::max);
@@ -324,13 +329,13 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
 
 #[test]
 fn auto_model_choice_follows_the_time_scales() {
-    let step = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
-    let ramp = Scene::load(std::path::Path::new("patterns/bridge_ramp.scene.json")).unwrap();
+    let step = scene_file("patterns/bridge_step.scene.json");
+    let ramp = scene_file("patterns/bridge_ramp.scene.json");
     let settings = SimulationSettings::default();
-    let step_response = simulate(&step, &settings).unwrap();
+    let step_response = simulate(&step, &settings).unwrap().response;
     assert_eq!(step_response.model, ModelKind::Dynamic);
     assert_eq!(step_response.time_scales.ratio, 0.0);
-    let ramp_response = simulate(&ramp, &settings).unwrap();
+    let ramp_response = simulate(&ramp, &settings).unwrap().response;
     assert_eq!(ramp_response.model, ModelKind::QuasiStatic);
     // SPEC §7: the etch ramp is ~10⁹ fastest periods long.
     assert!(
@@ -345,9 +350,9 @@ fn auto_model_choice_follows_the_time_scales() {
 }
 
 fn scene_error(json: &str) -> String {
-    match Scene::from_json(json, "bad.scene.json", "bad") {
+    match scene_text(json) {
         Ok(_) => panic!("accepted a bad scene"),
-        Err(e) => e.to_string(),
+        Err(e) => common::full_message(&e),
     }
 }
 
@@ -409,7 +414,7 @@ fn bad_scenes_get_errors_that_name_the_field() {
     let ramp = std::fs::read_to_string("patterns/bridge_ramp.scene.json").unwrap();
     let no_radius = ramp.replace(r#", "radius_of_curvature_um": 20"#, "");
     assert!(scene_error(&no_radius).contains("hinges[0].radius_of_curvature_um"));
-    let scene = Scene::load(std::path::Path::new("patterns/bridge_step.scene.json")).unwrap();
+    let scene = scene_file("patterns/bridge_step.scene.json");
     let bad_rtol = SimulationSettings {
         rtol: -1.0,
         ..Default::default()
@@ -428,14 +433,14 @@ fn quasi_static_forced_on_a_step_reports_its_large_error() {
         ignore_collisions: true,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap();
+    let response = simulate(&scene, &settings).unwrap().response;
     assert_eq!(response.model, ModelKind::QuasiStatic);
     let (_, measured) = response.measured_quasi_static_error.unwrap();
     // The undamped step would overshoot by its own size; drag takes a little off.
     assert!(measured > 0.5 * 60f64.to_radians(), "measured {measured}");
     assert!(measured <= response.quasi_static_error_estimate * 1.05);
     let last = response.samples.last().unwrap();
-    assert!((&last.angles - &scene.target_angles).amax() < 1e-15);
+    assert!((&last.angles - &scene.strip().unwrap().target_angles()).amax() < 1e-15);
 }
 
 #[test]
@@ -448,7 +453,7 @@ fn a_run_that_outgrows_its_step_budget_stops_with_advice() {
     };
     let message = simulate(&scene, &settings).unwrap_err().to_string();
     assert!(
-        message.contains("budget of 200 steps") && message.contains("--method"),
+        message.contains("budget of 200 steps") && message.contains("esdirk34"),
         "{message}"
     );
 }
@@ -459,18 +464,22 @@ fn stiffness_and_inertia_too_far_apart_for_doubles_is_an_error_not_nan() {
     let text = std::fs::read_to_string("patterns/bridge_step.scene.json")
         .unwrap()
         .replacen(r#""hinge_length_um": 32"#, r#""hinge_length_um": 1.2e-308"#, 1);
-    let scene = Scene::from_json(&text, "tiny hinge", "tiny").unwrap();
-    let message = modes(&scene.model, scene.target_angles.as_slice())
-        .unwrap_err()
-        .to_string();
+    let scene = scene_text(&text).unwrap();
+    let message = modes(
+        &scene.strip().unwrap().model,
+        scene.strip().unwrap().target_angles().as_slice(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(message.contains("overflow"), "{message}");
     assert!(simulate(&scene, &SimulationSettings::default()).is_err());
 }
 
 #[test]
 fn ramp_drive_rates_are_the_derivative_of_the_drive_angles() {
-    let ramp = Scene::load(std::path::Path::new("patterns/bridge_ramp.scene.json")).unwrap();
-    let t_p = ramp.forcing_time();
+    let scene = scene_file("patterns/bridge_ramp.scene.json");
+    let ramp = scene.forcing();
+    let t_p = ramp.duration();
     let (mut rates, mut plus, mut minus) = (vec![0.0; 4], vec![0.0; 4], vec![0.0; 4]);
     for (t, expected_moving) in [(0.3 * t_p, true), (0.99 * t_p, true), (1.01 * t_p, false)] {
         ramp.drive_rates(t, &mut rates);

@@ -5,8 +5,7 @@
 //! long run is `PROPTEST_CASES=100000 cargo test --release --test fuzz`.
 
 use nanofold::dynamics::modes::modes;
-use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::scene::Scene;
+use nanofold::pattern::LoadOptions;
 use proptest::prelude::*;
 use serde_json::Value;
 
@@ -30,7 +29,7 @@ fn scenes() -> Vec<String> {
 
 /// A pattern that loads must be usable: finite sector and fold angles.
 fn check_pattern(text: &str) {
-    if let Ok(pattern) = Pattern::from_str(text, "fuzz", "fuzz", &LoadOptions::default()) {
+    if let Ok(pattern) = nanofold::io::parse_pattern(text, "fuzz", "fuzz", &LoadOptions::default()) {
         assert!(pattern.sector_angles.iter().all(|a| a.is_finite() && *a > 0.0));
         assert!(pattern.creases.iter().all(|c| c.folded_angle.is_finite()));
         assert!(pattern.closure_residual.is_finite());
@@ -39,14 +38,17 @@ fn check_pattern(text: &str) {
 
 /// A scene that loads must give a finite model, and its modes must be finite.
 fn check_scene(text: &str) {
-    if let Ok(scene) = Scene::from_json(text, "fuzz", "fuzz") {
-        assert!(scene
-            .model
-            .joints
+    let built =
+        nanofold::io::parse_scene(text, "fuzz", "fuzz", std::path::Path::new("patterns")).and_then(|s| s.build());
+    if let Ok(scene) = built {
+        let Some(chain) = scene.strip() else { return };
+        let model = &chain.model;
+        assert!(model
+            .joints()
             .iter()
             .all(|j| j.stiffness.is_finite() && j.stiffness > 0.0));
-        assert!(scene.model.plates.iter().all(|p| p.mass.is_finite() && p.mass > 0.0));
-        if let Ok(m) = modes(&scene.model, scene.target_angles.as_slice()) {
+        assert!(model.plates().iter().all(|p| p.mass.is_finite() && p.mass > 0.0));
+        if let Ok(m) = modes(model, chain.target_angles().as_slice()) {
             assert!(m.eigenvalues.iter().all(|l| l.is_finite()));
         }
     }

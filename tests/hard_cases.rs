@@ -19,7 +19,7 @@ fn vertex(sectors: &[f64], fold: f64) -> String {
 }
 
 fn load(text: &str) -> nanofold::Result<Pattern> {
-    Pattern::from_str(text, "hard", "hard", &LoadOptions::default())
+    nanofold::io::parse_pattern(text, "hard", "hard", &LoadOptions::default())
 }
 
 #[test]
@@ -93,7 +93,7 @@ fn a_degree_twelve_fit_exported_in_degrees_on_0_to_180_stays_accurate() {
     // (measured: the same as the radian form to 3e-16 rad; fit error 6e-8 rad).
     use nanofold::constraints::chebyshev::eval_monomial;
     use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
-    let pattern = Pattern::load(
+    let pattern = nanofold::io::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
         &LoadOptions::default(),
     )
@@ -123,21 +123,19 @@ fn plates_touching_at_the_first_step_stop_the_run_at_once() {
     // Expectation: corner cube step 2 started at its end (crease 1 at 90°, so the doubled flap
     // already lies folded flat on the third square, crease 4 at −180°) reports that contact at
     // t = 0 with zero steps and finite angles, for the dynamic and the quasi-static model.
-    use nanofold::dynamics::closed::simulate_closed;
-    use nanofold::dynamics::simulate::{ModelChoice, SimulationSettings};
-    use nanofold::scene::closed::ClosedScene;
+    use nanofold::dynamics::simulate::{simulate, ModelChoice, SimulationSettings};
     let text = std::fs::read_to_string("patterns/corner_cube_step2.scene.json").unwrap();
     let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
     value["start_angle_deg"] = serde_json::json!(90);
     value["hinges"][1]["target_angle_deg"] = serde_json::json!(60);
     value["constraint"]["range_deg"] = serde_json::json!([0, 90]);
-    let scene = ClosedScene::from_json(&value.to_string(), "test", "test", std::path::Path::new("patterns")).unwrap();
+    let scene = common::scene_text(&value.to_string()).unwrap();
     for model in [ModelChoice::Dynamic, ModelChoice::QuasiStatic] {
         let settings = SimulationSettings {
             model,
             ..SimulationSettings::default()
         };
-        let response = simulate_closed(&scene, &settings).unwrap();
+        let response = simulate(&scene, &settings).unwrap().response;
         let contact = response.collision.as_ref().expect("touching at t = 0");
         assert_eq!(contact.time, 0.0, "{model:?}");
         assert!(contact.pair[0].starts_with("edges[4]"), "{model:?}: {:?}", contact.pair);
@@ -234,7 +232,7 @@ fn a_step_through_a_barrier_is_detected_even_where_the_energy_cannot_see_it() {
     // finite separable energy, so the energy alone would accept the jump; the crossing test
     // of the line search refuses it. And with a step cap of 3 rad (far past any barrier) no
     // accepted step of any library pattern carries a node through an arc.
-    use nanofold::kinematics::forward;
+    use nanofold::geometry::kinematics::forward;
     use nanofold::unfold::{find_crossing, UnfoldModel};
     let text = degrees_vertex(
         "closed",
@@ -251,8 +249,8 @@ fn a_step_through_a_barrier_is_detected_even_where_the_energy_cannot_see_it() {
         &model.sector_angles,
         &[0.0, -170f64.to_radians(), 0.0, -170f64.to_radians()],
     );
-    let energy = nanofold::energy::EnergyKind::Separable.build(None);
-    let mut ws = nanofold::energy::EnergyWorkspace::default();
+    let energy = nanofold::unfold::energy::EnergyKind::Separable.build(None);
+    let mut ws = nanofold::unfold::energy::EnergyWorkspace::default();
     let (u_before, u_after) = (
         energy.value(&before, &model.arcs, &mut ws),
         energy.value(&after, &model.arcs, &mut ws),
@@ -275,7 +273,7 @@ fn a_step_through_a_barrier_is_detected_even_where_the_energy_cannot_see_it() {
         if !(name.ends_with(".fold") || name.ends_with(".json")) || name.ends_with(".scene.json") {
             continue;
         }
-        let pattern = Pattern::load(&path, &LoadOptions::default()).unwrap();
+        let pattern = nanofold::io::load_pattern(&path, &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let report = unfold(&pattern, &settings).unwrap();
         for pair in report.trajectory.windows(2) {
@@ -294,7 +292,7 @@ fn a_folded_tiny_sector_unfolds() {
     // by loop closure) unfolds to flat without NaN. Newton onto ρ = 0 is refused here (the
     // fold angles beside a 1e-4 rad sector are 1e4 times as sensitive to the nodes), so the
     // end is the line search's: measured 3.9e-8 from the flat layout, asserted ≤ 1e-6.
-    use nanofold::kinematics::solve_closure;
+    use nanofold::geometry::kinematics::solve_closure;
     let sectors = [1e-4, 2.0, 2.0, TAU - 4.0 - 1e-4];
     let mut rho = vec![0.0; 4];
     for s in 1..=30 {

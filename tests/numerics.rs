@@ -3,13 +3,13 @@
 
 mod common;
 use common::native_json;
-use nanofold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::kinematics::{closure_residual, solve_closure};
-use nanofold::pattern::{LoadOptions, Pattern};
-use nanofold::qp::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
-use nanofold::sphere::{
+use nanofold::geometry::kinematics::{closure_residual, solve_closure};
+use nanofold::geometry::sphere::{
     fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3,
 };
+use nanofold::pattern::LoadOptions;
+use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
+use nanofold::unfold::qp::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
 use proptest::prelude::*;
 use std::f64::consts::{PI, TAU};
@@ -113,7 +113,7 @@ proptest! {
         separable in any::<bool>(),
     ) {
         let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
-        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let nodes = model.folded_nodes();
         let kind = if separable { EnergyKind::Separable } else { EnergyKind::NonSeparable };
@@ -143,7 +143,7 @@ proptest! {
         drive in proptest::collection::vec(-1.0..1.0f64, 12),
     ) {
         let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
-        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let mut solver = Unfolder::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
         let (bending, _) = solver.direction_problem().unwrap();
@@ -183,9 +183,9 @@ proptest! {
         let sectors: Vec<f64> = weights[..n].iter().map(|w| w / total * TAU).collect();
         let scale = [0.1, 1e-3, 1e-6, 0.0][scale_index];
         let rho: Vec<f64> = rho_seed[..n].iter().map(|r| r * scale).collect();
-        let pattern = Pattern::from_str(&native_json(&sectors, &vec![0.0; n]), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &vec![0.0; n]), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
-        let nodes = nanofold::kinematics::forward(&model.sector_angles, &rho);
+        let nodes = nanofold::geometry::kinematics::forward(&model.sector_angles, &rho);
         // Restoration can fail from a random fold (the loop gap is ~ρ²/ρ away along a
         // direction of singular value ~ρ); those draws are skipped.
         let Ok(mut solver) = Unfolder::new(&model, &UnfoldSettings::default(), nodes) else { return Ok(()) };
@@ -221,7 +221,7 @@ proptest! {
     ) {
         let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
         prop_assert!(closure_residual(&sectors, &rho) < 1e-12);
-        let pattern = Pattern::from_str(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let settings = UnfoldSettings { max_iterations: 5000, ..Default::default() };
         let report = unfold(&pattern, &settings).unwrap();
         for step in &report.trajectory {

@@ -3,8 +3,9 @@
 
 #![allow(dead_code)]
 
-use nanofold::kinematics::solve_closure;
-use nanofold::pattern::{is_pattern_file, LoadOptions, Pattern};
+use nanofold::geometry::kinematics::solve_closure;
+use nanofold::io::is_pattern_file;
+use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::unfold::SplitMix64;
 use serde_json::json;
 
@@ -81,7 +82,8 @@ pub fn many_creases(n: usize) -> Pattern {
         r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#,
         creases.join(",")
     );
-    Pattern::from_str(&json, &format!("random{n}"), "generated", &LoadOptions::default()).expect("a valid vertex")
+    nanofold::io::parse_pattern(&json, &format!("random{n}"), "generated", &LoadOptions::default())
+        .expect("a valid vertex")
 }
 
 /// The library's pattern files (scene files aside), in name order.
@@ -94,6 +96,6 @@ pub fn library_patterns() -> Vec<Pattern> {
     paths.sort();
     paths
         .iter()
-        .map(|p| Pattern::load(p, &LoadOptions::default()).expect("library pattern"))
+        .map(|p| nanofold::io::load_pattern(p, &LoadOptions::default()).expect("library pattern"))
         .collect()
 }

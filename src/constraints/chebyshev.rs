@@ -2,7 +2,7 @@
 //! t = (2x − a − b)/(b − a) ∈ [−1, 1] for conditioning (SPEC §6), evaluation with first and
 //! second derivatives, and conversion to monomial coefficients in x.
 
-use crate::error::{NanofoldError, Result};
+use crate::error::{NanofoldError, NumericalError, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -72,10 +72,10 @@ impl Chebyshev {
     /// SVD of the Chebyshev–Vandermonde matrix.
     pub fn fit(x: &[f64], y: &[f64], degree: usize, domain: [f64; 2]) -> Result<Chebyshev> {
         if x.len() != y.len() {
-            return Err(NanofoldError::Numerical {
-                stage: "polynomial fit".into(),
-                message: format!("{} abscissae but {} values", x.len(), y.len()),
-            });
+            return Err(NumericalError::Fit {
+                detail: format!("{} abscissae but {} values", x.len(), y.len()),
+            }
+            .into());
         }
         if x.len() < degree + 1 {
             return Err(NanofoldError::invalid(
@@ -108,10 +108,9 @@ impl Chebyshev {
         let rhs = DVector::from_column_slice(y);
         let svd = basis.svd(true, true);
         let largest = svd.singular_values.max();
-        let coeffs = svd.solve(&rhs, largest * 1e-13).map_err(|e| NanofoldError::Numerical {
-            stage: "polynomial fit".into(),
-            message: e.to_string(),
-        })?;
+        let coeffs = svd
+            .solve(&rhs, largest * 1e-13)
+            .map_err(|e| NumericalError::Fit { detail: e.to_string() })?;
         Ok(Chebyshev {
             domain,
             coeffs: coeffs.iter().copied().collect(),

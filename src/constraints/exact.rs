@@ -10,8 +10,8 @@
 
 use super::sweep::{CLOSURE_TOL, REFINE_ITERATIONS};
 use super::{check_in_domain, CurveSamples};
-use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_jacobian, forward, refine_closure, solve_closure};
+use crate::error::{NumericalError, Result};
+use crate::geometry::kinematics::{closure_jacobian, forward, refine_closure, solve_closure};
 use crate::pattern::Pattern;
 use nalgebra::{DMatrix, Vector3};
 use std::cell::Cell;
@@ -129,9 +129,9 @@ impl ExactConstraint {
         if smallest < SINGULAR_RATIO * largest {
             return Ok(false);
         }
-        let numerical = |e: &str| NanofoldError::Numerical {
-            stage: "exact constraint".into(),
-            message: e.to_string(),
+        let numerical = |e: &str| NumericalError::Singular {
+            what: "exact constraint",
+            detail: e.to_string(),
         };
         let g = svd.solve(&(-j_driver), 0.0).map_err(numerical)?;
         let mut rates = vec![0.0; rho.len()];
@@ -184,14 +184,15 @@ impl ExactConstraint {
         let regular = self.derivatives(&self.closed_rays(theta1)?, &mut near)?
             && self.derivatives(&self.closed_rays(theta2)?, &mut far)?;
         if !regular {
-            return Err(NanofoldError::Numerical {
-                stage: "exact constraint".into(),
-                message: format!(
-                    "the closure Jacobian is singular at and near {} = {:.6}°: the dependents are not a function of it here",
+            return Err(NumericalError::Singular {
+                what: "exact constraint",
+                detail: format!(
+                    "the closure Jacobian at and near {} = {:.6}°: the dependents are not a function of it here",
                     self.driver_label,
                     theta.to_degrees()
                 ),
-            });
+            }
+            .into());
         }
         let step = theta - theta1;
         for k in 0..self.dependent_rays.len() {
@@ -237,13 +238,17 @@ pub fn implicit_jacobian_rays(
     let svd = j_dep.svd(true, true);
     let (largest, smallest) = (svd.singular_values.max(), svd.singular_values.min());
     if smallest < SINGULAR_RATIO * largest {
-        return Err(NanofoldError::Numerical {
-            stage: "implicit-function Jacobian".into(),
-            message: format!("singular configuration (σ_min/σ_max = {:.1e})", smallest / largest),
-        });
+        return Err(NumericalError::Singular {
+            what: "implicit-function Jacobian",
+            detail: format!("singular configuration (σ_min/σ_max = {:.1e})", smallest / largest),
+        }
+        .into());
     }
-    svd.solve(&(-j_drivers), 0.0).map_err(|e| NanofoldError::Numerical {
-        stage: "implicit-function Jacobian".into(),
-        message: e.to_string(),
+    svd.solve(&(-j_drivers), 0.0).map_err(|e| {
+        NumericalError::Singular {
+            what: "implicit-function Jacobian",
+            detail: e.to_string(),
+        }
+        .into()
     })
 }

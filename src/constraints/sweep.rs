@@ -4,7 +4,7 @@
 
 use super::{CurveSamples, Setup, Source};
 use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
+use crate::geometry::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
 use crate::pattern::Pattern;
 use nalgebra::DVector;
 use std::f64::consts::PI;

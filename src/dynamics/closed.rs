@@ -1,33 +1,33 @@
-//! Closed chains (SPEC §7, T4.16–4.20): a single vertex cut at one unactuated crease, the
-//! sectors as an open chain of plates from the sector after the cut (anchored), tied back by
-//! θ_r = f(θ_c). One driving crease remains after the locks, so the generalised coordinate q
+//! Closed chains (`docs/model.md#closed-chains`): a single vertex cut at one unactuated
+//! crease, its sectors as plates on a kinematic tree rooted at the anchored sector (the
+//! creases on either side of it up to the cut), tied back by θ_r = f(θ_c). One driving crease remains after the locks, so the generalised coordinate q
 //! is its angle and, with g = ∂θ/∂q (1 for the driver, G for the dependents, 0 when held) and
 //! h = ∂²θ/∂q² (f″),
 //!   (gᵀ M g) q̈ = τ_q − gᵀ [M h q̇² + C(θ, g q̇) g q̇] − Σ_creases K ρ g + gᵀ Q_drag,
 //! the reduced equation Gᵀ[M(G θ̈_c + Ġ θ̇_c) + C G θ̇_c + N] = τ_c written for one coordinate.
 //! The elastic sum runs over every crease, the cut one included: it is a hinge too.
 
+pub mod assemble;
 pub mod modes;
-pub mod quasi_static;
+pub mod statics;
 
-use super::contact::{Collision, ContactProbe};
-use super::simulate::{
-    integrate, output_times, output_times_in, resolve_method, DynamicRun, ModelKind, Plant, Response, Sample,
-    SimulationSettings, TimeScales, QUASI_STATIC_RATIO,
+use super::algorithms::{
+    coriolis_torques, drag_torques, quadratic_form, update_corners, update_kinematics, update_mass_matrix,
+    update_poses, update_velocities,
 };
-use super::{Data, Model};
+use super::contact::{Collision, ContactProbe};
+use super::forcing::{Actuation, Forcing};
+use super::model::{convex_contains, Data, Model};
+use super::plant::{Plant, Sample, TimeScales};
 use crate::constraints::exact::{ConstraintPoint, ExactConstraint};
 use crate::constraints::ConstraintPoly;
-use crate::error::{NanofoldError, Result};
-use crate::kinematics::closure_residual;
-use crate::scene::closed::ClosedScene;
-use crate::scene::Actuation;
+use crate::error::{NanofoldError, NumericalError, Result};
+use crate::geometry::kinematics::closure_residual;
 use nalgebra::{DVector, Point3, Vector3};
-use quasi_static::quasi_static_path;
-use std::f64::consts::PI;
-use std::time::Instant;
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
 
-/// Where f comes from (SPEC §6).
+/// Where f comes from (`docs/model.md#constraint-curves`).
 #[derive(Debug, Clone)]
 pub enum ConstraintSource {
     /// The fitted polynomial and its derivatives.
@@ -37,6 +37,7 @@ pub enum ConstraintSource {
 }
 
 impl ConstraintSource {
+    /// "poly" or "exact".
     pub fn name(&self) -> &'static str {
         match self {
             ConstraintSource::Poly(_) => "poly",
@@ -48,6 +49,24 @@ impl ConstraintSource {
         match self {
             ConstraintSource::Poly(poly) => poly.evaluate_extended(theta, DOMAIN_MARGIN, point),
             ConstraintSource::Exact(exact) => exact.evaluate_extended(theta, DOMAIN_MARGIN, point),
+        }
+    }
+
+    /// The fit's largest errors against the exact sweep samples: (|f − exact| rad,
+    /// |f′ − G|), both 0 for the exact source.
+    pub fn errors(&self) -> (f64, f64) {
+        let largest = |errors: &[f64]| errors.iter().copied().fold(0.0, f64::max);
+        match self {
+            ConstraintSource::Poly(p) => (largest(&p.max_fit_error), largest(&p.max_slope_error)),
+            ConstraintSource::Exact(_) => (0.0, 0.0),
+        }
+    }
+
+    /// The polynomial's degree (poly only).
+    pub fn degree(&self) -> Option<usize> {
+        match self {
+            ConstraintSource::Poly(p) => Some(p.degree()),
+            ConstraintSource::Exact(_) => None,
         }
     }
 
@@ -65,41 +84,51 @@ impl ConstraintSource {
 /// domain is an error (see [`ClosedChain::check_samples`]).
 pub const DOMAIN_MARGIN: f64 = 0.1;
 
-/// A dynamic run of a slow forcing (≥ 10³ fastest periods) may stray from the quasi-static
-/// path by its linear error bound plus this, rad.
-const SLOW_FORCING_DEVIATION: f64 = 1e-3;
-
 /// Two sector plates touch when a fold angle reaches ±π to within this, rad.
 const FOLD_TOUCH: f64 = 1e-9;
 
-/// An immutable closed-chain description: geometry, hinges, the constraint and the actuation.
+/// An immutable closed-chain description: geometry, hinges, the constraint and the forcing.
 #[derive(Debug, Clone)]
 pub struct ClosedChain {
-    /// The open chain after the cut: joint j turns about the ray of crease `joint_creases[j]`
-    /// and carries sector plate j; the anchored sector is [`ClosedChain::ground`].
+    /// The sector plates on a tree rooted at the anchored sector: joint j turns about the ray
+    /// of crease `joint_creases[j]` and carries the plate of sector `joint_sectors[j]`.
     pub model: Model,
+    /// The crease of every joint.
     pub joint_creases: Vec<usize>,
+    /// The sector every joint's plate covers (sector k lies between rays k and k + 1).
+    pub joint_sectors: Vec<usize>,
+    /// The anchored sector (on the substrate).
+    pub ground_sector: usize,
     /// The anchored sector's outline (world frame, flat, m).
     pub ground: Vec<Point3<f64>>,
+    /// Where the loop is cut (a crease index).
     pub cut_crease: usize,
     /// Hinge stiffness of every crease (file order), N·m/rad.
     pub crease_stiffness: Vec<f64>,
+    /// How errors and outputs name every crease.
     pub crease_labels: Vec<String>,
     /// The far end of every crease in the flat state (world frame, m).
     pub crease_ends: Vec<Point3<f64>>,
+    /// The driving crease.
     pub driver: usize,
+    /// Held creases and their angles, rad.
     pub locked: Vec<(usize, f64)>,
+    /// The creases that follow the driver, in the order of the constraint's values.
     pub dependents: Vec<usize>,
+    /// f and its derivatives.
     pub source: ConstraintSource,
-    /// Sector angles and the ray of every crease, for loop-closure residuals.
+    /// Sector angles, for loop-closure residuals.
     pub sector_angles: Vec<f64>,
+    /// The ray of every crease.
     pub crease_rays: Vec<usize>,
-    /// Driver angle at rest at t = 0 and its target (rad).
+    /// Driver angle at rest at t = 0, rad.
     pub start: f64,
-    pub target: f64,
-    pub actuation: Actuation,
-    /// Radius of curvature of the driving hinge for a ramp, m.
-    pub radius_of_curvature: f64,
+    /// The file's index of every crease (FOLD edge index), for reports.
+    pub crease_user_indices: Vec<usize>,
+    /// FOLD face index of the anchored sector.
+    pub anchored_face: usize,
+    /// What drives every crease: only the driver is actuated.
+    pub forcing: Forcing,
 }
 
 /// Scratch of a [`ClosedChain`]: the open chain's buffers and the constraint's values.
@@ -120,6 +149,7 @@ pub struct ClosedData {
 }
 
 impl ClosedChain {
+    /// Scratch buffers sized for this chain.
     pub fn workspace(&self) -> ClosedData {
         let (n, c) = (self.model.dof(), self.crease_stiffness.len());
         ClosedData {
@@ -170,15 +200,14 @@ impl ClosedChain {
         Ok(())
     }
 
-    /// The angle the driving hinge's stressed layer drives to at time t (T5.9–5.12), rad.
+    /// The driver's target angle, rad.
+    pub fn target(&self) -> f64 {
+        self.forcing.hinges[self.driver].target
+    }
+
+    /// The angle the driving hinge's stressed layer drives to at time t, rad.
     pub fn drive_angle(&self, t: f64) -> f64 {
-        match &self.actuation {
-            Actuation::Step => self.target,
-            Actuation::Ramp { etch_rate, .. } => {
-                let reached = etch_rate * t / self.radius_of_curvature;
-                self.target.signum() * reached.min(self.target.abs())
-            }
-        }
+        self.forcing.drive_angle(self.driver, t)
     }
 
     /// τ_q(t) = K_driver θ_drive(t): the driving hinge's stressed-layer torque.
@@ -186,20 +215,17 @@ impl ClosedChain {
         self.crease_stiffness[self.driver] * self.drive_angle(t)
     }
 
-    /// The ramp's duration t_p (0 for a step), s.
-    pub fn forcing_time(&self) -> f64 {
-        match &self.actuation {
-            Actuation::Step => 0.0,
-            Actuation::Ramp { etch_rate, .. } => self.radius_of_curvature * self.target.abs() / etch_rate,
-        }
+    /// The plate of sector `sector`: None for the anchored sector, else its joint.
+    pub fn body_of_sector(&self, sector: usize) -> Option<usize> {
+        self.joint_sectors.iter().position(|&s| s == sector)
     }
 
     /// Reduced mass gᵀ M g (kg·m²) and stiffness Σ K g² (N·m/rad) at q.
     pub fn reduced_mass_and_stiffness(&self, q: f64, ws: &mut ClosedData) -> Result<(f64, f64)> {
         self.update_creases(q, ws)?;
-        self.model.update_kinematics(&ws.joint_angles, &mut ws.data);
-        self.model.update_mass_matrix(&mut ws.data);
-        let mass = quadratic_form(&ws.data, &ws.joint_g);
+        update_kinematics(&self.model, &ws.joint_angles, &mut ws.data);
+        update_mass_matrix(&self.model, &mut ws.data);
+        let mass = 2.0 * quadratic_form(&ws.data.mass_matrix, &ws.joint_g);
         let stiffness = self
             .crease_stiffness
             .iter()
@@ -217,11 +243,11 @@ impl ClosedChain {
             ws.joint_rates[j] = ws.joint_g[j] * q_dot;
         }
         let model = &self.model;
-        model.update_kinematics(&ws.joint_angles, &mut ws.data);
-        model.update_mass_matrix(&mut ws.data);
-        model.update_velocities(&ws.joint_rates, &mut ws.data);
-        model.coriolis_torques(&ws.joint_rates, &mut ws.data, &mut ws.coriolis);
-        model.drag_torques(&ws.data, &mut ws.drag);
+        update_kinematics(model, &ws.joint_angles, &mut ws.data);
+        update_mass_matrix(model, &mut ws.data);
+        update_velocities(model, &ws.joint_rates, &mut ws.data);
+        coriolis_torques(model, &ws.joint_rates, &mut ws.data, &mut ws.coriolis);
+        drag_torques(model, &ws.data, &mut ws.drag);
         let m = &ws.data.mass_matrix;
         let mut reduced_mass = 0.0;
         let mut force = self.drive_torque(t);
@@ -238,10 +264,11 @@ impl ClosedChain {
             force -= k * ws.crease_angles[c] * ws.crease_g[c];
         }
         if reduced_mass.is_nan() || reduced_mass <= 0.0 {
-            return Err(NanofoldError::Numerical {
-                stage: "closed-chain dynamics".into(),
-                message: format!("reduced mass gᵀMg = {reduced_mass:e} is not positive at q = {q}"),
-            });
+            return Err(NumericalError::NotPositiveDefinite {
+                matrix: "the reduced mass gᵀMg",
+                at: format!("q = {q} rad (gᵀMg = {reduced_mass:e})"),
+            }
+            .into());
         }
         Ok(force / reduced_mass)
     }
@@ -251,8 +278,9 @@ impl ClosedChain {
     pub fn torque_magnification(&self) -> Result<f64> {
         let mut ws = self.workspace();
         let [lo, hi] = self.source.domain();
-        self.update_creases(self.target.clamp(lo, hi), &mut ws)?;
-        let drive = self.crease_stiffness[self.driver] * self.target;
+        let target = self.target();
+        self.update_creases(target.clamp(lo, hi), &mut ws)?;
+        let drive = self.crease_stiffness[self.driver] * target;
         let holding: f64 = (0..self.crease_stiffness.len())
             .filter(|&c| c != self.driver)
             .map(|c| self.crease_stiffness[c] * ws.crease_angles[c] * ws.crease_g[c])
@@ -312,7 +340,7 @@ impl ClosedChain {
     /// summed over the joints.
     fn lever(&self) -> f64 {
         self.model
-            .plates
+            .plates()
             .iter()
             .map(|p| {
                 p.outline
@@ -324,24 +352,13 @@ impl ClosedChain {
     }
 }
 
-fn quadratic_form(data: &Data, g: &[f64]) -> f64 {
-    let m = &data.mass_matrix;
-    let mut sum = 0.0;
-    for (i, gi) in g.iter().enumerate() {
-        for (j, gj) in g.iter().enumerate() {
-            sum += m[(i, j)] * gi * gj;
-        }
-    }
-    sum
-}
-
 /// A contact candidate of a closed chain.
 #[derive(Debug, Clone, Copy)]
 enum Candidate {
     /// Two neighbouring sectors fold flat onto each other: |ρ| reaches π.
     Fold { crease: usize },
-    /// A corner (not the vertex) of sector plate `plate` crosses the face of a non-adjacent
-    /// sector (`face`; `None` for the anchored sector). Bodies are indexed by joint.
+    /// A corner (not the vertex) of sector plate `plate` crosses the face of a sector that is
+    /// not its neighbour (`face`; `None` for the anchored sector). Plates are indexed by joint.
     Face {
         face: Option<usize>,
         plate: usize,
@@ -351,7 +368,7 @@ enum Candidate {
 
 /// The closed chain as an integrator [`Plant`], with its contact candidates.
 pub struct ClosedPlant<'c> {
-    pub chain: &'c ClosedChain,
+    chain: &'c ClosedChain,
     candidates: Vec<Candidate>,
     touch_tolerance: f64,
     /// max over the domain of Σ_j |∂θ_j/∂q|, sampled.
@@ -370,26 +387,26 @@ impl<'c> ClosedPlant<'c> {
             for c in (0..chain.crease_stiffness.len()).filter(|c| !chain.locked.iter().any(|(l, _)| l == c)) {
                 candidates.push(Candidate::Fold { crease: c });
             }
-            // Bodies around the vertex: ground = position 0, plate j = position j + 1.
-            let bodies = chain.model.dof() + 1;
+            // Sectors two or more creases apart around the vertex can touch; neighbours meet
+            // along their shared crease.
+            let sectors = chain.model.dof() + 1;
             let apart = |a: usize, b: usize| {
                 let d = a.abs_diff(b);
-                d.min(bodies - d) >= 2
+                d.min(sectors - d) >= 2
             };
+            let bodies: Vec<(Option<usize>, usize)> = std::iter::once((None, chain.ground_sector))
+                .chain(chain.joint_sectors.iter().enumerate().map(|(j, &s)| (Some(j), s)))
+                .collect();
             for plate in 0..chain.model.dof() {
-                let outline = &chain.model.plates[plate].outline;
+                let outline = &chain.model.plates()[plate].outline;
                 for (corner, local) in outline.iter().enumerate() {
-                    let world = chain.model.plates[plate].reference_pose * local;
+                    let world = chain.model.plates()[plate].reference_pose * local;
                     if world.coords.norm() <= touch_tolerance {
                         continue;
                     }
-                    for face in 0..bodies {
-                        if apart(face, plate + 1) {
-                            candidates.push(Candidate::Face {
-                                face: face.checked_sub(1),
-                                plate,
-                                corner,
-                            });
+                    for &(face, sector) in &bodies {
+                        if apart(sector, chain.joint_sectors[plate]) {
+                            candidates.push(Candidate::Face { face, plate, corner });
                         }
                     }
                 }
@@ -438,7 +455,7 @@ impl<'c> ClosedPlant<'c> {
                     None => convex_contains(&self.chain.ground, &p, -self.touch_tolerance),
                     Some(f) => {
                         let local = ws.data.poses[f].inverse_transform_point(&p);
-                        self.chain.model.plates[f].contains(&local, -self.touch_tolerance)
+                        self.chain.model.plates()[f].contains(&local, -self.touch_tolerance)
                     }
                 }
             }
@@ -455,11 +472,12 @@ impl<'c> ClosedPlant<'c> {
         let ground = || "anchored sector".to_string();
         match self.candidates[k] {
             Candidate::Fold { crease } => {
-                // The crease's far end moves with the plate after it (fixed for the cut crease).
+                // The crease's far end moves with the sector after its ray (as with the one
+                // before: the end lies on their shared hinge axis).
                 let flat_end = self.chain.crease_ends[crease];
-                let ray_end = match self.chain.joint_creases.iter().position(|&c| c == crease) {
+                let ray_end = match self.chain.body_of_sector(self.chain.crease_rays[crease]) {
                     Some(j) => {
-                        let plate = &self.chain.model.plates[j];
+                        let plate = &self.chain.model.plates()[j];
                         (ws.data.poses[j] * plate.reference_pose.inverse_transform_point(&flat_end)).coords
                     }
                     None => flat_end.coords,
@@ -483,20 +501,10 @@ impl<'c> ClosedPlant<'c> {
 
     fn move_to(&self, q: f64, ws: &mut ClosedData) -> Result<()> {
         self.chain.update_creases(q, ws)?;
-        self.chain.model.update_poses(&ws.joint_angles, &mut ws.data);
-        self.chain.model.update_corners(&mut ws.data);
+        update_poses(&self.chain.model, &ws.joint_angles, &mut ws.data);
+        update_corners(&self.chain.model, &mut ws.data);
         Ok(())
     }
-}
-
-/// Whether p (z ignored) lies in the convex counter-clockwise polygon, within `tolerance`.
-fn convex_contains(outline: &[Point3<f64>], p: &Point3<f64>, tolerance: f64) -> bool {
-    let count = outline.len();
-    (0..count).all(|k| {
-        let (a, b) = (outline[k], outline[(k + 1) % count]);
-        let edge = b - a;
-        (edge.x * (p.y - a.y) - edge.y * (p.x - a.x)) / edge.x.hypot(edge.y) >= -tolerance
-    })
 }
 
 struct ClosedProbe<'a> {
@@ -535,6 +543,78 @@ impl ContactProbe for ClosedProbe<'_> {
     }
 }
 
+impl ClosedChain {
+    /// Natural periods of the one-degree-of-freedom chain at its start and its target
+    /// (ω² = Σ K g² / gᵀ M g) against the forcing.
+    pub fn time_scales(&self) -> Result<TimeScales> {
+        let omegas = self.omegas()?;
+        let fastest = omegas.iter().copied().fold(0.0, f64::max);
+        let slowest = omegas.iter().copied().fold(f64::INFINITY, f64::min);
+        let forcing = self.forcing.duration();
+        Ok(TimeScales {
+            fastest_period_s: TAU / fastest,
+            slowest_period_s: TAU / slowest,
+            forcing_time_s: forcing,
+            ratio: forcing * fastest / TAU,
+        })
+    }
+
+    /// ω at the start and at the target (clamped to the constraint's domain), rad/s.
+    fn omegas(&self) -> Result<[f64; 2]> {
+        let mut ws = self.workspace();
+        let [lo, hi] = self.source.domain();
+        let mut omegas = [0.0; 2];
+        for (omega, q) in omegas.iter_mut().zip([self.start, self.target().clamp(lo, hi)]) {
+            let (mass, stiffness) = self.reduced_mass_and_stiffness(q, &mut ws)?;
+            *omega = (stiffness / mass).sqrt();
+        }
+        Ok(omegas)
+    }
+
+    /// Linear bound on the distance from the quasi-static path, rad: one mode, so a step's
+    /// jump, or the ramp's rate jumps over ω at its start and end plus the jump from the start
+    /// to the balance at t = 0 (a start that the passive hinges do not hold, as in step 2 of
+    /// the corner cube, rings by that much).
+    pub fn quasi_static_error_estimate(&self) -> Result<f64> {
+        Ok(match self.forcing.actuation {
+            Actuation::Step => (self.target() - self.start).abs(),
+            Actuation::Ramp { .. } => {
+                let omegas = self.omegas()?;
+                let rate = self.forcing.drive_rate(self.driver, 0.0).abs();
+                let balance = self.quasi_static_angle(0.0, self.start, &mut self.workspace())?;
+                rate / omegas[0] + rate / omegas[1] + (balance - self.start).abs()
+            }
+        })
+    }
+
+    /// What a run reports of the chain besides its response: the constraint's errors, the
+    /// torque magnification and the largest loop-closure residual of the samples.
+    pub fn report(&self, samples: &[Sample]) -> Result<ClosedReport> {
+        let mut ws = self.workspace();
+        let mut max_closure_residual: f64 = 0.0;
+        for sample in samples {
+            ws.crease_angles.copy_from_slice(sample.angles.as_slice());
+            max_closure_residual = max_closure_residual.max(self.closure_residual(&ws));
+        }
+        let eta = self.torque_magnification()?;
+        let width = self.crease_ends[self.driver].coords.norm() * 1e6;
+        let (fit_error, slope_error) = self.source.errors();
+        Ok(ClosedReport {
+            cut_crease: self.crease_user_indices[self.cut_crease],
+            driver: self.crease_user_indices[self.driver],
+            anchored_face: self.anchored_face,
+            constraint_source: self.source.name(),
+            degree: self.source.degree(),
+            fit_error,
+            slope_error,
+            torque_magnification: eta,
+            driving_hinge_width_um: width,
+            required_hinge_width_um: width * eta,
+            max_closure_residual,
+        })
+    }
+}
+
 impl Plant for ClosedPlant<'_> {
     type Workspace = ClosedData;
 
@@ -544,6 +624,18 @@ impl Plant for ClosedPlant<'_> {
 
     fn dof(&self) -> usize {
         1
+    }
+
+    fn forcing(&self) -> &Forcing {
+        &self.chain.forcing
+    }
+
+    fn time_scales(&self) -> Result<TimeScales> {
+        self.chain.time_scales()
+    }
+
+    fn quasi_static_error_estimate(&self) -> Result<f64> {
+        self.chain.quasi_static_error_estimate()
     }
 
     fn slowest_omega(&self) -> Result<f64> {
@@ -565,11 +657,27 @@ impl Plant for ClosedPlant<'_> {
         self.chain.sample(t, q[0], q_dot[0], ws)
     }
 
-    fn forcing_breakpoints(&self) -> Vec<f64> {
-        match self.chain.actuation {
-            Actuation::Step => Vec::new(),
-            Actuation::Ramp { .. } => vec![self.chain.forcing_time()],
-        }
+    fn balance(&self, drive: &[f64], q: &mut [f64], ws: &mut ClosedData) -> Result<()> {
+        q[0] = self.chain.quasi_static_angle(drive[self.chain.driver], q[0], ws)?;
+        Ok(())
+    }
+
+    fn balance_rates(
+        &self,
+        q: &[f64],
+        drive: &[f64],
+        drive_rates: &[f64],
+        out: &mut [f64],
+        ws: &mut ClosedData,
+    ) -> Result<()> {
+        let driver = self.chain.driver;
+        let (_, stiffness) = self.chain.static_torque(q[0], drive[driver], ws)?;
+        out[0] = self.chain.crease_stiffness[driver] * drive_rates[driver] / stiffness;
+        Ok(())
+    }
+
+    fn check_samples(&self, samples: &[Sample]) -> Result<()> {
+        self.chain.check_samples(samples)
     }
 
     fn contact_count(&self) -> usize {
@@ -604,151 +712,31 @@ impl Plant for ClosedPlant<'_> {
     }
 }
 
-/// What a closed-chain run reports besides the open chain's keys.
-#[derive(Debug, Clone, serde::Serialize)]
+/// What a closed-chain run reports beside its response.
+#[derive(Debug, Clone, Serialize)]
 pub struct ClosedReport {
     /// FOLD edge index of the cut crease.
     pub cut_crease: usize,
+    /// FOLD edge index of the driving crease.
     pub driver: usize,
+    /// FOLD face index of the anchored sector.
+    pub anchored_face: usize,
     /// "poly" or "exact".
     pub constraint_source: &'static str,
+    /// The polynomial's degree (poly only).
     pub degree: Option<usize>,
     /// Largest |f − exact| over the sweep samples, rad (0 for exact).
     pub fit_error: f64,
     /// Largest |f′ − G| over the regular sweep samples (0 for exact).
     pub slope_error: f64,
-    /// T5.24–5.25: the torque the driving hinge must supply to hold the target against every
-    /// hinge of the loop, Σ K ρ g, over the torque its own stressed layer gives, K θ_target;
-    /// and the driving hinge width that would supply it (stiffness ∝ width).
+    /// The torque the driving hinge must supply to hold the target against every hinge of
+    /// the loop, Σ K ρ g, over the torque its own stressed layer gives, K θ_target
+    /// (`docs/model.md#torque-magnification`).
     pub torque_magnification: f64,
+    /// The driving hinge's width (its crease's length), µm.
     pub driving_hinge_width_um: f64,
+    /// The width that would supply that torque (stiffness ∝ width), µm.
     pub required_hinge_width_um: f64,
     /// Largest loop-closure residual of the recorded states, rad.
     pub max_closure_residual: f64,
-}
-
-/// Runs a closed-chain scene: the reduced dynamics, or the quasi-static path when the model
-/// is chosen so (`auto`: the forcing lasts ≥ 10³ fastest periods, as for open chains).
-pub fn simulate_closed(scene: &ClosedScene, settings: &SimulationSettings) -> Result<Response> {
-    let started = Instant::now();
-    if !(settings.rtol.is_finite() && settings.rtol > 0.0 && settings.rtol < 1.0) {
-        return Err(NanofoldError::invalid("--rtol", settings.rtol, "must lie in (0, 1)"));
-    }
-    let t_end = settings.t_end.unwrap_or(scene.t_end);
-    if !(t_end.is_finite() && t_end > 0.0) {
-        return Err(NanofoldError::invalid("t_end", t_end, "must be a finite time > 0 s"));
-    }
-    let chain = &scene.chain;
-    let plant = ClosedPlant::new(chain, !settings.ignore_collisions);
-    let mut ws = chain.workspace();
-    let [lo, hi] = chain.source.domain();
-    let mut omegas = Vec::new();
-    for q in [chain.start, chain.target.clamp(lo, hi)] {
-        let (mass, stiffness) = chain.reduced_mass_and_stiffness(q, &mut ws)?;
-        omegas.push((stiffness / mass).sqrt());
-    }
-    let fastest = omegas.iter().copied().fold(0.0, f64::max);
-    let slowest = omegas.iter().copied().fold(f64::INFINITY, f64::min);
-    let forcing = chain.forcing_time();
-    let scales = TimeScales {
-        fastest_period_s: std::f64::consts::TAU / fastest,
-        slowest_period_s: std::f64::consts::TAU / slowest,
-        forcing_time_s: forcing,
-        ratio: forcing * fastest / std::f64::consts::TAU,
-    };
-    // One mode: a step's jump, or the ramp's rate jumps over ω at its start and end.
-    let estimate = match chain.actuation {
-        Actuation::Step => (chain.target - chain.start).abs(),
-        Actuation::Ramp { etch_rate, .. } => {
-            // Plus the jump from the start to the balance at t = 0 (a start that the passive
-            // hinges do not hold, as in step 2 of the corner cube, rings by that much).
-            let rate = etch_rate / chain.radius_of_curvature;
-            let balance = chain.quasi_static_angle(0.0, chain.start, &mut ws)?;
-            rate / omegas[0] + rate / omegas[1] + (balance - chain.start).abs()
-        }
-    };
-    let kind = settings.model.resolve(&scales);
-    let times = output_times(t_end, scene.outputs.samples);
-    let (run, method, measured) = match kind {
-        ModelKind::Dynamic => {
-            let method = resolve_method(settings.method, &scales);
-            let run = integrate(&plant, method, &times, settings.run_options())?;
-            chain.check_samples(&run.samples)?;
-            // A slow forcing has an accurate second answer, the quasi-static path: a dynamic
-            // run far from it has been misled by its error control (ESDIRK34 at rtol 1e-6
-            // drifts past the equilibrium after a ramp's end), so it is refused, not returned.
-            let mut measured = None;
-            if scales.ratio >= QUASI_STATIC_RATIO {
-                let deviation = chain.quasi_static_deviation(&run.samples)?;
-                if deviation > SLOW_FORCING_DEVIATION + 10.0 * estimate {
-                    return Err(NanofoldError::Numerical {
-                        stage: "closed-chain dynamics".into(),
-                        message: format!(
-                            "the {method:?} run strays {:.3}° from the quasi-static path, whose linear error bound is {:.1e} rad: its error control failed on this stiff forcing; use a tighter --rtol (1e-10) or --model quasi-static",
-                            deviation.to_degrees(),
-                            estimate
-                        ),
-                    });
-                }
-                measured = Some((run.samples.last().map_or(0.0, |s| s.time), deviation));
-            }
-            (run, Some(method), measured)
-        }
-        ModelKind::QuasiStatic => {
-            let (samples, collision, steps) = quasi_static_path(&plant, &times)?;
-            // The check of the model, as for open chains: a short dynamic run from rest.
-            let (window, method, options) = settings.check_run(&scales, t_end);
-            let check = integrate(
-                &ClosedPlant::new(chain, false),
-                method,
-                &output_times_in(window, 201),
-                options,
-            )?;
-            let deviation = chain.quasi_static_deviation(&check.samples)?;
-            let run = DynamicRun {
-                samples,
-                collision,
-                steps,
-                rhs_evaluations: 0,
-            };
-            (run, None, Some((window, deviation)))
-        }
-    };
-    let mut max_closure_residual: f64 = 0.0;
-    for sample in &run.samples {
-        ws.crease_angles.copy_from_slice(sample.angles.as_slice());
-        max_closure_residual = max_closure_residual.max(chain.closure_residual(&ws));
-    }
-    let eta = chain.torque_magnification()?;
-    let width = chain.crease_ends[chain.driver].coords.norm() * 1e6;
-    let collision = run.collision;
-    Ok(Response {
-        model: kind,
-        method,
-        rtol: settings.rtol,
-        time_scales: scales,
-        quasi_static_error_estimate: estimate,
-        measured_quasi_static_error: measured,
-        t_end: collision.as_ref().map_or(t_end, |c| c.time),
-        collision,
-        samples: run.samples,
-        steps: run.steps,
-        rhs_evaluations: run.rhs_evaluations,
-        seconds: started.elapsed().as_secs_f64(),
-        closed: Some(ClosedReport {
-            cut_crease: scene.pattern.user_index(chain.cut_crease),
-            driver: scene.pattern.user_index(chain.driver),
-            constraint_source: chain.source.name(),
-            degree: match &chain.source {
-                ConstraintSource::Poly(p) => Some(p.degree()),
-                ConstraintSource::Exact(_) => None,
-            },
-            fit_error: scene.fit_error,
-            slope_error: scene.slope_error,
-            torque_magnification: eta,
-            driving_hinge_width_um: width,
-            required_hinge_width_um: width * eta,
-            max_closure_residual,
-        }),
-    })
 }

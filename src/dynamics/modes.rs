@@ -1,8 +1,9 @@
-//! Linearised stability and natural frequencies at an equilibrium (SPEC §7, T5.14):
+//! Linearised stability and natural frequencies at an equilibrium (`docs/model.md#modes`):
 //! M(θ*) δθ̈ + K δθ = 0, i.e. the eigenvalues λ of M⁻¹K and f = √λ / 2π.
 
-use super::{Data, Model};
-use crate::error::{NanofoldError, Result};
+use super::algorithms::{update_kinematics, update_mass_matrix};
+use super::model::{Data, Model};
+use crate::error::{NumericalError, Result};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 /// Eigen-analysis of one equilibrium, modes sorted by descending eigenvalue.
@@ -23,11 +24,11 @@ pub struct Modes {
 /// Solves K φ = λ M φ at the equilibrium of an open chain (K the diagonal hinge stiffness).
 pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
     let mut data = Data::new(model);
-    model.update_kinematics(equilibrium, &mut data);
-    model.update_mass_matrix(&mut data);
+    update_kinematics(model, equilibrium, &mut data);
+    update_mass_matrix(model, &mut data);
     let stiffness = DMatrix::from_diagonal(&model.stiffness());
     let mut result = generalized_modes(&data.mass_matrix, &stiffness, DVector::from_column_slice(equilibrium))?;
-    result.stable &= model.joints.iter().all(|j| j.stiffness > 0.0);
+    result.stable &= model.joints().iter().all(|j| j.stiffness > 0.0);
     Ok(result)
 }
 
@@ -35,21 +36,20 @@ pub fn modes(model: &Model, equilibrium: &[f64]) -> Result<Modes> {
 /// factor M = L Lᵀ: (L⁻¹ K L⁻ᵀ) v = λ v, φ = L⁻ᵀ v. Stable when every λ > 0.
 pub fn generalized_modes(mass: &DMatrix<f64>, stiffness: &DMatrix<f64>, equilibrium: DVector<f64>) -> Result<Modes> {
     let n = mass.nrows();
-    let numerical = |message: String| NanofoldError::Numerical {
-        stage: "modes".into(),
-        message,
+    let singular = || NumericalError::Singular {
+        what: "modes",
+        detail: "the mass matrix's Cholesky factor".into(),
     };
     let cholesky = mass
         .clone()
         .cholesky()
-        .ok_or_else(|| numerical("mass matrix is not positive definite".into()))?;
+        .ok_or_else(|| NumericalError::NotPositiveDefinite {
+            matrix: "the mass matrix",
+            at: format!("the equilibrium {:?} rad", equilibrium.as_slice()),
+        })?;
     let l = cholesky.l();
-    let l_inv_k = l
-        .solve_lower_triangular(stiffness)
-        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
-    let a = l
-        .solve_lower_triangular(&l_inv_k.transpose())
-        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
+    let l_inv_k = l.solve_lower_triangular(stiffness).ok_or_else(singular)?;
+    let a = l.solve_lower_triangular(&l_inv_k.transpose()).ok_or_else(singular)?;
     let symmetric = 0.5 * (&a + a.transpose());
     let eigen = SymmetricEigen::new(symmetric);
     let mut order: Vec<usize> = (0..n).collect();
@@ -57,7 +57,7 @@ pub fn generalized_modes(mass: &DMatrix<f64>, stiffness: &DMatrix<f64>, equilibr
     let shapes_unscaled = l
         .transpose()
         .solve_upper_triangular(&eigen.eigenvectors)
-        .ok_or_else(|| numerical("singular Cholesky factor".into()))?;
+        .ok_or_else(singular)?;
     let mut mode_shapes = DMatrix::zeros(n, n);
     let mut eigenvalues = Vec::with_capacity(n);
     for (column, &k) in order.iter().enumerate() {
@@ -70,9 +70,13 @@ pub fn generalized_modes(mass: &DMatrix<f64>, stiffness: &DMatrix<f64>, equilibr
         eigenvalues.push(eigen.eigenvalues[k]);
     }
     if eigenvalues.iter().any(|l| !l.is_finite()) {
-        return Err(numerical(format!(
-            "eigenvalues of M⁻¹K overflow ({eigenvalues:?}): stiffness and inertia are too far apart in double precision; check the scene's units"
-        )));
+        return Err(NumericalError::NonFinite {
+            what: "modes",
+            detail: format!(
+                "eigenvalues of M⁻¹K overflow ({eigenvalues:?}): stiffness and inertia are too far apart in double precision; check the scene's units"
+            ),
+        }
+        .into());
     }
     let stable = eigenvalues.iter().all(|&l| l > 0.0);
     Ok(Modes {

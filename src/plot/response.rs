@@ -3,11 +3,14 @@
 //! plates in 3D for a closed chain, figures 5-10 to 5-12).
 
 use super::{draw_legend, plot_error, series_colour};
-use crate::dynamics::simulate::{ModelKind, Response, Sample};
-use crate::dynamics::Data;
+use crate::dynamics::algorithms::{update_corners, update_poses};
+use crate::dynamics::closed::ClosedChain;
+use crate::dynamics::model::Data;
+use crate::dynamics::plant::Sample;
+use crate::dynamics::scene::{Scene, System};
+use crate::dynamics::simulate::{ModelKind, Response};
+use crate::dynamics::strip::StripChain;
 use crate::error::Result;
-use crate::scene::closed::ClosedScene;
-use crate::scene::Scene;
 use nalgebra::Point3;
 use plotters::prelude::*;
 
@@ -40,31 +43,78 @@ fn model_label(response: &Response) -> String {
 
 /// What the response figure labels: one entry per plotted angle.
 pub struct ResponseView {
+    /// The scene's name, for the title.
     pub name: String,
     /// Legend label of each angle series.
     pub labels: Vec<String>,
     /// A dashed target line per series, if any (rad).
     pub targets: Vec<Option<f64>>,
+    /// Whether drag is modelled (the energy plot says so).
     pub drag: bool,
 }
 
 impl ResponseView {
-    /// An open strip chain: hinge i, passive or with its target.
+    /// A scene's series: a strip's hinges (passive or with their targets), or a closed
+    /// chain's creases with their roles (driven, locked, cut).
     pub fn of_scene(scene: &Scene) -> Self {
+        match &scene.system {
+            System::Strip(chain) => Self::of_strip(&scene.name, chain),
+            System::Closed(chain) => Self::of_closed(&scene.name, chain),
+        }
+    }
+
+    fn of_strip(name: &str, chain: &StripChain) -> Self {
         ResponseView {
-            name: scene.name.clone(),
-            labels: (0..scene.model.dof())
-                .map(|i| format!("hinge {i}{}", if scene.actuated[i] { "" } else { " (passive)" }))
+            name: name.to_string(),
+            labels: (0..chain.model.dof())
+                .map(|i| {
+                    let passive = !chain.forcing.hinges[i].actuated;
+                    format!("hinge {i}{}", if passive { " (passive)" } else { "" })
+                })
                 .collect(),
-            targets: scene.target_angles.iter().map(|&t| Some(t)).collect(),
-            drag: scene.model.drag.is_some(),
+            targets: chain.forcing.hinges.iter().map(|h| Some(h.target)).collect(),
+            drag: chain.model.drag().is_some(),
+        }
+    }
+
+    fn of_closed(name: &str, chain: &ClosedChain) -> Self {
+        let creases = chain.crease_stiffness.len();
+        ResponseView {
+            name: name.to_string(),
+            labels: (0..creases)
+                .map(|c| {
+                    let role = if c == chain.driver {
+                        "driven"
+                    } else if chain.locked.iter().any(|&(l, _)| l == c) {
+                        "locked"
+                    } else if c == chain.cut_crease {
+                        "cut, follows"
+                    } else {
+                        "follows"
+                    };
+                    format!("{} ({role})", chain.crease_labels[c])
+                })
+                .collect(),
+            targets: (0..creases)
+                .map(|c| (c == chain.driver).then_some(chain.target()))
+                .collect(),
+            drag: chain.model.drag().is_some(),
         }
     }
 }
 
-/// Renders `response.svg` of a strip scene.
+/// Renders a scene's `response.svg`.
 pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
     response_view_svg(&ResponseView::of_scene(scene), response)
+}
+
+/// Renders a scene's `snapshots.svg`: a strip seen along its creases, a closed chain's
+/// plates in 3D.
+pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
+    match &scene.system {
+        System::Strip(chain) => strip_snapshots_svg(&scene.name, chain, scene.outputs.snapshots, response),
+        System::Closed(chain) => closed_snapshots_svg(&scene.name, chain, response, 5),
+    }
 }
 
 /// Renders `response.svg`: angles (deg) per series with dashed targets, and the energy terms.
@@ -238,19 +288,19 @@ pub fn snapshot_samples(response: &Response, count: usize) -> Vec<usize> {
     picks
 }
 
-/// Renders `snapshots.svg`: the chain seen along the creases (the y–z plane) at several
+/// A strip's `snapshots.svg`: the chain seen along the creases (the y–z plane) at several
 /// times, the substrate solid where it remains and dashed where it is etched away.
-pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
-    let model = &scene.model;
+fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &Response) -> Result<String> {
+    let model = &chain.model;
     let mut data = Data::new(model);
-    let picks = snapshot_samples(response, scene.outputs.snapshots);
+    let picks = snapshot_samples(response, count);
     let (scale, unit) = time_unit(response.t_end);
     // Centre lines of the plates in µm, per snapshot.
     let mut outlines: Vec<(f64, Vec<(f64, f64)>)> = Vec::new();
     for &k in &picks {
         let sample = &response.samples[k];
-        model.update_poses(sample.angles.as_slice(), &mut data);
-        model.update_corners(&mut data);
+        update_poses(model, sample.angles.as_slice(), &mut data);
+        update_corners(model, &mut data);
         let mut points = Vec::new();
         for i in 0..model.dof() {
             let first = model.corner_index(i, 0);
@@ -273,7 +323,7 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
             z_hi = z_hi.max(z);
         }
     }
-    let edge = scene.substrate_edge_y * 1e6;
+    let edge = chain.substrate_edge_y * 1e6;
     y_lo = y_lo.min(edge - 50.0);
     let (width, height) = (1000u32, 620u32);
     // Equal scales on both axes: widen whichever range is short.
@@ -293,11 +343,7 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
         root.fill(&WHITE).map_err(plot_error)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(
-                format!(
-                    "{}: side view along the creases ({})",
-                    scene.name,
-                    model_label(response)
-                ),
+                format!("{}: side view along the creases ({})", name, model_label(response)),
                 ("sans-serif", 18),
             )
             .margin(12)
@@ -356,20 +402,19 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
     Ok(svg)
 }
 
-/// Renders a closed chain's `snapshots.svg`: the sector plates in 3D (the anchored one grey)
-/// at `count` moments of the response, like the thesis's figures 5-10 to 5-12.
-pub fn closed_snapshots_svg(scene: &ClosedScene, response: &Response, count: usize) -> Result<String> {
-    let chain = &scene.chain;
+/// A closed chain's `snapshots.svg`: the sector plates in 3D (the anchored one grey) at
+/// `count` moments of the response, like the thesis's figures 5-10 to 5-12.
+fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, count: usize) -> Result<String> {
     let model = &chain.model;
     let mut data = Data::new(model);
     let reach = chain
         .ground
         .iter()
-        .chain(model.plates.iter().flat_map(|p| p.outline.iter()))
+        .chain(model.plates().iter().flat_map(|p| p.outline.iter()))
         .map(|c| c.coords.norm())
         .chain(
             model
-                .plates
+                .plates()
                 .iter()
                 .map(|p| p.radius() + p.reference_pose.translation.vector.norm()),
         )
@@ -385,7 +430,7 @@ pub fn closed_snapshots_svg(scene: &ClosedScene, response: &Response, count: usi
             .titled(
                 &format!(
                     "{}: the plates in 3D (grey: anchored sector; µm){}",
-                    scene.name,
+                    name,
                     response
                         .collision
                         .as_ref()
@@ -400,8 +445,8 @@ pub fn closed_snapshots_svg(scene: &ClosedScene, response: &Response, count: usi
         for (panel, &index) in panels.iter().zip(&picks) {
             let sample = &response.samples[index];
             let joint_angles: Vec<f64> = chain.joint_creases.iter().map(|&c| sample.angles[c]).collect();
-            model.update_poses(&joint_angles, &mut data);
-            model.update_corners(&mut data);
+            update_poses(model, &joint_angles, &mut data);
+            update_corners(model, &mut data);
             let mut view = ChartBuilder::on(panel)
                 .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
                 .margin(4)
@@ -417,7 +462,7 @@ pub fn closed_snapshots_svg(scene: &ClosedScene, response: &Response, count: usi
                 chain.ground.iter().map(to_plot).collect::<Vec<_>>(),
                 RGBColor(150, 150, 150),
             )];
-            for (j, plate) in model.plates.iter().enumerate() {
+            for (j, plate) in model.plates().iter().enumerate() {
                 let corners = (0..plate.outline.len())
                     .map(|k| to_plot(&data.corners[model.corner_index(j, k)]))
                     .collect();

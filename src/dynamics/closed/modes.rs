@@ -1,22 +1,23 @@
-//! Modes of a closed chain at its folded equilibrium (SPEC §7, T5.14, T5.28): every lock is
+//! Modes of a closed chain at its folded equilibrium (`docs/model.md#modes`): every lock is
 //! released, so the coordinates θ_c are the driver and the locked creases (n − 3 of them for
 //! a single vertex), the others follow by loop closure θ = θ(θ_c) with Γ = ∂θ/∂θ_c.
 //!
 //! The hinge energy V(θ_c) = Σ_i ½ K_i (θ_i − r_i)² (r_i: the driver's target, a released
 //! lock's angle, 0 for a passive hinge) has gradient Σ K_i (θ_i − r_i) Γ_i and Hessian
 //!   ∂²V/∂θ_c² = Γᵀ K Γ + Σ_i K_i (θ_i − r_i) ∂²θ_i/∂θ_c²,
-//! the second term being the loaded passive hinges' share (zero in SPEC §7's Γᵀ K Γ, which
-//! holds only where every hinge is at rest). The equilibrium is found by Newton on ∇V = 0
+//! the second term being the loaded passive hinges' share (zero in the thesis's Γᵀ K Γ,
+//! which holds only where every hinge is at rest). The equilibrium is found by Newton on ∇V = 0
 //! from the scene's folded pose; the modes solve ∂²V φ = λ (Γᵀ M Γ) φ there.
 
 use super::ClosedChain;
 use crate::constraints::exact::ConstraintPoint;
 use crate::constraints::exact::{closure_bias, implicit_jacobian_rays};
 use crate::constraints::sweep::{CLOSURE_TOL, REFINE_ITERATIONS};
+use crate::dynamics::algorithms::{update_kinematics, update_mass_matrix};
+use crate::dynamics::model::Data;
 use crate::dynamics::modes::{generalized_modes, Modes};
-use crate::dynamics::Data;
-use crate::error::{NanofoldError, Result};
-use crate::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
+use crate::error::{NumericalError, Result};
+use crate::geometry::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
@@ -85,7 +86,7 @@ impl ClosedChain {
     /// angle (the hinge that holds it there), 0 for a passive hinge.
     pub fn rest_angles(&self) -> Vec<f64> {
         let mut rest = vec![0.0; self.crease_stiffness.len()];
-        rest[self.driver] = self.target;
+        rest[self.driver] = self.target();
         for &(c, angle) in &self.locked {
             rest[c] = angle;
         }
@@ -135,9 +136,12 @@ impl ClosedChain {
             }
             let bias = closure_bias(&self.sector_angles, &rho, &rates);
             lu.solve(&DVector::from_column_slice((-bias).as_slice()))
-                .ok_or_else(|| NanofoldError::Numerical {
-                    stage: "closed-chain modes".into(),
-                    message: "the dependents' closure Jacobian is singular".into(),
+                .ok_or_else(|| {
+                    NumericalError::Singular {
+                        what: "closed-chain modes",
+                        detail: "the dependents' closure Jacobian".into(),
+                    }
+                    .into()
                 })
         };
         let unit = |a: usize| DVector::from_fn(m, |i, _| if i == a { 1.0 } else { 0.0 });
@@ -186,8 +190,8 @@ impl ClosedChain {
     pub fn reduced_mass_matrix(&self, state: &ClosureState, data: &mut Data) -> DMatrix<f64> {
         let joint_angles: Vec<f64> = self.joint_creases.iter().map(|&c| state.angles[c]).collect();
         let joint_jacobian = state.jacobian.select_rows(&self.joint_creases);
-        self.model.update_kinematics(&joint_angles, data);
-        self.model.update_mass_matrix(data);
+        update_kinematics(&self.model, &joint_angles, data);
+        update_mass_matrix(&self.model, data);
         let reduced = joint_jacobian.transpose() * &data.mass_matrix * &joint_jacobian;
         0.5 * (&reduced + reduced.transpose())
     }
@@ -196,9 +200,9 @@ impl ClosedChain {
     /// angles, the dependents from the scene's constraint source.
     pub fn folded_pose(&self) -> Result<Vec<f64>> {
         let mut point = ConstraintPoint::zeros(self.dependents.len());
-        self.source.evaluate(self.target, &mut point)?;
+        self.source.evaluate(self.target(), &mut point)?;
         let mut angles = vec![0.0; self.crease_stiffness.len()];
-        angles[self.driver] = self.target;
+        angles[self.driver] = self.target();
         for &(c, angle) in &self.locked {
             angles[c] = angle;
         }
@@ -223,10 +227,10 @@ impl ClosedChain {
                 .lu()
                 .solve(&(-&gradient))
                 .filter(|s| s.iter().all(|v| v.is_finite()))
-                .ok_or_else(|| NanofoldError::Numerical {
-                    stage: "closed-chain equilibrium".into(),
-                    message: format!(
-                        "the hinge energy's Hessian is singular at θ_c = {:?}°",
+                .ok_or_else(|| NumericalError::Singular {
+                    what: "closed-chain equilibrium",
+                    detail: format!(
+                        "the hinge energy's Hessian at θ_c = {:?}°",
                         theta_c.iter().map(|t| t.to_degrees()).collect::<Vec<_>>()
                     ),
                 })?;
@@ -235,10 +239,11 @@ impl ClosedChain {
                 break (gradient, hinge, load);
             }
             if iterations == NEWTON_ITERATIONS {
-                return Err(NanofoldError::Numerical {
-                    stage: "closed-chain equilibrium".into(),
-                    message: format!("Newton on ∇V = 0 did not converge: last step {size:.3e} rad"),
-                });
+                return Err(NumericalError::NoEquilibrium {
+                    what: "closed-chain equilibrium",
+                    detail: format!("Newton on ∇V = 0 did not converge: last step {size:.3e} rad"),
+                }
+                .into());
             }
             let scale = (NEWTON_STEP_CAP / size).min(1.0);
             for (t, s) in theta_c.iter_mut().zip(step.iter()) {

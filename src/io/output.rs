@@ -2,13 +2,14 @@
 //! to a temporary file and renamed, so nothing is left half-written.
 
 use crate::dynamics::closed::modes::ClosedModes;
+use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::modes::Modes;
-use crate::dynamics::simulate::{Response, Sample, SimulationSettings};
+use crate::dynamics::plant::Sample;
+use crate::dynamics::scene::{Scene, System};
+use crate::dynamics::simulate::{Response, Simulation, SimulationSettings};
 use crate::error::{NanofoldError, Result};
-use crate::pattern::{Chain, FoldMesh, Pattern, RayRole};
-use crate::scene::closed::ClosedScene;
-use crate::scene::Scene;
-use crate::sphere::Vec3;
+use crate::geometry::sphere::Vec3;
+use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -18,21 +19,21 @@ use std::path::Path;
 
 /// Writes `contents` to `path` through a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
-    let err = |message: String| NanofoldError::Output {
+    let err = |source: std::io::Error| NanofoldError::Output {
         path: path.display().to_string(),
-        message,
+        source,
     };
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
+    std::fs::create_dir_all(dir).map_err(err)?;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("output");
     let temporary = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    std::fs::write(&temporary, contents).map_err(|e| err(e.to_string()))?;
+    std::fs::write(&temporary, contents).map_err(err)?;
     std::fs::rename(&temporary, path).map_err(|e| {
         let _ = std::fs::remove_file(&temporary);
-        err(e.to_string())
+        err(e)
     })
 }
 
@@ -76,7 +77,7 @@ struct ExportMesh {
 }
 
 fn export_mesh(pattern: &Pattern) -> ExportMesh {
-    if let Some(FoldMesh {
+    if let Some(FlatMesh {
         vertices_coords,
         edges_vertices,
         edges_assignment,
@@ -288,44 +289,28 @@ pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &Un
     })
 }
 
+/// The target of every output angle: each hinge's for a strip; for a closed chain the
+/// driver's target and the locks' angles (0 for the creases that follow).
+pub fn target_angles(scene: &Scene) -> Vec<f64> {
+    match &scene.system {
+        System::Strip(chain) => chain.target_angles().as_slice().to_vec(),
+        System::Closed(chain) => {
+            let mut targets = vec![0.0; chain.crease_stiffness.len()];
+            targets[chain.driver] = chain.target();
+            for &(c, value) in &chain.locked {
+                targets[c] = value;
+            }
+            targets
+        }
+    }
+}
+
 /// The summary of a dynamics run: the `--json` object, and the head of `response.json`.
-pub fn response_summary(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
-    summary_of(&scene.name, scene.target_angles.as_slice(), settings, response)
-}
-
-/// The summary of a closed-chain run: the open chain's keys (angles are every crease's, in
-/// FOLD edge order) plus `cut_crease`, `constraint_source`, `torque_magnification`,
-/// `max_closure_residual` and the fit's error.
-pub fn closed_response_summary(scene: &ClosedScene, settings: &SimulationSettings, response: &Response) -> Value {
-    let chain = &scene.chain;
-    let mut targets = vec![0.0; chain.crease_stiffness.len()];
-    targets[chain.driver] = chain.target;
-    for &(c, value) in &chain.locked {
-        targets[c] = value;
-    }
-    let mut value = summary_of(&scene.name, &targets, settings, response);
-    if let Some(closed) = &response.closed {
-        value["cut_crease"] = json!(closed.cut_crease);
-        value["driving_crease"] = json!(closed.driver);
-        value["constraint_source"] = json!(closed.constraint_source);
-        value["constraint_degree"] = json!(closed.degree);
-        value["constraint_fit_error_rad"] = json!(closed.fit_error);
-        value["constraint_slope_error"] = json!(closed.slope_error);
-        value["torque_magnification"] = json!(closed.torque_magnification);
-        value["driving_hinge_width_um"] = json!(closed.driving_hinge_width_um);
-        value["required_hinge_width_um"] = json!(closed.required_hinge_width_um);
-        value["max_closure_residual"] = json!(closed.max_closure_residual);
-        value["crease_edges"] = json!(scene.pattern.user_indices());
-    }
-    value
-}
-
-/// `response.json` of a closed-chain run.
-pub fn closed_response_json(scene: &ClosedScene, settings: &SimulationSettings, response: &Response) -> Value {
-    with_samples(closed_response_summary(scene, settings, response), response)
-}
-
-fn summary_of(name: &str, target_angles: &[f64], settings: &SimulationSettings, response: &Response) -> Value {
+/// A closed chain adds `cut_crease`, `anchored_face`, `constraint_source`,
+/// `torque_magnification`, `max_closure_residual` and the fit's errors (angles are every
+/// crease's, in FOLD edge order).
+pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> Value {
+    let response = &simulation.response;
     let collision = response.collision.as_ref().map(|c| {
         json!({
             "time_s": c.time,
@@ -339,8 +324,8 @@ fn summary_of(name: &str, target_angles: &[f64], settings: &SimulationSettings, 
         .last()
         .map(|s| s.angles.as_slice().to_vec())
         .unwrap_or_default();
-    json!({
-        "scene": name,
+    let mut value = json!({
+        "scene": scene.name,
         "model": response.model,
         "method": response.method,
         "rtol": response.rtol,
@@ -353,16 +338,31 @@ fn summary_of(name: &str, target_angles: &[f64], settings: &SimulationSettings, 
         "t_end_s": response.t_end,
         "collision": collision,
         "final_angles_rad": final_angles,
-        "target_angles_rad": target_angles,
+        "target_angles_rad": target_angles(scene),
         "steps": response.steps,
         "rhs_evaluations": response.rhs_evaluations,
         "seconds": response.seconds,
-    })
+    });
+    if let (Some(closed), Some(chain)) = (&simulation.closed, scene.closed()) {
+        value["cut_crease"] = json!(closed.cut_crease);
+        value["anchored_face"] = json!(closed.anchored_face);
+        value["driving_crease"] = json!(closed.driver);
+        value["constraint_source"] = json!(closed.constraint_source);
+        value["constraint_degree"] = json!(closed.degree);
+        value["constraint_fit_error_rad"] = json!(closed.fit_error);
+        value["constraint_slope_error"] = json!(closed.slope_error);
+        value["torque_magnification"] = json!(closed.torque_magnification);
+        value["driving_hinge_width_um"] = json!(closed.driving_hinge_width_um);
+        value["required_hinge_width_um"] = json!(closed.required_hinge_width_um);
+        value["max_closure_residual"] = json!(closed.max_closure_residual);
+        value["crease_edges"] = json!(chain.crease_user_indices);
+    }
+    value
 }
 
 /// `response.json`: the summary plus every output sample.
-pub fn response_json(scene: &Scene, settings: &SimulationSettings, response: &Response) -> Value {
-    with_samples(response_summary(scene, settings, response), response)
+pub fn response_json(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> Value {
+    with_samples(response_summary(scene, settings, simulation), &simulation.response)
 }
 
 fn with_samples(mut value: Value, response: &Response) -> Value {
@@ -384,7 +384,7 @@ fn with_samples(mut value: Value, response: &Response) -> Value {
     value
 }
 
-/// `nanofold modes` output.
+/// `nanofold modes` output of a strip.
 pub fn modes_json(scene: &Scene, modes: &Modes) -> Value {
     let n = modes.eigenvalues.len();
     json!({
@@ -395,16 +395,14 @@ pub fn modes_json(scene: &Scene, modes: &Modes) -> Value {
         "frequencies_hz": modes.frequencies_hz,
         "mode_shapes": (0..n).map(|k| modes.mode_shapes.column(k).iter().copied().collect::<Vec<f64>>()).collect::<Vec<_>>(),
         "stable": modes.stable,
-        "stiffness_n_m_per_rad": scene.model.stiffness().as_slice(),
+        "stiffness_n_m_per_rad": scene.stiffness(),
     })
 }
 
-/// `nanofold modes` output of a closed chain: the open chain's keys (`equilibrium_rad` and
+/// `nanofold modes` output of a closed chain: the strip's keys (`equilibrium_rad` and
 /// `mode_shapes` are over the released coordinates) plus every crease's angles and shapes,
 /// the reduced matrices and the closed-chain keys. Crease numbers are FOLD edge indices.
-pub fn closed_modes_json(scene: &ClosedScene, modes: &ClosedModes, torque_magnification: f64) -> Value {
-    let chain = &scene.chain;
-    let pattern = &scene.pattern;
+pub fn closed_modes_json(name: &str, chain: &ClosedChain, modes: &ClosedModes, torque_magnification: f64) -> Value {
     let columns = |m: &DMatrix<f64>| {
         (0..m.ncols())
             .map(|k| m.column(k).iter().copied().collect::<Vec<f64>>())
@@ -416,15 +414,21 @@ pub fn closed_modes_json(scene: &ClosedScene, modes: &ClosedModes, torque_magnif
             .collect::<Vec<_>>()
     };
     let stiffness = &modes.hinge_stiffness + &modes.load_stiffness;
-    let user = |creases: &[usize]| creases.iter().map(|&c| pattern.user_index(c)).collect::<Vec<_>>();
+    let user = |creases: &[usize]| {
+        creases
+            .iter()
+            .map(|&c| chain.crease_user_indices[c])
+            .collect::<Vec<_>>()
+    };
     json!({
-        "scene": scene.name,
-        "cut_crease": pattern.user_index(chain.cut_crease),
+        "scene": name,
+        "cut_crease": chain.crease_user_indices[chain.cut_crease],
+        "anchored_face": chain.anchored_face,
         "constraint_source": chain.source.name(),
         "torque_magnification": torque_magnification,
         "max_closure_residual": modes.closure_residual,
         "coordinates": user(&modes.coordinates),
-        "crease_edges": pattern.user_indices(),
+        "crease_edges": chain.crease_user_indices,
         "equilibrium_rad": modes.modes.equilibrium.as_slice(),
         "equilibrium": "∇V = 0 with every lock released; V = Σ ½ K (θ − rest)² along the loop closure",
         "equilibrium_crease_angles_rad": modes.equilibrium,

@@ -1,8 +1,8 @@
 //! The native single-vertex schema (documented in patterns/README.md): sector angles,
 //! closed or open chain, one entry per crease with assignment, folded angle and lock.
 
-use super::{Assignment, Chain, RawCrease, RawRay, RawVertex};
 use crate::error::{NanofoldError, Result};
+use crate::pattern::{Assignment, Chain, CreaseSpec, RaySpec, VertexBuilder};
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -29,10 +29,10 @@ struct NativeCrease {
 /// Reads a native vertex. `chain` is "closed" (interior vertex: one sector after each
 /// crease) or "open" (boundary vertex: the sheet's edge, then the creases, then the other
 /// edge; one more sector than creases).
-pub(crate) fn read_native(value: &Value, name: &str) -> Result<RawVertex> {
+pub(crate) fn read_native(value: &Value, name: &str) -> Result<VertexBuilder> {
     for key in ["chain", "angle_unit", "sector_angles", "creases"] {
         if value.get(key).is_none() {
-            return Err(NanofoldError::MissingField { field: key.to_string() });
+            return Err(NanofoldError::missing(key));
         }
     }
     let vertex: NativeVertex = serde_json::from_value(value.clone())
@@ -73,13 +73,13 @@ pub(crate) fn read_native(value: &Value, name: &str) -> Result<RawVertex> {
     }
     let mut rays = Vec::new();
     if chain == Chain::Open {
-        rays.push(RawRay::Boundary);
+        rays.push(RaySpec::Boundary);
     }
     for (i, c) in vertex.creases.iter().enumerate() {
-        rays.push(RawRay::Crease(RawCrease {
+        rays.push(RaySpec::Crease(CreaseSpec {
             label: format!("creases[{i}]"),
             assignment: Assignment::from_letter(&c.assignment, &format!("creases[{i}].assignment"))?,
-            folded_angle: c.fold_angle * to_rad,
+            fold_angle: c.fold_angle * to_rad,
             locked: c.locked,
             fold_edge: None,
             order: i,
@@ -87,9 +87,9 @@ pub(crate) fn read_native(value: &Value, name: &str) -> Result<RawVertex> {
         }));
     }
     if chain == Chain::Open {
-        rays.push(RawRay::Boundary);
+        rays.push(RaySpec::Boundary);
     }
-    Ok(RawVertex {
+    Ok(VertexBuilder {
         name: vertex.name.unwrap_or_else(|| name.to_string()),
         chain,
         rays,

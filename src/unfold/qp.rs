@@ -7,7 +7,7 @@ mod row_space;
 
 pub use row_space::{ConstraintJacobian, JacobianRow, RowSpace, RANK_TOL};
 
-use crate::error::{NanofoldError, Result};
+use crate::error::{NumericalError, Result};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use nalgebra::{DMatrix, DVector};
@@ -82,23 +82,20 @@ pub fn solve_clarabel(problem: &DirectionProblem) -> Result<DirectionSolution> {
         .tol_feas(1e-13)
         .presolve_enable(false)
         .build()
-        .map_err(|e| NanofoldError::Numerical {
-            stage: "QP settings".into(),
+        .map_err(|e| NumericalError::QpSetup {
             message: format!("{e:?}"),
         })?;
-    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| NanofoldError::Numerical {
-        stage: "QP setup".into(),
-        message: e.to_string(),
-    })?;
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
+        .map_err(|e| NumericalError::QpSetup { message: e.to_string() })?;
     solver.solve();
     let status = match solver.solution.status {
         SolverStatus::Solved => QpStatus::Solved,
         SolverStatus::AlmostSolved => QpStatus::AlmostSolved,
         other => {
-            return Err(NanofoldError::Numerical {
-                stage: "direction QP (Clarabel)".into(),
-                message: format!("status {other:?}"),
-            })
+            return Err(NumericalError::QpStatus {
+                status: format!("{other:?}"),
+            }
+            .into())
         }
     };
     Ok(DirectionSolution {

@@ -3,7 +3,7 @@
 //! the rows that close the loop, O(n) per factorisation; a dense SVD is the reference and
 //! the fallback.
 
-use crate::error::{NanofoldError, Result};
+use crate::error::{NumericalError, Result};
 use clarabel::algebra::CscMatrix;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
@@ -404,10 +404,11 @@ impl DenseRowSpace {
         let (u, v_t) = match (svd.u, svd.v_t) {
             (Some(u), Some(v_t)) => (u, v_t),
             _ => {
-                return Err(NanofoldError::Numerical {
-                    stage: "SVD".into(),
-                    message: "no singular vectors".into(),
-                })
+                return Err(NumericalError::Singular {
+                    what: "SVD",
+                    detail: "no singular vectors".into(),
+                }
+                .into())
             }
         };
         let sigma_max = svd.singular_values.max();
@@ -416,10 +417,11 @@ impl DenseRowSpace {
             .collect();
         let sigma = DVector::from_iterator(keep.len(), keep.iter().map(|&i| svd.singular_values[i]));
         if sigma.iter().any(|s| !s.is_finite()) {
-            return Err(NanofoldError::Numerical {
-                stage: "SVD".into(),
-                message: "non-finite singular value".into(),
-            });
+            return Err(NumericalError::NonFinite {
+                what: "SVD",
+                detail: "a singular value".into(),
+            }
+            .into());
         }
         Ok(DenseRowSpace {
             v_t: v_t.select_rows(keep.iter()),
@@ -465,10 +467,11 @@ impl RowSpace {
             .iter()
             .any(|r| r.entries().iter().any(|(_, g)| !g[0].is_finite() || !g[1].is_finite()))
         {
-            return Err(NanofoldError::Numerical {
-                stage: "constraint Jacobian".into(),
-                message: "non-finite entry".into(),
-            });
+            return Err(NumericalError::NonFinite {
+                what: "constraint Jacobian",
+                detail: "an entry".into(),
+            }
+            .into());
         }
         match ChainRowSpace::new(a) {
             Some(chain) => Ok(RowSpace {

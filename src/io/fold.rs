@@ -2,8 +2,8 @@
 //! order and its sector angles; `edges_foldAngle` (degrees, valley positive) is the folded
 //! state. Locked creases use the custom key `edges_nanofold:locked` (FOLD's namespace rule).
 
-use super::{Assignment, Chain, FoldMesh, RawCrease, RawRay, RawVertex};
 use crate::error::{NanofoldError, Result};
+use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder};
 use serde_json::Value;
 use std::f64::consts::TAU;
 
@@ -12,7 +12,7 @@ pub const LOCKED_KEY: &str = "edges_nanofold:locked";
 
 fn array<'a>(value: &'a Value, key: &str) -> Result<&'a Vec<Value>> {
     match value.get(key) {
-        None => Err(NanofoldError::MissingField { field: key.to_string() }),
+        None => Err(NanofoldError::missing(key)),
         Some(Value::Array(items)) => Ok(items),
         Some(other) => Err(NanofoldError::invalid(key, short(other), "expected an array")),
     }
@@ -52,7 +52,7 @@ fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> 
 }
 
 /// Reads the key frame of a FOLD object into a raw vertex.
-pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
+pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
     // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).
     let coords_json = array(value, "vertices_coords")?;
     let mut coords = Vec::with_capacity(coords_json.len());
@@ -119,9 +119,10 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
         (Some(_), _) => ("edges_foldAngle", array(value, "edges_foldAngle")?),
         (None, Some(_)) => ("edges_foldAngles", array(value, "edges_foldAngles")?),
         (None, None) => {
-            return Err(NanofoldError::MissingField {
-                field: "edges_foldAngle (the folded state, degrees)".to_string(),
-            })
+            return Err(NanofoldError::missing_with(
+                "edges_foldAngle",
+                "the folded state, degrees",
+            ))
         }
     };
     if angles_json.len() != ne {
@@ -301,17 +302,17 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
         if is_crease[edge] {
             let field = format!("{angle_key}[{edge}]");
             let degrees = number(&angles_json[edge], &field)?;
-            rays.push(RawRay::Crease(RawCrease {
+            rays.push(RaySpec::Crease(CreaseSpec {
                 label: format!("edges[{edge}]"),
                 assignment: Assignment::from_letter(&letters[edge], &format!("edges_assignment[{edge}]"))?,
-                folded_angle: degrees.to_radians(),
+                fold_angle: degrees.to_radians(),
                 locked: locked[edge],
                 fold_edge: Some(edge),
                 order: order_of_edge[edge],
                 angle_field: field,
             }));
         } else {
-            rays.push(RawRay::Boundary);
+            rays.push(RaySpec::Boundary);
         }
         let last = match chain {
             Chain::Closed => false,
@@ -327,13 +328,13 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<RawVertex> {
         }
     }
 
-    Ok(RawVertex {
+    Ok(VertexBuilder {
         name: name.to_string(),
         chain,
         rays,
         sector_angles,
         sector_fields,
-        mesh: Some(FoldMesh {
+        mesh: Some(FlatMesh {
             vertices_coords: coords,
             edges_vertices: edges,
             edges_assignment: letters,

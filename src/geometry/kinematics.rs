@@ -6,8 +6,8 @@
 //! T_{k+1} = T_k R_x(ρ_k) R_z(α_k); node k is T_k e_x. A positive ρ_k (valley) lifts the
 //! sectors after ray k towards +z.
 
-use crate::error::{NanofoldError, Result};
-use crate::sphere::Vec3;
+use crate::error::{NumericalError, Result};
+use crate::geometry::sphere::Vec3;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
 fn rot_x(angle: f64) -> Matrix3<f64> {
@@ -111,9 +111,9 @@ pub fn solve_closure(
         // Relative cutoff: near a singular configuration a tiny singular value would
         // amplify the residual into a jump along the kernel, onto another branch.
         let cutoff = SINGULAR_CUTOFF * svd.singular_values.max();
-        let step = svd.solve(&rhs, cutoff).map_err(|e| NanofoldError::Numerical {
-            stage: "loop closure".into(),
-            message: e.to_string(),
+        let step = svd.solve(&rhs, cutoff).map_err(|e| NumericalError::Singular {
+            what: "loop closure",
+            detail: e.to_string(),
         })?;
         // Damp huge steps (far from the solution the linearisation is poor).
         let largest = step.amax();
@@ -122,10 +122,11 @@ pub fn solve_closure(
             fold_angles[k] += scale * step[col];
         }
     }
-    Err(NanofoldError::Numerical {
-        stage: "loop closure".into(),
-        message: format!("Newton did not converge: residual {residual:.3e} rad after {max_iterations} iterations"),
-    })
+    Err(NumericalError::ClosureNotConverged {
+        residual,
+        iterations: max_iterations,
+    }
+    .into())
 }
 
 /// Continues Newton (undamped, minimum-norm) after [`solve_closure`] until the step stops
@@ -207,7 +208,7 @@ fn left_jacobian_inverse(r: &Vector3<f64>) -> Matrix3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sphere::{fold_angle, geodesic};
+    use crate::geometry::sphere::{fold_angle, geodesic};
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
     #[test]

@@ -1,7 +1,7 @@
 //! Repulsive energies on the sphere (SPEC §4, T3.1–3.2), behind one trait so another
 //! reading can be added without touching the solver.
 
-use crate::sphere::{geodesic_with_gradient, Vec3};
+use crate::geometry::sphere::{geodesic_with_gradient, Vec3};
 use serde::Serialize;
 
 /// A great-circle arc (one sector) between nodes `a` and `b`, of length `length`.
@@ -104,7 +104,7 @@ impl SeparableEnergy {
                     ws.gamma_grad[v * n + w] = dv;
                     ws.gamma_grad[w * n + v] = dw;
                 } else {
-                    let g = crate::sphere::geodesic(&nodes[v], &nodes[w]);
+                    let g = crate::geometry::sphere::geodesic(&nodes[v], &nodes[w]);
                     ws.gamma[v * n + w] = g;
                     ws.gamma[w * n + v] = g;
                 }
@@ -191,7 +191,7 @@ impl Energy for MidpointEnergy {
                 if v == arc.a || v == arc.b {
                     continue;
                 }
-                let g = crate::sphere::geodesic(x, &mid);
+                let g = crate::geometry::sphere::geodesic(x, &mid);
                 if g <= 0.0 {
                     return f64::INFINITY;
                 }

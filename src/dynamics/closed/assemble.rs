@@ -1,0 +1,418 @@
+//! The closed-chain pipeline: a validated [`ClosedSpec`] → the constraint's exact sweep →
+//! its fit (or the exact source) → the tree of sector plates rooted at the anchored face
+//! (`docs/model.md#closed-chains`). Loaders never call this; building a scene does.
+
+use super::{ClosedChain, ConstraintSource};
+use crate::constraints::exact::ExactConstraint;
+use crate::constraints::{sweep_samples, ConstraintPoly, Setup};
+use crate::dynamics::forcing::{Forcing, HingeDrive};
+use crate::dynamics::model::{Joint, Model, Plate};
+use crate::dynamics::scene::{
+    actuation, crease_hinge, drag_law, finite, hinge_stiffness, material, positive, validate_materials, ClosedSpec,
+    HingeSpec, SourceKind, MICROMETRE,
+};
+use crate::error::{NanofoldError, Result};
+use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
+use nalgebra::{Point3, Unit, Vector3};
+use std::f64::consts::TAU;
+
+/// The flat geometry of the sectors in SI units, centred at the vertex.
+struct SectorGeometry {
+    /// Polar angle of every ray.
+    ray_direction: Vec<f64>,
+    /// The far end of every crease (file order), m.
+    crease_ends: Vec<Point3<f64>>,
+    /// The face covering every sector, counter-clockwise outline in m, and its FOLD index.
+    outlines: Vec<Option<(Vec<[f64; 2]>, usize)>>,
+}
+
+/// Assembles the closed chain a scene describes.
+pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
+    validate_materials(&spec.materials)?;
+    let pattern = &spec.pattern;
+    let mesh = check_pattern(pattern)?;
+    let unit = positive("length_unit_um", spec.length_unit_um)? * MICROMETRE;
+    let geometry = sector_geometry(pattern, mesh, unit)?;
+    let user = |field: &str, index: usize| {
+        pattern.crease_from_user_index(index).ok_or_else(|| {
+            NanofoldError::invalid(
+                field,
+                index,
+                format!(
+                    "not a crease of {} (creases: {:?})",
+                    pattern.name,
+                    pattern.user_indices()
+                ),
+            )
+        })
+    };
+    let creases = pattern.creases.len();
+
+    // Hinges, one per crease.
+    let hinges: Vec<HingeSpec> = spec.hinges.iter().map(crease_hinge).collect();
+    let mut hinge_of: Vec<Option<&HingeSpec>> = vec![None; creases];
+    let mut stiffness = vec![0.0; creases];
+    for (i, hinge) in spec.hinges.iter().enumerate() {
+        let c = user(&format!("hinges[{i}].crease"), hinge.crease)?;
+        if hinge_of[c].replace(&hinges[i]).is_some() {
+            return Err(NanofoldError::invalid(
+                format!("hinges[{i}].crease"),
+                hinge.crease,
+                "this crease already has a hinge",
+            ));
+        }
+        stiffness[c] = hinge_stiffness(&spec.materials, i, &hinges[i], geometry.crease_ends[c].coords.norm())?;
+    }
+    if let Some(c) = hinge_of.iter().position(Option::is_none) {
+        return Err(NanofoldError::missing(format!(
+            "hinges: an entry with crease {}",
+            pattern.user_index(c)
+        )));
+    }
+    let actuated: Vec<usize> = (0..creases)
+        .filter(|&c| hinge_of[c].is_some_and(|h| h.actuated))
+        .collect();
+    let [driver] = actuated[..] else {
+        return Err(NanofoldError::invalid(
+            "hinges[*].actuated",
+            format!("{} actuated", actuated.len()),
+            "a closed-chain step drives exactly one crease; lock the others",
+        ));
+    };
+    let driver_hinge = hinge_of[driver].expect("every crease has a hinge");
+    let target_field = "hinges[driver].target_angle_deg";
+    let target_deg = driver_hinge
+        .target_angle_deg
+        .ok_or_else(|| NanofoldError::missing(target_field))?;
+    finite(target_field, target_deg)?;
+    if target_deg.abs() > 180.0 {
+        return Err(NanofoldError::invalid(
+            target_field,
+            target_deg,
+            "must lie in [−180, 180]",
+        ));
+    }
+    let cut = user("cut_crease", spec.cut_crease)?;
+    if cut == driver {
+        return Err(NanofoldError::invalid(
+            "cut_crease",
+            spec.cut_crease,
+            "cannot cut the actuated crease: its torque would have no hinge to act on (the reduced equations cut an unactuated one)",
+        ));
+    }
+    let mut locks = Vec::new();
+    for (i, lock) in spec.locks.iter().enumerate() {
+        let c = user(&format!("locks[{i}].crease"), lock.crease)?;
+        locks.push((
+            c,
+            finite(&format!("locks[{i}].angle_deg"), lock.angle_deg)?.to_radians(),
+        ));
+    }
+    let free = creases as i64 - locks.len() as i64 - 3;
+    if free != 1 {
+        return Err(NanofoldError::invalid(
+            "locks",
+            format!("{} lock(s)", locks.len()),
+            format!(
+                "{creases} creases with {} locked leave {free} degree(s) of freedom (loop closure removes 3); a closed-chain step needs exactly 1",
+                locks.len()
+            ),
+        ));
+    }
+    let setup = Setup::new(pattern, driver, &locks)?;
+    let start = finite("start_angle_deg", spec.start_angle_deg)?.to_radians();
+    let target = target_deg.to_radians();
+    let domain = constraint_domain(spec.constraint.range_deg, start, target)?;
+    if start < domain[0] - 1e-12 || start > domain[1] + 1e-12 {
+        return Err(NanofoldError::invalid(
+            "start_angle_deg",
+            spec.start_angle_deg,
+            "must lie inside constraint.range_deg",
+        ));
+    }
+    let source = match (spec.constraint.source, spec.constraint.degree) {
+        (SourceKind::Poly, None) => {
+            return Err(NanofoldError::missing_with(
+                "constraint.degree",
+                "needed by source \"poly\"",
+            ))
+        }
+        (SourceKind::Exact, Some(degree)) => {
+            return Err(NanofoldError::invalid(
+                "constraint.degree",
+                degree,
+                "only the \"poly\" source has a degree",
+            ))
+        }
+        (SourceKind::Poly, Some(degree)) => {
+            let samples = sweep_samples(pattern, &setup, domain, spec.constraint.samples)?;
+            ConstraintSource::Poly(ConstraintPoly::fit(pattern, &samples, degree)?)
+        }
+        (SourceKind::Exact, None) => {
+            let samples = sweep_samples(pattern, &setup, domain, spec.constraint.samples)?;
+            ConstraintSource::Exact(ExactConstraint::new(pattern, &samples))
+        }
+    };
+
+    // The anchored sector and the tree of plates on either side of it up to the cut.
+    let thickness = positive("plates.thickness_um", spec.plates.thickness_um)? * MICROMETRE;
+    let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
+    let rays = pattern.rays.len();
+    let cut_ray = pattern.creases[cut].ray;
+    let ground_sector = match spec.anchored_face {
+        None => cut_ray,
+        Some(face) => (0..rays)
+            .find(|&s| geometry.outlines[s].as_ref().is_some_and(|(_, f)| *f == face))
+            .ok_or_else(|| {
+                NanofoldError::invalid(
+                    "anchored_face",
+                    face,
+                    format!("not a face of {} that covers a sector", pattern.name),
+                )
+            })?,
+    };
+    let outline = |sector: usize| {
+        geometry.outlines[sector]
+            .as_ref()
+            .map(|(o, _)| o.clone())
+            .ok_or_else(|| {
+                NanofoldError::invalid(
+                    format!("{}: faces_vertices", pattern.name),
+                    format!("sector {sector}"),
+                    "no face covers this sector",
+                )
+            })
+    };
+    let ray_crease = |r: usize| match pattern.rays[r] {
+        RayRole::Crease(c) => c,
+        _ => unreachable!("closed chains without virtual rays have a crease on every ray"),
+    };
+    let direction = |r: usize, sign: f64| {
+        let phi = geometry.ray_direction[r];
+        Unit::new_normalize(Vector3::new(sign * phi.cos(), sign * phi.sin(), 0.0))
+    };
+    let (mut joints, mut plates, mut parents) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut joint_creases, mut joint_sectors) = (Vec::new(), Vec::new());
+    // Counter-clockwise from the anchored sector: the crease at ray r turns sector r about
+    // +ray_r relative to sector r − 1 (a valley lifts it).
+    let mut parent = None;
+    for step in 1..rays {
+        let r = (ground_sector + step) % rays;
+        if r == cut_ray {
+            break;
+        }
+        joints.push(Joint {
+            axis: direction(r, 1.0),
+            point: Point3::origin(),
+            stiffness: stiffness[ray_crease(r)],
+        });
+        plates.push(Plate::lamina(&outline(r)?, thickness, density));
+        parents.push(parent);
+        parent = Some(joints.len() - 1);
+        joint_creases.push(ray_crease(r));
+        joint_sectors.push(r);
+    }
+    // Clockwise: the crease at ray r turns sector r − 1 about −ray_r relative to sector r.
+    let mut parent = None;
+    for step in 0..rays {
+        let r = (ground_sector + rays - step) % rays;
+        if r == cut_ray {
+            break;
+        }
+        let sector = (r + rays - 1) % rays;
+        joints.push(Joint {
+            axis: direction(r, -1.0),
+            point: Point3::origin(),
+            stiffness: stiffness[ray_crease(r)],
+        });
+        plates.push(Plate::lamina(&outline(sector)?, thickness, density));
+        parents.push(parent);
+        parent = Some(joints.len() - 1);
+        joint_creases.push(ray_crease(r));
+        joint_sectors.push(sector);
+    }
+    let ground = outline(ground_sector)?
+        .iter()
+        .map(|&[x, y]| Point3::new(x, y, 0.0))
+        .collect();
+    let actuation = actuation(&spec.actuation)?;
+    let mut drives = vec![HingeDrive::PASSIVE; creases];
+    drives[driver] = HingeDrive {
+        target,
+        radius_of_curvature: match actuation {
+            crate::dynamics::forcing::Actuation::Step => f64::INFINITY,
+            crate::dynamics::forcing::Actuation::Ramp { .. } => {
+                let field = "hinges[driver].radius_of_curvature_um";
+                positive(
+                    field,
+                    driver_hinge
+                        .radius_of_curvature_um
+                        .ok_or_else(|| NanofoldError::missing(field))?,
+                )? * MICROMETRE
+            }
+        },
+        actuated: true,
+    };
+    let anchored_face = geometry.outlines[ground_sector]
+        .as_ref()
+        .map(|(_, f)| *f)
+        .expect("the anchored sector has a face");
+    Ok(ClosedChain {
+        model: Model::tree(joints, plates, parents, drag_law(&spec.environment)?)?,
+        joint_creases,
+        joint_sectors,
+        ground_sector,
+        ground,
+        cut_crease: cut,
+        crease_stiffness: stiffness,
+        crease_labels: pattern.creases.iter().map(|c| c.label.clone()).collect(),
+        crease_ends: geometry.crease_ends,
+        driver,
+        locked: setup.locked.clone(),
+        dependents: setup.dependents.clone(),
+        source,
+        sector_angles: pattern.sector_angles.clone(),
+        crease_rays: pattern.creases.iter().map(|c| c.ray).collect(),
+        start,
+        crease_user_indices: pattern.user_indices(),
+        anchored_face,
+        forcing: Forcing {
+            actuation,
+            hinges: drives,
+        },
+    })
+}
+
+/// A closed vertex from a FOLD file with faces, and no sector split by a virtual ray.
+fn check_pattern(pattern: &Pattern) -> Result<&FlatMesh> {
+    if pattern.chain != Chain::Closed {
+        return Err(NanofoldError::invalid(
+            "pattern",
+            &pattern.name,
+            "a closed-chain scene needs an interior vertex (a closed loop of sectors)",
+        ));
+    }
+    if pattern.rays.iter().any(|r| matches!(r, RayRole::Virtual)) {
+        return Err(NanofoldError::invalid(
+            "pattern",
+            &pattern.name,
+            "sectors of 180° or more are not supported as plates: add a crease that splits them",
+        ));
+    }
+    let mesh = pattern.mesh.as_ref().ok_or_else(|| {
+        NanofoldError::invalid(
+            "pattern",
+            &pattern.name,
+            "must be a FOLD file (its faces are the plates)",
+        )
+    })?;
+    if mesh.faces_vertices.is_none() {
+        return Err(NanofoldError::missing_with(
+            format!("{}: faces_vertices", pattern.name),
+            "the plate outlines",
+        ));
+    }
+    Ok(mesh)
+}
+
+/// Ray directions, crease ends and which face covers which sector (the one its centroid's
+/// direction falls in), in m about the vertex.
+fn sector_geometry(pattern: &Pattern, mesh: &FlatMesh, unit: f64) -> Result<SectorGeometry> {
+    let rays = pattern.rays.len();
+    let centre = mesh.vertices_coords[mesh.center];
+    let mut ray_direction = vec![mesh.ray0_direction; rays];
+    for r in 1..rays {
+        ray_direction[r] = ray_direction[r - 1] + pattern.sector_angles[r - 1];
+    }
+    let crease_ends = pattern
+        .creases
+        .iter()
+        .enumerate()
+        .map(|(c, crease)| {
+            let edge = mesh.edges_vertices[crease.fold_edge.unwrap_or(c)];
+            let other = if edge[0] == mesh.center { edge[1] } else { edge[0] };
+            let [x, y] = mesh.vertices_coords[other];
+            Point3::new((x - centre[0]) * unit, (y - centre[1]) * unit, 0.0)
+        })
+        .collect();
+    let faces = mesh.faces_vertices.as_ref().expect("checked by check_pattern");
+    let mut outlines: Vec<Option<(Vec<[f64; 2]>, usize)>> = vec![None; rays];
+    for (i, face) in faces.iter().enumerate() {
+        let mut points: Vec<[f64; 2]> = face
+            .iter()
+            .map(|&v| {
+                let [x, y] = mesh.vertices_coords[v];
+                [(x - centre[0]) * unit, (y - centre[1]) * unit]
+            })
+            .collect();
+        let signed_area: f64 = (0..points.len())
+            .map(|k| {
+                let (a, b) = (points[k], points[(k + 1) % points.len()]);
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        if signed_area < 0.0 {
+            points.reverse();
+        }
+        if !is_convex(&points) {
+            return Err(NanofoldError::invalid(
+                format!("{}: faces_vertices[{i}]", pattern.name),
+                format!("{face:?}"),
+                "plates must be convex polygons",
+            ));
+        }
+        let n = points.len() as f64;
+        let (cx, cy) = points.iter().fold((0.0, 0.0), |(a, b), p| (a + p[0] / n, b + p[1] / n));
+        let angle = (cy.atan2(cx) - mesh.ray0_direction).rem_euclid(TAU);
+        let sector = (0..rays)
+            .rev()
+            .find(|&r| ray_direction[r] - mesh.ray0_direction <= angle)
+            .unwrap_or(0);
+        if outlines[sector].replace((points, i)).is_some() {
+            return Err(NanofoldError::invalid(
+                format!("{}: faces_vertices[{i}]", pattern.name),
+                format!("{face:?}"),
+                format!("a second face in sector {sector}: one face per sector"),
+            ));
+        }
+    }
+    Ok(SectorGeometry {
+        ray_direction,
+        crease_ends,
+        outlines,
+    })
+}
+
+/// The swept interval of the driving angle: `range_deg`, or from the start to the target.
+fn constraint_domain(range_deg: Option<[f64; 2]>, start: f64, target: f64) -> Result<[f64; 2]> {
+    Ok(match range_deg {
+        Some([a, b]) => {
+            let field = "constraint.range_deg";
+            if !(a.is_finite() && b.is_finite() && a < b) {
+                return Err(NanofoldError::invalid(
+                    field,
+                    format!("[{a}, {b}]"),
+                    "needs finite [A, B] with A < B",
+                ));
+            }
+            if a < -180.0 || b > 180.0 {
+                return Err(NanofoldError::invalid(
+                    field,
+                    format!("[{a}, {b}]"),
+                    "fold angles lie in [−180°, 180°]",
+                ));
+            }
+            [a.to_radians(), b.to_radians()]
+        }
+        None => [start.min(target), start.max(target)],
+    })
+}
+
+fn is_convex(points: &[[f64; 2]]) -> bool {
+    let n = points.len();
+    n >= 3
+        && (0..n).all(|k| {
+            let (a, b, c) = (points[k], points[(k + 1) % n], points[(k + 2) % n]);
+            (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) >= -1e-12 * (1.0 + a[0].abs() + a[1].abs())
+        })
+}

@@ -1,0 +1,52 @@
+//! The io layer: files other tools write and read (FOLD), nanofold's own inputs (native
+//! vertices, scene files) and every output file (JSON reports, FOLD animations, MuJoCo),
+//! written atomically. Loaders parse and validate; they run no numerics.
+
+pub mod fold;
+pub mod native;
+pub mod output;
+pub mod scene;
+
+pub use scene::{load_scene, parse_scene};
+
+use crate::error::{NanofoldError, Result};
+use crate::pattern::{LoadOptions, Pattern};
+use std::path::Path;
+
+/// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
+pub fn is_pattern_file(path: &Path) -> bool {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    (name.ends_with(".fold") || name.ends_with(".json")) && !name.ends_with(".scene.json")
+}
+
+/// A pattern's name: its file name without `.fold` or `.json` (names output folders).
+pub fn pattern_name(path: &Path) -> String {
+    path.file_name()
+        .and_then(|s| s.to_str())
+        .map(|s| s.trim_end_matches(".json").trim_end_matches(".fold").to_string())
+        .unwrap_or_else(|| "pattern".to_string())
+}
+
+/// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
+/// `vertices_coords`).
+pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
+    let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse_pattern(&text, &pattern_name(path), &path.display().to_string(), options)
+}
+
+/// Parses pattern text (FOLD or native); `origin` names it in error messages.
+pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|source| NanofoldError::Json {
+        path: origin.to_string(),
+        source,
+    })?;
+    let builder = if value.get("vertices_coords").is_some() {
+        fold::read_fold(&value, name)?
+    } else {
+        native::read_native(&value, name)?
+    };
+    builder.build_with(options)
+}

@@ -1,0 +1,56 @@
+//! Scene files (`*.scene.json`): a strip (`plates`, `hinges`) or a closed chain (a
+//! `pattern` FOLD file whose faces are the plates). The loader parses, names the scene after
+//! its file when it has no `name`, and loads the pattern; building the scene
+//! ([`SceneSpec::build`]) validates it and runs the closed chain's sweep and fit.
+
+use crate::dynamics::scene::{ClosedSpec, SceneSpec, StripSpec};
+use crate::error::{NanofoldError, Result};
+use crate::pattern::LoadOptions;
+use std::path::Path;
+
+/// A scene's name from its file name: `bridge_step.scene.json` → `bridge_step`.
+pub fn scene_name(path: &Path) -> String {
+    let stem = path.file_name().and_then(|n| n.to_str()).unwrap_or("scene");
+    stem.strip_suffix(".scene.json")
+        .or_else(|| stem.strip_suffix(".json"))
+        .unwrap_or(stem)
+        .to_string()
+}
+
+/// Loads a scene file; a closed chain's `pattern` is read relative to the scene's folder.
+pub fn load_scene(path: &Path) -> Result<SceneSpec> {
+    let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    parse_scene(&text, &path.display().to_string(), &scene_name(path), base)
+}
+
+/// Parses scene text; `source` names it in errors, `fallback_name` names the scene when it
+/// has no `name`, `base` is the folder a closed chain's pattern path is relative to.
+pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -> Result<SceneSpec> {
+    let json = |e: serde_json::Error| NanofoldError::Json {
+        path: source.to_string(),
+        source: e,
+    };
+    let value: serde_json::Value = serde_json::from_str(text).map_err(json)?;
+    let closed = value.get("pattern").is_some();
+    let mut spec = if closed {
+        let file: ClosedSpec<String> = serde_json::from_value(value).map_err(json)?;
+        let loaded = file.with_pattern(|path| crate::io::load_pattern(&base.join(path), &LoadOptions::default()))?;
+        SceneSpec::Closed(Box::new(loaded))
+    } else {
+        let file: StripSpec = serde_json::from_value(value).map_err(json)?;
+        SceneSpec::Strip(file)
+    };
+    match &mut spec {
+        SceneSpec::Strip(s) => {
+            s.name.get_or_insert_with(|| fallback_name.to_string());
+        }
+        SceneSpec::Closed(s) => {
+            s.name.get_or_insert_with(|| fallback_name.to_string());
+        }
+    }
+    Ok(spec)
+}
