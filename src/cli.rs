@@ -4,8 +4,8 @@
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{
-    default_domain, fit_to_tolerance, mujoco_snippet, sweep_samples, unfold_samples, ConstraintPoly, ConstraintReport,
-    Setup,
+    default_domain, fit_to_tolerance, held_pattern, mujoco_snippet, sweep_samples, trajectory_samples, ConstraintPoly,
+    ConstraintReport, Setup,
 };
 use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
@@ -609,24 +609,37 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         .map(|text| parse_lock(&pattern, text))
         .collect::<Result<Vec<_>>>()?;
     let range = args.range.as_deref().map(parse_range).transpose()?;
-    let setup = Setup::new(&pattern, driver, &locks)?;
+    let setup = Setup::new(&pattern, driver, &locks).map_err(constraints_flags)?;
     let samples = match args.source {
         SourceArg::Sweep => {
             let domain = match range {
                 Some(d) => d,
-                None => default_domain(&pattern, driver)?,
+                None => default_domain(&pattern, driver).map_err(constraints_flags)?,
             };
-            sweep_samples(&pattern, &setup, domain, args.samples)?
+            sweep_samples(&pattern, &setup, domain, args.samples).map_err(constraints_flags)?
         }
-        SourceArg::Unfold => unfold_samples(&pattern, &setup, range, &UnfoldSettings::default())?,
+        SourceArg::Unfold => {
+            let settings = UnfoldSettings::default();
+            let report = unfold(&held_pattern(&pattern, &setup).map_err(constraints_flags)?, &settings)?;
+            let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
+            trajectory_samples(
+                &pattern,
+                &setup,
+                range,
+                &states,
+                report.verdict.as_str(),
+                settings.flat_tol,
+            )
+            .map_err(constraints_flags)?
+        }
     };
     let (poly, report) = match degree {
         Some(d) => {
-            let poly = ConstraintPoly::fit(&pattern, &samples, d)?;
-            let report = ConstraintReport::new(&pattern, &samples, &poly)?;
+            let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
+            let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
             (poly, report)
         }
-        None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default())?,
+        None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default()).map_err(constraints_flags)?,
     };
     // Render everything before writing anything.
     let dir = args
@@ -637,7 +650,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     let svg = constraints_svg(&pattern, &samples, &poly)?;
     let mut files = vec![("constraints.json", report_json), ("constraints.svg", svg)];
     if args.format == ExportFormat::Mujoco {
-        files.push(("constraints.xml", mujoco_snippet(&report)?));
+        files.push(("constraints.xml", mujoco_snippet(&report).map_err(constraints_flags)?));
     }
     write_outputs(&dir, &files)?;
     if args.json {
@@ -861,6 +874,27 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     }
     print_written(&dir, &files);
     Ok(())
+}
+
+/// Library errors name the constraint request's fields; say which flag sets each.
+fn constraints_flags(error: nanofold::NanofoldError) -> anyhow::Error {
+    let flag = match &error {
+        nanofold::NanofoldError::InvalidField { field, .. } => match field.as_str() {
+            "driver" => Some("--drive"),
+            "locks" => Some("--lock"),
+            "domain" => Some("--range"),
+            "samples" => Some("--samples"),
+            "degree" => Some("--degree"),
+            "tolerance" => Some("--tol"),
+            "source" => Some("--source"),
+            _ => None,
+        },
+        _ => None,
+    };
+    match flag {
+        Some(flag) => anyhow::Error::new(error).context(flag),
+        None => anyhow::Error::new(error),
+    }
 }
 
 /// Library errors name library settings; say which flags set them.

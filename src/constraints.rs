@@ -10,7 +10,6 @@ pub mod sweep;
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, Pattern};
-use crate::unfold::{unfold, UnfoldSettings};
 use chebyshev::{eval_monomial, Chebyshev};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -44,34 +43,34 @@ impl Setup {
         }
         let label = |c: usize| pattern.creases[c].label.clone();
         if driver >= pattern.creases.len() {
-            return Err(NanofoldError::invalid("--drive", driver, "no such crease"));
+            return Err(NanofoldError::invalid("driver", driver, "no such crease"));
         }
         let mut locked: Vec<(usize, f64)> = Vec::new();
         for &(crease, angle) in user_locks {
             if crease == driver {
                 return Err(NanofoldError::invalid(
-                    "--lock",
+                    "locks",
                     pattern.user_index(crease),
                     format!("cannot drive a locked crease ({} is the driver)", label(crease)),
                 ));
             }
             if !angle.is_finite() || angle.abs() > PI + 1e-12 {
                 return Err(NanofoldError::invalid(
-                    "--lock",
+                    "locks",
                     format!("{}={}", pattern.user_index(crease), angle.to_degrees()),
                     "a lock angle must lie in [−180°, 180°]",
                 ));
             }
             if pattern.creases[crease].assignment == Assignment::Flat && angle != 0.0 {
                 return Err(NanofoldError::invalid(
-                    "--lock",
+                    "locks",
                     format!("{}={}", pattern.user_index(crease), angle.to_degrees()),
                     format!("{} is a flat (F) crease and stays at 0°", label(crease)),
                 ));
             }
             if locked.iter().any(|&(c, _)| c == crease) {
                 return Err(NanofoldError::invalid(
-                    "--lock",
+                    "locks",
                     pattern.user_index(crease),
                     "the same crease is locked twice",
                 ));
@@ -81,7 +80,7 @@ impl Setup {
         let driver_crease = &pattern.creases[driver];
         if driver_crease.locked {
             return Err(NanofoldError::invalid(
-                "--drive",
+                "driver",
                 pattern.user_index(driver),
                 format!(
                     "cannot drive a locked crease ({} is locked in the pattern)",
@@ -91,7 +90,7 @@ impl Setup {
         }
         if driver_crease.assignment == Assignment::Flat {
             return Err(NanofoldError::invalid(
-                "--drive",
+                "driver",
                 pattern.user_index(driver),
                 format!("cannot drive a flat (F) crease ({})", label(driver)),
             ));
@@ -113,11 +112,11 @@ impl Setup {
                 .collect::<Vec<_>>()
                 .join(", ");
             return Err(NanofoldError::invalid(
-                "--lock",
+                "locks",
                 format!("{} lock(s)", user_locks.len()),
                 format!(
                     "{} creases besides the driver are free ({free}) but loop closure fixes only 3: \
-                     lock {} more with --lock J=DEG to leave one degree of freedom",
+                     lock {} more to leave one degree of freedom",
                     dependents.len(),
                     dependents.len() - 3
                 ),
@@ -125,7 +124,7 @@ impl Setup {
         }
         if dependents.is_empty() {
             return Err(NanofoldError::invalid(
-                "--lock",
+                "locks",
                 format!("{} lock(s)", user_locks.len()),
                 "no crease is left to follow the driver",
             ));
@@ -184,10 +183,10 @@ pub fn default_domain(pattern: &Pattern, driver: usize) -> Result<[f64; 2]> {
     let folded = pattern.creases[driver].folded_angle;
     if folded.abs() < 1e-9 {
         return Err(NanofoldError::invalid(
-            "--range",
+            "domain",
             "(default)",
             format!(
-                "{} is flat in the folded state, so the default range (flat to folded) is empty: give --range A:B",
+                "{} is flat in the folded state, so the default domain (flat to folded) is empty: give one",
                 pattern.creases[driver].label
             ),
         ));
@@ -199,11 +198,11 @@ pub fn default_domain(pattern: &Pattern, driver: usize) -> Result<[f64; 2]> {
 pub fn check_domain(domain: [f64; 2]) -> Result<()> {
     let shown = format!("{}:{}", domain[0].to_degrees(), domain[1].to_degrees());
     if !domain.iter().all(|v| v.is_finite()) || domain[0] >= domain[1] {
-        return Err(NanofoldError::invalid("--range", shown, "needs finite A < B (degrees)"));
+        return Err(NanofoldError::invalid("domain", shown, "needs finite A < B (degrees)"));
     }
     if domain.iter().any(|v| v.abs() > PI + 1e-12) {
         return Err(NanofoldError::invalid(
-            "--range",
+            "domain",
             shown,
             "fold angles lie in [−180°, 180°]",
         ));
@@ -216,7 +215,7 @@ pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples
     check_domain(domain)?;
     if samples < 2 {
         return Err(NanofoldError::invalid(
-            "--samples",
+            "samples",
             samples,
             "a sweep needs at least 2 samples",
         ));
@@ -224,36 +223,56 @@ pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples
     sweep::sweep(pattern, setup, domain, samples)
 }
 
-/// Samples along an unfolding trajectory. Locks must equal the folded angles (the
-/// unfolding starts from the folded state); `domain`, if given, must lie inside the range
-/// the trajectory covers.
-pub fn unfold_samples(
-    pattern: &Pattern,
-    setup: &Setup,
-    domain: Option<[f64; 2]>,
-    settings: &UnfoldSettings,
-) -> Result<CurveSamples> {
+/// The pattern to unfold for constraint samples along an unfolding: every held crease of
+/// `setup` locked at its folded angle. A lock at another angle is refused (the unfolding
+/// starts from the folded state).
+pub fn held_pattern(pattern: &Pattern, setup: &Setup) -> Result<Pattern> {
     let mut held = pattern.clone();
     for &(c, value) in &setup.locked {
         let folded = pattern.creases[c].folded_angle;
         if (value - folded).abs() > 1e-9 {
             return Err(NanofoldError::invalid(
-                "--lock",
+                "locks",
                 format!("{}={}", pattern.user_index(c), value.to_degrees()),
                 format!(
-                    "with --source unfold a lock must equal the crease's folded angle {:.6}° (the unfolding starts from the folded state); use --source sweep",
+                    "with samples from an unfolding a lock must equal the crease's folded angle {:.6}° (the unfolding starts from the folded state); use a sweep",
                     folded.to_degrees()
                 ),
             ));
         }
         held.creases[c].locked = true;
     }
-    let report = unfold(&held, settings)?;
+    Ok(held)
+}
+
+/// Samples along an unfolding trajectory of [`held_pattern`]: `fold_angles[k]` every
+/// crease's angle at recorded step k (as [`crate::unfold::StepRecord`] holds them), `verdict`
+/// the unfolding's verdict (for messages), `flat_tol` its flatness tolerance. `domain`, if
+/// given, must lie inside the range the trajectory covers.
+///
+/// ```no_run
+/// # use nanofold::prelude::*;
+/// # use nanofold::constraints::{held_pattern, trajectory_samples};
+/// # let pattern = load_pattern("patterns/corner_cube.fold".as_ref(), &LoadOptions::default())?;
+/// let setup = Setup::new(&pattern, 0, &[(1, pattern.creases[1].folded_angle)])?;
+/// let settings = UnfoldSettings::default();
+/// let report = unfold(&held_pattern(&pattern, &setup)?, &settings)?;
+/// let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
+/// let samples = trajectory_samples(&pattern, &setup, None, &states, report.verdict.as_str(), settings.flat_tol)?;
+/// # Ok::<(), NanofoldError>(())
+/// ```
+pub fn trajectory_samples(
+    pattern: &Pattern,
+    setup: &Setup,
+    domain: Option<[f64; 2]>,
+    fold_angles: &[Vec<f64>],
+    verdict: &str,
+    flat_tol: f64,
+) -> Result<CurveSamples> {
     let driver = setup.driver;
-    let mut points: Vec<(f64, Vec<f64>)> = report
-        .trajectory
+    let mut points: Vec<(f64, Vec<f64>)> = fold_angles
         .iter()
-        .map(|step| (step.fold_angles[driver], step.fold_angles.clone()))
+        .map(|angles| (angles[driver], angles.clone()))
         .collect();
     // A step may pass through the flat state, where the branches of the constraint curve
     // meet; points past the driver's first change of sign lie on another branch. The flat
@@ -262,7 +281,7 @@ pub fn unfold_samples(
     if let Some(first_past) = points.iter().position(|p| p.0 * start_sign < -1e-12) {
         let flat_end = points
             .last()
-            .filter(|p| p.1.iter().all(|a| a.abs() <= settings.flat_tol))
+            .filter(|p| p.1.iter().all(|a| a.abs() <= flat_tol))
             .cloned();
         points.truncate(first_past);
         points.extend(flat_end);
@@ -275,14 +294,14 @@ pub fn unfold_samples(
             check_domain(d)?;
             if d[0] < covered[0] - 1e-9 || d[1] > covered[1] + 1e-9 {
                 return Err(NanofoldError::invalid(
-                    "--range",
+                    "domain",
                     format!("{}:{}", d[0].to_degrees(), d[1].to_degrees()),
                     format!(
                         "the unfolding trajectory covers {} ∈ [{:.4}°, {:.4}°] only ({})",
                         pattern.creases[driver].label,
                         covered[0].to_degrees(),
                         covered[1].to_degrees(),
-                        report.verdict.as_str()
+                        verdict
                     ),
                 ));
             }
@@ -294,7 +313,7 @@ pub fn unfold_samples(
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
     if domain[0] >= domain[1] || points.len() < 2 {
         return Err(NanofoldError::invalid(
-            "--source",
+            "source",
             "unfold",
             format!(
                 "the unfolding moved {} only over [{:.6}°, {:.6}°]: nothing to fit",
@@ -364,7 +383,7 @@ impl ConstraintPoly {
     pub fn fit(pattern: &Pattern, samples: &CurveSamples, degree: usize) -> Result<ConstraintPoly> {
         if degree == 0 || degree > MAX_DEGREE {
             return Err(NanofoldError::invalid(
-                "--degree",
+                "degree",
                 degree,
                 format!("the degree must lie in 1..={MAX_DEGREE}"),
             ));
@@ -664,7 +683,7 @@ pub fn fit_to_tolerance(
 ) -> Result<(ConstraintPoly, ConstraintReport)> {
     if !tol.is_finite() || tol <= 0.0 {
         return Err(NanofoldError::invalid(
-            "--tol",
+            "tolerance",
             tol,
             "must be a positive number of radians",
         ));
@@ -690,10 +709,10 @@ pub fn fit_to_tolerance(
         }
     }
     Err(NanofoldError::invalid(
-        "--tol",
+        "tolerance",
         format!("{tol:e}"),
         format!(
-            "no degree ≤ {highest} meets it: the best is {:.3e} rad at degree {}; narrow --range or raise --tol",
+            "no degree ≤ {highest} meets it: the best is {:.3e} rad at degree {}; narrow the domain or raise the tolerance",
             best.0, best.1
         ),
     ))
@@ -706,9 +725,9 @@ pub fn fit_to_tolerance(
 pub fn mujoco_snippet(report: &ConstraintReport) -> Result<String> {
     if report.degree > 4 {
         return Err(NanofoldError::invalid(
-            "--degree",
+            "degree",
             report.degree,
-            "MuJoCo's polycoef holds a quartic at most: use --degree 4 or lower with --format mujoco",
+            "MuJoCo's polycoef holds a quartic at most: fit degree 4 or lower for MuJoCo",
         ));
     }
     let joint = |i: usize| format!("crease_{i}");

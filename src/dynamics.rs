@@ -18,6 +18,7 @@ pub mod plant;
 pub mod quasi_static;
 pub mod scene;
 pub mod simulate;
+pub mod spec;
 pub mod strip;
 
 pub use model::{Data, Drag, Joint, Model, Plate};

@@ -2,8 +2,9 @@
 
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::Method;
-pub use crate::dynamics::scene::{ClosedSpec, Scene, SceneSpec, StripSpec, System};
+pub use crate::dynamics::scene::{Scene, SceneSpec, System};
 pub use crate::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
+pub use crate::dynamics::spec::{ClosedSpec, StripSpec};
 pub use crate::error::{NanofoldError, NumericalError, Result};
 pub use crate::io::{load_pattern, load_scene};
 pub use crate::pattern::{Assignment, Chain, LoadOptions, Pattern, VertexBuilder};

@@ -200,11 +200,26 @@ fn constraint_jacobian_and_its_rate_match_finite_differences() {
     assert!(err.contains("outside the fitted domain"), "{err}");
 }
 
+/// Constraint samples along an unfolding of the pattern with the setup's locks held.
+fn unfold_samples(pattern: &Pattern, setup: &Setup) -> nanofold::Result<CurveSamples> {
+    let settings = UnfoldSettings::default();
+    let report = nanofold::unfold::unfold(&held_pattern(pattern, setup)?, &settings)?;
+    let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
+    trajectory_samples(
+        pattern,
+        setup,
+        None,
+        &states,
+        report.verdict.as_str(),
+        settings.flat_tol,
+    )
+}
+
 #[test]
 fn sweep_and_unfolding_trajectory_give_the_same_curve() {
     let pattern = load("degree4_generic.fold");
     let setup = Setup::new(&pattern, 0, &[]).unwrap();
-    let unfolded = unfold_samples(&pattern, &setup, None, &UnfoldSettings::default()).unwrap();
+    let unfolded = unfold_samples(&pattern, &setup).unwrap();
     assert!(unfolded.drive_angles.len() > 5);
     let domain = [unfolded.domain[0], unfolded.domain[1]];
     let swept = sweep_samples(&pattern, &setup, domain, 201).unwrap();
@@ -277,7 +292,7 @@ fn bad_constraint_requests_get_clear_errors() {
     let samples = sweep_samples(&generic, &setup, [0.0, 1.0], 41).unwrap();
     for degree in [0, 21] {
         let err = ConstraintPoly::fit(&generic, &samples, degree).unwrap_err().to_string();
-        assert!(err.contains("--degree") && err.contains(&degree.to_string()), "{err}");
+        assert!(err.contains("`degree`") && err.contains(&degree.to_string()), "{err}");
     }
     // Too many free creases, an open chain, an out-of-range lock.
     let err = Setup::new(&load("waterbomb.fold"), 0, &[]).unwrap_err().to_string();
@@ -287,13 +302,11 @@ fn bad_constraint_requests_get_clear_errors() {
     let err = Setup::new(&generic, 0, &[(1, 4.0)]).unwrap_err().to_string();
     assert!(err.contains("[−180°, 180°]"), "{err}");
     let err = sweep_samples(&generic, &setup, [1.0, 0.5], 41).unwrap_err().to_string();
-    assert!(err.contains("--range"), "{err}");
+    assert!(err.contains("`domain`"), "{err}");
     // --source unfold cannot move a lock away from the folded state.
     let corner = load("corner_cube.fold");
     let setup = Setup::new(&corner, 0, &[(1, 0.0)]).unwrap();
-    let err = unfold_samples(&corner, &setup, None, &UnfoldSettings::default())
-        .unwrap_err()
-        .to_string();
+    let err = unfold_samples(&corner, &setup).unwrap_err().to_string();
     assert!(err.contains("folded angle"), "{err}");
 }
 

@@ -79,7 +79,7 @@ impl Chebyshev {
         }
         if x.len() < degree + 1 {
             return Err(NanofoldError::invalid(
-                "--samples",
+                "samples",
                 x.len(),
                 format!("a degree-{degree} fit needs at least {} samples", degree + 1),
             ));

@@ -3,7 +3,8 @@
 //! its file when it has no `name`, and loads the pattern; building the scene
 //! ([`SceneSpec::build`]) validates it and runs the closed chain's sweep and fit.
 
-use crate::dynamics::scene::{ClosedSpec, SceneSpec, StripSpec};
+use crate::dynamics::scene::SceneSpec;
+use crate::dynamics::spec::{ClosedSpec, StripSpec};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::LoadOptions;
 use std::path::Path;

@@ -7,8 +7,8 @@ use crate::constraints::exact::ExactConstraint;
 use crate::constraints::{sweep_samples, ConstraintPoly, Setup};
 use crate::dynamics::forcing::{Forcing, HingeDrive};
 use crate::dynamics::model::{Joint, Model, Plate};
-use crate::dynamics::scene::{
-    actuation, crease_hinge, drag_law, finite, hinge_stiffness, material, positive, validate_materials, ClosedSpec,
+use crate::dynamics::spec::{
+    actuation, drag_law, finite, hinge_stiffness, material, positive, validate_materials, ClosedSpec, CreaseHingeSpec,
     HingeSpec, SourceKind, MICROMETRE,
 };
 use crate::error::{NanofoldError, Result};
@@ -49,7 +49,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
     let creases = pattern.creases.len();
 
     // Hinges, one per crease.
-    let hinges: Vec<HingeSpec> = spec.hinges.iter().map(crease_hinge).collect();
+    let hinges: Vec<HingeSpec> = spec.hinges.iter().map(CreaseHingeSpec::hinge).collect();
     let mut hinge_of: Vec<Option<&HingeSpec>> = vec![None; creases];
     let mut stiffness = vec![0.0; creases];
     for (i, hinge) in spec.hinges.iter().enumerate() {

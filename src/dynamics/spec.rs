@@ -1,0 +1,443 @@
+//! Scene descriptions (`docs/model.md#scenes`): what a dynamics run models and no more —
+//! the plates, their materials, the hinges, the actuation, the air, the time span — as a
+//! scene file holds it: plain data, buildable from code, validated when built into a
+//! [`super::scene::Scene`].
+//!
+//! Every dimensional field carries its unit in its name (`_um`, `_gpa`, `_g_cm3`, `_s`, …);
+//! a scene file with an unknown field, such as a length without its unit, is refused.
+
+use super::forcing::Actuation;
+use super::model::Drag;
+use crate::error::{NanofoldError, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+pub(crate) const MICROMETRE: f64 = 1e-6;
+
+/// One isotropic material.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// E, GPa.
+    pub youngs_modulus_gpa: f64,
+    /// ν, in (−1, 0.5).
+    pub poisson_ratio: f64,
+    /// ρ, g/cm³.
+    pub density_g_cm3: f64,
+}
+
+/// One rigid plate of a strip, in chain order from the anchored hinge.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlateSpec {
+    /// Along the chain (perpendicular to the creases).
+    pub length_um: f64,
+    /// Along the creases.
+    pub width_um: f64,
+    /// Structural thickness t₁: the plate's mass and inertia come from this layer only.
+    pub thickness_um: f64,
+    /// A key of `materials`.
+    pub material: String,
+}
+
+/// One layer of a hinge: structural (first) or stressed (actuating).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerSpec {
+    /// A key of `materials`.
+    pub material: String,
+    /// t, µm.
+    pub thickness_um: f64,
+}
+
+/// Hinge i of a strip joins plate i to plate i − 1 (hinge 0 anchors plate 0 to the substrate).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HingeSpec {
+    /// l, the hinge's length across the crease, µm.
+    pub hinge_length_um: f64,
+    /// Layers whose bending stiffnesses add (`docs/model.md#hinge-stiffness`): a passive
+    /// hinge lists only the structural layer.
+    pub layers: Vec<LayerSpec>,
+    /// Whether a stressed layer drives it.
+    pub actuated: bool,
+    /// The folded angle the stressed layer drives to (valley positive); actuated hinges only.
+    #[serde(default)]
+    pub target_angle_deg: Option<f64>,
+    /// ρ_c of the released hinge; needed by a ramp.
+    #[serde(default)]
+    pub radius_of_curvature_um: Option<f64>,
+}
+
+/// How the hinges are released.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ActuationSpec {
+    /// τ = K θ_target from t = 0.
+    Step,
+    /// An etch front frees the hinges at `etch_rate_um_per_min`: θ(t) = a t / ρ_c up to the target.
+    Ramp {
+        /// a, µm/min (KOH: 1.5).
+        etch_rate_um_per_min: f64,
+    },
+}
+
+fn default_drag_coefficient() -> f64 {
+    1.28
+}
+fn default_air_density() -> f64 {
+    1.2
+}
+
+/// The surrounding air.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Whether to model drag at all.
+    pub drag: bool,
+    /// C_D (default 1.28, a flat plate).
+    #[serde(default = "default_drag_coefficient")]
+    pub drag_coefficient: f64,
+    /// ρ_air, kg/m³ (default 1.2).
+    #[serde(default = "default_air_density")]
+    pub air_density_kg_m3: f64,
+}
+
+/// Where the substrate of a strip is still there: the plane z = 0 for y ≤ `edge_y_um`.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SubstrateSpec {
+    /// The etch front's edge, µm (default 0: the anchored hinge).
+    #[serde(default)]
+    pub edge_y_um: f64,
+}
+
+/// The time span.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// End of the run, s.
+    pub t_end_s: f64,
+}
+
+fn default_samples() -> usize {
+    401
+}
+fn default_snapshots() -> usize {
+    6
+}
+
+/// What to record: `samples` evenly spaced output times, `snapshots` views.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Evenly spaced output times (at least 2; default 401).
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Views in `snapshots.svg` (default 6).
+    #[serde(default = "default_snapshots")]
+    pub snapshots: usize,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            samples: default_samples(),
+            snapshots: default_snapshots(),
+        }
+    }
+}
+
+/// A strip scene: plates in a row along +y from the substrate edge, creases parallel to x,
+/// all in the plane z = 0 when flat.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StripSpec {
+    /// Names the scene (and its output folder); "scene" when absent (the loader puts the
+    /// file's name here).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// The plates, from the anchored hinge outwards.
+    pub plates: Vec<PlateSpec>,
+    /// One hinge per plate: hinge i carries plate i.
+    pub hinges: Vec<HingeSpec>,
+    /// Step or ramp.
+    pub actuation: ActuationSpec,
+    /// The air.
+    pub environment: EnvironmentSpec,
+    /// Where the substrate remains.
+    #[serde(default)]
+    pub substrate: SubstrateSpec,
+    /// The time span.
+    pub time: TimeSpec,
+    /// What to record.
+    #[serde(default)]
+    pub outputs: OutputSpec,
+}
+
+/// Every sector plate of a closed chain: one structural layer.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SectorPlateSpec {
+    /// t₁, µm.
+    pub thickness_um: f64,
+    /// A key of `materials`.
+    pub material: String,
+}
+
+/// The hinge of one crease of a closed chain (`crease`: the FOLD edge index); the other
+/// fields as in a strip's hinge, the width being the crease's length.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CreaseHingeSpec {
+    /// FOLD edge index.
+    pub crease: usize,
+    /// l, µm.
+    pub hinge_length_um: f64,
+    /// Structural layer first, then the stressed one if actuated.
+    pub layers: Vec<LayerSpec>,
+    /// Whether a stressed layer drives it (exactly one crease of a closed step).
+    pub actuated: bool,
+    /// The driver's target, degrees.
+    #[serde(default)]
+    pub target_angle_deg: Option<f64>,
+    /// ρ_c of the driver, µm (needed by a ramp).
+    #[serde(default)]
+    pub radius_of_curvature_um: Option<f64>,
+}
+
+impl CreaseHingeSpec {
+    /// The same hinge as a strip's hinge spec (same fields), for the shared checks.
+    pub(crate) fn hinge(&self) -> HingeSpec {
+        HingeSpec {
+            hinge_length_um: self.hinge_length_um,
+            layers: self.layers.clone(),
+            actuated: self.actuated,
+            target_angle_deg: self.target_angle_deg,
+            radius_of_curvature_um: self.radius_of_curvature_um,
+        }
+    }
+}
+
+/// A crease held at an angle during this step.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LockSpec {
+    /// FOLD edge index.
+    pub crease: usize,
+    /// The angle, degrees.
+    pub angle_deg: f64,
+}
+
+/// Where f comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceKind {
+    /// A Chebyshev fit of an exact sweep.
+    Poly,
+    /// Newton loop closure at every evaluation.
+    Exact,
+}
+
+fn default_constraint_samples() -> usize {
+    401
+}
+
+/// How the closed chain's constraint f is made.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Poly or exact.
+    pub source: SourceKind,
+    /// Polynomial degree (poly only).
+    #[serde(default)]
+    pub degree: Option<usize>,
+    /// Exact sweep samples the fit (and the exact source's branch) use.
+    #[serde(default = "default_constraint_samples")]
+    pub samples: usize,
+    /// Driving-angle range [a, b] in degrees; default from the start to the target.
+    #[serde(default)]
+    pub range_deg: Option<[f64; 2]>,
+}
+
+/// A closed-chain scene: a single-vertex pattern whose faces are the plates, the crease
+/// where the loop is cut, the anchored face, the locks, the hinges and where f comes from.
+/// `P` is the pattern: a FOLD path in a scene file, a [`Pattern`] once loaded.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosedSpec<P> {
+    /// Names the scene; "scene" when absent (the loader puts the file's name here).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// The pattern: a FOLD file (relative to the scene file) with `faces_vertices`.
+    pub pattern: P,
+    /// One pattern coordinate unit in µm.
+    pub length_unit_um: f64,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// The sector plates.
+    pub plates: SectorPlateSpec,
+    /// One hinge per crease.
+    pub hinges: Vec<CreaseHingeSpec>,
+    /// The unactuated crease where the loop is cut for the numerics (FOLD edge index).
+    pub cut_crease: usize,
+    /// The face on the substrate (FOLD face index); default: the face after the cut crease
+    /// (counter-clockwise), which is what scenes without this field meant.
+    #[serde(default)]
+    pub anchored_face: Option<usize>,
+    /// Creases held during this step.
+    #[serde(default)]
+    pub locks: Vec<LockSpec>,
+    /// The driving crease's angle at rest at t = 0, degrees.
+    #[serde(default)]
+    pub start_angle_deg: f64,
+    /// Where f comes from.
+    pub constraint: ConstraintSpec,
+    /// Step or ramp.
+    pub actuation: ActuationSpec,
+    /// The air.
+    pub environment: EnvironmentSpec,
+    /// The time span.
+    pub time: TimeSpec,
+    /// What to record.
+    #[serde(default)]
+    pub outputs: OutputSpec,
+}
+
+impl<P> ClosedSpec<P> {
+    /// The same scene with its pattern resolved (e.g. a path loaded into a [`Pattern`]).
+    pub fn with_pattern<Q>(self, resolve: impl FnOnce(P) -> Result<Q>) -> Result<ClosedSpec<Q>> {
+        Ok(ClosedSpec {
+            name: self.name,
+            description: self.description,
+            pattern: resolve(self.pattern)?,
+            length_unit_um: self.length_unit_um,
+            materials: self.materials,
+            plates: self.plates,
+            hinges: self.hinges,
+            cut_crease: self.cut_crease,
+            anchored_face: self.anchored_face,
+            locks: self.locks,
+            start_angle_deg: self.start_angle_deg,
+            constraint: self.constraint,
+            actuation: self.actuation,
+            environment: self.environment,
+            time: self.time,
+            outputs: self.outputs,
+        })
+    }
+}
+
+pub(crate) fn positive(field: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(NanofoldError::invalid(field, value, "must be a finite number > 0"))
+    }
+}
+
+pub(crate) fn finite(field: &str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(NanofoldError::invalid(field, value, "must be finite"))
+    }
+}
+
+pub(crate) fn material<'a>(
+    materials: &'a BTreeMap<String, MaterialSpec>,
+    field: &str,
+    name: &str,
+) -> Result<&'a MaterialSpec> {
+    materials.get(name).ok_or_else(|| {
+        let known: Vec<&str> = materials.keys().map(String::as_str).collect();
+        NanofoldError::invalid(
+            field,
+            format!("\"{name}\""),
+            format!("not in `materials` ({})", known.join(", ")),
+        )
+    })
+}
+
+/// Every material's moduli and density in range.
+pub(crate) fn validate_materials(materials: &BTreeMap<String, MaterialSpec>) -> Result<()> {
+    for (name, m) in materials {
+        positive(&format!("materials.{name}.youngs_modulus_gpa"), m.youngs_modulus_gpa)?;
+        positive(&format!("materials.{name}.density_g_cm3"), m.density_g_cm3)?;
+        let field = format!("materials.{name}.poisson_ratio");
+        finite(&field, m.poisson_ratio)?;
+        if !(-1.0 < m.poisson_ratio && m.poisson_ratio < 0.5) {
+            return Err(NanofoldError::invalid(field, m.poisson_ratio, "must lie in (−1, 0.5)"));
+        }
+    }
+    Ok(())
+}
+
+/// The drag law of the environment (`docs/model.md#drag`), or none.
+pub(crate) fn drag_law(env: &EnvironmentSpec) -> Result<Option<Drag>> {
+    Ok(if env.drag {
+        Some(Drag {
+            drag_coefficient: positive("environment.drag_coefficient", env.drag_coefficient)?,
+            air_density: positive("environment.air_density_kg_m3", env.air_density_kg_m3)?,
+        })
+    } else {
+        None
+    })
+}
+
+/// The etch rate of a ramp, m/s; a step has none.
+pub(crate) fn actuation(spec: &ActuationSpec) -> Result<Actuation> {
+    Ok(match spec {
+        ActuationSpec::Step => Actuation::Step,
+        ActuationSpec::Ramp { etch_rate_um_per_min } => Actuation::Ramp {
+            etch_rate: positive("actuation.etch_rate_um_per_min", *etch_rate_um_per_min)? * MICROMETRE / 60.0,
+        },
+    })
+}
+
+/// The time span and outputs every scene shares.
+pub(crate) fn time_and_outputs(time: &TimeSpec, outputs: &OutputSpec) -> Result<f64> {
+    let t_end = positive("time.t_end_s", time.t_end_s)?;
+    if outputs.samples < 2 {
+        return Err(NanofoldError::invalid(
+            "outputs.samples",
+            outputs.samples,
+            "need at least 2",
+        ));
+    }
+    Ok(t_end)
+}
+
+/// K = Σ_layers w t³ E / (3 l (1 − ν²)) (`docs/model.md#hinge-stiffness`), with w the width
+/// of the plate the hinge carries (a crease's length for a sector plate).
+pub(crate) fn hinge_stiffness(
+    materials: &BTreeMap<String, MaterialSpec>,
+    i: usize,
+    hinge: &HingeSpec,
+    width: f64,
+) -> Result<f64> {
+    let length = positive(&format!("hinges[{i}].hinge_length_um"), hinge.hinge_length_um)? * MICROMETRE;
+    if hinge.layers.is_empty() {
+        return Err(NanofoldError::invalid(
+            format!("hinges[{i}].layers"),
+            "[]",
+            "a hinge needs its structural layer",
+        ));
+    }
+    let mut stiffness = 0.0;
+    for (k, layer) in hinge.layers.iter().enumerate() {
+        let t = positive(&format!("hinges[{i}].layers[{k}].thickness_um"), layer.thickness_um)? * MICROMETRE;
+        let m = material(materials, &format!("hinges[{i}].layers[{k}].material"), &layer.material)?;
+        let modulus = m.youngs_modulus_gpa * 1e9;
+        stiffness += width * t.powi(3) * modulus / (3.0 * length * (1.0 - m.poisson_ratio * m.poisson_ratio));
+    }
+    Ok(stiffness)
+}
