@@ -25,7 +25,7 @@ use nanofold::plot::work_precision::{
 };
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::{self, QpMethod};
-use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
+use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -490,7 +490,7 @@ fn scaling_part(out: &Path) -> Value {
         let pattern = many_creases(n);
         let model = UnfoldModel::new(&pattern);
         let settings = UnfoldSettings::default();
-        let mut solver = Unfolder::new(&model, &settings, model.folded_nodes()).expect("start");
+        let mut solver = ProjectedGradient::new(&model, &settings, model.folded_nodes()).expect("start");
         let kind = EnergyKind::Separable.build(None);
         let mut ws = EnergyWorkspace::default();
         let mut gradient = vec![Vec3::zeros(); model.node_count];
@@ -499,8 +499,9 @@ fn scaling_part(out: &Path) -> Value {
             black_box(kind.value_and_gradient(&nodes, &model.arcs, &mut ws, &mut gradient));
         });
         let direction_seconds = per_call(|| {
-            let (problem, row_space) = solver.direction_problem().expect("direction");
-            black_box(qp::solve_direct_with(&problem, &row_space).expect("direction solve"));
+            let problem = solver.direction_problem().expect("direction");
+            let mut row_space = qp::RowSpace::new(&problem.a).expect("factorisation");
+            black_box(qp::solve_direct_with(&problem, &mut row_space).expect("direction solve"));
         });
         // Steps change the state: time a fixed number from the folded start.
         let step_times: Vec<f64> = (0..15)

@@ -225,6 +225,12 @@ pub enum NumericalError {
         /// Where the search looked and what to change.
         detail: String,
     },
+    /// The optimisation executor (argmin) failed for a reason of its own.
+    #[error("the unfolding executor failed: {detail}")]
+    Executor {
+        /// argmin's account.
+        detail: String,
+    },
     /// A least-squares fit failed.
     #[error("polynomial fit: {detail}")]
     Fit {

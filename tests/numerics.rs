@@ -10,7 +10,7 @@ use nanofold::geometry::sphere::{
 use nanofold::pattern::LoadOptions;
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
-use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings, Unfolder, Verdict};
+use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
 use proptest::prelude::*;
 use std::f64::consts::{PI, TAU};
 
@@ -145,8 +145,8 @@ proptest! {
         let Some((sectors, rho)) = random_vertex(n, &weights, &drive) else { return Ok(()) };
         let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
-        let mut solver = Unfolder::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
-        let (bending, _) = solver.direction_problem().unwrap();
+        let mut solver = ProjectedGradient::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
+        let bending = solver.direction_problem().unwrap();
         prop_assert!(bending.metric.is_some(), "the default direction uses the bending metric");
         let euclidean = DirectionProblem { metric: None, ..bending.clone() };
         for problem in [euclidean, bending] {
@@ -188,10 +188,10 @@ proptest! {
         let nodes = nanofold::geometry::kinematics::forward(&model.sector_angles, &rho);
         // Restoration can fail from a random fold (the loop gap is ~ρ²/ρ away along a
         // direction of singular value ~ρ); those draws are skipped.
-        let Ok(mut solver) = Unfolder::new(&model, &UnfoldSettings::default(), nodes) else { return Ok(()) };
-        let (problem, _) = solver.direction_problem().unwrap();
-        let chain = RowSpace::new(&problem.a).unwrap();
-        let dense = RowSpace::dense(&problem.a).unwrap();
+        let Ok(mut solver) = ProjectedGradient::new(&model, &UnfoldSettings::default(), nodes) else { return Ok(()) };
+        let problem = solver.direction_problem().unwrap();
+        let mut chain = RowSpace::new(&problem.a).unwrap();
+        let mut dense = RowSpace::dense(&problem.a).unwrap();
         prop_assert!(chain.is_banded());
         prop_assert_eq!(chain.rank(), dense.rank(), "rank at scale {}", scale);
         if scale == 0.0 {

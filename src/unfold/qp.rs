@@ -124,79 +124,132 @@ fn upper_triangle_csc(p: &DMatrix<f64>) -> CscMatrix<f64> {
 /// The direct path: y = −(I − A⁺A) q, or with the metric M = I + SᵀS the same projection
 /// in the variables (y, e) under A y = 0, S y − e = 0 (so ½‖y‖² + ½‖e‖² = ½ yᵀMy).
 pub fn solve_direct(problem: &DirectionProblem) -> Result<DirectionSolution> {
-    match &problem.metric {
-        None => solve_direct_with(problem, &RowSpace::new(&problem.a)?),
-        Some(s) => solve_with_metric(problem, s),
-    }
+    let mut row_space = RowSpace::new(&problem.a)?;
+    solve_direct_with(problem, &mut row_space)
 }
 
 /// The direct path with A already factorised (the unfolder reuses it for the restoration).
-pub fn solve_direct_with(problem: &DirectionProblem, row_space: &RowSpace) -> Result<DirectionSolution> {
-    match &problem.metric {
-        None => Ok(DirectionSolution {
-            y: -row_space.project_to_null(&problem.q),
-            status: QpStatus::Solved,
-            iterations: 0,
-        }),
-        Some(s) => solve_with_metric(problem, s),
-    }
-}
-
-/// Each row of S gets its own variable e, placed right after the last node the row
-/// touches so the augmented rows keep the chain's band (and pivot on e: independent).
-fn solve_with_metric(problem: &DirectionProblem, s: &ConstraintJacobian) -> Result<DirectionSolution> {
-    let nodes = problem.a.columns / 2;
-    let mut rows_at = vec![0usize; nodes];
-    for row in &s.rows {
-        if let Some(pivot) = row.entries().iter().map(|e| e.0).max() {
-            rows_at[pivot] += 1;
-        }
-    }
-    let mut node_slot = vec![0; nodes];
-    let mut extra_first = vec![0; nodes];
-    let mut cursor = 0;
-    for k in 0..nodes {
-        node_slot[k] = cursor;
-        extra_first[k] = cursor + 1;
-        cursor += 1 + rows_at[k].div_ceil(2);
-    }
-    let mut augmented = ConstraintJacobian::new(problem.a.rows.len(), 2 * cursor);
-    for (out, row) in augmented.rows.iter_mut().zip(&problem.a.rows) {
-        out.clear(row.closing);
-        for (slot, g) in row.entries() {
-            out.add(node_slot[*slot], *g);
-        }
-    }
-    let mut used = vec![0usize; nodes];
-    for row in &s.rows {
-        let Some(pivot) = row.entries().iter().map(|e| e.0).max() else {
-            continue;
-        };
-        let mut out = JacobianRow::default();
-        out.clear(false);
-        for (slot, g) in row.entries() {
-            out.add(node_slot[*slot], *g);
-        }
-        let k = used[pivot];
-        used[pivot] += 1;
-        out.add(
-            extra_first[pivot] + k / 2,
-            if k.is_multiple_of(2) { [-1.0, 0.0] } else { [0.0, -1.0] },
-        );
-        augmented.rows.push(out);
-    }
-    let mut q = DVector::zeros(2 * cursor);
-    for k in 0..nodes {
-        q[2 * node_slot[k]] = problem.q[2 * k];
-        q[2 * node_slot[k] + 1] = problem.q[2 * k + 1];
-    }
-    let projected = RowSpace::new(&augmented)?.project_to_null(&q);
-    let y = DVector::from_fn(2 * nodes, |c, _| -projected[2 * node_slot[c / 2] + c % 2]);
+pub fn solve_direct_with(problem: &DirectionProblem, row_space: &mut RowSpace) -> Result<DirectionSolution> {
+    let mut workspace = DirectWorkspace::default();
+    let mut y = DVector::zeros(problem.q.len());
+    workspace.solve(
+        &problem.a,
+        problem.q.as_slice(),
+        problem.metric.as_ref(),
+        row_space,
+        y.as_mut_slice(),
+    )?;
     Ok(DirectionSolution {
         y,
         status: QpStatus::Solved,
         iterations: 0,
     })
+}
+
+/// Scratch of the direct path with the bending metric: the augmented constraint rows
+/// (A and S y − e = 0), their factorisation and the augmented vectors. Reused from one
+/// direction to the next, so a direction allocates nothing once the buffers have grown.
+#[derive(Debug, Default)]
+pub struct DirectWorkspace {
+    rows_at: Vec<usize>,
+    used: Vec<usize>,
+    node_slot: Vec<usize>,
+    extra_first: Vec<usize>,
+    augmented: ConstraintJacobian,
+    augmented_space: RowSpace,
+    q: Vec<f64>,
+    projected: Vec<f64>,
+}
+
+impl DirectWorkspace {
+    /// Writes the direction y (minimiser of ½ yᵀMy + qᵀy with A y = 0) into `y`; with no
+    /// metric, `row_space` (A factorised) does it alone.
+    pub fn solve(
+        &mut self,
+        a: &ConstraintJacobian,
+        q: &[f64],
+        metric: Option<&ConstraintJacobian>,
+        row_space: &mut RowSpace,
+        y: &mut [f64],
+    ) -> Result<()> {
+        match metric {
+            None => {
+                row_space.project_to_null_into(q, y);
+                y.iter_mut().for_each(|v| *v = -*v);
+                Ok(())
+            }
+            Some(s) => self.solve_with_metric(a, q, s, y),
+        }
+    }
+
+    /// Each row of S gets its own variable e, placed right after the last node the row
+    /// touches so the augmented rows keep the chain's band (and pivot on e: independent).
+    fn solve_with_metric(
+        &mut self,
+        a: &ConstraintJacobian,
+        q: &[f64],
+        s: &ConstraintJacobian,
+        y: &mut [f64],
+    ) -> Result<()> {
+        let nodes = a.columns / 2;
+        self.rows_at.clear();
+        self.rows_at.resize(nodes, 0);
+        for row in &s.rows {
+            if let Some(pivot) = row.entries().iter().map(|e| e.0).max() {
+                self.rows_at[pivot] += 1;
+            }
+        }
+        self.node_slot.clear();
+        self.extra_first.clear();
+        let mut cursor = 0;
+        for k in 0..nodes {
+            self.node_slot.push(cursor);
+            self.extra_first.push(cursor + 1);
+            cursor += 1 + self.rows_at[k].div_ceil(2);
+        }
+        self.augmented.columns = 2 * cursor;
+        self.augmented.rows.clear();
+        for row in &a.rows {
+            let mut out = JacobianRow::default();
+            out.clear(row.closing);
+            for (slot, g) in row.entries() {
+                out.add(self.node_slot[*slot], *g);
+            }
+            self.augmented.rows.push(out);
+        }
+        self.used.clear();
+        self.used.resize(nodes, 0);
+        for row in &s.rows {
+            let Some(pivot) = row.entries().iter().map(|e| e.0).max() else {
+                continue;
+            };
+            let mut out = JacobianRow::default();
+            out.clear(false);
+            for (slot, g) in row.entries() {
+                out.add(self.node_slot[*slot], *g);
+            }
+            let k = self.used[pivot];
+            self.used[pivot] += 1;
+            out.add(
+                self.extra_first[pivot] + k / 2,
+                if k.is_multiple_of(2) { [-1.0, 0.0] } else { [0.0, -1.0] },
+            );
+            self.augmented.rows.push(out);
+        }
+        self.q.clear();
+        self.q.resize(2 * cursor, 0.0);
+        for k in 0..nodes {
+            self.q[2 * self.node_slot[k]] = q[2 * k];
+            self.q[2 * self.node_slot[k] + 1] = q[2 * k + 1];
+        }
+        self.projected.resize(2 * cursor, 0.0);
+        self.augmented_space.factorise(&self.augmented)?;
+        self.augmented_space.project_to_null_into(&self.q, &mut self.projected);
+        for (c, out) in y.iter_mut().enumerate() {
+            *out = -self.projected[2 * self.node_slot[c / 2] + c % 2];
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -219,7 +272,7 @@ mod tests {
         assert!((&direct.y - &clarabel.y).amax() < 1e-10);
         assert!((&dense * &direct.y).amax() < 1e-14);
         // Optimality: y + q lies in the row space of A, so it is orthogonal to null(A).
-        let rs = RowSpace::dense(&a).unwrap();
+        let mut rs = RowSpace::dense(&a).unwrap();
         assert!(rs.project_to_null(&(&direct.y + &problem.q)).amax() < 1e-14);
     }
 

@@ -1,14 +1,20 @@
 //! The constraint Jacobian in tangent coordinates and the projection onto its null space
-//! (SPEC §5): a banded Cholesky of the open chain's rows plus a small Schur complement for
-//! the rows that close the loop, O(n) per factorisation; a dense SVD is the reference and
-//! the fallback.
+//! (`docs/model.md#projected-gradient`): a banded Cholesky of the open chain's rows plus a
+//! small Schur complement (faer's dense Cholesky and symmetric eigensolver) for the rows
+//! that close the loop, O(n) per factorisation and no allocation once its buffers have
+//! grown; a dense SVD is the reference and the fallback.
 
 use crate::error::{NumericalError, Result};
 use clarabel::algebra::CscMatrix;
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
+use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
+use faer::{MatMut, MatRef, Par};
+use nalgebra::{DMatrix, DVector};
 
 /// Relative singular-value threshold below which a constraint direction is taken as
-/// dependent (the rank drop at the flat state, SPEC §9).
+/// dependent (the rank drop at the flat state, `docs/model.md#hard-cases`).
 pub const RANK_TOL: f64 = 1e-10;
 
 /// Nodes one row may touch: three for a fold angle, two for an arc or an antipodal pair.
@@ -28,6 +34,7 @@ pub struct JacobianRow {
 }
 
 impl JacobianRow {
+    /// Empties the row and marks whether it closes the loop.
     pub fn clear(&mut self, closing: bool) {
         self.len = 0;
         self.closing = closing;
@@ -48,11 +55,12 @@ impl JacobianRow {
         self.len += 1;
     }
 
+    /// The (slot, gradient) pairs.
     pub fn entries(&self) -> &[(usize, [f64; 2])] {
         &self.entries[..self.len]
     }
 
-    fn dot(&self, y: &DVector<f64>) -> f64 {
+    fn dot(&self, y: &[f64]) -> f64 {
         self.entries()
             .iter()
             .map(|(s, g)| g[0] * y[2 * s] + g[1] * y[2 * s + 1])
@@ -60,7 +68,7 @@ impl JacobianRow {
     }
 
     /// y += scale · rowᵀ.
-    fn axpy(&self, scale: f64, y: &mut DVector<f64>) {
+    fn axpy(&self, scale: f64, y: &mut [f64]) {
         for (s, g) in self.entries() {
             y[2 * s] += scale * g[0];
             y[2 * s + 1] += scale * g[1];
@@ -95,11 +103,14 @@ impl JacobianRow {
 /// The sparse constraint Jacobian A: one row per constraint, two columns per free node.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ConstraintJacobian {
+    /// Columns: two tangent coordinates per free node.
     pub columns: usize,
+    /// The rows.
     pub rows: Vec<JacobianRow>,
 }
 
 impl ConstraintJacobian {
+    /// `rows` empty rows over `columns` columns.
     pub fn new(rows: usize, columns: usize) -> ConstraintJacobian {
         ConstraintJacobian {
             columns,
@@ -123,6 +134,7 @@ impl ConstraintJacobian {
         jacobian
     }
 
+    /// The dense matrix.
     pub fn to_dense(&self) -> DMatrix<f64> {
         let mut a = DMatrix::zeros(self.rows.len(), self.columns);
         for (r, row) in self.rows.iter().enumerate() {
@@ -134,6 +146,7 @@ impl ConstraintJacobian {
         a
     }
 
+    /// The matrix in Clarabel's compressed-column form.
     pub fn to_csc(&self) -> CscMatrix<f64> {
         let mut by_column: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.columns];
         for (r, row) in self.rows.iter().enumerate() {
@@ -158,14 +171,14 @@ impl ConstraintJacobian {
 
     /// A y.
     pub fn mul(&self, y: &DVector<f64>) -> DVector<f64> {
-        DVector::from_iterator(self.rows.len(), self.rows.iter().map(|row| row.dot(y)))
+        DVector::from_iterator(self.rows.len(), self.rows.iter().map(|row| row.dot(y.as_slice())))
     }
 
     /// Aᵀ v.
     pub fn mul_transpose(&self, v: &DVector<f64>) -> DVector<f64> {
         let mut out = DVector::zeros(self.columns);
         for (row, value) in self.rows.iter().zip(v.iter()) {
-            row.axpy(*value, &mut out);
+            row.axpy(*value, out.as_mut_slice());
         }
         out
     }
@@ -173,11 +186,17 @@ impl ConstraintJacobian {
     fn largest_row_norm(&self) -> f64 {
         self.rows.iter().map(|r| r.norm_squared()).fold(0.0, f64::max).sqrt()
     }
+
+    fn has_non_finite_entry(&self) -> bool {
+        self.rows
+            .iter()
+            .any(|r| r.entries().iter().any(|(_, g)| !g[0].is_finite() || !g[1].is_finite()))
+    }
 }
 
 /// Cholesky factor L of a symmetric positive definite band matrix (half-bandwidth w),
-/// row i holding L[i, i−w..=i].
-#[derive(Debug, Clone)]
+/// row i holding L[i, i−w..=i]; its buffer is reused from one factorisation to the next.
+#[derive(Debug, Clone, Default)]
 struct BandedCholesky {
     size: usize,
     width: usize,
@@ -185,11 +204,21 @@ struct BandedCholesky {
 }
 
 impl BandedCholesky {
-    /// Factorises the matrix whose (i, j) entry for |i − j| ≤ w is `entry(i, j)`. None when
+    /// Factorises the matrix whose (i, j) entry for |i − j| ≤ w is `entry(i, j)`. False when
     /// a pivot falls below `relative_pivot` times the largest diagonal entry.
-    fn new(size: usize, width: usize, entry: impl Fn(usize, usize) -> f64, relative_pivot: f64) -> Option<Self> {
+    fn factorise(
+        &mut self,
+        size: usize,
+        width: usize,
+        entry: impl Fn(usize, usize) -> f64,
+        relative_pivot: f64,
+    ) -> bool {
         let stride = width + 1;
-        let mut factor = vec![0.0; size * stride];
+        self.size = size;
+        self.width = width;
+        self.factor.clear();
+        self.factor.resize(size * stride, 0.0);
+        let factor = &mut self.factor;
         let largest_diagonal = (0..size).map(|i| entry(i, i)).fold(0.0, f64::max);
         for i in 0..size {
             let first = i.saturating_sub(width);
@@ -201,7 +230,7 @@ impl BandedCholesky {
                 if i == j {
                     // Also refuses a NaN pivot.
                     if sum.is_nan() || sum <= relative_pivot * largest_diagonal {
-                        return None;
+                        return false;
                     }
                     factor[i * stride + width] = sum.sqrt();
                 } else {
@@ -209,7 +238,7 @@ impl BandedCholesky {
                 }
             }
         }
-        Some(BandedCholesky { size, width, factor })
+        true
     }
 
     /// Solves L Lᵀ x = b in place.
@@ -229,35 +258,77 @@ impl BandedCholesky {
     }
 }
 
+/// Smallest accepted Cholesky pivot of B Bᵀ relative to its largest diagonal entry: below
+/// it (cond(B) beyond ~1e7) the dense SVD takes over.
+const CHAIN_PIVOT_TOL: f64 = 1e-14;
+
 /// The open-chain rows B (banded Gram matrix B Bᵀ) and the closing rows C, with
 /// W = (I − B⁺B) Cᵀ and the eigen-decomposition of Wᵀ W kept above the rank threshold.
 /// null(A) = null(B) ∩ null(C), so (I − A⁺A) g = P_B g − W (WᵀW)⁺ Wᵀ g.
-#[derive(Debug, Clone)]
-pub struct ChainRowSpace {
-    dimension: usize,
+#[derive(Debug, Default)]
+struct ChainFactors {
     /// Open-chain rows sorted by pivot, and their indices in A.
     chain: Vec<JacobianRow>,
     chain_index: Vec<usize>,
     gram: BandedCholesky,
     closing: Vec<JacobianRow>,
     closing_index: Vec<usize>,
-    /// P_B Cᵀ, one column per closing row.
-    w: DMatrix<f64>,
-    /// Generalised eigenvectors V (Vᵀ(I + ΛᵀΛ)V = I) and eigenvalues σ² of WᵀW above the
-    /// threshold, so that (WᵀW)⁺ restricted to them is V diag(1/σ²) Vᵀ.
-    schur_vectors: DMatrix<f64>,
+    /// P_B Cᵀ, column-major, one column per closing row.
+    w: Vec<f64>,
+    /// (B Bᵀ)⁻¹ B Cᵀ, column-major.
+    multipliers: Vec<f64>,
+    /// k × k scratch: I + ΛᵀΛ (then its Cholesky factor L), the reduced WᵀW, eigenvectors.
+    weight: Vec<f64>,
+    reduced: Vec<f64>,
+    eigenvectors: Vec<f64>,
+    eigenvalues: Vec<f64>,
+    /// Generalised eigenvectors V (Vᵀ(I + ΛᵀΛ)V = I), column-major k × kept, and the
+    /// eigenvalues σ² of WᵀW above the threshold: (WᵀW)⁺ restricted to them is V diag(1/σ²) Vᵀ.
+    schur_vectors: Vec<f64>,
     schur_values: Vec<f64>,
+    /// faer's scratch, and the k it is sized for.
+    stack: Option<Scratch>,
+    stack_size: usize,
+    /// Vectors of the columns' and the rows' sizes.
+    column_a: Vec<f64>,
+    column_b: Vec<f64>,
+    chain_a: Vec<f64>,
+    chain_b: Vec<f64>,
+    small_a: Vec<f64>,
+    small_b: Vec<f64>,
 }
 
-/// Smallest accepted Cholesky pivot of B Bᵀ relative to its largest diagonal entry: below
-/// it (cond(B) beyond ~1e7) the dense SVD takes over.
-const CHAIN_PIVOT_TOL: f64 = 1e-14;
+/// faer's memory for the small dense factorisations.
+struct Scratch(MemBuffer);
 
-impl ChainRowSpace {
-    fn new(a: &ConstraintJacobian) -> Option<ChainRowSpace> {
-        let mut chain_index: Vec<usize> = (0..a.rows.len()).filter(|&r| !a.rows[r].closing).collect();
-        chain_index.sort_by_key(|&r| a.rows[r].pivot_slot());
-        let chain: Vec<JacobianRow> = chain_index.iter().map(|&r| a.rows[r]).collect();
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Scratch({} bytes)", self.0.len())
+    }
+}
+
+/// Stable, allocation-free sort of row indices by pivot (the rows come nearly sorted).
+fn sort_by_pivot(index: &mut [usize], rows: &[JacobianRow]) {
+    for i in 1..index.len() {
+        let mut j = i;
+        while j > 0 && rows[index[j - 1]].pivot_slot() > rows[index[j]].pivot_slot() {
+            index.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+}
+
+impl ChainFactors {
+    /// Factorises A; false when the chain rows are nearly dependent (the SVD takes over).
+    fn factorise(&mut self, a: &ConstraintJacobian) -> bool {
+        let dimension = a.columns;
+        self.chain_index.clear();
+        self.chain_index
+            .extend((0..a.rows.len()).filter(|&r| !a.rows[r].closing));
+        sort_by_pivot(&mut self.chain_index, &a.rows);
+        self.chain.clear();
+        self.chain.extend(self.chain_index.iter().map(|&r| a.rows[r]));
+        let chain = &self.chain;
         // Half-bandwidth of B Bᵀ: with rows sorted by pivot, an earlier row meets a later one
         // only if its pivot reaches the later row's lowest slot.
         let width = chain
@@ -266,113 +337,212 @@ impl ChainRowSpace {
             .map(|(j, row)| j - chain.partition_point(|earlier| earlier.pivot_slot() < row.lowest_slot()))
             .max()
             .unwrap_or(0);
-        let gram = BandedCholesky::new(chain.len(), width, |i, j| chain[i].dot_row(&chain[j]), CHAIN_PIVOT_TOL)?;
-        let closing_index: Vec<usize> = (0..a.rows.len()).filter(|&r| a.rows[r].closing).collect();
-        let closing: Vec<JacobianRow> = closing_index.iter().map(|&r| a.rows[r]).collect();
-        let mut space = ChainRowSpace {
-            dimension: a.columns,
-            chain,
-            chain_index,
-            gram,
-            closing,
-            closing_index,
-            w: DMatrix::zeros(a.columns, 0),
-            schur_vectors: DMatrix::zeros(0, 0),
-            schur_values: Vec::new(),
-        };
-        let k = space.closing.len();
-        let mut w = DMatrix::zeros(a.columns, k);
+        if !self
+            .gram
+            .factorise(chain.len(), width, |i, j| chain[i].dot_row(&chain[j]), CHAIN_PIVOT_TOL)
+        {
+            return false;
+        }
+        self.closing_index.clear();
+        self.closing_index
+            .extend((0..a.rows.len()).filter(|&r| a.rows[r].closing));
+        self.closing.clear();
+        self.closing.extend(self.closing_index.iter().map(|&r| a.rows[r]));
+        let (m, k) = (self.chain.len(), self.closing.len());
+        for buffer in [&mut self.column_a, &mut self.column_b] {
+            buffer.resize(dimension, 0.0);
+        }
+        for buffer in [&mut self.chain_a, &mut self.chain_b] {
+            buffer.resize(m, 0.0);
+        }
+        self.w.resize(dimension * k, 0.0);
+        self.multipliers.resize(m * k, 0.0);
+        self.schur_vectors.clear();
+        self.schur_values.clear();
+        if k == 0 {
+            return true;
+        }
         // Y Yᵀ-like weight: the vector y = (−(B Bᵀ)⁻¹ B Cᵀ μ, μ) has Aᵀ y = W μ, so the
         // singular values of A along the closing rows are those of W measured against
         // ‖y‖² = μᵀ (I + ΛᵀΛ) μ, Λ = (B Bᵀ)⁻¹ B Cᵀ.
-        let mut multipliers = DMatrix::zeros(space.chain.len(), k);
-        for (c, row) in space.closing.iter().enumerate() {
-            let mut column = DVector::zeros(a.columns);
-            row.axpy(1.0, &mut column);
-            let (projected, lambda) = space.project_chain_with_multipliers(&column);
-            w.set_column(c, &projected);
-            multipliers.set_column(c, &DVector::from_vec(lambda));
+        for c in 0..k {
+            self.column_a.iter_mut().for_each(|x| *x = 0.0);
+            self.closing[c].axpy(1.0, &mut self.column_a);
+            self.project_chain(c);
         }
-        space.w = w;
-        if k == 0 {
-            return Some(space);
+        for buffer in [&mut self.weight, &mut self.reduced, &mut self.eigenvectors] {
+            buffer.clear();
+            buffer.resize(k * k, 0.0);
+        }
+        self.eigenvalues.resize(k, 0.0);
+        self.small_a.resize(k, 0.0);
+        self.small_b.resize(k, 0.0);
+        for i in 0..k {
+            for j in 0..k {
+                let lambda_i = &self.multipliers[i * m..(i + 1) * m];
+                let lambda_j = &self.multipliers[j * m..(j + 1) * m];
+                let w_i = &self.w[i * dimension..(i + 1) * dimension];
+                let w_j = &self.w[j * dimension..(j + 1) * dimension];
+                let identity = if i == j { 1.0 } else { 0.0 };
+                self.weight[i + j * k] = identity + dot(lambda_i, lambda_j);
+                self.reduced[i + j * k] = dot(w_i, w_j);
+            }
         }
         // Generalised eigenproblem WᵀW v = σ² (I + ΛᵀΛ) v, through the Cholesky factor L of
         // I + ΛᵀΛ (≥ I, so well-conditioned): σ estimates A's smallest singular values, and
         // the rank test matches the dense one, σ > RANK_TOL·σ_max.
-        let weight = DMatrix::identity(k, k) + multipliers.transpose() * &multipliers;
-        let l = weight.cholesky()?.unpack();
-        let l_inv = l.clone().try_inverse()?;
-        let reduced = &l_inv * (space.w.transpose() * &space.w) * l_inv.transpose();
-        let schur = SymmetricEigen::new((&reduced + reduced.transpose()) * 0.5);
+        self.ensure_stack(k);
+        let stack = MemStack::new(&mut self.stack.as_mut().expect("sized by ensure_stack").0);
+        let mut l = MatMut::from_column_major_slice_mut(&mut self.weight, k, k);
+        if cholesky_in_place(l.as_mut(), Default::default(), Par::Seq, stack, Default::default()).is_err() {
+            return false;
+        }
+        let l = MatRef::from_column_major_slice(&self.weight, k, k);
+        // reduced ← L⁻¹ WᵀW L⁻ᵀ by two triangular solves (the second on the transpose).
+        {
+            let mut x = MatMut::from_column_major_slice_mut(&mut self.reduced, k, k);
+            solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq);
+            for i in 0..k {
+                for j in 0..i {
+                    let (a, b) = (x[(i, j)], x[(j, i)]);
+                    x[(i, j)] = b;
+                    x[(j, i)] = a;
+                }
+            }
+            solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq);
+            for i in 0..k {
+                for j in 0..i {
+                    let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
+                    x[(i, j)] = mean;
+                    x[(j, i)] = mean;
+                }
+            }
+        }
+        let stack = MemStack::new(&mut self.stack.as_mut().expect("sized by ensure_stack").0);
+        let reduced = MatRef::from_column_major_slice(&self.reduced, k, k);
+        let values = faer::diag::DiagMut::from_slice_mut(&mut self.eigenvalues);
+        let vectors = MatMut::from_column_major_slice_mut(&mut self.eigenvectors, k, k);
+        if self_adjoint_evd(reduced, values, Some(vectors), Par::Seq, stack, Default::default()).is_err() {
+            return false;
+        }
         let threshold = (RANK_TOL * a.largest_row_norm().max(f64::MIN_POSITIVE)).powi(2);
-        let keep: Vec<usize> = (0..k).filter(|&i| schur.eigenvalues[i] > threshold).collect();
-        space.schur_vectors = l_inv.transpose() * schur.eigenvectors.select_columns(keep.iter());
-        space.schur_values = keep.iter().map(|&i| schur.eigenvalues[i]).collect();
-        Some(space)
+        for i in 0..k {
+            if self.eigenvalues[i] > threshold {
+                self.schur_values.push(self.eigenvalues[i]);
+                self.schur_vectors
+                    .extend_from_slice(&self.eigenvectors[i * k..(i + 1) * k]);
+            }
+        }
+        // V = L⁻ᵀ U: solve Lᵀ V = U.
+        let kept = self.schur_values.len();
+        let v = MatMut::from_column_major_slice_mut(&mut self.schur_vectors, k, kept);
+        solve_upper_triangular_in_place(l.transpose(), v, Par::Seq);
+        true
     }
 
-    /// (B Bᵀ)⁻¹ b for b in chain order.
-    fn gram_solve(&self, mut b: Vec<f64>) -> Vec<f64> {
-        self.gram.solve_in_place(&mut b);
-        b
+    /// faer's scratch for k × k Cholesky and eigen-decomposition (grown, never shrunk).
+    fn ensure_stack(&mut self, k: usize) {
+        if self.stack.is_some() && self.stack_size >= k {
+            return;
+        }
+        let req = StackReq::any_of(&[
+            cholesky_in_place_scratch::<f64>(k, Par::Seq, Default::default()),
+            self_adjoint_evd_scratch::<f64>(k, ComputeEigenvectors::Yes, Par::Seq, Default::default()),
+        ]);
+        self.stack = Some(Scratch(MemBuffer::new(req)));
+        self.stack_size = k;
     }
 
-    /// P_B y = y − Bᵀ (B Bᵀ)⁻¹ B y, with one step of refinement (the Gram matrix squares
-    /// B's condition number; the refinement recovers it).
-    fn project_chain(&self, y: &DVector<f64>) -> DVector<f64> {
-        self.project_chain_with_multipliers(y).0
-    }
-
-    /// P_B y and the multipliers (B Bᵀ)⁻¹ B y.
-    fn project_chain_with_multipliers(&self, y: &DVector<f64>) -> (DVector<f64>, Vec<f64>) {
-        let mut p = y.clone();
-        let mut total = vec![0.0; self.chain.len()];
+    /// P_B of `column_a` into column `c` of W, its multipliers into column `c` of Λ.
+    fn project_chain(&mut self, c: usize) {
+        let (dimension, m) = (self.column_a.len(), self.chain.len());
+        self.chain_b.iter_mut().for_each(|t| *t = 0.0);
         for _ in 0..2 {
-            let lambda = self.gram_solve(self.chain.iter().map(|row| row.dot(&p)).collect());
-            for ((row, l), t) in self.chain.iter().zip(&lambda).zip(total.iter_mut()) {
-                row.axpy(-l, &mut p);
+            for (lambda, row) in self.chain_a.iter_mut().zip(&self.chain) {
+                *lambda = row.dot(&self.column_a);
+            }
+            self.gram.solve_in_place(&mut self.chain_a);
+            for ((row, l), t) in self.chain.iter().zip(&self.chain_a).zip(self.chain_b.iter_mut()) {
+                row.axpy(-l, &mut self.column_a);
                 *t += l;
             }
         }
-        (p, total)
+        self.w[c * dimension..(c + 1) * dimension].copy_from_slice(&self.column_a);
+        self.multipliers[c * m..(c + 1) * m].copy_from_slice(&self.chain_b);
     }
 
-    /// W (WᵀW)⁺ v for v indexed by closing row.
-    fn schur_correction(&self, v: &DVector<f64>) -> DVector<f64> {
-        let mut coefficients = self.schur_vectors.transpose() * v;
-        for (c, value) in coefficients.iter_mut().zip(&self.schur_values) {
-            *c /= value;
+    /// P_B y = y − Bᵀ (B Bᵀ)⁻¹ B y into `out`, with one step of refinement (the Gram matrix
+    /// squares B's condition number; the refinement recovers it).
+    fn project_chain_into(&mut self, y: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(y);
+        for _ in 0..2 {
+            for (lambda, row) in self.chain_a.iter_mut().zip(&self.chain) {
+                *lambda = row.dot(out);
+            }
+            self.gram_solve_chain_a();
+            for (row, l) in self.chain.iter().zip(&self.chain_a) {
+                row.axpy(-l, out);
+            }
         }
-        &self.w * (&self.schur_vectors * coefficients)
     }
 
-    fn project_to_null(&self, g: &DVector<f64>) -> DVector<f64> {
-        let p = self.project_chain(g);
-        if self.closing.is_empty() {
-            return p;
-        }
-        let v = self.w.transpose() * g;
-        p - self.schur_correction(&v)
+    fn gram_solve_chain_a(&mut self) {
+        let (gram, b) = (&self.gram, &mut self.chain_a);
+        gram.solve_in_place(b);
     }
 
-    fn solve_min_norm(&self, r: &DVector<f64>) -> DVector<f64> {
-        let lambda = self.gram_solve(self.chain_index.iter().map(|&i| r[i]).collect());
-        let mut z = DVector::zeros(self.dimension);
-        for (row, l) in self.chain.iter().zip(&lambda) {
-            row.axpy(*l, &mut z);
+    /// out −= W (WᵀW)⁺ v with v = `small_a` (one entry per closing row).
+    fn subtract_schur_correction(&mut self, out: &mut [f64], sign: f64) {
+        let (dimension, k, kept) = (out.len(), self.closing.len(), self.schur_values.len());
+        // coefficients = V diag(1/σ²) Vᵀ v, then out −= W · coefficients.
+        self.small_b.iter_mut().for_each(|x| *x = 0.0);
+        for j in 0..kept {
+            let column = &self.schur_vectors[j * k..(j + 1) * k];
+            let scale = dot(column, &self.small_a) / self.schur_values[j];
+            for (b, v) in self.small_b.iter_mut().zip(column) {
+                *b += scale * v;
+            }
         }
-        if self.closing.is_empty() {
-            return z;
+        for c in 0..k {
+            let coefficient = self.small_b[c];
+            if coefficient != 0.0 {
+                for (o, w) in out.iter_mut().zip(&self.w[c * dimension..(c + 1) * dimension]) {
+                    *o -= sign * coefficient * w;
+                }
+            }
         }
-        let rest = DVector::from_iterator(
-            self.closing.len(),
-            self.closing
-                .iter()
-                .zip(&self.closing_index)
-                .map(|(row, &i)| r[i] - row.dot(&z)),
-        );
-        z + self.schur_correction(&rest)
+    }
+
+    fn project_to_null(&mut self, g: &[f64], out: &mut [f64]) {
+        self.project_chain_into(g, out);
+        let (dimension, k) = (g.len(), self.closing.len());
+        if k == 0 {
+            return;
+        }
+        for c in 0..k {
+            self.small_a[c] = dot(&self.w[c * dimension..(c + 1) * dimension], g);
+        }
+        self.subtract_schur_correction(out, 1.0);
+    }
+
+    fn solve_min_norm(&mut self, r: &[f64], out: &mut [f64]) {
+        for (lambda, &i) in self.chain_a.iter_mut().zip(&self.chain_index) {
+            *lambda = r[i];
+        }
+        self.gram_solve_chain_a();
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for (row, l) in self.chain.iter().zip(&self.chain_a) {
+            row.axpy(*l, out);
+        }
+        let k = self.closing.len();
+        if k == 0 {
+            return;
+        }
+        for c in 0..k {
+            self.small_a[c] = r[self.closing_index[c]] - self.closing[c].dot(out);
+        }
+        // z + W (WᵀW)⁺ rest.
+        self.subtract_schur_correction(out, -1.0);
     }
 
     fn rank(&self) -> usize {
@@ -380,10 +550,14 @@ impl ChainRowSpace {
     }
 }
 
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 /// The SVD-based projector (the reference, and the fallback when the chain rows are
-/// nearly dependent).
+/// nearly dependent). It allocates.
 #[derive(Debug, Clone)]
-pub struct DenseRowSpace {
+struct DenseRowSpace {
     /// Right singular vectors with σ > RANK_TOL·σ_max, as rows.
     v_t: DMatrix<f64>,
     /// Matching left singular vectors (columns) and singular values.
@@ -430,76 +604,77 @@ impl DenseRowSpace {
         })
     }
 
-    fn project_to_null(&self, w: &DVector<f64>) -> DVector<f64> {
-        let coefficients = &self.v_t * w;
-        w - self.v_t.transpose() * coefficients
+    fn project_to_null(&self, w: &[f64], out: &mut [f64]) {
+        let w = DVector::from_column_slice(w);
+        let coefficients = &self.v_t * &w;
+        out.copy_from_slice((w - self.v_t.transpose() * coefficients).as_slice());
     }
 
-    fn solve_min_norm(&self, r: &DVector<f64>) -> DVector<f64> {
-        let mut coefficients = self.u.transpose() * r;
+    fn solve_min_norm(&self, r: &[f64], out: &mut [f64]) {
+        let mut coefficients = self.u.transpose() * DVector::from_column_slice(r);
         for (c, s) in coefficients.iter_mut().zip(self.sigma.iter()) {
             *c /= s;
         }
-        self.v_t.transpose() * coefficients
+        out.copy_from_slice((self.v_t.transpose() * coefficients).as_slice());
     }
 }
 
-#[derive(Debug, Clone)]
-enum Factorisation {
-    Chain(ChainRowSpace),
-    Dense(DenseRowSpace),
-}
-
 /// The projector onto the row space of A, reused for the direction, the Newton
-/// restoration of the constraints and the restart kicks.
-#[derive(Debug, Clone)]
+/// restoration of the constraints and the restart kicks. [`RowSpace::factorise`] refills it
+/// in place: after the first call at a size, the chain path allocates nothing.
+#[derive(Debug, Default)]
 pub struct RowSpace {
-    factorisation: Factorisation,
+    chain: ChainFactors,
+    dense: Option<DenseRowSpace>,
     /// Columns of A (tangent coordinates).
     pub dimension: usize,
 }
 
 impl RowSpace {
+    /// Factorises A (see [`RowSpace::factorise`]).
+    pub fn new(a: &ConstraintJacobian) -> Result<RowSpace> {
+        let mut space = RowSpace::default();
+        space.factorise(a)?;
+        Ok(space)
+    }
+
     /// Factorises A by its chain structure, O(rows) plus the closing rows' Schur
     /// complement; falls back on the dense SVD if the chain rows are nearly dependent.
-    pub fn new(a: &ConstraintJacobian) -> Result<RowSpace> {
-        if a.rows
-            .iter()
-            .any(|r| r.entries().iter().any(|(_, g)| !g[0].is_finite() || !g[1].is_finite()))
-        {
+    pub fn factorise(&mut self, a: &ConstraintJacobian) -> Result<()> {
+        if a.has_non_finite_entry() {
             return Err(NumericalError::NonFinite {
                 what: "constraint Jacobian",
                 detail: "an entry".into(),
             }
             .into());
         }
-        match ChainRowSpace::new(a) {
-            Some(chain) => Ok(RowSpace {
-                factorisation: Factorisation::Chain(chain),
-                dimension: a.columns,
-            }),
-            None => RowSpace::dense(a),
+        self.dimension = a.columns;
+        self.dense = None;
+        if !self.chain.factorise(a) {
+            self.dense = Some(DenseRowSpace::new(&a.to_dense())?);
         }
+        Ok(())
     }
 
     /// The dense SVD of A (the reference).
     pub fn dense(a: &ConstraintJacobian) -> Result<RowSpace> {
         Ok(RowSpace {
-            factorisation: Factorisation::Dense(DenseRowSpace::new(&a.to_dense())?),
+            chain: ChainFactors::default(),
+            dense: Some(DenseRowSpace::new(&a.to_dense())?),
             dimension: a.columns,
         })
     }
 
     /// Whether the chain factorisation is in use (false: the dense fallback).
     pub fn is_banded(&self) -> bool {
-        matches!(self.factorisation, Factorisation::Chain(_))
+        self.dense.is_none()
     }
 
     /// Numerical rank of A.
     pub fn rank(&self) -> usize {
-        match &self.factorisation {
-            Factorisation::Chain(c) => c.rank(),
-            Factorisation::Dense(d) => d.sigma.len(),
+        match &self.dense {
+            None => self.chain.rank(),
+            Some(d) => d.sigma.len(),
         }
     }
 
@@ -508,20 +683,35 @@ impl RowSpace {
         self.dimension - self.rank()
     }
 
-    /// (I − A⁺A) w: the component of `w` in the null space of A.
-    pub fn project_to_null(&self, w: &DVector<f64>) -> DVector<f64> {
-        match &self.factorisation {
-            Factorisation::Chain(c) => c.project_to_null(w),
-            Factorisation::Dense(d) => d.project_to_null(w),
+    /// (I − A⁺A) w into `out`: the component of `w` in the null space of A.
+    pub fn project_to_null_into(&mut self, w: &[f64], out: &mut [f64]) {
+        match &self.dense {
+            None => self.chain.project_to_null(w, out),
+            Some(d) => d.project_to_null(w, out),
         }
     }
 
-    /// Minimum-norm z with A z = r (least squares on the dependent closing directions).
-    pub fn solve_min_norm(&self, r: &DVector<f64>) -> DVector<f64> {
-        match &self.factorisation {
-            Factorisation::Chain(c) => c.solve_min_norm(r),
-            Factorisation::Dense(d) => d.solve_min_norm(r),
+    /// Minimum-norm z with A z = r (least squares on the dependent closing directions),
+    /// into `out`.
+    pub fn solve_min_norm_into(&mut self, r: &[f64], out: &mut [f64]) {
+        match &self.dense {
+            None => self.chain.solve_min_norm(r, out),
+            Some(d) => d.solve_min_norm(r, out),
         }
+    }
+
+    /// (I − A⁺A) w, allocating the result.
+    pub fn project_to_null(&mut self, w: &DVector<f64>) -> DVector<f64> {
+        let mut out = DVector::zeros(w.len());
+        self.project_to_null_into(w.as_slice(), out.as_mut_slice());
+        out
+    }
+
+    /// Minimum-norm z with A z = r, allocating the result.
+    pub fn solve_min_norm(&mut self, r: &DVector<f64>) -> DVector<f64> {
+        let mut out = DVector::zeros(self.dimension);
+        self.solve_min_norm_into(r.as_slice(), out.as_mut_slice());
+        out
     }
 }
 
@@ -541,13 +731,14 @@ mod tests {
         };
         let dense = DMatrix::from_fn(n, n, entry);
         let b: Vec<f64> = (0..n).map(|i| (i as f64).sin() + 0.5).collect();
-        let cholesky = BandedCholesky::new(n, 2, entry, 1e-14).unwrap();
+        let mut cholesky = BandedCholesky::default();
+        assert!(cholesky.factorise(n, 2, entry, 1e-14));
         let mut x = b.clone();
         cholesky.solve_in_place(&mut x);
         let expected = dense.cholesky().unwrap().solve(&DVector::from_vec(b));
         assert!((DVector::from_vec(x) - expected).amax() < 1e-14);
         // Indefinite: refused, not a NaN.
-        assert!(BandedCholesky::new(2, 1, |i, j| if i == j { 1.0 } else { 2.0 }, 1e-14).is_none());
+        assert!(!BandedCholesky::default().factorise(2, 1, |i, j| if i == j { 1.0 } else { 2.0 }, 1e-14));
     }
 
     #[test]
@@ -563,8 +754,8 @@ mod tests {
             1.3, 0.2, 0.0, 0.0, 1.0, -0.4,
         ]);
         let jacobian = ConstraintJacobian::from_dense(&a, &[false, false, false, true, true]);
-        let chain = RowSpace::new(&jacobian).unwrap();
-        let dense = RowSpace::dense(&jacobian).unwrap();
+        let mut chain = RowSpace::new(&jacobian).unwrap();
+        let mut dense = RowSpace::dense(&jacobian).unwrap();
         assert!(chain.is_banded() && !dense.is_banded());
         assert_eq!((chain.rank(), dense.rank()), (4, 4));
         let g = DVector::from_vec(vec![0.3, -1.0, 2.0, 0.5, -0.2, 0.7]);
