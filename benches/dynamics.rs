@@ -1,4 +1,4 @@
-//! Criterion benches for the bridge (SPEC §8): M(θ), C(θ, θ̇)θ̇, the whole right-hand side,
+//! Criterion benches for the bridge (`docs/model.md#reference-devices`): M(θ), C(θ, θ̇)θ̇, the whole right-hand side,
 //! and the step response to first collision at two tolerances. The example
 //! `work_precision` prints each run's error beside its time.
 

@@ -166,7 +166,7 @@ fn main() {
         ),
     );
 
-    // Corner cube (SPEC §8): sectors 45, 90, 90, 90, 45 from the flap's centre crease (ray 0).
+    // Corner cube (`docs/model.md#reference-devices`): sectors 45, 90, 90, 90, 45 from the flap's centre crease (ray 0).
     // Its two-step path, taken to 90%: step 1 drives ray 0 to 162° with ray 1 held flat,
     // step 2 holds ray 0 and drives ray 1 to 81°.
     let cc = [45.0, 90.0, 90.0, 90.0, 45.0];
@@ -182,7 +182,7 @@ fn main() {
     write(
         "corner_cube",
         &fold_file(
-            "corner cube (SPEC §8), 90% along its two-step folding path",
+            "corner cube (`docs/model.md#reference-devices`), 90% along its two-step folding path",
             &cumulative(&cc),
             &corner_cube,
             None,

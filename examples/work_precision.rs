@@ -101,7 +101,7 @@ fn unfold_part(out: &Path) -> Value {
             }
         }
     }
-    // SPEC §5's plain QP (M = I) beside the default bending metric.
+    // The plain QP (M = I) beside the default bending metric.
     for flat_tol in [1e-2, 1e-4, 1e-6] {
         configs.push(UnfoldConfig {
             qp: QpMethod::Direct,

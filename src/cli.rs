@@ -68,10 +68,10 @@ pub enum Command {
         parallel: ParallelArgs,
     },
     /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
-    /// (SPEC §6); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
+    /// (`docs/model.md#constraint-curves`); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
     Constraints(ConstraintsArgs),
     /// Response of a scene (a chain of plates) to its actuation: writes response.json,
-    /// response.svg and snapshots.svg (SPEC §7).
+    /// response.svg and snapshots.svg (`docs/model.md#dynamics`).
     Simulate(SimulateArgs),
     /// Natural frequencies, mode shapes and stability at the folded equilibrium of a scene.
     Modes {
@@ -181,7 +181,7 @@ pub enum SourceArg {
     Unfold,
 }
 
-/// `--energy`: the repulsive energy (SPEC §4).
+/// `--energy`: the repulsive energy (`docs/model.md#energy`).
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum EnergyArg {
     /// Σ (γ(v,a) + γ(v,b) − α)^(−p), default p = 2: a barrier wherever a node touches an arc.
@@ -228,7 +228,7 @@ pub enum ExportFormat {
 
 #[derive(Args, Clone)]
 pub struct SolverArgs {
-    /// Repulsive energy (SPEC §4).
+    /// Repulsive energy (`docs/model.md#energy`).
     #[arg(long, value_enum, default_value_t = EnergyArg::Separable)]
     pub energy: EnergyArg,
     /// Exponent p (default 2 separable, 4 non-separable).
@@ -240,7 +240,7 @@ pub struct SolverArgs {
     /// Flat when every |fold angle| ≤ this (rad).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub flat_tol: f64,
-    /// Weight κ of the bending metric of the direction (0: SPEC's plain QP, M = I).
+    /// Weight κ of the bending metric of the direction (0: the plain QP, M = I).
     #[arg(long, default_value_t = UnfoldSettings::default().bending_metric, allow_negative_numbers = true)]
     pub bending_metric: f64,
     /// Iteration limit.

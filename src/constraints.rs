@@ -1,4 +1,4 @@
-//! Holonomic constraint curves θ_r = f(θ_c) of a closed vertex (SPEC §6): which creases
+//! Holonomic constraint curves θ_r = f(θ_c) of a closed vertex (`docs/model.md#constraint-curves`): which creases
 //! drive, hold and follow ([`Setup`]), exact samples ([`sweep`] or an unfolding), least-squares
 //! Chebyshev fits ([`ConstraintPoly`], with the Jacobian G of T4.18 and its rate), and the
 //! exported report with its errors against exact loop closure.
@@ -23,6 +23,7 @@ pub const MAX_DEGREE: usize = 20;
 /// [`Pattern::creases`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setup {
+    /// The driving crease.
     pub driver: usize,
     /// Held creases with their angles (rad): user locks, pattern locks, F creases.
     pub locked: Vec<(usize, f64)>,
@@ -146,7 +147,7 @@ impl Setup {
     }
 }
 
-/// Where the samples of a curve come from (SPEC §6).
+/// Where the samples of a curve come from (`docs/model.md#constraint-curves`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Source {
@@ -159,7 +160,9 @@ pub enum Source {
 /// Exact samples of the constraint curves.
 #[derive(Debug, Clone)]
 pub struct CurveSamples {
+    /// Which creases drive, hold and follow.
     pub setup: Setup,
+    /// Where the samples come from.
     pub source: Source,
     /// [a, b] of the driving angle, rad.
     pub domain: [f64; 2],
@@ -210,7 +213,20 @@ pub fn check_domain(domain: [f64; 2]) -> Result<()> {
     Ok(())
 }
 
-/// Exact samples by a kinematic sweep (see [`sweep::sweep`]).
+/// Exact samples by a kinematic sweep (see [`sweep::sweep`]): the driver moves over
+/// `domain` (rad) and loop closure is solved at each of `samples` points.
+///
+/// ```
+/// use nanofold::prelude::*;
+/// let pattern = load_pattern("patterns/corner_cube.fold".as_ref(), &LoadOptions::default())?;
+/// let setup = Setup::new(&pattern, 0, &[(1, 0.0)])?;
+/// let samples = sweep_samples(&pattern, &setup, [0.0, std::f64::consts::PI], 101)?;
+/// assert!(samples.max_closure_residual < 1e-12);
+/// // With the flap closed (crease 0 at 180°) the cube corner stands: creases 2, 3 at 90°.
+/// let end = samples.fold_angles.last().unwrap();
+/// assert!((end[2].to_degrees() - 90.0).abs() < 1e-6);
+/// # Ok::<(), NanofoldError>(())
+/// ```
 pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
     check_domain(domain)?;
     if samples < 2 {
@@ -362,6 +378,7 @@ pub(crate) fn check_in_domain(driver_label: &str, domain: [f64; 2], theta: f64, 
 pub struct ConstraintPoly {
     /// Driving crease (index into [`Pattern::creases`]) and its label for errors.
     pub driver: usize,
+    /// The driver's label, for errors.
     pub driver_label: String,
     /// Held creases and angles (rad).
     pub locked: Vec<(usize, f64)>,
@@ -555,6 +572,7 @@ pub fn implicit_jacobian(pattern: &Pattern, setup: &Setup, crease_angles: &[f64]
 pub struct CurveReport {
     /// The crease's user index (FOLD edge index for FOLD input).
     pub crease: usize,
+    /// The crease's label (`edges[3]`).
     pub label: String,
     /// c_0 … c_D: θ in rad → rad, ascending powers.
     pub coeffs_rad: Vec<f64>,
@@ -574,21 +592,29 @@ pub struct CurveReport {
 /// What `nanofold constraints` exports.
 #[derive(Debug, Clone, Serialize)]
 pub struct ConstraintReport {
+    /// The pattern's name.
     pub pattern: String,
+    /// Where the samples came from.
     pub source: Source,
     /// The driving crease's user index.
     pub driver: usize,
+    /// The driver's label.
     pub driver_label: String,
     /// Held creases: user index → angle in rad.
     pub locked: BTreeMap<String, f64>,
+    /// Polynomial degree.
     pub degree: usize,
+    /// The fitted interval of the driving angle, rad.
     pub domain_rad: [f64; 2],
+    /// The same in degrees.
     pub domain_deg: [f64; 2],
+    /// Exact samples fitted.
     pub samples: usize,
     /// Largest loop-closure residual of the samples themselves, rad.
     pub samples_max_closure_residual: f64,
     /// Loop-closure residual with every dependent on its polynomial, over the fine grid, rad.
     pub max_closure_residual: f64,
+    /// One curve per dependent crease.
     pub curves: Vec<CurveReport>,
 }
 

@@ -29,6 +29,16 @@ pub fn pattern_name(path: &Path) -> String {
 
 /// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
 /// `vertices_coords`).
+///
+/// ```
+/// use nanofold::prelude::*;
+/// let pattern = load_pattern("patterns/waterbomb.fold".as_ref(), &LoadOptions::default())?;
+/// assert_eq!((pattern.chain, pattern.creases.len()), (Chain::Closed, 8));
+/// // A file that is not there is an error naming it.
+/// let missing = load_pattern("patterns/nothing.fold".as_ref(), &LoadOptions::default());
+/// assert!(missing.unwrap_err().to_string().contains("nothing.fold"));
+/// # Ok::<(), NanofoldError>(())
+/// ```
 pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
     let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
         path: path.display().to_string(),

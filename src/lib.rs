@@ -1,5 +1,61 @@
-//! nanofold: rigid origami of single-vertex crease patterns — unfolding by constrained
-//! energy minimisation on the sphere (SPEC §3–5).
+#![warn(missing_docs)]
+//! # nanofold
+//!
+//! Rigid origami of single-vertex crease patterns: unfolding a folded vertex to flat by
+//! constrained energy minimisation on the sphere, the holonomic constraint curves between
+//! its fold angles, and the folding dynamics of plates on stress-actuated hinges (strips and
+//! closed vertices). The model — every equation, and the readings chosen where the thesis
+//! it comes from is ambiguous — is in `docs/model.md`; code cites its anchors.
+//!
+//! ## A pattern from numbers, unfolded
+//!
+//! ```
+//! use nanofold::prelude::*;
+//! use std::f64::consts::FRAC_PI_2;
+//!
+//! // A Miura-like degree-4 vertex: sectors 60°, 120°, 60°, 120°, folded by loop closure.
+//! let sectors = [60f64, 120.0, 60.0, 120.0].map(f64::to_radians);
+//! let mut rho = [0.8, 0.0, 0.0, 0.0];
+//! nanofold::geometry::kinematics::solve_closure(&sectors, &mut rho, &[1, 2, 3], 1e-14, 50)?;
+//! let pattern = rho
+//!     .iter()
+//!     .fold(VertexBuilder::closed("miura").sector_angles(sectors), |b, &r| {
+//!         b.crease(Assignment::Unassigned, r)
+//!     })
+//!     .build()?;
+//! let report = unfold(&pattern, &UnfoldSettings::default())?;
+//! assert_eq!(report.verdict, Verdict::Flat);
+//! // Reversed, the recorded trajectory is a folding path.
+//! assert!(report.trajectory.len() > 2 && report.max_arc_residual < 1e-10);
+//! # let _ = FRAC_PI_2;
+//! # Ok::<(), NanofoldError>(())
+//! ```
+//!
+//! ## Constraint curves and a closed chain
+//!
+//! ```
+//! use nanofold::prelude::*;
+//! let pattern = load_pattern("patterns/corner_cube.fold".as_ref(), &LoadOptions::default())?;
+//! // Drive crease 0 from flat to 180° with crease 1 held flat: one degree of freedom.
+//! let setup = Setup::new(&pattern, 0, &[(1, 0.0)])?;
+//! let samples = sweep_samples(&pattern, &setup, [0.0, std::f64::consts::PI], 201)?;
+//! let fit = ConstraintPoly::fit(&pattern, &samples, 8)?;
+//! assert!(fit.max_fit_error.iter().all(|&e| e < 1e-4));
+//! // A degree-8 fit drives the corner cube's dynamics in a bundled scene; the loop stays
+//! // closed to about the fit's error.
+//! let scene = load_scene("patterns/corner_cube_step1.scene.json".as_ref())?.build()?;
+//! let run = simulate(&scene, &SimulationSettings::default())?;
+//! let closed = run.closed.unwrap();
+//! assert!(closed.max_closure_residual < 10.0 * closed.fit_error);
+//! # Ok::<(), NanofoldError>(())
+//! ```
+//!
+//! ## Layers
+//!
+//! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
+//! [`unfold`] and [`constraints`] → [`dynamics`] → [`io`] → `plot` (feature `plot`) → the
+//! `nanofold` binary (feature `cli`). [`error`] sits beneath them all; [`prelude`] gathers
+//! the names most programs need.
 
 pub mod constraints;
 pub mod dynamics;

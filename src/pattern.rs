@@ -1,4 +1,4 @@
-//! The crease-pattern model (SPEC §2): a validated single vertex — its rays, sectors and
+//! The crease-pattern model (`docs/model.md#the-vertex`): a validated single vertex — its rays, sectors and
 //! creases — that every algorithm reads. Built from numbers with [`VertexBuilder`], or from
 //! files by the io layer ([`crate::io`]).
 
@@ -10,10 +10,13 @@ use std::f64::consts::{PI, TAU};
 /// Mountain / valley / flat / unassigned assignment of a crease (FOLD's letters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Assignment {
+    /// Folds away from the viewer: fold angle ≤ 0.
     Mountain,
+    /// Folds towards the viewer: fold angle ≥ 0.
     Valley,
-    /// A crease held flat (SPEC §2: a "virtual" crease, fold angle constrained to 0).
+    /// A crease held flat (`docs/model.md#the-vertex`: a "virtual" crease, fold angle constrained to 0).
     Flat,
+    /// Either way.
     Unassigned,
 }
 
@@ -53,7 +56,9 @@ impl Assignment {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Chain {
+    /// An interior vertex: the sectors go all the way round.
     Closed,
+    /// A vertex on the sheet's edge: the sectors end at two boundary rays.
     Open,
 }
 
@@ -65,15 +70,16 @@ pub enum RayRole {
     Crease(usize),
     /// An end of the sheet at a boundary vertex.
     Boundary,
-    /// A flat ray added to split a sector of π or more (SPEC §3).
+    /// A flat ray added to split a sector of π or more (`docs/model.md#the-sphere`).
     Virtual,
 }
 
 /// A crease as the user wrote it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Crease {
-    /// How errors and outputs name it ("edges[3]", "creases[1]").
+    /// How errors and outputs name it (`edges[3]`, `creases[1]`).
     pub label: String,
+    /// Mountain, valley, flat or unassigned.
     pub assignment: Assignment,
     /// Fold angle of the given folded state, radians, valley positive.
     pub folded_angle: f64,
@@ -88,10 +94,15 @@ pub struct Crease {
 /// The original FOLD geometry, kept so outputs can be written back on the same mesh.
 #[derive(Debug, Clone)]
 pub struct FlatMesh {
+    /// Vertex positions in the flat pattern.
     pub vertices_coords: Vec<[f64; 2]>,
+    /// Edges as vertex pairs.
     pub edges_vertices: Vec<[usize; 2]>,
+    /// Every edge's FOLD letter.
     pub edges_assignment: Vec<String>,
+    /// Faces as vertex cycles, when given.
     pub faces_vertices: Option<Vec<Vec<usize>>>,
+    /// The vertex where the creases meet.
     pub center: usize,
     /// Polar angle of ray 0 in the crease pattern's xy-plane.
     pub ray0_direction: f64,
@@ -100,7 +111,9 @@ pub struct FlatMesh {
 /// A validated single vertex.
 #[derive(Debug, Clone)]
 pub struct Pattern {
+    /// Names the pattern (and its output folder).
     pub name: String,
+    /// Interior (closed) or boundary (open) vertex.
     pub chain: Chain,
     /// Rays in counter-clockwise order, sectors of π or more already split.
     pub rays: Vec<RayRole>,
@@ -150,7 +163,7 @@ pub enum RaySpec {
 /// A crease as given, before validation.
 #[derive(Debug, Clone)]
 pub struct CreaseSpec {
-    /// How errors and outputs name it ("edges[3]", "creases[1]").
+    /// How errors and outputs name it (`edges[3]`, `creases[1]`).
     pub label: String,
     /// Mountain, valley, flat or unassigned.
     pub assignment: Assignment,
@@ -255,12 +268,12 @@ impl VertexBuilder {
         self
     }
 
-    /// Validates with the default [`LoadOptions`] (SPEC §2, §3).
+    /// Validates with the default [`LoadOptions`] (`docs/model.md#the-vertex`).
     pub fn build(self) -> Result<Pattern> {
         self.build_with(&LoadOptions::default())
     }
 
-    /// Validates and splits sectors of π or more (SPEC §2, §3). An open chain built with
+    /// Validates and splits sectors of π or more (`docs/model.md#the-vertex`). An open chain built with
     /// [`VertexBuilder::crease`] gets its two boundary rays here.
     pub fn build_with(mut self, options: &LoadOptions) -> Result<Pattern> {
         if self.chain == Chain::Open && !matches!(self.rays.first(), Some(RaySpec::Boundary)) {
@@ -277,7 +290,7 @@ impl VertexBuilder {
 }
 
 impl Pattern {
-    /// Validates and splits a builder's vertex (SPEC §2, §3).
+    /// Validates and splits a builder's vertex (`docs/model.md#the-vertex`).
     fn build(raw: VertexBuilder, options: &LoadOptions) -> Result<Pattern> {
         let VertexBuilder {
             name,
@@ -360,7 +373,7 @@ impl Pattern {
             }
         }
 
-        // Split sectors of π or more with virtual flat rays (SPEC §3).
+        // Split sectors of π or more with virtual flat rays (`docs/model.md#the-sphere`).
         let mut rays = Vec::new();
         let mut sectors = Vec::new();
         let mut creases: Vec<Option<Crease>> = vec![None; creases_given];
@@ -503,7 +516,7 @@ impl Pattern {
     }
 }
 
-/// Range and sign checks of one crease's folded angle (SPEC §1).
+/// Range and sign checks of one crease's folded angle (`docs/model.md#conventions`).
 fn check_crease_angle(c: &CreaseSpec) -> Result<()> {
     let rho = c.fold_angle;
     let shown = format!("{:.6}°", rho.to_degrees());

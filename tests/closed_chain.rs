@@ -337,7 +337,7 @@ fn reduced_mass_is_symmetric_positive_definite_along_the_path() {
     }
 }
 
-/// The released-lock modes of the folded corner cube (SPEC §7, T5.28): the equilibrium's
+/// The released-lock modes of the folded corner cube (`docs/model.md#modes`, T5.28): the equilibrium's
 /// torque vanishes, ∇V and ∂²V match finite differences of V along the exact closure, and the
 /// eigenvalues solve det(K − λM) = 0 (closed form of the 2 × 2 pencil).
 #[test]

@@ -101,7 +101,7 @@ fn library_sweeps_close_the_loop_and_are_continuous() {
 #[test]
 fn corner_cube_step_one_closes_the_cube_corner() {
     // Flap centre crease driven 0 → 180° with crease 1 locked flat: at 180° the flap halves
-    // lie on each other and creases 2, 3, 4 form a cube corner (fold angles ±90°, SPEC §8).
+    // lie on each other and creases 2, 3, 4 form a cube corner (fold angles ±90°, `docs/model.md#reference-devices`).
     let pattern = load("corner_cube.fold");
     let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
     assert_eq!(setup.dependents, vec![2, 3, 4]);

@@ -1,4 +1,4 @@
-//! Open-chain dynamics (SPEC §7) against independent answers: closed forms for one hinged
+//! Open-chain dynamics (`docs/model.md#dynamics`) against independent answers: closed forms for one hinged
 //! plate, kinetic energy from the plates' own motion, energy balance, the quasi-static limit,
 //! contact times from plane geometry.
 
@@ -337,7 +337,7 @@ fn auto_model_choice_follows_the_time_scales() {
     assert_eq!(step_response.time_scales.ratio, 0.0);
     let ramp_response = simulate(&ramp, &settings).unwrap().response;
     assert_eq!(ramp_response.model, ModelKind::QuasiStatic);
-    // SPEC §7: the etch ramp is ~10⁹ fastest periods long.
+    // `docs/model.md#dynamics`: the etch ramp is ~10⁹ fastest periods long.
     assert!(
         (1e8..1e10).contains(&ramp_response.time_scales.ratio),
         "{}",

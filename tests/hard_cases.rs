@@ -1,4 +1,4 @@
-//! Hard cases of SPEC §9, each with its stated expectation (issue 6): Σα near 2π, tiny
+//! Hard cases (`docs/model.md#hard-cases`), each with its stated expectation (issue 6): Σα near 2π, tiny
 //! sectors (flat and folded), n = 64 and 256, sectors ≥ π, a node through the coordinate
 //! pole, a step through a barrier, a degree-12 fit exported in degrees, plates touching at
 //! the first step. Others live beside the feature they stress: the exactly flat-folded input

@@ -60,7 +60,7 @@ fn every_library_pattern_gets_its_expected_verdict() {
 
 #[test]
 fn corner_cube_final_state_reaches_the_exact_flat_layout_closely() {
-    // The separable energy's flat state is its minimum (SPEC §4): at the end every node sits
+    // The separable energy's flat state is its minimum (`docs/model.md#energy`): at the end every node sits
     // at its cumulative sector angle on the equator.
     let (_, report) = run("corner_cube.fold");
     let layout = [0.0_f64, 45.0, 135.0, 225.0, 315.0];

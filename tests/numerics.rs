@@ -195,7 +195,7 @@ proptest! {
         prop_assert!(chain.is_banded());
         prop_assert_eq!(chain.rank(), dense.rank(), "rank at scale {}", scale);
         if scale == 0.0 {
-            // The flat state: the closing arc depends on the others (SPEC §9).
+            // The flat state: the closing arc depends on the others (`docs/model.md#hard-cases`).
             prop_assert_eq!(chain.rank(), problem.a.rows.len() - 1);
         }
         let g = nalgebra::DVector::from_iterator(problem.a.columns, g_seed.iter().copied().cycle().take(problem.a.columns));

@@ -1,5 +1,5 @@
 //! Chebyshev series on an interval [a, b]: least-squares fits on the scaled variable
-//! t = (2x − a − b)/(b − a) ∈ [−1, 1] for conditioning (SPEC §6), evaluation with first and
+//! t = (2x − a − b)/(b − a) ∈ [−1, 1] for conditioning (`docs/model.md#constraint-curves`), evaluation with first and
 //! second derivatives, and conversion to monomial coefficients in x.
 
 use crate::error::{NanofoldError, NumericalError, Result};

@@ -1,10 +1,10 @@
-//! The `exact` constraint source (SPEC §6–7): θ_r = f(θ_c) by Newton loop closure at every
+//! The `exact` constraint source (`docs/model.md#constraint-curves`): θ_r = f(θ_c) by Newton loop closure at every
 //! evaluation, G = ∂f/∂θ_c by the implicit function theorem (T4.18) and f″ from the closure's
 //! second-order condition, on the branch traced by an exact sweep.
 //!
 //! Along a closed path the holonomy's spatial angular velocity Σ_k x_k ρ̇_k vanishes (x_k the
 //! world axis of ray k). Differentiating once more, with the axes moved by the joints before
-//! them in the product of SPEC §2 (rays 1, 2, …, n−1, then 0):
+//! them in the product of `docs/model.md#loop-closure` (rays 1, 2, …, n−1, then 0):
 //!   Σ_k x_k ρ̈_k + Σ_{a before b} ρ̇_a ρ̇_b (x_a × x_b) = 0,
 //! so J_dep f″ = −Σ_{a before b} ρ′_a ρ′_b (x_a × x_b) with ρ′ = (1 for the driver, G, 0 held).
 
@@ -27,12 +27,16 @@ const NEWTON_ITERATIONS: usize = 20;
 /// f, G and f″ at one driving angle; one entry per dependent crease.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConstraintPoint {
+    /// f: the dependents' angles, rad.
     pub values: Vec<f64>,
+    /// G = ∂f/∂θ_c.
     pub jacobian: Vec<f64>,
+    /// f″ = ∂²f/∂θ_c².
     pub curvature: Vec<f64>,
 }
 
 impl ConstraintPoint {
+    /// A point for `dependents` dependent creases, all zero.
     pub fn zeros(dependents: usize) -> Self {
         ConstraintPoint {
             values: vec![0.0; dependents],
@@ -56,6 +60,7 @@ pub struct ExactConstraint {
     /// The branch: driving angles (ascending) and ray angles of the sweep's samples.
     branch_drive: Vec<f64>,
     branch_rays: Vec<Vec<f64>>,
+    /// The swept interval of the driving angle, rad.
     pub domain: [f64; 2],
     /// How far beyond `domain` the current evaluation may go.
     margin: Cell<f64>,
@@ -209,7 +214,7 @@ impl ExactConstraint {
     }
 }
 
-/// Σ_{a before b} ρ̇_a ρ̇_b (x_a × x_b) over the product order of SPEC §2 (rays 1 … n−1, then
+/// Σ_{a before b} ρ̇_a ρ̇_b (x_a × x_b) over the product order of `docs/model.md#loop-closure` (rays 1 … n−1, then
 /// ray 0): the velocity-product part of the holonomy's spatial angular acceleration at a
 /// closed configuration.
 pub fn closure_bias(sector_angles: &[f64], fold_angles: &[f64], rates: &[f64]) -> Vector3<f64> {

@@ -1,4 +1,4 @@
-//! The exact reference for every fit (SPEC §6): drive one crease, hold the locked ones, and
+//! The exact reference for every fit (`docs/model.md#constraint-curves`): drive one crease, hold the locked ones, and
 //! solve loop closure by Newton at every sample, continuing along one branch from the
 //! pattern's folded state (secant predictor, Newton corrector, adaptive step).
 

@@ -134,11 +134,14 @@ pub struct ClosedChain {
 /// Scratch of a [`ClosedChain`]: the open chain's buffers and the constraint's values.
 #[derive(Debug, Clone)]
 pub struct ClosedData {
+    /// The tree's rigid-body buffers.
     pub data: Data,
     point: ConstraintPoint,
     /// Every crease's angle, ∂θ/∂q and ∂²θ/∂q² (file order).
     pub crease_angles: Vec<f64>,
+    /// Every crease's ∂θ/∂q.
     pub crease_g: Vec<f64>,
+    /// Every crease's ∂²θ/∂q².
     pub crease_h: Vec<f64>,
     joint_angles: Vec<f64>,
     joint_rates: Vec<f64>,

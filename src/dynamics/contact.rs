@@ -71,6 +71,7 @@ pub trait ContactProbe {
     fn gap(&self, k: usize) -> f64;
     /// Whether a zero of candidate k's gap at the current configuration is a real contact.
     fn gate(&self, k: usize) -> bool;
+    /// The description of candidate k touching at t.
     fn collision(&self, k: usize, t: f64) -> Collision;
 }
 

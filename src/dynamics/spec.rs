@@ -180,6 +180,143 @@ pub struct StripSpec {
     pub outputs: OutputSpec,
 }
 
+impl MaterialSpec {
+    /// A material from E (GPa), ν and ρ (g/cm³).
+    pub fn new(youngs_modulus_gpa: f64, poisson_ratio: f64, density_g_cm3: f64) -> Self {
+        MaterialSpec {
+            youngs_modulus_gpa,
+            poisson_ratio,
+            density_g_cm3,
+        }
+    }
+}
+
+impl LayerSpec {
+    /// A layer of `thickness_um` µm of `material`.
+    pub fn new(material: &str, thickness_um: f64) -> Self {
+        LayerSpec {
+            material: material.to_string(),
+            thickness_um,
+        }
+    }
+}
+
+impl HingeSpec {
+    /// A passive hinge `hinge_length_um` long (its structural layer only, usually).
+    pub fn passive(hinge_length_um: f64, layers: Vec<LayerSpec>) -> Self {
+        HingeSpec {
+            hinge_length_um,
+            layers,
+            actuated: false,
+            target_angle_deg: None,
+            radius_of_curvature_um: None,
+        }
+    }
+
+    /// An actuated hinge driving to `target_angle_deg`; `radius_of_curvature_um` is needed by
+    /// a ramp.
+    pub fn actuated(
+        hinge_length_um: f64,
+        layers: Vec<LayerSpec>,
+        target_angle_deg: f64,
+        radius_of_curvature_um: Option<f64>,
+    ) -> Self {
+        HingeSpec {
+            hinge_length_um,
+            layers,
+            actuated: true,
+            target_angle_deg: Some(target_angle_deg),
+            radius_of_curvature_um,
+        }
+    }
+}
+
+impl StripSpec {
+    /// An empty strip named `name`: add materials, plates and hinges; a step by default, no
+    /// drag, 1 ms.
+    ///
+    /// ```
+    /// use nanofold::dynamics::spec::{HingeSpec, LayerSpec, MaterialSpec, StripSpec};
+    /// use nanofold::prelude::*;
+    /// // One 100 µm SiN plate on a SiN/Cr bilayer hinge, released by a step towards 100°.
+    /// let scene = StripSpec::new("flap")
+    ///     .material("SiN", MaterialSpec::new(300.0, 0.28, 3.27))
+    ///     .material("Cr", MaterialSpec::new(140.0, 0.21, 7.19))
+    ///     .plate(100.0, 100.0, 0.2, "SiN")
+    ///     .hinge(HingeSpec::actuated(
+    ///         32.0,
+    ///         vec![LayerSpec::new("SiN", 0.2), LayerSpec::new("Cr", 0.1)],
+    ///         100.0,
+    ///         None,
+    ///     ))
+    ///     .build()?;
+    /// let run = simulate(&scene, &SimulationSettings::default())?;
+    /// // No drag: θ = θ_target (1 − cos ωt) overshoots to 200°, past the substrate at 180°.
+    /// assert!(run.response.collision.is_some());
+    /// # Ok::<(), NanofoldError>(())
+    /// ```
+    pub fn new(name: &str) -> Self {
+        StripSpec {
+            name: Some(name.to_string()),
+            description: None,
+            materials: BTreeMap::new(),
+            plates: Vec::new(),
+            hinges: Vec::new(),
+            actuation: ActuationSpec::Step,
+            environment: EnvironmentSpec {
+                drag: false,
+                drag_coefficient: default_drag_coefficient(),
+                air_density_kg_m3: default_air_density(),
+            },
+            substrate: SubstrateSpec::default(),
+            time: TimeSpec { t_end_s: 1e-3 },
+            outputs: OutputSpec::default(),
+        }
+    }
+
+    /// Adds (or replaces) a material.
+    pub fn material(mut self, name: &str, material: MaterialSpec) -> Self {
+        self.materials.insert(name.to_string(), material);
+        self
+    }
+
+    /// Adds the next plate outwards: length along the chain, width along the creases and
+    /// structural thickness, µm.
+    pub fn plate(mut self, length_um: f64, width_um: f64, thickness_um: f64, material: &str) -> Self {
+        self.plates.push(PlateSpec {
+            length_um,
+            width_um,
+            thickness_um,
+            material: material.to_string(),
+        });
+        self
+    }
+
+    /// Adds the next hinge (hinge i carries plate i).
+    pub fn hinge(mut self, hinge: HingeSpec) -> Self {
+        self.hinges.push(hinge);
+        self
+    }
+
+    /// Releases the hinges by an etch front at `etch_rate_um_per_min` instead of a step.
+    pub fn ramp(mut self, etch_rate_um_per_min: f64) -> Self {
+        self.actuation = ActuationSpec::Ramp { etch_rate_um_per_min };
+        self
+    }
+
+    /// Models quadratic drag with the default coefficients.
+    pub fn with_drag(mut self) -> Self {
+        self.environment.drag = true;
+        self
+    }
+
+    /// Sets the end of the run, s.
+    pub fn t_end_s(mut self, t_end_s: f64) -> Self {
+        self.time.t_end_s = t_end_s;
+        self
+    }
+}
+
 /// Every sector plate of a closed chain: one structural layer.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -267,7 +404,7 @@ pub struct ConstraintSpec {
 
 /// A closed-chain scene: a single-vertex pattern whose faces are the plates, the crease
 /// where the loop is cut, the anchored face, the locks, the hinges and where f comes from.
-/// `P` is the pattern: a FOLD path in a scene file, a [`Pattern`] once loaded.
+/// `P` is the pattern: a FOLD path in a scene file, a [`crate::pattern::Pattern`] once loaded.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClosedSpec<P> {
@@ -313,7 +450,7 @@ pub struct ClosedSpec<P> {
 }
 
 impl<P> ClosedSpec<P> {
-    /// The same scene with its pattern resolved (e.g. a path loaded into a [`Pattern`]).
+    /// The same scene with its pattern resolved (e.g. a path loaded into a [`crate::pattern::Pattern`]).
     pub fn with_pattern<Q>(self, resolve: impl FnOnce(P) -> Result<Q>) -> Result<ClosedSpec<Q>> {
         Ok(ClosedSpec {
             name: self.name,

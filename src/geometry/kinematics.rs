@@ -1,4 +1,4 @@
-//! Fold angles ↔ node positions of a single vertex, and loop closure (SPEC §2):
+//! Fold angles ↔ node positions of a single vertex, and loop closure (`docs/model.md#loop-closure`):
 //! R_z(α_0) R_x(ρ_1) R_z(α_1) … R_x(ρ_{n−1}) R_z(α_{n−1}) R_x(ρ_0) = I.
 //!
 //! Frame convention (fixed here, tested below): ray 0 is +x, sector 0 lies in the xy-plane
@@ -76,7 +76,9 @@ const SINGULAR_CUTOFF: f64 = 1e-9;
 /// Outcome of [`solve_closure`].
 #[derive(Debug, Clone, Copy)]
 pub struct ClosureSolve {
+    /// Newton iterations taken.
     pub iterations: usize,
+    /// Rotation angle of the holonomy left, rad.
     pub residual: f64,
 }
 
@@ -163,7 +165,7 @@ pub fn refine_closure(sector_angles: &[f64], fold_angles: &mut [f64], free: &[us
 }
 
 /// The closure residual vector r (rotation vector of the holonomy) and its Jacobian
-/// ∂r/∂ρ_k for the rays in `columns`: the implicit-function-theorem data of SPEC §6.
+/// ∂r/∂ρ_k for the rays in `columns`: the implicit-function-theorem data of `docs/model.md#constraint-curves`.
 pub fn closure_jacobian(sector_angles: &[f64], fold_angles: &[f64], columns: &[usize]) -> (Vector3<f64>, DMatrix<f64>) {
     let holonomy = closure_rotation(sector_angles, fold_angles);
     let r = rotation_vector(&holonomy);

@@ -1,4 +1,4 @@
-//! The spherical model (SPEC §3): geodesic distance, its gradient, arc midpoints and the
+//! The spherical model (`docs/model.md#the-sphere`): geodesic distance, its gradient, arc midpoints and the
 //! fold angle of a ray measured from node positions.
 
 use nalgebra::Vector3;
@@ -15,7 +15,7 @@ pub fn geodesic_cosine_rule(a: &Vec3, b: &Vec3) -> f64 {
 }
 
 /// Geodesic distance between the directions of `a` and `b`, in the stable form
-/// γ = atan2(|a×b|, a·b) (SPEC §3). Scale-invariant in both arguments.
+/// γ = atan2(|a×b|, a·b) (`docs/model.md#the-sphere`). Scale-invariant in both arguments.
 #[inline]
 pub fn geodesic(a: &Vec3, b: &Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
@@ -30,7 +30,7 @@ pub const KINK_WINDOW: f64 = 1e-12;
 /// the direction, divided by |a|. At sin γ = 0 (coincident or antipodal points) γ is not
 /// differentiable and its gradient has unit length in a direction set by rounding; within
 /// [`KINK_WINDOW`] of that the zero vector is returned, a valid subgradient of the V-shaped
-/// minimum the energies have at antipodal pairs (SPEC §9), so that rounding noise does not
+/// minimum the energies have at antipodal pairs (`docs/model.md#hard-cases`), so that rounding noise does not
 /// steer the search at the flat state.
 #[inline]
 pub fn geodesic_with_gradient(a: &Vec3, b: &Vec3) -> (f64, Vec3, Vec3) {
@@ -56,7 +56,7 @@ pub fn arc_midpoint(a: &Vec3, b: &Vec3) -> Vec3 {
 }
 
 /// Signed fold angle at the ray `axis`, between the sector (prev, axis) and the sector
-/// (axis, next), with the CCW order prev → axis → next of the flat pattern (SPEC §1):
+/// (axis, next), with the CCW order prev → axis → next of the flat pattern (`docs/model.md#conventions`):
 /// 0 when flat, positive for a valley (the sector after the ray rotates by +ρ about the
 /// outward ray, lifting it to +z from a flat pattern in the xy-plane).
 ///

@@ -19,6 +19,16 @@ pub fn scene_name(path: &Path) -> String {
 }
 
 /// Loads a scene file; a closed chain's `pattern` is read relative to the scene's folder.
+/// Building the scene ([`SceneSpec::build`]) validates it.
+///
+/// ```
+/// use nanofold::prelude::*;
+/// let spec = load_scene("patterns/bridge_step.scene.json".as_ref())?;
+/// let scene = spec.build()?;
+/// assert_eq!(scene.name, "bridge_step");
+/// assert_eq!(scene.strip().unwrap().model.dof(), 4);
+/// # Ok::<(), NanofoldError>(())
+/// ```
 pub fn load_scene(path: &Path) -> Result<SceneSpec> {
     let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
         path: path.display().to_string(),

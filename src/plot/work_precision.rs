@@ -13,13 +13,16 @@ pub struct WorkPoint {
     pub label: String,
     /// Wall time, s.
     pub seconds: f64,
+    /// Its error (any unit; the plot states it).
     pub error: f64,
 }
 
 /// A line of points.
 #[derive(Debug, Clone)]
 pub struct WorkSeries {
+    /// Legend entry.
     pub name: String,
+    /// The points, in the order the line joins them.
     pub points: Vec<WorkPoint>,
 }
 
@@ -163,7 +166,9 @@ pub fn largest_sizes(points: &[(f64, f64)]) -> &[(f64, f64)] {
 /// One line of a scaling figure: cost (s) against size.
 #[derive(Debug, Clone)]
 pub struct ScalingSeries {
+    /// Legend entry.
     pub name: String,
+    /// (creases, seconds) pairs.
     pub points: Vec<(f64, f64)>,
 }
 

@@ -1,4 +1,4 @@
-//! Repulsive energies on the sphere (SPEC §4, T3.1–3.2), behind one trait so another
+//! Repulsive energies on the sphere (`docs/model.md#energy`, T3.1–3.2), behind one trait so another
 //! reading can be added without touching the solver.
 
 use crate::geometry::sphere::{geodesic_with_gradient, Vec3};
@@ -7,8 +7,11 @@ use serde::Serialize;
 /// A great-circle arc (one sector) between nodes `a` and `b`, of length `length`.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct Arc {
+    /// The node at the start of the arc.
     pub a: usize,
+    /// The node at its end.
     pub b: usize,
+    /// Its length (the sector angle), rad.
     pub length: f64,
 }
 
@@ -48,7 +51,7 @@ pub enum EnergyKind {
 }
 
 impl EnergyKind {
-    /// The SPEC's default exponent for this energy.
+    /// The default exponent of this energy.
     pub fn default_exponent(self) -> f64 {
         match self {
             EnergyKind::Separable => 2.0,
@@ -80,9 +83,10 @@ fn inverse_power(s: f64, p: f64) -> (f64, f64) {
     (value, -p * value / s)
 }
 
-/// The separable, admissible energy (SPEC §4, default p = 2).
+/// The separable, admissible energy (`docs/model.md#energy`, default p = 2).
 #[derive(Debug, Clone, Copy)]
 pub struct SeparableEnergy {
+    /// The exponent p.
     pub p: f64,
 }
 
@@ -169,10 +173,11 @@ impl Energy for SeparableEnergy {
     }
 }
 
-/// The non-separable midpoint-charge energy (SPEC §4, default p = 4). The midpoint m_e is
+/// The non-separable midpoint-charge energy (`docs/model.md#energy`, default p = 4). The midpoint m_e is
 /// the direction of x_a + x_b, and γ is scale-invariant, so γ(v, m_e) = γ(v, x_a + x_b).
 #[derive(Debug, Clone, Copy)]
 pub struct MidpointEnergy {
+    /// The exponent p.
     pub p: f64,
 }
 

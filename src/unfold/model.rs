@@ -30,6 +30,7 @@ pub struct UnfoldModel {
     pub fold_rays: Vec<usize>,
     /// Ray of each user crease, in file order.
     pub crease_rays: Vec<usize>,
+    /// Rays held at a fold angle: virtual, flat and locked creases.
     pub held: Vec<HeldFold>,
     /// Nodes 0 and 1 are fixed (gauge: sector 0 stays in the xy-plane); the rest are free.
     pub free: Vec<usize>,
@@ -181,7 +182,7 @@ impl UnfoldModel {
         rows
     }
 
-    /// Node positions of the given folded state (forward kinematics, SPEC §2).
+    /// Node positions of the given folded state (forward kinematics, `docs/model.md#loop-closure`).
     pub fn folded_nodes(&self) -> Vec<Vec3> {
         kinematics::forward(&self.sector_angles, &self.folded_ray_angles)
     }

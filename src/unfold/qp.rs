@@ -1,5 +1,5 @@
-//! The direction subproblem of the projected gradient step (SPEC §5):
-//! min_y ½ yᵀMy + qᵀy  s.t.  A y = 0, with M = I (SPEC's QP) or the bending metric
+//! The direction subproblem of the projected gradient step (`docs/model.md#projected-gradient`):
+//! min_y ½ yᵀMy + qᵀy  s.t.  A y = 0, with M = I (the plain QP) or the bending metric
 //! M = I + SᵀS, solved by Clarabel (the general path) or by a direct projection onto the
 //! null space of A (the equality-only closed form).
 
@@ -29,8 +29,11 @@ pub enum QpMethod {
 /// M = I + SᵀS (None: M = I).
 #[derive(Debug, Clone)]
 pub struct DirectionProblem {
+    /// ∇U in the tangent coordinates of the free nodes.
     pub q: DVector<f64>,
+    /// The constraint rows A.
     pub a: ConstraintJacobian,
+    /// S of the metric M = I + SᵀS (None: M = I).
     pub metric: Option<ConstraintJacobian>,
 }
 
@@ -48,6 +51,7 @@ impl DirectionProblem {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum QpStatus {
+    /// Solved to the requested accuracy.
     Solved,
     /// Clarabel's reduced-accuracy success.
     AlmostSolved,
@@ -56,7 +60,9 @@ pub enum QpStatus {
 /// The direction and how it was obtained.
 #[derive(Debug, Clone)]
 pub struct DirectionSolution {
+    /// The direction, in tangent coordinates.
     pub y: DVector<f64>,
+    /// How well it was solved.
     pub status: QpStatus,
     /// Interior-point iterations (0 for the direct projection).
     pub iterations: u32,

@@ -42,6 +42,7 @@ pub struct ClosedModes {
     pub equilibrium: Vec<f64>,
     /// Largest |∂V/∂θ_c| left at the equilibrium, N·m.
     pub residual_torque: f64,
+    /// Newton steps taken to the equilibrium.
     pub newton_iterations: usize,
     /// Loop-closure residual of `equilibrium`, rad.
     pub closure_residual: f64,
