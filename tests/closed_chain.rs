@@ -212,9 +212,10 @@ fn scene(name: &str, edit: impl Fn(&mut serde_json::Value)) -> Scene {
 }
 
 /// The fit states its error on f and on f′ = G at the sweep samples; between the samples,
-/// on the whole fitted domain, f and G of the polynomial stay within those (5% slack for the
-/// error curve's maxima falling between samples), against Newton closure and the implicit
-/// function theorem evaluated independently.
+/// on the whole fitted domain, f and G of the polynomial stay within those, against Newton
+/// closure and the implicit function theorem evaluated independently. The largest errors
+/// sit at sample points (measured: the ratio is 1 to within 2e-13 at degrees 2 to 8), so
+/// the slack is rounding only.
 #[test]
 fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() {
     let reference = scene("corner_cube_step1", |v| {
@@ -247,12 +248,12 @@ fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() 
         }
         assert!(fitted.closed().unwrap().source.errors().1 > 0.0 && fitted.closed().unwrap().source.errors().0 > 0.0);
         assert!(
-            value_error <= 1.05 * fitted.closed().unwrap().source.errors().0,
+            value_error <= (1.0 + 1e-9) * fitted.closed().unwrap().source.errors().0,
             "degree {degree}: f off by {value_error:e}, stated {:e}",
             fitted.closed().unwrap().source.errors().0
         );
         assert!(
-            slope_error <= 1.05 * fitted.closed().unwrap().source.errors().1,
+            slope_error <= (1.0 + 1e-9) * fitted.closed().unwrap().source.errors().1,
             "degree {degree}: G off by {slope_error:e}, stated {:e}",
             fitted.closed().unwrap().source.errors().1
         );
@@ -444,8 +445,9 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
             // still leaves 1.1e-5) while the physical lag is below the 7.6e-8 rad bound: the
             // quasi-static path is the more accurate answer here, and 4× faster.
             let along = quasi_static_deviation(&ClosedPlant::new(chain, false), &dynamic.samples).unwrap();
+            // Measured 1.195e-4 rad: the bound is that lag and 25% more.
             assert!(
-                along < 5e-4,
+                along < 1.5e-4,
                 "{name}: dynamic vs quasi-static along the path {along:e} rad"
             );
             let last = dynamic.samples.last().unwrap();

@@ -284,10 +284,30 @@ fn bad_constraint_requests_get_clear_errors() {
     let held = locked.creases.iter().position(|c| c.locked).unwrap();
     let err = Setup::new(&locked, held, &[]).unwrap_err().to_string();
     assert!(err.contains("cannot drive a locked crease"), "{err}");
-    // A range the pattern cannot reach: the driver turns back at 158.70°.
+    // A range the pattern cannot reach. Closed form: crease 0 sits between sectors a, b
+    // (70°, 70°); the diagonal between its neighbours' nodes has cos d = cos a cos b +
+    // sin a sin b cos φ with φ = π − |ρ₀|, and the other two sectors c, e (100°, 120°) close
+    // only while d ≥ |c − e|: the driver turns back at cos φ* = (cos|c−e| − cos a cos b) /
+    // (sin a sin b).
     let setup = Setup::new(&generic, 0, &[]).unwrap();
     let err = sweep_samples(&generic, &setup, [0.0, PI], 181).unwrap_err().to_string();
-    assert!(err.contains("158.70"), "{err}");
+    let ray = generic.creases[0].ray;
+    let alpha = |k: usize| generic.sector_angles[k % 4];
+    let (a, b, c, e) = (alpha(ray + 3), alpha(ray), alpha(ray + 1), alpha(ray + 2));
+    let cos_phi = ((c - e).abs().cos() - a.cos() * b.cos()) / (a.sin() * b.sin());
+    let turning = (PI - cos_phi.acos()).to_degrees();
+    let reported: f64 = err
+        .split(" = ")
+        .nth(1)
+        .and_then(|rest| rest.split('°').next())
+        .and_then(|number| number.parse().ok())
+        .unwrap_or_else(|| panic!("no angle in {err}"));
+    // The message rounds to 1e-6°; the sweep's last solvable point matched the closed form
+    // to that (measured).
+    assert!(
+        (reported - turning).abs() < 2e-6,
+        "stopped at {reported}°, turning point {turning}°: {err}"
+    );
     // Degrees 0 and 21.
     let samples = sweep_samples(&generic, &setup, [0.0, 1.0], 41).unwrap();
     for degree in [0, 21] {

@@ -315,8 +315,10 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
         })
         .fold(0.0, f64::max);
     let estimate = quasi.quasi_static_error_estimate;
+    // The estimate is the linear bound with no slack: measured 0.66 of it here (no drag),
+    // and the quasi-static check's own run 0.58.
     assert!(
-        difference <= estimate * 1.05,
+        difference <= estimate,
         "dynamic − quasi-static {difference:.3e} rad > estimate {estimate:.3e}"
     );
     assert!(
@@ -324,7 +326,7 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
         "estimate {estimate:.3e} far above the difference {difference:.3e}"
     );
     let (_, measured) = quasi.measured_quasi_static_error.unwrap();
-    assert!(measured <= estimate * 1.05);
+    assert!(measured <= estimate);
 }
 
 #[test]
@@ -438,7 +440,8 @@ fn quasi_static_forced_on_a_step_reports_its_large_error() {
     let (_, measured) = response.measured_quasi_static_error.unwrap();
     // The undamped step would overshoot by its own size; drag takes a little off.
     assert!(measured > 0.5 * 60f64.to_radians(), "measured {measured}");
-    assert!(measured <= response.quasi_static_error_estimate * 1.05);
+    // Drag only takes energy out, so the linear (drag-free) bound holds: measured 0.989 of it.
+    assert!(measured <= response.quasi_static_error_estimate);
     let last = response.samples.last().unwrap();
     assert!((&last.angles - &scene.strip().unwrap().target_angles()).amax() < 1e-15);
 }
