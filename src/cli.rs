@@ -256,28 +256,7 @@ pub struct SolverArgs {
 
 impl SolverArgs {
     fn settings(&self) -> Result<UnfoldSettings> {
-        if let Some(p) = self.p {
-            anyhow::ensure!(
-                p.is_finite() && p > 0.0,
-                "invalid --p {p}: the exponent must be a positive number"
-            );
-        }
-        anyhow::ensure!(
-            self.flat_tol.is_finite() && self.flat_tol > 0.0,
-            "invalid --flat-tol {}: must be a positive number",
-            self.flat_tol
-        );
-        anyhow::ensure!(
-            self.bending_metric.is_finite() && self.bending_metric >= 0.0,
-            "invalid --bending-metric {}: must be a number ≥ 0 (0 is the plain QP)",
-            self.bending_metric
-        );
-        anyhow::ensure!(
-            self.closure_tol.is_finite() && self.closure_tol > 0.0,
-            "invalid --closure-tol {}: must be a positive number",
-            self.closure_tol
-        );
-        Ok(UnfoldSettings {
+        let settings = UnfoldSettings {
             energy: self.energy.into(),
             p: self.p,
             qp: self.qp.into(),
@@ -286,7 +265,12 @@ impl SolverArgs {
             max_iterations: self.max_iter,
             restarts: self.restarts,
             ..UnfoldSettings::default()
-        })
+        };
+        settings.validate().map_err(|e| with_flags(e, UNFOLD_FLAGS))?;
+        self.load_options()
+            .validate()
+            .map_err(|e| with_flags(e, UNFOLD_FLAGS))?;
+        Ok(settings)
     }
 
     fn load_options(&self) -> LoadOptions {
@@ -573,11 +557,6 @@ fn parse_range(text: &str) -> Result<[f64; 2]> {
 }
 
 fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
-    anyhow::ensure!(
-        args.closure_tol.is_finite() && args.closure_tol > 0.0,
-        "invalid --closure-tol {}: must be a positive number",
-        args.closure_tol
-    );
     let degree = match args.degree.as_str() {
         "auto" => None,
         text => {
@@ -601,6 +580,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         closure_tol: args.closure_tol,
         ..LoadOptions::default()
     };
+    options.validate().map_err(constraints_flags)?;
     let pattern = nanofold::io::load_pattern(&args.pattern, &options)?;
     let driver = crease_index(&pattern, args.drive, "--drive")?;
     let locks = args
@@ -876,46 +856,55 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     Ok(())
 }
 
-/// Library errors name the constraint request's fields; say which flag sets each.
-fn constraints_flags(error: nanofold::NanofoldError) -> anyhow::Error {
-    let flag = match &error {
-        nanofold::NanofoldError::InvalidField { field, .. } => match field.as_str() {
-            "driver" => Some("--drive"),
-            "locks" => Some("--lock"),
-            "domain" => Some("--range"),
-            "samples" => Some("--samples"),
-            "degree" => Some("--degree"),
-            "tolerance" => Some("--tol"),
-            "source" => Some("--source"),
-            _ => None,
-        },
+/// Library settings and the flags that set them, per command.
+const UNFOLD_FLAGS: &[(&str, &str)] = &[
+    ("p", "--p"),
+    ("flat_tol", "--flat-tol"),
+    ("bending_metric", "--bending-metric"),
+    ("max_iterations", "--max-iter"),
+    ("restarts", "--restarts"),
+    ("closure_tol", "--closure-tol"),
+];
+const CONSTRAINT_FLAGS: &[(&str, &str)] = &[
+    ("driver", "--drive"),
+    ("locks", "--lock"),
+    ("domain", "--range"),
+    ("samples", "--samples"),
+    ("degree", "--degree"),
+    ("tolerance", "--tol"),
+    ("source", "--source"),
+    ("closure_tol", "--closure-tol"),
+];
+const SIMULATE_FLAGS: &[(&str, &str)] = &[("rtol", "--rtol"), ("t_end", "--t-end"), ("max_steps", "--max-steps")];
+
+/// Library errors name library fields: an invalid field that a flag sets gets the flag and
+/// its value in front ("invalid --p -1: invalid `p`: …"); a run that a flag can rescue gets
+/// the flags to try.
+fn with_flags(error: nanofold::NanofoldError, flags: &[(&str, &str)]) -> anyhow::Error {
+    use nanofold::error::NumericalError;
+    use nanofold::NanofoldError;
+    let context = match &error {
+        NanofoldError::InvalidField { field, value, .. } => flags
+            .iter()
+            .find(|(name, _)| name == field)
+            .map(|(_, flag)| format!("invalid {flag} {value}")),
+        NanofoldError::Numerical(
+            NumericalError::StepBudget { .. } | NumericalError::NewtonFailures { .. } | NumericalError::Strayed { .. },
+        ) => Some("simulate (flags that help: --method, --model, --rtol, --max-steps)".to_string()),
         _ => None,
     };
-    match flag {
-        Some(flag) => anyhow::Error::new(error).context(flag),
+    match context {
+        Some(context) => anyhow::Error::new(error).context(context),
         None => anyhow::Error::new(error),
     }
 }
 
-/// Library errors name library settings; say which flags set them.
+fn constraints_flags(error: nanofold::NanofoldError) -> anyhow::Error {
+    with_flags(error, CONSTRAINT_FLAGS)
+}
+
 fn simulate_flags(error: nanofold::NanofoldError) -> anyhow::Error {
-    use nanofold::error::NumericalError;
-    let flags = match &error {
-        nanofold::NanofoldError::InvalidField { field, .. } => match field.as_str() {
-            "rtol" => Some("--rtol"),
-            "t_end" => Some("--t-end"),
-            "max_steps" => Some("--max-steps"),
-            _ => None,
-        },
-        nanofold::NanofoldError::Numerical(
-            NumericalError::StepBudget { .. } | NumericalError::NewtonFailures { .. } | NumericalError::Strayed { .. },
-        ) => Some("--method, --model, --rtol, --max-steps"),
-        _ => None,
-    };
-    match flags {
-        Some(flags) => anyhow::Error::new(error).context(format!("simulate (set by {flags})")),
-        None => anyhow::Error::new(error),
-    }
+    with_flags(error, SIMULATE_FLAGS)
 }
 
 fn run_modes(path: &Path, json: bool) -> Result<()> {

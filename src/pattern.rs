@@ -151,6 +151,28 @@ impl Default for LoadOptions {
     }
 }
 
+impl LoadOptions {
+    /// Both tolerances in range: `closure_tol` in (0, 0.1] rad, `angle_sum_tol` in
+    /// [0, 1e-3] rad.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.closure_tol.is_finite() && self.closure_tol > 0.0 && self.closure_tol <= 0.1) {
+            return Err(NanofoldError::invalid(
+                "closure_tol",
+                self.closure_tol,
+                "must lie in (0, 0.1] rad",
+            ));
+        }
+        if !(self.angle_sum_tol.is_finite() && (0.0..=1e-3).contains(&self.angle_sum_tol)) {
+            return Err(NanofoldError::invalid(
+                "angle_sum_tol",
+                self.angle_sum_tol,
+                "must lie in [0, 1e-3] rad",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One ray handed to a [`VertexBuilder`], counter-clockwise.
 #[derive(Debug, Clone)]
 pub enum RaySpec {
@@ -276,6 +298,7 @@ impl VertexBuilder {
     /// Validates and splits sectors of π or more (`docs/model.md#the-vertex`). An open chain built with
     /// [`VertexBuilder::crease`] gets its two boundary rays here.
     pub fn build_with(mut self, options: &LoadOptions) -> Result<Pattern> {
+        options.validate()?;
         if self.chain == Chain::Open && !matches!(self.rays.first(), Some(RaySpec::Boundary)) {
             self.rays.insert(0, RaySpec::Boundary);
             self.rays.push(RaySpec::Boundary);

@@ -5,7 +5,7 @@
 use super::{ClosedChain, ConstraintSource};
 use crate::constraints::exact::ExactConstraint;
 use crate::constraints::{sweep_samples, ConstraintPoly, Setup};
-use crate::dynamics::forcing::{Forcing, HingeDrive};
+use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::model::{Joint, Model, Plate};
 use crate::dynamics::spec::{
     actuation, drag_law, finite, hinge_stiffness, material, positive, validate_materials, ClosedSpec, CreaseHingeSpec,
@@ -26,51 +26,147 @@ struct SectorGeometry {
     outlines: Vec<Option<(Vec<[f64; 2]>, usize)>>,
 }
 
-/// Assembles the closed chain a scene describes.
+/// The hinges of every crease: stiffness and spec, one per crease (file order).
+struct Hinges {
+    stiffness: Vec<f64>,
+    spec: Vec<HingeSpec>,
+    of_crease: Vec<usize>,
+}
+
+/// What one step of the closed chain does: the driver and its target, the cut, the locks
+/// as a constraint setup, the start and the swept domain.
+struct Step {
+    driver: usize,
+    target: f64,
+    cut: usize,
+    setup: Setup,
+    start: f64,
+    domain: [f64; 2],
+}
+
+/// Assembles the closed chain a scene describes: validates the pattern and the hinges,
+/// sets up the step, sweeps and fits the constraint, and builds the tree of sector plates.
 pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
     validate_materials(&spec.materials)?;
     let pattern = &spec.pattern;
     let mesh = check_pattern(pattern)?;
     let unit = positive("length_unit_um", spec.length_unit_um)? * MICROMETRE;
     let geometry = sector_geometry(pattern, mesh, unit)?;
-    let user = |field: &str, index: usize| {
-        pattern.crease_from_user_index(index).ok_or_else(|| {
-            NanofoldError::invalid(
-                field,
-                index,
-                format!(
-                    "not a crease of {} (creases: {:?})",
-                    pattern.name,
-                    pattern.user_indices()
-                ),
-            )
-        })
+    let hinges = crease_hinges(spec, &geometry)?;
+    let step = step_of(spec, &hinges)?;
+    let source = constraint_source(spec, &step)?;
+    let ground_sector = anchored_sector(spec, &geometry, &step)?;
+    let (model, joint_creases, joint_sectors) = sector_tree(spec, &geometry, &hinges, &step, ground_sector)?;
+    let outline = outline_of(pattern, &geometry, ground_sector)?;
+    let ground = outline.iter().map(|&[x, y]| Point3::new(x, y, 0.0)).collect();
+    let actuation = actuation(&spec.actuation)?;
+    let driver_hinge = &hinges.spec[hinges.of_crease[step.driver]];
+    let mut drives = vec![HingeDrive::PASSIVE; pattern.creases.len()];
+    drives[step.driver] = HingeDrive {
+        target: step.target,
+        radius_of_curvature: match actuation {
+            Actuation::Step => f64::INFINITY,
+            Actuation::Ramp { .. } => {
+                let field = "hinges[driver].radius_of_curvature_um";
+                positive(
+                    field,
+                    driver_hinge
+                        .radius_of_curvature_um
+                        .ok_or_else(|| NanofoldError::missing(field))?,
+                )? * MICROMETRE
+            }
+        },
+        actuated: true,
     };
-    let creases = pattern.creases.len();
+    let anchored_face = geometry.outlines[ground_sector]
+        .as_ref()
+        .map(|(_, f)| *f)
+        .expect("the anchored sector has a face");
+    Ok(ClosedChain {
+        model,
+        joint_creases,
+        joint_sectors,
+        ground_sector,
+        ground,
+        cut_crease: step.cut,
+        crease_stiffness: hinges.stiffness,
+        crease_labels: pattern.creases.iter().map(|c| c.label.clone()).collect(),
+        crease_ends: geometry.crease_ends,
+        driver: step.driver,
+        locked: step.setup.locked.clone(),
+        dependents: step.setup.dependents.clone(),
+        source,
+        sector_angles: pattern.sector_angles.clone(),
+        crease_rays: pattern.creases.iter().map(|c| c.ray).collect(),
+        start: step.start,
+        crease_user_indices: pattern.user_indices(),
+        anchored_face,
+        forcing: Forcing {
+            actuation,
+            hinges: drives,
+        },
+    })
+}
 
-    // Hinges, one per crease.
-    let hinges: Vec<HingeSpec> = spec.hinges.iter().map(CreaseHingeSpec::hinge).collect();
-    let mut hinge_of: Vec<Option<&HingeSpec>> = vec![None; creases];
+/// The crease a scene field names by its FOLD edge index.
+fn crease_of(pattern: &Pattern, field: &str, index: usize) -> Result<usize> {
+    pattern.crease_from_user_index(index).ok_or_else(|| {
+        NanofoldError::invalid(
+            field,
+            index,
+            format!(
+                "not a crease of {} (creases: {:?})",
+                pattern.name,
+                pattern.user_indices()
+            ),
+        )
+    })
+}
+
+/// One hinge per crease, its stiffness from its layers and the crease's length.
+fn crease_hinges(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry) -> Result<Hinges> {
+    let pattern = &spec.pattern;
+    let creases = pattern.creases.len();
+    let mut of_crease: Vec<Option<usize>> = vec![None; creases];
     let mut stiffness = vec![0.0; creases];
+    let spec_hinges: Vec<HingeSpec> = spec.hinges.iter().map(CreaseHingeSpec::hinge).collect();
     for (i, hinge) in spec.hinges.iter().enumerate() {
-        let c = user(&format!("hinges[{i}].crease"), hinge.crease)?;
-        if hinge_of[c].replace(&hinges[i]).is_some() {
+        let c = crease_of(pattern, &format!("hinges[{i}].crease"), hinge.crease)?;
+        if of_crease[c].replace(i).is_some() {
             return Err(NanofoldError::invalid(
                 format!("hinges[{i}].crease"),
                 hinge.crease,
                 "this crease already has a hinge",
             ));
         }
-        stiffness[c] = hinge_stiffness(&spec.materials, i, &hinges[i], geometry.crease_ends[c].coords.norm())?;
+        stiffness[c] = hinge_stiffness(
+            &spec.materials,
+            i,
+            &spec_hinges[i],
+            geometry.crease_ends[c].coords.norm(),
+        )?;
     }
-    if let Some(c) = hinge_of.iter().position(Option::is_none) {
-        return Err(NanofoldError::missing(format!(
-            "hinges: an entry with crease {}",
-            pattern.user_index(c)
-        )));
-    }
+    let of_crease = of_crease
+        .iter()
+        .enumerate()
+        .map(|(c, h)| {
+            h.ok_or_else(|| NanofoldError::missing(format!("hinges: an entry with crease {}", pattern.user_index(c))))
+        })
+        .collect::<Result<Vec<usize>>>()?;
+    Ok(Hinges {
+        stiffness,
+        spec: spec_hinges,
+        of_crease,
+    })
+}
+
+/// The driver (the one actuated crease) and its target, the cut, the locks leaving one
+/// freedom, the start and the domain the constraint is swept over.
+fn step_of(spec: &ClosedSpec<Pattern>, hinges: &Hinges) -> Result<Step> {
+    let pattern = &spec.pattern;
+    let creases = pattern.creases.len();
     let actuated: Vec<usize> = (0..creases)
-        .filter(|&c| hinge_of[c].is_some_and(|h| h.actuated))
+        .filter(|&c| hinges.spec[hinges.of_crease[c]].actuated)
         .collect();
     let [driver] = actuated[..] else {
         return Err(NanofoldError::invalid(
@@ -79,9 +175,8 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
             "a closed-chain step drives exactly one crease; lock the others",
         ));
     };
-    let driver_hinge = hinge_of[driver].expect("every crease has a hinge");
     let target_field = "hinges[driver].target_angle_deg";
-    let target_deg = driver_hinge
+    let target_deg = hinges.spec[hinges.of_crease[driver]]
         .target_angle_deg
         .ok_or_else(|| NanofoldError::missing(target_field))?;
     finite(target_field, target_deg)?;
@@ -92,7 +187,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
             "must lie in [−180, 180]",
         ));
     }
-    let cut = user("cut_crease", spec.cut_crease)?;
+    let cut = crease_of(pattern, "cut_crease", spec.cut_crease)?;
     if cut == driver {
         return Err(NanofoldError::invalid(
             "cut_crease",
@@ -102,7 +197,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
     }
     let mut locks = Vec::new();
     for (i, lock) in spec.locks.iter().enumerate() {
-        let c = user(&format!("locks[{i}].crease"), lock.crease)?;
+        let c = crease_of(pattern, &format!("locks[{i}].crease"), lock.crease)?;
         locks.push((
             c,
             finite(&format!("locks[{i}].angle_deg"), lock.angle_deg)?.to_radians(),
@@ -130,7 +225,22 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
             "must lie inside constraint.range_deg",
         ));
     }
-    let source = match (spec.constraint.source, spec.constraint.degree) {
+    Ok(Step {
+        driver,
+        target,
+        cut,
+        setup,
+        start,
+        domain,
+    })
+}
+
+/// f: a Chebyshev fit of the exact sweep (`poly`), or Newton closure on the sweep's branch
+/// (`exact`). The sweep runs here (the numerics of assembling, never of loading).
+fn constraint_source(spec: &ClosedSpec<Pattern>, step: &Step) -> Result<ConstraintSource> {
+    let pattern = &spec.pattern;
+    let sweep = || sweep_samples(pattern, &step.setup, step.domain, spec.constraint.samples);
+    Ok(match (spec.constraint.source, spec.constraint.degree) {
         (SourceKind::Poly, None) => {
             return Err(NanofoldError::missing_with(
                 "constraint.degree",
@@ -144,24 +254,17 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
                 "only the \"poly\" source has a degree",
             ))
         }
-        (SourceKind::Poly, Some(degree)) => {
-            let samples = sweep_samples(pattern, &setup, domain, spec.constraint.samples)?;
-            ConstraintSource::Poly(ConstraintPoly::fit(pattern, &samples, degree)?)
-        }
-        (SourceKind::Exact, None) => {
-            let samples = sweep_samples(pattern, &setup, domain, spec.constraint.samples)?;
-            ConstraintSource::Exact(ExactConstraint::new(pattern, &samples))
-        }
-    };
+        (SourceKind::Poly, Some(degree)) => ConstraintSource::Poly(ConstraintPoly::fit(pattern, &sweep()?, degree)?),
+        (SourceKind::Exact, None) => ConstraintSource::Exact(ExactConstraint::new(pattern, &sweep()?)),
+    })
+}
 
-    // The anchored sector and the tree of plates on either side of it up to the cut.
-    let thickness = positive("plates.thickness_um", spec.plates.thickness_um)? * MICROMETRE;
-    let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
-    let rays = pattern.rays.len();
-    let cut_ray = pattern.creases[cut].ray;
-    let ground_sector = match spec.anchored_face {
-        None => cut_ray,
-        Some(face) => (0..rays)
+/// The sector on the substrate: the anchored face's, or the one after the cut.
+fn anchored_sector(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry, step: &Step) -> Result<usize> {
+    let pattern = &spec.pattern;
+    match spec.anchored_face {
+        None => Ok(pattern.creases[step.cut].ray),
+        Some(face) => (0..pattern.rays.len())
             .find(|&s| geometry.outlines[s].as_ref().is_some_and(|(_, f)| *f == face))
             .ok_or_else(|| {
                 NanofoldError::invalid(
@@ -169,20 +272,38 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
                     face,
                     format!("not a face of {} that covers a sector", pattern.name),
                 )
-            })?,
-    };
-    let outline = |sector: usize| {
-        geometry.outlines[sector]
-            .as_ref()
-            .map(|(o, _)| o.clone())
-            .ok_or_else(|| {
-                NanofoldError::invalid(
-                    format!("{}: faces_vertices", pattern.name),
-                    format!("sector {sector}"),
-                    "no face covers this sector",
-                )
-            })
-    };
+            }),
+    }
+}
+
+/// The outline of the face covering `sector`, m.
+fn outline_of(pattern: &Pattern, geometry: &SectorGeometry, sector: usize) -> Result<Vec<[f64; 2]>> {
+    geometry.outlines[sector]
+        .as_ref()
+        .map(|(o, _)| o.clone())
+        .ok_or_else(|| {
+            NanofoldError::invalid(
+                format!("{}: faces_vertices", pattern.name),
+                format!("sector {sector}"),
+                "no face covers this sector",
+            )
+        })
+}
+
+/// The sector plates on a tree rooted at the anchored sector, both ways round to the cut;
+/// with the crease and the sector of every joint.
+fn sector_tree(
+    spec: &ClosedSpec<Pattern>,
+    geometry: &SectorGeometry,
+    hinges: &Hinges,
+    step: &Step,
+    ground_sector: usize,
+) -> Result<(Model, Vec<usize>, Vec<usize>)> {
+    let pattern = &spec.pattern;
+    let thickness = positive("plates.thickness_um", spec.plates.thickness_um)? * MICROMETRE;
+    let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
+    let rays = pattern.rays.len();
+    let cut_ray = pattern.creases[step.cut].ray;
     let ray_crease = |r: usize| match pattern.rays[r] {
         RayRole::Crease(c) => c,
         _ => unreachable!("closed chains without virtual rays have a crease on every ray"),
@@ -193,94 +314,43 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
     };
     let (mut joints, mut plates, mut parents) = (Vec::new(), Vec::new(), Vec::new());
     let (mut joint_creases, mut joint_sectors) = (Vec::new(), Vec::new());
-    // Counter-clockwise from the anchored sector: the crease at ray r turns sector r about
-    // +ray_r relative to sector r − 1 (a valley lifts it).
-    let mut parent = None;
-    for step in 1..rays {
-        let r = (ground_sector + step) % rays;
-        if r == cut_ray {
-            break;
-        }
-        joints.push(Joint {
-            axis: direction(r, 1.0),
-            point: Point3::origin(),
-            stiffness: stiffness[ray_crease(r)],
-        });
-        plates.push(Plate::lamina(&outline(r)?, thickness, density));
-        parents.push(parent);
-        parent = Some(joints.len() - 1);
-        joint_creases.push(ray_crease(r));
-        joint_sectors.push(r);
-    }
-    // Clockwise: the crease at ray r turns sector r − 1 about −ray_r relative to sector r.
-    let mut parent = None;
-    for step in 0..rays {
-        let r = (ground_sector + rays - step) % rays;
-        if r == cut_ray {
-            break;
-        }
-        let sector = (r + rays - 1) % rays;
-        joints.push(Joint {
-            axis: direction(r, -1.0),
-            point: Point3::origin(),
-            stiffness: stiffness[ray_crease(r)],
-        });
-        plates.push(Plate::lamina(&outline(sector)?, thickness, density));
-        parents.push(parent);
-        parent = Some(joints.len() - 1);
-        joint_creases.push(ray_crease(r));
-        joint_sectors.push(sector);
-    }
-    let ground = outline(ground_sector)?
-        .iter()
-        .map(|&[x, y]| Point3::new(x, y, 0.0))
-        .collect();
-    let actuation = actuation(&spec.actuation)?;
-    let mut drives = vec![HingeDrive::PASSIVE; creases];
-    drives[driver] = HingeDrive {
-        target,
-        radius_of_curvature: match actuation {
-            crate::dynamics::forcing::Actuation::Step => f64::INFINITY,
-            crate::dynamics::forcing::Actuation::Ramp { .. } => {
-                let field = "hinges[driver].radius_of_curvature_um";
-                positive(
-                    field,
-                    driver_hinge
-                        .radius_of_curvature_um
-                        .ok_or_else(|| NanofoldError::missing(field))?,
-                )? * MICROMETRE
+    // Counter-clockwise from the anchored sector the crease at ray r turns sector r about
+    // +ray_r relative to sector r − 1 (a valley lifts it); clockwise it turns sector r − 1
+    // about −ray_r relative to sector r. Each branch stops at the cut.
+    for clockwise in [false, true] {
+        let mut parent = None;
+        for step in 0..rays {
+            let r = if clockwise {
+                (ground_sector + rays - step) % rays
+            } else {
+                (ground_sector + step + 1) % rays
+            };
+            if r == cut_ray {
+                break;
             }
-        },
-        actuated: true,
-    };
-    let anchored_face = geometry.outlines[ground_sector]
-        .as_ref()
-        .map(|(_, f)| *f)
-        .expect("the anchored sector has a face");
-    Ok(ClosedChain {
-        model: Model::tree(joints, plates, parents, drag_law(&spec.environment)?)?,
-        joint_creases,
-        joint_sectors,
-        ground_sector,
-        ground,
-        cut_crease: cut,
-        crease_stiffness: stiffness,
-        crease_labels: pattern.creases.iter().map(|c| c.label.clone()).collect(),
-        crease_ends: geometry.crease_ends,
-        driver,
-        locked: setup.locked.clone(),
-        dependents: setup.dependents.clone(),
-        source,
-        sector_angles: pattern.sector_angles.clone(),
-        crease_rays: pattern.creases.iter().map(|c| c.ray).collect(),
-        start,
-        crease_user_indices: pattern.user_indices(),
-        anchored_face,
-        forcing: Forcing {
-            actuation,
-            hinges: drives,
-        },
-    })
+            let (sector, sign) = if clockwise {
+                ((r + rays - 1) % rays, -1.0)
+            } else {
+                (r, 1.0)
+            };
+            joints.push(Joint {
+                axis: direction(r, sign),
+                point: Point3::origin(),
+                stiffness: hinges.stiffness[ray_crease(r)],
+            });
+            plates.push(Plate::lamina(
+                &outline_of(pattern, geometry, sector)?,
+                thickness,
+                density,
+            ));
+            parents.push(parent);
+            parent = Some(joints.len() - 1);
+            joint_creases.push(ray_crease(r));
+            joint_sectors.push(sector);
+        }
+    }
+    let model = Model::tree(joints, plates, parents, drag_law(&spec.environment)?)?;
+    Ok((model, joint_creases, joint_sectors))
 }
 
 /// A closed vertex from a FOLD file with faces, and no sector split by a virtual ray.
