@@ -307,15 +307,11 @@ impl std::fmt::Debug for Scratch {
     }
 }
 
-/// Stable, allocation-free sort of row indices by pivot (the rows come nearly sorted).
+/// Sorts row indices by pivot, ties in their original order, without allocating (the
+/// metric's augmented rows come in two sorted runs, so an insertion sort would be
+/// quadratic).
 fn sort_by_pivot(index: &mut [usize], rows: &[JacobianRow]) {
-    for i in 1..index.len() {
-        let mut j = i;
-        while j > 0 && rows[index[j - 1]].pivot_slot() > rows[index[j]].pivot_slot() {
-            index.swap(j - 1, j);
-            j -= 1;
-        }
-    }
+    index.sort_unstable_by_key(|&r| (rows[r].pivot_slot(), r));
 }
 
 impl ChainFactors {
