@@ -11,8 +11,9 @@ use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::{Scene, System};
 use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, SimulationSettings};
+use nanofold::io::folder::{folder_name, write_folder};
 use nanofold::io::output::{
-    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json, write_atomic,
+    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
 };
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::plot::response::{response_svg, snapshots_svg};
@@ -378,18 +379,17 @@ fn unfold_one(pattern_path: &Path, solver: &SolverArgs, dir: Option<&Path>) -> R
     let pattern = nanofold::io::load_pattern(pattern_path, &solver.load_options())?;
     let report = unfold(&pattern, &settings)?;
     let model = UnfoldModel::new(&pattern);
-    let dir = dir.map_or_else(|| PathBuf::from("output").join(&pattern.name), Path::to_path_buf);
+    let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
     let trajectory = serde_json::to_string(&trajectory_json(&pattern, &settings, &report, 1000))?;
     let fold = serde_json::to_string_pretty(&fold_animation(&pattern, &model, &report))?;
     let svg = unfold_svg(&pattern, &report)?;
-    for (name, contents) in [
+    let files = [
         ("trajectory.json", trajectory.as_bytes()),
         ("unfold.fold", fold.as_bytes()),
         ("unfold.svg", svg.as_bytes()),
-    ] {
-        write_atomic(&dir.join(name), contents).with_context(|| format!("writing {}", dir.display()))?;
-    }
+    ];
+    write_folder(&dir, &files).with_context(|| format!("writing {}", dir.display()))?;
     let mut summary = summary(&pattern, pattern_path, &report);
     summary["out"] = json!(dir.display().to_string());
     let mut text = String::new();
@@ -456,7 +456,8 @@ fn run_unfold(
     let mut jobs: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
     let mut writer_of: std::collections::HashMap<PathBuf, PathBuf> = std::collections::HashMap::new();
     for path in files {
-        let dir = parent.join(nanofold::io::pattern_name(&path));
+        let file_name = nanofold::io::pattern_name(&path);
+        let dir = parent.join(folder_name(&file_name, &file_name));
         if let Some(other) = writer_of.insert(dir.clone(), path.clone()) {
             anyhow::bail!(
                 "{} and {} would both write {}: unfold them separately with --out",
@@ -625,7 +626,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("output").join(&pattern.name));
+        .unwrap_or_else(|| default_folder(&pattern.name, &args.pattern));
     let report_json = serde_json::to_string_pretty(&report)?;
     let svg = constraints_svg(&pattern, &samples, &poly)?;
     let mut files = vec![("constraints.json", report_json), ("constraints.svg", svg)];
@@ -674,12 +675,20 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
 }
 
 /// The first contact of a run, or that there was none, as one line.
-/// Writes each (file name, contents) into `dir`, each atomically; everything is rendered first.
+/// `output/<name>`, where a name that is not one plain folder name (`..`, `/abs`, empty)
+/// gives way to the file's own name.
+fn default_folder(name: &str, file: &Path) -> PathBuf {
+    PathBuf::from("output").join(folder_name(name, &nanofold::io::pattern_name(file)))
+}
+
+/// Writes the (file name, contents) set into `dir` as one (see `io::folder`); everything is
+/// rendered first.
 fn write_outputs(dir: &Path, files: &[(&str, String)]) -> Result<()> {
-    for (name, contents) in files {
-        write_atomic(&dir.join(name), contents.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
-    }
-    Ok(())
+    let files: Vec<(&str, &[u8])> = files
+        .iter()
+        .map(|(name, contents)| (*name, contents.as_bytes()))
+        .collect();
+    write_folder(dir, &files).with_context(|| format!("writing {}", dir.display()))
 }
 
 /// The "wrote DIR/{a, b}" line.
@@ -789,10 +798,10 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     let simulation = simulate(&scene, &settings).map_err(simulate_flags)?;
     let response = &simulation.response;
     // Render everything before writing anything.
-    let dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("output").join(&scene.name));
+    let dir = args.out.clone().unwrap_or_else(|| {
+        let file_name = nanofold::io::scene::scene_name(&args.scene);
+        PathBuf::from("output").join(folder_name(&scene.name, &file_name))
+    });
     let files = [
         (
             "response.json",

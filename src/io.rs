@@ -3,13 +3,15 @@
 //! written atomically. Loaders parse and validate; they run no numerics.
 
 pub mod fold;
+pub mod folder;
+pub mod input;
 pub mod native;
 pub mod output;
 pub mod scene;
 
 pub use scene::{load_scene, parse_scene};
 
-use crate::error::{NanofoldError, Result};
+use crate::error::Result;
 use crate::pattern::{LoadOptions, Pattern};
 use std::path::Path;
 
@@ -40,19 +42,13 @@ pub fn pattern_name(path: &Path) -> String {
 /// # Ok::<(), NanofoldError>(())
 /// ```
 pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
-    let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let text = input::read_text(path, input::MAX_PATTERN_BYTES)?;
     parse_pattern(&text, &pattern_name(path), &path.display().to_string(), options)
 }
 
 /// Parses pattern text (FOLD or native); `origin` names it in error messages.
 pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
-    let value: serde_json::Value = serde_json::from_str(text).map_err(|source| NanofoldError::Json {
-        path: origin.to_string(),
-        source,
-    })?;
+    let value = input::parse_json(text, origin)?;
     let builder = if value.get("vertices_coords").is_some() {
         fold::read_fold(&value, name)?
     } else {

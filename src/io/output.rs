@@ -30,7 +30,10 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(err)?;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("output");
     let temporary = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    std::fs::write(&temporary, contents).map_err(err)?;
+    std::fs::write(&temporary, contents).map_err(|e| {
+        let _ = std::fs::remove_file(&temporary);
+        err(e)
+    })?;
     std::fs::rename(&temporary, path).map_err(|e| {
         let _ = std::fs::remove_file(&temporary);
         err(e)

@@ -30,10 +30,7 @@ pub fn scene_name(path: &Path) -> String {
 /// # Ok::<(), NanofoldError>(())
 /// ```
 pub fn load_scene(path: &Path) -> Result<SceneSpec> {
-    let text = std::fs::read_to_string(path).map_err(|source| NanofoldError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let text = crate::io::input::read_text(path, crate::io::input::MAX_SCENE_BYTES)?;
     let base = path.parent().unwrap_or(Path::new("."));
     parse_scene(&text, &path.display().to_string(), &scene_name(path), base)
 }
@@ -45,7 +42,7 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         path: source.to_string(),
         source: e,
     };
-    let value: serde_json::Value = serde_json::from_str(text).map_err(json)?;
+    let value = crate::io::input::parse_json(text, source)?;
     let closed = value.get("pattern").is_some();
     let mut spec = if closed {
         let file: ClosedSpec<String> = serde_json::from_value(value).map_err(json)?;
