@@ -161,7 +161,9 @@ pub fn unfold_observed(
         ));
     }
     let energy = settings.energy.build(settings.p);
-    if touching_charges(&model, &start)
+    // A start already flat needs no back-off (scaling zero fold angles changes nothing).
+    let already_flat = model.max_fold_angle(&start) <= settings.flat_tol;
+    if !already_flat && touching_charges(&model, &start)
         || !energy
             .value(&start, &model.arcs, &mut EnergyWorkspace::default())
             .is_finite()

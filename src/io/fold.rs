@@ -3,7 +3,7 @@
 //! state. Locked creases use the custom key `edges_nanofold:locked` (FOLD's namespace rule).
 
 use crate::error::{NanofoldError, Result};
-use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder};
+use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
 use serde_json::Value;
 use std::f64::consts::TAU;
 
@@ -237,12 +237,15 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         });
     }
     spokes.sort_by(|a, b| a.direction.total_cmp(&b.direction));
-    for pair in spokes.windows(2) {
-        if pair[1].direction - pair[0].direction < 1e-12 {
+    // Every neighbouring pair, the last and the first (across 0 rad) included.
+    for k in 0..spokes.len() {
+        let (here, next) = (&spokes[k], &spokes[(k + 1) % spokes.len()]);
+        let gap = (next.direction - here.direction).rem_euclid(TAU);
+        if spokes.len() > 1 && gap < MIN_SECTOR_RAD {
             return Err(NanofoldError::invalid(
-                format!("edges_vertices[{}]", pair[1].edge),
-                format!("edges {} and {}", pair[0].edge, pair[1].edge),
-                "two edges leave the vertex in the same direction",
+                format!("edges_vertices[{}]", next.edge),
+                format!("edges {} and {}, {gap:.1e} rad apart", here.edge, next.edge),
+                format!("two edges leave the vertex in the same direction (less than {MIN_SECTOR_RAD:.0e} rad apart)"),
             ));
         }
     }

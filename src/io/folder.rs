@@ -245,6 +245,29 @@ mod tests {
     }
 
     #[test]
+    fn concurrent_runs_never_mix_their_files() {
+        let root = scratch("concurrent");
+        let dir = root.join("run");
+        std::thread::scope(|scope| {
+            for writer in 0..4u8 {
+                let dir = &dir;
+                scope.spawn(move || {
+                    for _ in 0..25 {
+                        let tag = [b'0' + writer];
+                        // A write may lose a race for the rename; it must then fail cleanly.
+                        let _ = write_folder(dir, &[("response.json", &tag), ("response.svg", &tag)]);
+                    }
+                });
+            }
+        });
+        let json = std::fs::read(dir.join("response.json")).unwrap();
+        let svg = std::fs::read(dir.join("response.svg")).unwrap();
+        assert_eq!(json, svg, "files of two runs mixed");
+        assert_eq!(std::fs::read_dir(&root).unwrap().count(), 1, "temporaries left");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
     fn an_orphan_of_a_killed_run_is_removed() {
         let root = scratch("orphan");
         std::fs::create_dir_all(&root).unwrap();
