@@ -285,9 +285,9 @@ impl SolverArgs {
 /// How many patterns run at once.
 #[derive(Args, Debug, Clone)]
 pub struct ParallelArgs {
-    /// Patterns run at once (0: one per core). Lines come out as patterns finish, each
-    /// naming its file.
-    #[arg(long, default_value_t = 0)]
+    /// Patterns run at once (0: one per core; at most 256). Lines come out as patterns
+    /// finish, each naming its file.
+    #[arg(long, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=256))]
     pub jobs: usize,
 }
 
@@ -297,7 +297,12 @@ impl ParallelArgs {
     fn all<T: Sync>(&self, items: &[T], work: impl Fn(&T) -> bool + Sync) -> Result<bool> {
         use rayon::prelude::*;
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(self.jobs)
+            // No more threads than items: a thread per item at most.
+            .num_threads(if self.jobs == 0 {
+                0
+            } else {
+                self.jobs.min(items.len().max(1))
+            })
             .build()
             .context("starting the worker threads")?;
         // `map` then `all`, not `all` alone: every item runs even after a failure.
@@ -316,7 +321,15 @@ impl ParallelArgs {
 /// recursively for `.fold` and `.json` files (scene files skipped), each directory's in
 /// name order. A directory without any is an error naming it.
 fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    fn walk(dir: &Path, found: &mut Vec<PathBuf>) -> Result<()> {
+    use std::collections::HashSet;
+    /// Walks `dir`; a directory reached twice (a symlink loop, or a link to a sibling) is
+    /// walked once.
+    fn walk(dir: &Path, seen_dirs: &mut HashSet<PathBuf>, found: &mut Vec<PathBuf>) -> Result<()> {
+        let canonical =
+            std::fs::canonicalize(dir).with_context(|| format!("cannot read directory {}", dir.display()))?;
+        if !seen_dirs.insert(canonical) {
+            return Ok(());
+        }
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
             .with_context(|| format!("cannot read directory {}", dir.display()))?
             .map(|entry| entry.map(|e| e.path()))
@@ -325,18 +338,24 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         entries.sort();
         for path in entries {
             if path.is_dir() {
-                walk(&path, found)?;
+                walk(&path, seen_dirs, found)?;
             } else if nanofold::io::is_pattern_file(&path) {
                 found.push(path);
             }
+            anyhow::ensure!(
+                found.len() <= MAX_BATCH_FILES,
+                "more than {MAX_BATCH_FILES} pattern files under {}: give fewer at a time",
+                dir.display()
+            );
         }
         Ok(())
     }
     let mut found = Vec::new();
+    let mut seen_dirs = HashSet::new();
     for path in paths {
         if path.is_dir() {
             let before = found.len();
-            walk(path, &mut found)?;
+            walk(path, &mut seen_dirs, &mut found)?;
             anyhow::ensure!(
                 found.len() > before,
                 "no pattern files (.fold or .json, scene files aside) in directory {}",
@@ -346,8 +365,19 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
             found.push(path.clone());
         }
     }
+    // One run per file, however many names (links, repeated arguments) lead to it.
+    let mut seen_files = HashSet::new();
+    found.retain(|path| seen_files.insert(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())));
+    anyhow::ensure!(
+        found.len() <= MAX_BATCH_FILES,
+        "{} pattern files: at most {MAX_BATCH_FILES} in one run",
+        found.len()
+    );
     Ok(found)
 }
+
+/// Most pattern files one `unfold` run takes.
+const MAX_BATCH_FILES: usize = 10_000;
 
 /// The `--json` summary of one run.
 fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json::Value {

@@ -30,7 +30,7 @@ pub fn pattern_name(path: &Path) -> String {
 }
 
 /// Loads a `.fold` file or a native `.json` vertex (decided by content: a FOLD file has
-/// `vertices_coords`).
+/// keys of FOLD's `file_`, `frame_`, `vertices_`, `edges_` or `faces_` families).
 ///
 /// ```
 /// use nanofold::prelude::*;
@@ -46,10 +46,18 @@ pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
     parse_pattern(&text, &pattern_name(path), &path.display().to_string(), options)
 }
 
+/// Does this JSON object use FOLD's keys (rather than the native vertex's)?
+fn is_fold_object(value: &serde_json::Value) -> bool {
+    const FAMILIES: [&str; 5] = ["file_", "frame_", "vertices_", "edges_", "faces_"];
+    value
+        .as_object()
+        .is_some_and(|object| object.keys().any(|key| FAMILIES.iter().any(|f| key.starts_with(f))))
+}
+
 /// Parses pattern text (FOLD or native); `origin` names it in error messages.
 pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
     let value = input::parse_json(text, origin)?;
-    let builder = if value.get("vertices_coords").is_some() {
+    let builder = if is_fold_object(&value) {
         fold::read_fold(&value, name)?
     } else {
         native::read_native(&value, name)?

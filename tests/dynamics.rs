@@ -387,11 +387,11 @@ fn bad_scenes_get_errors_that_name_the_field() {
         ),
         (
             bridge_text().replacen(r#""length_um": 100"#, r#""length": 100"#, 1),
-            "unknown field `length`",
+            "invalid `plates[0].length`: an unknown key",
         ),
         (
             bridge_text().replace(r#""t_end_s": 0.002"#, r#""t_end": 0.002"#),
-            "unknown field `t_end`",
+            "invalid `time.t_end`: an unknown key",
         ),
         (
             bridge_text().replacen(r#""material": "SiN" }"#, r#""material": "Si" }"#, 1),

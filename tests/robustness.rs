@@ -196,3 +196,66 @@ fn a_run_replaces_its_own_files_and_keeps_the_other_commands() {
     assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn native_type_errors_name_the_field_and_the_value() {
+    // Was: "invalid `native pattern`:  (invalid type: string "x", expected f64)".
+    let text = r#"{"chain":"closed","angle_unit":"deg","sector_angles":[90,90,"x",90],"creases":[]}"#;
+    let e = error_of(text);
+    assert!(e.contains("`sector_angles[2]`") && e.contains(r#""x""#), "{e}");
+    let text = r#"{"chain":"closed","angle_unit":"deg","sector_angles":[90,90,90,90],"creases":[{"assignment":"V","fold_angle":"10"}]}"#;
+    let e = error_of(text);
+    assert!(e.contains("`creases[0].fold_angle`") && e.contains(r#""10""#), "{e}");
+}
+
+#[test]
+fn a_fold_file_without_geometry_is_told_what_fold_lacks() {
+    // Was: read as a native vertex and told "missing key `chain`".
+    let e = error_of(r#"{"file_spec":1.1,"edges_vertices":[[0,1]]}"#);
+    assert!(e.contains("vertices_coords") && !e.contains("chain"), "{e}");
+}
+
+#[test]
+fn a_non_ascii_value_in_an_error_is_cut_between_characters() {
+    // Was: a panic, the message cut by bytes inside a UTF-8 character.
+    let long = "é".repeat(100);
+    let text = format!(
+        r#"{{"vertices_coords":[[0,0],[1,0]],"edges_vertices":[[0,"{long}"]],"edges_assignment":["V"],"edges_foldAngle":[0]}}"#
+    );
+    let e = error_of(&text);
+    assert!(e.contains("edges_vertices[0]") && e.contains('…'), "{e}");
+}
+
+#[test]
+fn a_symlink_loop_runs_each_file_once() {
+    // Was: the walk followed dir/self -> dir until the OS refused, running one file 41 times.
+    let dir = scratch("loop");
+    std::fs::copy("patterns/half_paper.fold", dir.join("half_paper.fold")).unwrap();
+    std::os::unix::fs::symlink(&dir, dir.join("self")).unwrap();
+    std::os::unix::fs::symlink(dir.join("half_paper.fold"), dir.join("again.fold")).unwrap();
+    let out = nanofold()
+        .args(["unfold", "--json", "--out"])
+        .arg(dir.join("out"))
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let runs: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(runs.as_array().map_or(1, Vec::len), 1, "{runs}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn thousands_of_jobs_are_refused_by_name() {
+    // Was: --jobs 100000 started thousands of threads (5000 took 76 s).
+    let out = nanofold()
+        .args(["unfold", "patterns/half_paper.fold", "--jobs", "100000"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--jobs") && stderr.contains("100000") && stderr.contains("256"),
+        "{stderr}"
+    );
+}

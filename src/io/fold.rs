@@ -3,6 +3,7 @@
 //! state. Locked creases use the custom key `edges_nanofold:locked` (FOLD's namespace rule).
 
 use crate::error::{NanofoldError, Result};
+use crate::io::input::short_json;
 use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
 use serde_json::Value;
 use std::f64::consts::TAU;
@@ -14,23 +15,14 @@ fn array<'a>(value: &'a Value, key: &str) -> Result<&'a Vec<Value>> {
     match value.get(key) {
         None => Err(NanofoldError::missing(key)),
         Some(Value::Array(items)) => Ok(items),
-        Some(other) => Err(NanofoldError::invalid(key, short(other), "expected an array")),
-    }
-}
-
-fn short(value: &Value) -> String {
-    let text = value.to_string();
-    if text.len() > 40 {
-        format!("{}…", &text[..40])
-    } else {
-        text
+        Some(other) => Err(NanofoldError::invalid(key, short_json(other), "expected an array")),
     }
 }
 
 fn number(value: &Value, field: &str) -> Result<f64> {
     let x = value
         .as_f64()
-        .ok_or_else(|| NanofoldError::invalid(field, short(value), "expected a number"))?;
+        .ok_or_else(|| NanofoldError::invalid(field, short_json(value), "expected a number"))?;
     if !x.is_finite() {
         return Err(NanofoldError::invalid(field, x, "must be finite"));
     }
@@ -40,7 +32,7 @@ fn number(value: &Value, field: &str) -> Result<f64> {
 fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> {
     let i = value
         .as_u64()
-        .ok_or_else(|| NanofoldError::invalid(field, short(value), "expected a non-negative integer"))?;
+        .ok_or_else(|| NanofoldError::invalid(field, short_json(value), "expected a non-negative integer"))?;
     if i as usize >= bound {
         return Err(NanofoldError::invalid(
             field,
@@ -60,16 +52,20 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         let field = format!("vertices_coords[{i}]");
         let items = c
             .as_array()
-            .ok_or_else(|| NanofoldError::invalid(&field, short(c), "expected [x, y] or [x, y, z]"))?;
+            .ok_or_else(|| NanofoldError::invalid(&field, short_json(c), "expected [x, y] or [x, y, z]"))?;
         if items.len() < 2 || items.len() > 3 {
-            return Err(NanofoldError::invalid(&field, short(c), "expected [x, y] or [x, y, z]"));
+            return Err(NanofoldError::invalid(
+                &field,
+                short_json(c),
+                "expected [x, y] or [x, y, z]",
+            ));
         }
         let x = number(&items[0], &field)?;
         let y = number(&items[1], &field)?;
         if items.len() == 3 && number(&items[2], &field)? != 0.0 {
             return Err(NanofoldError::invalid(
                 &field,
-                short(c),
+                short_json(c),
                 "z must be 0: nanofold reads the flat crease pattern and takes the folded state from edges_foldAngle",
             ));
         }
@@ -84,13 +80,13 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         let items = e
             .as_array()
             .filter(|a| a.len() == 2)
-            .ok_or_else(|| NanofoldError::invalid(&field, short(e), "expected [u, v]"))?;
+            .ok_or_else(|| NanofoldError::invalid(&field, short_json(e), "expected [u, v]"))?;
         let u = index(&items[0], &field, nv, "vertices")?;
         let v = index(&items[1], &field, nv, "vertices")?;
         if u == v {
             return Err(NanofoldError::invalid(
                 &field,
-                short(e),
+                short_json(e),
                 "an edge needs two distinct vertices",
             ));
         }
@@ -111,7 +107,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         let field = format!("edges_assignment[{i}]");
         let letter = a
             .as_str()
-            .ok_or_else(|| NanofoldError::invalid(&field, short(a), "expected a one-letter string"))?;
+            .ok_or_else(|| NanofoldError::invalid(&field, short_json(a), "expected a one-letter string"))?;
         letters.push(letter.to_string());
     }
 
@@ -139,13 +135,13 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             let items = v
                 .as_array()
                 .filter(|a| a.len() == ne)
-                .ok_or_else(|| NanofoldError::invalid(LOCKED_KEY, short(v), format!("expected {ne} booleans")))?;
+                .ok_or_else(|| NanofoldError::invalid(LOCKED_KEY, short_json(v), format!("expected {ne} booleans")))?;
             items
                 .iter()
                 .enumerate()
                 .map(|(i, b)| {
                     b.as_bool().ok_or_else(|| {
-                        NanofoldError::invalid(format!("{LOCKED_KEY}[{i}]"), short(b), "expected true or false")
+                        NanofoldError::invalid(format!("{LOCKED_KEY}[{i}]"), short_json(b), "expected true or false")
                     })
                 })
                 .collect::<Result<_>>()?
@@ -157,13 +153,13 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         Some(v) => {
             let items = v
                 .as_array()
-                .ok_or_else(|| NanofoldError::invalid("faces_vertices", short(v), "expected an array"))?;
+                .ok_or_else(|| NanofoldError::invalid("faces_vertices", short_json(v), "expected an array"))?;
             let mut faces = Vec::with_capacity(items.len());
             for (i, f) in items.iter().enumerate() {
                 let field = format!("faces_vertices[{i}]");
                 let ids = f
                     .as_array()
-                    .ok_or_else(|| NanofoldError::invalid(&field, short(f), "expected an array of vertex ids"))?;
+                    .ok_or_else(|| NanofoldError::invalid(&field, short_json(f), "expected an array of vertex ids"))?;
                 faces.push(
                     ids.iter()
                         .map(|id| index(id, &field, nv, "vertices"))

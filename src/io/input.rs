@@ -64,6 +64,72 @@ pub fn parse_json(text: &str, origin: &str) -> Result<Value> {
     Ok(value)
 }
 
+/// Deserialises `value` into `T`; a type error names the field by its path in the input
+/// (`creases[2].fold_angle`) and shows the value found there.
+pub fn from_value<T: serde::de::DeserializeOwned>(value: &Value) -> Result<T> {
+    serde_path_to_error::deserialize(value).map_err(|error| {
+        let path = error.path().clone();
+        let message = error.into_inner().to_string();
+        let mut field = path.to_string();
+        if field == "." {
+            field.clear();
+        }
+        let join = |parent: &str, key: &str| {
+            if parent.is_empty() {
+                key.to_string()
+            } else {
+                format!("{parent}.{key}")
+            }
+        };
+        // serde reports a missing or unknown key at the object that lacks or holds it.
+        if let Some(key) = quoted_after(&message, "missing field `") {
+            return NanofoldError::missing(join(&field, key));
+        }
+        if let Some(key) = quoted_after(&message, "unknown field `") {
+            let expected = message.split_once(", expected").map_or("", |(_, rest)| rest).trim();
+            // Here the path already ends at the key.
+            let at = if field == key || field.ends_with(&format!(".{key}")) {
+                field.clone()
+            } else {
+                join(&field, key)
+            };
+            return NanofoldError::invalid(at, "an unknown key", format!("expected {expected}"));
+        }
+        let found = lookup(value, &path).map_or_else(String::new, short_json);
+        NanofoldError::invalid(
+            if field.is_empty() { "(top level)".into() } else { field },
+            found,
+            message,
+        )
+    })
+}
+
+/// The text between `prefix` and the next backtick of `message`.
+fn quoted_after<'m>(message: &'m str, prefix: &str) -> Option<&'m str> {
+    let rest = message.strip_prefix(prefix)?;
+    rest.split_once('`').map(|(key, _)| key)
+}
+
+/// The value at `path` inside `value`, when the path leads to one.
+fn lookup<'v>(value: &'v Value, path: &serde_path_to_error::Path) -> Option<&'v Value> {
+    use serde_path_to_error::Segment;
+    path.iter().try_fold(value, |here, segment| match segment {
+        Segment::Seq { index } => here.get(*index),
+        Segment::Map { key } => here.get(key.as_str()),
+        Segment::Enum { .. } | Segment::Unknown => Some(here),
+    })
+}
+
+/// A value as compact JSON, cut to 60 characters (by characters, not bytes).
+pub fn short_json(value: &Value) -> String {
+    let text = value.to_string();
+    if text.chars().count() > 60 {
+        format!("{}…", text.chars().take(57).collect::<String>())
+    } else {
+        text
+    }
+}
+
 /// A `serde_json::Value` deserialiser that errors on duplicate object keys.
 struct StrictValue;
 
@@ -146,5 +212,35 @@ mod tests {
         assert_eq!(value["a"][1], 2.5);
         assert_eq!(value["b"]["c"], -3);
         assert!(parse_json("{} trailing", "t").is_err());
+    }
+
+    #[derive(serde::Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Outer {
+        inner: Vec<Inner>,
+    }
+    #[derive(serde::Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Inner {
+        angle: f64,
+    }
+
+    #[test]
+    fn type_errors_name_the_path_and_the_value() {
+        let message = |text: &str| {
+            from_value::<Outer>(&parse_json(text, "t").unwrap())
+                .unwrap_err()
+                .to_string()
+        };
+        let e = message(r#"{"inner": [{"angle": 1}, {"angle": "ten"}]}"#);
+        assert!(e.contains("`inner[1].angle`") && e.contains(r#""ten""#), "{e}");
+        let e = message(r#"{"inner": [{}]}"#);
+        assert!(e.contains("missing key `inner[0].angle`"), "{e}");
+        let e = message(r#"{"inner": [], "extra": 1}"#);
+        assert!(e.contains("`extra`") && e.contains("inner"), "{e}");
+        let long = format!(r#"{{"inner": [{{"angle": "{}"}}]}}"#, "é".repeat(100));
+        assert!(message(&long).contains('…'));
     }
 }

@@ -35,8 +35,7 @@ pub(crate) fn read_native(value: &Value, name: &str) -> Result<VertexBuilder> {
             return Err(NanofoldError::missing(key));
         }
     }
-    let vertex: NativeVertex = serde_json::from_value(value.clone())
-        .map_err(|e| NanofoldError::invalid("native pattern", "", e.to_string()))?;
+    let vertex: NativeVertex = crate::io::input::from_value(value)?;
     let to_rad = match vertex.angle_unit.as_str() {
         "deg" | "degrees" => std::f64::consts::PI / 180.0,
         "rad" | "radians" => 1.0,

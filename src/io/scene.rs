@@ -5,7 +5,7 @@
 
 use crate::dynamics::scene::SceneSpec;
 use crate::dynamics::spec::{ClosedSpec, StripSpec};
-use crate::error::{NanofoldError, Result};
+use crate::error::Result;
 use crate::pattern::LoadOptions;
 use std::path::Path;
 
@@ -38,18 +38,14 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec> {
 /// Parses scene text; `source` names it in errors, `fallback_name` names the scene when it
 /// has no `name`, `base` is the folder a closed chain's pattern path is relative to.
 pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -> Result<SceneSpec> {
-    let json = |e: serde_json::Error| NanofoldError::Json {
-        path: source.to_string(),
-        source: e,
-    };
     let value = crate::io::input::parse_json(text, source)?;
     let closed = value.get("pattern").is_some();
     let mut spec = if closed {
-        let file: ClosedSpec<String> = serde_json::from_value(value).map_err(json)?;
+        let file: ClosedSpec<String> = crate::io::input::from_value(&value)?;
         let loaded = file.with_pattern(|path| crate::io::load_pattern(&base.join(path), &LoadOptions::default()))?;
         SceneSpec::Closed(Box::new(loaded))
     } else {
-        let file: StripSpec = serde_json::from_value(value).map_err(json)?;
+        let file: StripSpec = crate::io::input::from_value(&value)?;
         SceneSpec::Strip(file)
     };
     match &mut spec {
