@@ -20,7 +20,7 @@ use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::unfold::energy::EnergyKind;
 use nanofold::unfold::qp::QpMethod;
-use nanofold::unfold::{unfold, UnfoldModel, UnfoldReport, UnfoldSettings};
+use nanofold::unfold::{unfold, unfold_observed, UnfoldModel, UnfoldProgress, UnfoldReport, UnfoldSettings};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -403,11 +403,16 @@ fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json:
 }
 
 /// Unfolds one pattern into `dir`; returns its JSON summary and its human-readable lines.
-fn unfold_one(pattern_path: &Path, solver: &SolverArgs, dir: Option<&Path>) -> Result<(serde_json::Value, String)> {
+fn unfold_one(
+    pattern_path: &Path,
+    solver: &SolverArgs,
+    dir: Option<&Path>,
+    progress: Option<UnfoldProgress>,
+) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
     let pattern = nanofold::io::load_pattern(pattern_path, &solver.load_options())?;
-    let report = unfold(&pattern, &settings)?;
+    let report = unfold_observed(&pattern, &settings, progress)?;
     let model = UnfoldModel::new(&pattern);
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
@@ -476,7 +481,26 @@ fn run_unfold(
     solver.settings()?;
     let single = patterns.len() == 1 && !patterns[0].is_dir();
     if single {
-        let (summary, text) = unfold_one(&patterns[0], solver, out.as_deref())?;
+        // A long unfold (hundreds of creases) shows its progress on stderr.
+        let spinner = if as_json {
+            indicatif::ProgressBar::hidden()
+        } else {
+            indicatif::ProgressBar::new_spinner()
+        };
+        spinner.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} unfolding: {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
+        let shown = spinner.clone();
+        let progress = UnfoldProgress(std::sync::Arc::new(move |step, largest, energy| {
+            if step % 16 == 0 {
+                shown.set_message(format!("step {step}, max |ρ| = {largest:.2e} rad, U = {energy:.6e}"));
+                shown.tick();
+            }
+        }));
+        let result = unfold_one(&patterns[0], solver, out.as_deref(), Some(progress));
+        spinner.finish_and_clear();
+        let (summary, text) = result?;
         println!("{}", if as_json { summary.to_string() } else { text });
         return Ok(true);
     }
@@ -498,7 +522,7 @@ fn run_unfold(
         }
         jobs.push((path, dir));
     }
-    parallel.all(&jobs, |(path, dir)| match unfold_one(path, solver, Some(dir)) {
+    parallel.all(&jobs, |(path, dir)| match unfold_one(path, solver, Some(dir), None) {
         Ok((summary, text)) => {
             println!("{}", if as_json { summary.to_string() } else { text });
             true

@@ -18,6 +18,8 @@ use std::fmt::Write as _;
 
 /// Highest polynomial degree accepted.
 pub const MAX_DEGREE: usize = 20;
+/// Most samples one sweep takes (each a Newton solve; 100 000 take about a second).
+pub const MAX_SAMPLES: usize = 100_000;
 
 /// Which crease drives, which are held and at what angle, which follow. Indices are into
 /// [`Pattern::creases`].
@@ -229,11 +231,11 @@ pub fn check_domain(domain: [f64; 2]) -> Result<()> {
 /// ```
 pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
     check_domain(domain)?;
-    if samples < 2 {
+    if !(2..=MAX_SAMPLES).contains(&samples) {
         return Err(NanofoldError::invalid(
             "samples",
             samples,
-            "a sweep needs at least 2 samples",
+            format!("a sweep takes 2 to {MAX_SAMPLES} samples"),
         ));
     }
     sweep::sweep(pattern, setup, domain, samples)

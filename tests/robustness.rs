@@ -259,3 +259,257 @@ fn thousands_of_jobs_are_refused_by_name() {
         "{stderr}"
     );
 }
+
+/// The bridge scene with `from` replaced by `to` (every occurrence), parsed and built.
+fn bridge_with(from: &str, to: &str) -> nanofold::Result<nanofold::dynamics::scene::Scene> {
+    let text = std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap();
+    assert!(text.contains(from), "{from}");
+    common::scene_text(&text.replace(from, to))
+}
+
+fn scene_error(result: nanofold::Result<nanofold::dynamics::scene::Scene>) -> String {
+    match result {
+        Ok(_) => panic!("accepted"),
+        Err(e) => full_message(&e),
+    }
+}
+
+#[test]
+fn extreme_magnitudes_are_refused_by_name_before_they_become_nan() {
+    // Was: air density or drag coefficient 1e30 gave a contact at 2.7e-43 s with NaN
+    // angles (exit 0); 1e20 and moduli, thicknesses or length units of 1e±300 hung.
+    for (from, to, field) in [
+        (
+            r#""air_density_kg_m3": 1.2"#,
+            r#""air_density_kg_m3": 1e30"#,
+            "environment.air_density_kg_m3",
+        ),
+        (
+            r#""air_density_kg_m3": 1.2"#,
+            r#""air_density_kg_m3": 1e20"#,
+            "environment.air_density_kg_m3",
+        ),
+        (
+            r#""drag_coefficient": 1.28"#,
+            r#""drag_coefficient": 1e30"#,
+            "environment.drag_coefficient",
+        ),
+        (
+            r#""youngs_modulus_gpa": 300"#,
+            r#""youngs_modulus_gpa": 1e300"#,
+            "materials.SiN.youngs_modulus_gpa",
+        ),
+        (
+            r#""youngs_modulus_gpa": 300"#,
+            r#""youngs_modulus_gpa": 1e-300"#,
+            "materials.SiN.youngs_modulus_gpa",
+        ),
+        (
+            r#""density_g_cm3": 3.27"#,
+            r#""density_g_cm3": 1e-20"#,
+            "materials.SiN.density_g_cm3",
+        ),
+        (
+            r#""thickness_um": 0.1"#,
+            r#""thickness_um": 1e-300"#,
+            "hinges[0].layers[1].thickness_um",
+        ),
+        (r#""length_um": 400"#, r#""length_um": 1e300"#, "plates[1].length_um"),
+        (r#""t_end_s": 0.002"#, r#""t_end_s": 1e300"#, "time.t_end_s"),
+    ] {
+        let e = scene_error(bridge_with(from, to));
+        assert!(e.contains(field) && e.contains("must lie in"), "{to}: {e}");
+    }
+}
+
+#[test]
+fn output_sample_counts_are_bounded_by_name() {
+    // Was: 2^64 − 1 overflowed a capacity (a panic) and 1e12 asked for 8 TB.
+    for (value, shown) in [
+        ("18446744073709551615", "18446744073709551615"),
+        ("1000000000000", "1000000000000"),
+    ] {
+        let e = scene_error(bridge_with(r#""samples": 401"#, &format!(r#""samples": {value}"#)));
+        assert!(e.contains("outputs.samples") && e.contains(shown), "{e}");
+    }
+    let e = scene_error(bridge_with(r#""samples": 401"#, r#""samples": 1e12"#));
+    assert!(e.contains("outputs.samples"), "{e}");
+    let e = scene_error(bridge_with(r#""snapshots": 6"#, r#""snapshots": 100000"#));
+    assert!(e.contains("outputs.snapshots"), "{e}");
+}
+
+#[test]
+fn a_strip_of_a_thousand_plates_is_refused() {
+    // Was: a 300 KB scene of 1000 plates took more than 12 GB (∂M has n³ entries).
+    let text = std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let plate = scene["plates"][0].clone();
+    let hinge = scene["hinges"][0].clone();
+    scene["plates"] = serde_json::Value::Array(vec![plate; 1000]);
+    scene["hinges"] = serde_json::Value::Array(vec![hinge; 1000]);
+    let e = scene_error(common::scene_text(&scene.to_string()));
+    assert!(
+        e.contains("`plates`") && e.contains("1000") && e.contains("100]"),
+        "{e}"
+    );
+}
+
+/// Writes a copy of the corner cube's plates with `faces` into `dir` and a step-1 scene
+/// over it; returns the scene's load-and-build result.
+fn corner_cube_with_faces(
+    dir: &Path,
+    faces: serde_json::Value,
+    extra_vertex: Option<[f64; 2]>,
+) -> nanofold::Result<nanofold::dynamics::scene::Scene> {
+    let mut fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/corner_cube_plates.fold").unwrap()).unwrap();
+    fold["faces_vertices"] = faces;
+    if let Some(point) = extra_vertex {
+        fold["vertices_coords"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!(point));
+    }
+    std::fs::write(dir.join("plates.fold"), fold.to_string()).unwrap();
+    let scene = std::fs::read_to_string("patterns/corner_cube_step1.scene.json")
+        .unwrap()
+        .replace("corner_cube_plates.fold", "plates.fold");
+    std::fs::write(dir.join("step.scene.json"), scene).unwrap();
+    nanofold::io::load_scene(&dir.join("step.scene.json"))?.build()
+}
+
+#[test]
+fn faces_that_are_not_a_sector_plate_are_refused() {
+    // Was: a face listed twice doubled the plate's mass, a zero-area face passed as convex,
+    // and a face reaching across a crease made the run hang.
+    let dir = scratch("faces");
+    let good = serde_json::json!([[0, 1, 2], [0, 2, 3, 4], [0, 4, 5, 6], [0, 6, 7, 8], [0, 8, 1]]);
+    assert!(corner_cube_with_faces(&dir, good, None).is_ok());
+    let twice = serde_json::json!([[0, 1, 2, 0, 1, 2], [0, 2, 3, 4], [0, 4, 5, 6], [0, 6, 7, 8], [0, 8, 1]]);
+    let e = scene_error(corner_cube_with_faces(&dir, twice, None));
+    assert!(e.contains("faces_vertices[0]") && e.contains("appears twice"), "{e}");
+    // Vertex 9 halfway along crease 0 (0 → 1): the face 0, 9, 1 has no area.
+    let flat = serde_json::json!([[0, 9, 1], [0, 2, 3, 4], [0, 4, 5, 6], [0, 6, 7, 8], [0, 8, 1]]);
+    let e = scene_error(corner_cube_with_faces(
+        &dir,
+        flat,
+        Some([std::f64::consts::FRAC_1_SQRT_2, 0.0]),
+    ));
+    assert!(e.contains("faces_vertices[0]") && e.contains("no area"), "{e}");
+    let across = serde_json::json!([[0, 1, 2, 3, 4], [0, 4, 5, 6], [0, 6, 7, 8], [0, 8, 1]]);
+    let e = scene_error(corner_cube_with_faces(&dir, across, None));
+    assert!(e.contains("faces_vertices[0]") && e.contains("out of sector"), "{e}");
+    let apart = serde_json::json!([[1, 2, 3], [0, 2, 3, 4], [0, 4, 5, 6], [0, 6, 7, 8], [0, 8, 1]]);
+    let e = scene_error(corner_cube_with_faces(&dir, apart, None));
+    assert!(
+        e.contains("faces_vertices[0]") && e.contains("does not touch the vertex"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn closed_scene_errors_name_the_scene_fields() {
+    // Was: a closed scene's constraint errors named the CLI's --degree and --samples.
+    let text = std::fs::read_to_string("patterns/corner_cube_step1.scene.json").unwrap();
+    let e = scene_error(common::scene_text(&text.replace(r#""degree": 8"#, r#""degree": 25"#)));
+    assert!(e.contains("constraint.degree") && !e.contains("--"), "{e}");
+    let e = scene_error(common::scene_text(
+        &text.replace(r#""degree": 8,"#, r#""degree": 8, "samples": 18446744073709551615,"#),
+    ));
+    assert!(e.contains("constraint.samples") && e.contains("100000"), "{e}");
+    let e = scene_error(common::scene_text(
+        &text.replace(r#""target_angle_deg": 180"#, r#""target_angle_deg": 181"#),
+    ));
+    assert!(e.contains("hinges[0].target_angle_deg") && e.contains("181"), "{e}");
+}
+
+/// Runs the binary with `args`, killing it (and failing) if it has not finished in
+/// `limit_s`: a hang must fail the test, not stall the suite.
+fn run_bounded(args: &[&str], limit_s: u64) -> std::process::Output {
+    let mut child = nanofold()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed().as_secs() > limit_s {
+            child.kill().unwrap();
+            panic!("{args:?} did not finish in {limit_s} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn a_narrow_sweep_far_from_the_fold_finishes() {
+    // Was: the continuation step was capped by the sample spacing, so reaching
+    // 90°–90.001° from the folded 162° took ~10⁵ Newton steps (48 s); a 1e-12° range hung.
+    let dir = scratch("narrow");
+    for range in ["90:90.001", "90:90.000000000001"] {
+        let out = run_bounded(
+            &[
+                "constraints",
+                "patterns/corner_cube.fold",
+                "--drive",
+                "0",
+                "--lock",
+                "1=0",
+                "--range",
+                range,
+                "--out",
+                dir.join("c").to_str().unwrap(),
+            ],
+            60,
+        );
+        assert!(
+            out.status.success(),
+            "{range}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_dense_sweep_through_the_flat_state_is_not_refused() {
+    // Was: "no solution beyond 0.2°" at 5001 samples and more.
+    use nanofold::constraints::{sweep_samples, Setup};
+    let pattern = nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
+    let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
+    for samples in [5001, 20001] {
+        let curve = sweep_samples(&pattern, &setup, [0.0, std::f64::consts::PI], samples).unwrap();
+        assert_eq!(curve.drive_angles.len(), samples);
+        assert!(curve.max_closure_residual < 1e-12);
+    }
+    let e = sweep_samples(&pattern, &setup, [0.0, 1.0], usize::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("samples") && e.contains("100000"), "{e}");
+}
+
+#[test]
+fn four_hundred_flat_held_creases_unfold() {
+    // Was: refused with "restoration residual 2.1e-13": the tolerance did not grow with n.
+    let base: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/degree4_native.json").unwrap()).unwrap();
+    let (mut sectors, mut creases) = (Vec::new(), Vec::new());
+    for k in 0..4 {
+        creases.push(base["creases"][k].clone());
+        for j in 0..100 {
+            sectors.push(base["sector_angles"][k].as_f64().unwrap() / 100.0);
+            if j < 99 {
+                creases.push(serde_json::json!({"assignment": "F", "fold_angle": 0}));
+            }
+        }
+    }
+    let text =
+        serde_json::json!({"chain": "closed", "angle_unit": "deg", "sector_angles": sectors, "creases": creases});
+    let pattern = parse(&text.to_string()).unwrap();
+    let report = unfold(&pattern, &UnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, Verdict::Flat, "{}", report.evidence);
+    assert!(report.flat_layout_error < 1e-10, "{}", report.flat_layout_error);
+}

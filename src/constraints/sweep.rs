@@ -19,6 +19,9 @@ pub const REFINE_ITERATIONS: usize = 60;
 const MAX_DEPENDENT_CHANGE: f64 = 0.05;
 /// Below this step (in the sweep parameter) the continuation gives up.
 const MIN_STEP: f64 = 1e-11;
+/// Largest continuation step of the driver sweep, rad. Not capped by the sample spacing:
+/// a narrow range far from the folded start (90°–90.001°) would take ~10⁷ steps to reach.
+const MAX_SWEEP_STEP: f64 = 0.035;
 
 /// Why the continuation stopped short.
 #[derive(Debug, Clone)]
@@ -224,12 +227,11 @@ pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize)
     let grid: Vec<f64> = (0..samples)
         .map(|i| domain[0] + (domain[1] - domain[0]) * i as f64 / (samples - 1) as f64)
         .collect();
-    let spacing = (domain[1] - domain[0]) / (samples - 1) as f64;
     let held = [driver_ray];
     let set_driver = |value: f64, r: &mut [f64]| r[driver_ray] = value;
     let mut points: Vec<(f64, Vec<f64>)> = Vec::with_capacity(samples);
     for direction in [1.0, -1.0] {
-        let mut path = Continuation::new(sectors, &free_rays, rho.clone(), start_drive, spacing.min(0.035));
+        let mut path = Continuation::new(sectors, &free_rays, rho.clone(), start_drive, MAX_SWEEP_STEP);
         let targets: Vec<f64> = if direction > 0.0 {
             grid.iter().copied().filter(|&g| g >= start_drive).collect()
         } else {

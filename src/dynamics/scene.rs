@@ -6,8 +6,8 @@ use super::closed::{assemble, ClosedChain};
 use super::forcing::{Actuation, Forcing, HingeDrive};
 use super::model::{Joint, Model, Plate};
 use super::spec::{
-    actuation, drag_law, finite, hinge_stiffness, material, positive, time_and_outputs, validate_materials, ClosedSpec,
-    StripSpec, MICROMETRE,
+    actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, time_and_outputs, validate_materials,
+    within, ClosedSpec, StripSpec, MICROMETRE,
 };
 use super::strip::StripChain;
 use crate::error::{NanofoldError, Result};
@@ -113,6 +113,7 @@ impl StripSpec {
                 "a chain needs at least one plate",
             ));
         }
+        count_within("plates", n, (1, limits::MAX_PLATES))?;
         if self.hinges.len() != n {
             return Err(NanofoldError::invalid(
                 "hinges",
@@ -125,9 +126,19 @@ impl StripSpec {
         let mut plates = Vec::with_capacity(n);
         let mut y = edge_y;
         for (i, spec) in self.plates.iter().enumerate() {
-            let length = positive(&format!("plates[{i}].length_um"), spec.length_um)? * MICROMETRE;
-            let width = positive(&format!("plates[{i}].width_um"), spec.width_um)? * MICROMETRE;
-            let thickness = positive(&format!("plates[{i}].thickness_um"), spec.thickness_um)? * MICROMETRE;
+            let length = within(
+                &format!("plates[{i}].length_um"),
+                spec.length_um,
+                limits::LENGTH_UM,
+                "µm",
+            )? * MICROMETRE;
+            let width = within(&format!("plates[{i}].width_um"), spec.width_um, limits::LENGTH_UM, "µm")? * MICROMETRE;
+            let thickness = within(
+                &format!("plates[{i}].thickness_um"),
+                spec.thickness_um,
+                limits::THICKNESS_UM,
+                "µm",
+            )? * MICROMETRE;
             let density =
                 material(&self.materials, &format!("plates[{i}].material"), &spec.material)?.density_g_cm3 * 1e3;
             // The flat plate spans x ∈ [−w/2, w/2], y ∈ [y, y + L]: a box whose moment about the
@@ -193,7 +204,7 @@ impl StripSpec {
                     let value = hinge
                         .radius_of_curvature_um
                         .ok_or_else(|| NanofoldError::missing(field.clone()))?;
-                    drives[i].radius_of_curvature = positive(&field, value)? * MICROMETRE;
+                    drives[i].radius_of_curvature = within(&field, value, limits::LENGTH_UM, "µm")? * MICROMETRE;
                 }
             }
         }
@@ -226,8 +237,9 @@ impl ClosedSpec<Pattern> {
     /// Validates the scene and assembles its chain: the sweep, the fit and the tree of
     /// sector plates ([`assemble::closed_chain`]).
     pub fn build(&self) -> Result<Scene> {
-        let chain = assemble::closed_chain(self)?;
+        // The cheap checks first: the chain's assembly runs a sweep.
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
+        let chain = assemble::closed_chain(self)?;
         Ok(Scene {
             name: self.name.clone().unwrap_or_else(|| "scene".to_string()),
             system: System::Closed(Box::new(chain)),

@@ -473,11 +473,67 @@ impl<P> ClosedSpec<P> {
     }
 }
 
-pub(crate) fn positive(field: &str, value: f64) -> Result<f64> {
-    if value.is_finite() && value > 0.0 {
+/// Accepted ranges of a scene's inputs, (lowest, highest): wide enough for nanometre films
+/// and centimetre models, narrow enough that every derived quantity (masses ~ρ L² t,
+/// stiffnesses ~E t³, their ratio) stays far inside double precision.
+pub mod limits {
+    /// Young's modulus, GPa (1 kPa gels to 10 TPa).
+    pub const YOUNGS_MODULUS_GPA: (f64, f64) = (1e-6, 1e4);
+    /// Density, g/cm³.
+    pub const DENSITY_G_CM3: (f64, f64) = (1e-3, 1e2);
+    /// A plate's or a layer's thickness, µm (1 Å to 1 cm).
+    pub const THICKNESS_UM: (f64, f64) = (1e-4, 1e4);
+    /// Plate lengths and widths, hinge lengths, radii of curvature, µm (1 nm to 1 m).
+    pub const LENGTH_UM: (f64, f64) = (1e-3, 1e6);
+    /// A closed chain's length unit, µm per pattern unit.
+    pub const LENGTH_UNIT_UM: (f64, f64) = (1e-6, 1e6);
+    /// The drag coefficient.
+    pub const DRAG_COEFFICIENT: (f64, f64) = (1e-6, 1e2);
+    /// The surrounding fluid's density, kg/m³ (a rarefied gas to mercury).
+    pub const FLUID_DENSITY_KG_M3: (f64, f64) = (1e-6, 2e4);
+    /// The etch front's speed, µm/min.
+    pub const ETCH_RATE_UM_PER_MIN: (f64, f64) = (1e-6, 1e6);
+    /// The simulated time, s.
+    pub const T_END_S: (f64, f64) = (1e-12, 1e7);
+    /// Output samples of a run.
+    pub const OUTPUT_SAMPLES: (usize, usize) = (2, 100_000);
+    /// Views in `snapshots.svg`.
+    pub const SNAPSHOTS: (usize, usize) = (1, 64);
+    /// Plates of a strip (∂M has n³ entries: 8 MB at 100).
+    pub const MAX_PLATES: usize = 100;
+    /// Exact sweep samples of a closed chain's constraint.
+    pub const CONSTRAINT_SAMPLES: (usize, usize) = (3, 100_000);
+}
+
+/// `value` if it lies in `range` (closed); else an error naming `field` and the range.
+pub(crate) fn within(field: &str, value: f64, range: (f64, f64), unit: &str) -> Result<f64> {
+    if value.is_finite() && value >= range.0 && value <= range.1 {
         Ok(value)
     } else {
-        Err(NanofoldError::invalid(field, value, "must be a finite number > 0"))
+        // 1.2e-308, not three hundred zeros.
+        let shown = if value == 0.0 || (1e-4..1e7).contains(&value.abs()) || !value.is_finite() {
+            value.to_string()
+        } else {
+            format!("{value:e}")
+        };
+        Err(NanofoldError::invalid(
+            field,
+            shown,
+            format!("must lie in [{:e}, {:e}] {unit}", range.0, range.1),
+        ))
+    }
+}
+
+/// A count in `range` (closed); else an error naming `field` and the range.
+pub(crate) fn count_within(field: &str, value: usize, range: (usize, usize)) -> Result<usize> {
+    if (range.0..=range.1).contains(&value) {
+        Ok(value)
+    } else {
+        Err(NanofoldError::invalid(
+            field,
+            value,
+            format!("must lie in [{}, {}]", range.0, range.1),
+        ))
     }
 }
 
@@ -507,8 +563,18 @@ pub(crate) fn material<'a>(
 /// Every material's moduli and density in range.
 pub(crate) fn validate_materials(materials: &BTreeMap<String, MaterialSpec>) -> Result<()> {
     for (name, m) in materials {
-        positive(&format!("materials.{name}.youngs_modulus_gpa"), m.youngs_modulus_gpa)?;
-        positive(&format!("materials.{name}.density_g_cm3"), m.density_g_cm3)?;
+        within(
+            &format!("materials.{name}.youngs_modulus_gpa"),
+            m.youngs_modulus_gpa,
+            limits::YOUNGS_MODULUS_GPA,
+            "GPa",
+        )?;
+        within(
+            &format!("materials.{name}.density_g_cm3"),
+            m.density_g_cm3,
+            limits::DENSITY_G_CM3,
+            "g/cm³",
+        )?;
         let field = format!("materials.{name}.poisson_ratio");
         finite(&field, m.poisson_ratio)?;
         if !(-1.0 < m.poisson_ratio && m.poisson_ratio < 0.5) {
@@ -522,8 +588,18 @@ pub(crate) fn validate_materials(materials: &BTreeMap<String, MaterialSpec>) -> 
 pub(crate) fn drag_law(env: &EnvironmentSpec) -> Result<Option<Drag>> {
     Ok(if env.drag {
         Some(Drag {
-            drag_coefficient: positive("environment.drag_coefficient", env.drag_coefficient)?,
-            air_density: positive("environment.air_density_kg_m3", env.air_density_kg_m3)?,
+            drag_coefficient: within(
+                "environment.drag_coefficient",
+                env.drag_coefficient,
+                limits::DRAG_COEFFICIENT,
+                "",
+            )?,
+            air_density: within(
+                "environment.air_density_kg_m3",
+                env.air_density_kg_m3,
+                limits::FLUID_DENSITY_KG_M3,
+                "kg/m³",
+            )?,
         })
     } else {
         None
@@ -535,21 +611,22 @@ pub(crate) fn actuation(spec: &ActuationSpec) -> Result<Actuation> {
     Ok(match spec {
         ActuationSpec::Step => Actuation::Step,
         ActuationSpec::Ramp { etch_rate_um_per_min } => Actuation::Ramp {
-            etch_rate: positive("actuation.etch_rate_um_per_min", *etch_rate_um_per_min)? * MICROMETRE / 60.0,
+            etch_rate: within(
+                "actuation.etch_rate_um_per_min",
+                *etch_rate_um_per_min,
+                limits::ETCH_RATE_UM_PER_MIN,
+                "µm/min",
+            )? * MICROMETRE
+                / 60.0,
         },
     })
 }
 
 /// The time span and outputs every scene shares.
 pub(crate) fn time_and_outputs(time: &TimeSpec, outputs: &OutputSpec) -> Result<f64> {
-    let t_end = positive("time.t_end_s", time.t_end_s)?;
-    if outputs.samples < 2 {
-        return Err(NanofoldError::invalid(
-            "outputs.samples",
-            outputs.samples,
-            "need at least 2",
-        ));
-    }
+    let t_end = within("time.t_end_s", time.t_end_s, limits::T_END_S, "s")?;
+    count_within("outputs.samples", outputs.samples, limits::OUTPUT_SAMPLES)?;
+    count_within("outputs.snapshots", outputs.snapshots, limits::SNAPSHOTS)?;
     Ok(t_end)
 }
 
@@ -561,7 +638,12 @@ pub(crate) fn hinge_stiffness(
     hinge: &HingeSpec,
     width: f64,
 ) -> Result<f64> {
-    let length = positive(&format!("hinges[{i}].hinge_length_um"), hinge.hinge_length_um)? * MICROMETRE;
+    let length = within(
+        &format!("hinges[{i}].hinge_length_um"),
+        hinge.hinge_length_um,
+        limits::LENGTH_UM,
+        "µm",
+    )? * MICROMETRE;
     if hinge.layers.is_empty() {
         return Err(NanofoldError::invalid(
             format!("hinges[{i}].layers"),
@@ -571,7 +653,12 @@ pub(crate) fn hinge_stiffness(
     }
     let mut stiffness = 0.0;
     for (k, layer) in hinge.layers.iter().enumerate() {
-        let t = positive(&format!("hinges[{i}].layers[{k}].thickness_um"), layer.thickness_um)? * MICROMETRE;
+        let t = within(
+            &format!("hinges[{i}].layers[{k}].thickness_um"),
+            layer.thickness_um,
+            limits::THICKNESS_UM,
+            "µm",
+        )? * MICROMETRE;
         let m = material(materials, &format!("hinges[{i}].layers[{k}].material"), &layer.material)?;
         let modulus = m.youngs_modulus_gpa * 1e9;
         stiffness += width * t.powi(3) * modulus / (3.0 * length * (1.0 - m.poisson_ratio * m.poisson_ratio));

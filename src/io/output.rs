@@ -292,6 +292,20 @@ pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &Un
     })
 }
 
+/// A number for JSON, which has no infinity or NaN: those are written as the strings
+/// "inf", "-inf" and "nan" (serde_json would write `null`, the mark of an absent value).
+pub fn number(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else if x.is_nan() {
+        json!("nan")
+    } else if x > 0.0 {
+        json!("inf")
+    } else {
+        json!("-inf")
+    }
+}
+
 /// The target of every output angle: each hinge's for a strip; for a closed chain the
 /// driver's target and the locks' angles (0 for the creases that follow).
 pub fn target_angles(scene: &Scene) -> Vec<f64> {
@@ -332,9 +346,14 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         "model": response.model,
         "method": response.method,
         "rtol": response.rtol,
-        "time_scale_ratio": response.time_scales.ratio,
-        "time_scales": response.time_scales,
-        "quasi_static_error_estimate_rad": response.quasi_static_error_estimate,
+        "time_scale_ratio": number(response.time_scales.ratio),
+        "time_scales": {
+            "fastest_period_s": number(response.time_scales.fastest_period_s),
+            "slowest_period_s": number(response.time_scales.slowest_period_s),
+            "forcing_time_s": number(response.time_scales.forcing_time_s),
+            "ratio": number(response.time_scales.ratio),
+        },
+        "quasi_static_error_estimate_rad": number(response.quasi_static_error_estimate),
         "measured_quasi_static_error_rad": response.measured_quasi_static_error.map(|(_, e)| e),
         "quasi_static_check_window_s": response.measured_quasi_static_error.map(|(w, _)| w),
         "ignore_collisions": settings.ignore_collisions,
@@ -354,9 +373,9 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         value["constraint_degree"] = json!(closed.degree);
         value["constraint_fit_error_rad"] = json!(closed.fit_error);
         value["constraint_slope_error"] = json!(closed.slope_error);
-        value["torque_magnification"] = json!(closed.torque_magnification);
-        value["driving_hinge_width_um"] = json!(closed.driving_hinge_width_um);
-        value["required_hinge_width_um"] = json!(closed.required_hinge_width_um);
+        value["torque_magnification"] = number(closed.torque_magnification);
+        value["driving_hinge_width_um"] = number(closed.driving_hinge_width_um);
+        value["required_hinge_width_um"] = number(closed.required_hinge_width_um);
         value["max_closure_residual"] = json!(closed.max_closure_residual);
         value["crease_edges"] = json!(chain.crease_user_indices);
     }
@@ -428,7 +447,7 @@ pub fn closed_modes_json(name: &str, chain: &ClosedChain, modes: &ClosedModes, t
         "cut_crease": chain.crease_user_indices[chain.cut_crease],
         "anchored_face": chain.anchored_face,
         "constraint_source": chain.source.name(),
-        "torque_magnification": torque_magnification,
+        "torque_magnification": number(torque_magnification),
         "max_closure_residual": modes.closure_residual,
         "coordinates": user(&modes.coordinates),
         "crease_edges": chain.crease_user_indices,
@@ -451,4 +470,17 @@ pub fn closed_modes_json(name: &str, chain: &ClosedChain, modes: &ClosedModes, t
         "reduced_stiffness_n_m_per_rad": rows(&stiffness),
         "load_stiffness_n_m_per_rad": rows(&modes.load_stiffness),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    #[test]
+    fn non_finite_numbers_are_written_as_text_not_null() {
+        assert_eq!(number(f64::INFINITY), "inf");
+        assert_eq!(number(f64::NEG_INFINITY), "-inf");
+        assert_eq!(number(f64::NAN), "nan");
+        assert_eq!(number(2.5), 2.5);
+    }
 }

@@ -182,6 +182,12 @@ impl UnfoldModel {
         rows
     }
 
+    /// The restoration tolerance used for `requested`: no tighter than rounding allows,
+    /// 4 ε per node, since residuals accumulate along the chain (`docs/model.md#projected-gradient`).
+    pub fn restore_tolerance(&self, requested: f64) -> f64 {
+        requested.max(4.0 * f64::EPSILON * self.node_count as f64)
+    }
+
     /// Node positions of the given folded state (forward kinematics, `docs/model.md#loop-closure`).
     pub fn folded_nodes(&self) -> Vec<Vec3> {
         kinematics::forward(&self.sector_angles, &self.folded_ray_angles)

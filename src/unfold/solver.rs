@@ -195,6 +195,9 @@ impl<'a> ProjectedGradient<'a> {
         mut nodes: Vec<Vec3>,
     ) -> Result<ProjectedGradient<'a>> {
         settings.validate()?;
+        let mut settings = settings.clone();
+        settings.restore_tol = model.restore_tolerance(settings.restore_tol);
+        let settings = &settings;
         let energy = settings.energy.build(settings.p);
         let mut ws = Workspace::new(model);
         restore(model, &ws.rows, &mut ws.restore, &mut nodes, settings.restore_tol, None)?;

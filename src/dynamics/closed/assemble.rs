@@ -8,8 +8,8 @@ use crate::constraints::{sweep_samples, ConstraintPoly, Setup};
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::model::{Joint, Model, Plate};
 use crate::dynamics::spec::{
-    actuation, drag_law, finite, hinge_stiffness, material, positive, validate_materials, ClosedSpec, CreaseHingeSpec,
-    HingeSpec, SourceKind, MICROMETRE,
+    actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, validate_materials, within,
+    ClosedSpec, CreaseHingeSpec, HingeSpec, SourceKind, MICROMETRE,
 };
 use crate::error::{NanofoldError, Result};
 use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
@@ -50,7 +50,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
     validate_materials(&spec.materials)?;
     let pattern = &spec.pattern;
     let mesh = check_pattern(pattern)?;
-    let unit = positive("length_unit_um", spec.length_unit_um)? * MICROMETRE;
+    let unit = within("length_unit_um", spec.length_unit_um, limits::LENGTH_UNIT_UM, "µm")? * MICROMETRE;
     let geometry = sector_geometry(pattern, mesh, unit)?;
     let hinges = crease_hinges(spec, &geometry)?;
     let step = step_of(spec, &hinges)?;
@@ -68,11 +68,13 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
             Actuation::Step => f64::INFINITY,
             Actuation::Ramp { .. } => {
                 let field = "hinges[driver].radius_of_curvature_um";
-                positive(
+                within(
                     field,
                     driver_hinge
                         .radius_of_curvature_um
                         .ok_or_else(|| NanofoldError::missing(field))?,
+                    limits::LENGTH_UM,
+                    "µm",
                 )? * MICROMETRE
             }
         },
@@ -175,7 +177,7 @@ fn step_of(spec: &ClosedSpec<Pattern>, hinges: &Hinges) -> Result<Step> {
             "a closed-chain step drives exactly one crease; lock the others",
         ));
     };
-    let target_field = "hinges[driver].target_angle_deg";
+    let target_field = &format!("hinges[{}].target_angle_deg", hinges.of_crease[driver]);
     let target_deg = hinges.spec[hinges.of_crease[driver]]
         .target_angle_deg
         .ok_or_else(|| NanofoldError::missing(target_field))?;
@@ -239,7 +241,12 @@ fn step_of(spec: &ClosedSpec<Pattern>, hinges: &Hinges) -> Result<Step> {
 /// (`exact`). The sweep runs here (the numerics of assembling, never of loading).
 fn constraint_source(spec: &ClosedSpec<Pattern>, step: &Step) -> Result<ConstraintSource> {
     let pattern = &spec.pattern;
-    let sweep = || sweep_samples(pattern, &step.setup, step.domain, spec.constraint.samples);
+    count_within(
+        "constraint.samples",
+        spec.constraint.samples,
+        limits::CONSTRAINT_SAMPLES,
+    )?;
+    let sweep = || sweep_samples(pattern, &step.setup, step.domain, spec.constraint.samples).map_err(scene_fields);
     Ok(match (spec.constraint.source, spec.constraint.degree) {
         (SourceKind::Poly, None) => {
             return Err(NanofoldError::missing_with(
@@ -254,9 +261,26 @@ fn constraint_source(spec: &ClosedSpec<Pattern>, step: &Step) -> Result<Constrai
                 "only the \"poly\" source has a degree",
             ))
         }
-        (SourceKind::Poly, Some(degree)) => ConstraintSource::Poly(ConstraintPoly::fit(pattern, &sweep()?, degree)?),
+        (SourceKind::Poly, Some(degree)) => {
+            ConstraintSource::Poly(ConstraintPoly::fit(pattern, &sweep()?, degree).map_err(scene_fields)?)
+        }
         (SourceKind::Exact, None) => ConstraintSource::Exact(ExactConstraint::new(pattern, &sweep()?)),
     })
+}
+
+/// The constraint layer's errors under the scene's names for its fields.
+fn scene_fields(error: NanofoldError) -> NanofoldError {
+    match error {
+        NanofoldError::InvalidField { field, value, reason } => {
+            let field = match field.as_str() {
+                "samples" | "degree" | "source" => format!("constraint.{field}"),
+                "domain" => "constraint.range_deg".to_string(),
+                _ => field,
+            };
+            NanofoldError::InvalidField { field, value, reason }
+        }
+        other => other,
+    }
 }
 
 /// The sector on the substrate: the anchored face's, or the one after the cut.
@@ -300,7 +324,12 @@ fn sector_tree(
     ground_sector: usize,
 ) -> Result<(Model, Vec<usize>, Vec<usize>)> {
     let pattern = &spec.pattern;
-    let thickness = positive("plates.thickness_um", spec.plates.thickness_um)? * MICROMETRE;
+    let thickness = within(
+        "plates.thickness_um",
+        spec.plates.thickness_um,
+        limits::THICKNESS_UM,
+        "µm",
+    )? * MICROMETRE;
     let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
     let rays = pattern.rays.len();
     let cut_ray = pattern.creases[step.cut].ray;
@@ -408,27 +437,40 @@ fn sector_geometry(pattern: &Pattern, mesh: &FlatMesh, unit: f64) -> Result<Sect
     let faces = mesh.faces_vertices.as_ref().expect("checked by check_pattern");
     let mut outlines: Vec<Option<(Vec<[f64; 2]>, usize)>> = vec![None; rays];
     for (i, face) in faces.iter().enumerate() {
+        let field = || format!("{}: faces_vertices[{i}]", pattern.name);
+        check_face_indices(face, mesh.center)
+            .map_err(|reason| NanofoldError::invalid(field(), format!("{face:?}"), reason))?;
+        // In the pattern's units about the vertex, so the tolerances are relative to the face.
         let mut points: Vec<[f64; 2]> = face
             .iter()
             .map(|&v| {
                 let [x, y] = mesh.vertices_coords[v];
-                [(x - centre[0]) * unit, (y - centre[1]) * unit]
+                [x - centre[0], y - centre[1]]
             })
             .collect();
-        let signed_area: f64 = (0..points.len())
+        let extent = points.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max);
+        let twice_area: f64 = (0..points.len())
             .map(|k| {
                 let (a, b) = (points[k], points[(k + 1) % points.len()]);
                 a[0] * b[1] - b[0] * a[1]
             })
             .sum();
-        if signed_area < 0.0 {
+        if twice_area < 0.0 {
             points.reverse();
         }
-        if !is_convex(&points) {
+        // Convexity first: a self-crossing face (a bow tie) can have zero signed area too.
+        if !is_convex(&points, extent) {
             return Err(NanofoldError::invalid(
-                format!("{}: faces_vertices[{i}]", pattern.name),
+                field(),
                 format!("{face:?}"),
                 "plates must be convex polygons",
+            ));
+        }
+        if twice_area.abs() <= 1e-9 * extent * extent {
+            return Err(NanofoldError::invalid(
+                field(),
+                format!("{face:?}"),
+                "the face has no area",
             ));
         }
         let n = points.len() as f64;
@@ -438,9 +480,27 @@ fn sector_geometry(pattern: &Pattern, mesh: &FlatMesh, unit: f64) -> Result<Sect
             .rev()
             .find(|&r| ray_direction[r] - mesh.ray0_direction <= angle)
             .unwrap_or(0);
+        // Every corner within the sector's wedge (the face is the sector's plate, not a
+        // polygon reaching across a crease).
+        let tolerance = 1e-6;
+        for p in &points {
+            if p[0].hypot(p[1]) <= 1e-9 * extent {
+                continue;
+            }
+            let within = (p[1].atan2(p[0]) - ray_direction[sector]).rem_euclid(TAU);
+            let within = if within > TAU - tolerance { within - TAU } else { within };
+            if within > pattern.sector_angles[sector] + tolerance {
+                return Err(NanofoldError::invalid(
+                    field(),
+                    format!("{face:?}"),
+                    format!("the face reaches out of sector {sector} (between rays {sector} and {}): a plate lies between two neighbouring creases", (sector + 1) % rays),
+                ));
+            }
+        }
+        let points = points.iter().map(|p| [p[0] * unit, p[1] * unit]).collect();
         if outlines[sector].replace((points, i)).is_some() {
             return Err(NanofoldError::invalid(
-                format!("{}: faces_vertices[{i}]", pattern.name),
+                field(),
                 format!("{face:?}"),
                 format!("a second face in sector {sector}: one face per sector"),
             ));
@@ -478,11 +538,27 @@ fn constraint_domain(range_deg: Option<[f64; 2]>, start: f64, target: f64) -> Re
     })
 }
 
-fn is_convex(points: &[[f64; 2]]) -> bool {
+fn is_convex(points: &[[f64; 2]], extent: f64) -> bool {
     let n = points.len();
     n >= 3
         && (0..n).all(|k| {
             let (a, b, c) = (points[k], points[(k + 1) % n], points[(k + 2) % n]);
-            (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) >= -1e-12 * (1.0 + a[0].abs() + a[1].abs())
+            (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) >= -1e-9 * extent * extent
         })
+}
+
+/// A face's vertex list: at least three, none twice, the crease vertex among them.
+fn check_face_indices(face: &[usize], center: usize) -> std::result::Result<(), String> {
+    if face.len() < 3 {
+        return Err("a face needs at least three vertices".into());
+    }
+    if let Some((k, v)) = face.iter().enumerate().find(|(k, v)| face[..*k].contains(v)) {
+        return Err(format!("vertex {v} appears twice (again at position {k})"));
+    }
+    if !face.contains(&center) {
+        return Err(format!(
+            "the face does not touch the vertex {center} where the creases meet: each plate is a sector"
+        ));
+    }
+    Ok(())
 }
