@@ -12,6 +12,21 @@ use crate::unfold::UnfoldReport;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// An axis range from the data's `lo`..`hi` plus `pad` (a fraction of the width) each side,
+/// always finite and wider than rounding: a degenerate or non-finite range (all values
+/// equal, a NaN) would otherwise stall or break the axis's tick placement.
+pub(crate) fn axis_range(lo: f64, hi: f64, pad: f64) -> std::ops::Range<f64> {
+    let (lo, hi) = if lo.is_finite() && hi.is_finite() && lo <= hi {
+        (lo, hi)
+    } else {
+        (-1.0, 1.0)
+    };
+    let scale = lo.abs().max(hi.abs()).max(1e-300);
+    let width = (hi - lo).max(1e-6 * scale);
+    let margin = pad * width;
+    (lo - margin)..(hi + margin)
+}
+
 pub(crate) fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
     NanofoldError::Plot {
         figure: "an SVG figure".into(),
@@ -165,7 +180,7 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
                 hi = hi.max(a.to_degrees());
             }
         }
-        let pad = 0.05 * (hi - lo).max(1.0);
+        let y_range = axis_range(lo.min(hi - 1.0), hi, 0.05);
         let driver = &pattern.creases[poly.driver];
         let mut chart = ChartBuilder::on(&top)
             .caption(
@@ -180,7 +195,7 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(52)
-            .build_cartesian_2d(domain_deg.0..domain_deg.1, (lo - pad)..(hi + pad))
+            .build_cartesian_2d(axis_range(domain_deg.0, domain_deg.1, 0.0), y_range)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
@@ -263,4 +278,29 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
         root.present().map_err(plot_error)?;
     }
     Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::axis_range;
+
+    #[test]
+    fn axis_ranges_are_finite_and_wider_than_rounding() {
+        for (lo, hi) in [
+            (0.0, 0.0),
+            (1e20, 1e20),
+            (1e-40, 1e-40),
+            (f64::NAN, 1.0),
+            (3.0, 1.0),
+            (-f64::INFINITY, 0.0),
+        ] {
+            let range = axis_range(lo, hi, 0.06);
+            assert!(range.start.is_finite() && range.end.is_finite(), "{lo} {hi}");
+            assert!(
+                range.end - range.start > 1e-7 * range.end.abs().max(range.start.abs()),
+                "{lo} {hi}: {range:?}"
+            );
+        }
+        assert_eq!(axis_range(0.0, 10.0, 0.1), -1.0..11.0);
+    }
 }

@@ -513,3 +513,55 @@ fn four_hundred_flat_held_creases_unfold() {
     assert_eq!(report.verdict, Verdict::Flat, "{}", report.evidence);
     assert!(report.flat_layout_error < 1e-10, "{}", report.flat_layout_error);
 }
+
+#[test]
+fn a_fold_mesh_too_large_for_its_outputs_is_refused() {
+    // Was: a 42 MB FOLD file took 3.8 GB and wrote a 1.07 GB unfold.fold (every frame
+    // repeats the mesh).
+    let mut fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/corner_cube.fold").unwrap()).unwrap();
+    let extra: Vec<serde_json::Value> = (0..5000).map(|i| serde_json::json!([10.0 + i as f64, 10.0])).collect();
+    fold["vertices_coords"].as_array_mut().unwrap().extend(extra);
+    let e = error_of(&fold.to_string());
+    assert!(e.contains("vertices_coords") && e.contains("4096"), "{e}");
+}
+
+#[test]
+fn extreme_solver_settings_are_refused_by_name() {
+    // Was: `--p 1e-300` and `--bending-metric 1e300` gave a confident local_minimum.
+    let p = UnfoldSettings {
+        p: Some(1e-300),
+        ..Default::default()
+    };
+    assert!(p.validate().unwrap_err().to_string().contains("`p`"));
+    let metric = UnfoldSettings {
+        bending_metric: 1e300,
+        ..Default::default()
+    };
+    assert!(metric.validate().unwrap_err().to_string().contains("bending_metric"));
+    for (flag, value) in [("--p", "1e-300"), ("--bending-metric", "1e300")] {
+        let out = nanofold()
+            .args(["unfold", "patterns/corner_cube.fold", flag, value])
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(flag), "{stderr}");
+    }
+    // And a sample count past any allocation is refused, not a capacity overflow.
+    let out = nanofold()
+        .args([
+            "constraints",
+            "patterns/corner_cube.fold",
+            "--drive",
+            "0",
+            "--lock",
+            "1=0",
+        ])
+        .args(["--samples", "18446744073709551615"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("--samples") && !stderr.contains("panicked"), "{stderr}");
+}

@@ -8,6 +8,12 @@ use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBui
 use serde_json::Value;
 use std::f64::consts::TAU;
 
+/// Most vertices a FOLD file may have: a vertex of 512 rays with a corner per face needs
+/// about 1 000.
+pub const MAX_FOLD_VERTICES: usize = 4096;
+/// Most edges (and faces) a FOLD file may have.
+pub const MAX_FOLD_EDGES: usize = 8192;
+
 /// Custom FOLD key for creases held at their folded angle.
 pub const LOCKED_KEY: &str = "edges_nanofold:locked";
 
@@ -47,6 +53,33 @@ fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> 
 pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
     // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).
     let coords_json = array(value, "vertices_coords")?;
+    for (key, count, limit) in [
+        ("vertices_coords", coords_json.len(), MAX_FOLD_VERTICES),
+        (
+            "edges_vertices",
+            value
+                .get("edges_vertices")
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len),
+            MAX_FOLD_EDGES,
+        ),
+        (
+            "faces_vertices",
+            value
+                .get("faces_vertices")
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len),
+            MAX_FOLD_EDGES,
+        ),
+    ] {
+        if count > limit {
+            return Err(NanofoldError::invalid(
+                key,
+                format!("{count} entries"),
+                format!("a single-vertex pattern has at most {limit} (its outputs repeat the mesh in every frame)"),
+            ));
+        }
+    }
     let mut coords = Vec::with_capacity(coords_json.len());
     for (i, c) in coords_json.iter().enumerate() {
         let field = format!("vertices_coords[{i}]");

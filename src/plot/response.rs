@@ -2,7 +2,7 @@
 //! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of a strip, figure 5-7; the
 //! plates in 3D for a closed chain, figures 5-10 to 5-12).
 
-use super::{draw_legend, plot_error, series_colour};
+use super::{axis_range, draw_legend, plot_error, series_colour};
 use crate::dynamics::algorithms::{update_corners, update_poses};
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::model::Data;
@@ -138,7 +138,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             lo = lo.min(t.to_degrees());
             hi = hi.max(t.to_degrees());
         }
-        let pad = 0.06 * (hi - lo);
+        let y_range = axis_range(lo, hi, 0.06);
         let collision = response.collision.as_ref().map_or("no collision".to_string(), |c| {
             format!("{} hits {} at t = {:.4} {unit}", c.pair[0], c.pair[1], c.time / scale)
         });
@@ -150,7 +150,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(56)
-            .build_cartesian_2d(0.0..t_max, (lo - pad)..(hi + pad))
+            .build_cartesian_2d(axis_range(0.0, t_max, 0.0), y_range.clone())
             .map_err(plot_error)?;
         chart
             .configure_mesh()
@@ -187,7 +187,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             let x = c.time / scale;
             chart
                 .draw_series(std::iter::once(PathElement::new(
-                    vec![(x, lo - pad), (x, hi + pad)],
+                    vec![(x, y_range.start), (x, y_range.end)],
                     RED.stroke_width(2),
                 )))
                 .map_err(plot_error)?
@@ -228,7 +228,6 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 e_hi = e_hi.max(f(s) / e_scale);
             }
         }
-        let e_pad = 0.06 * (e_hi - e_lo).max(1e-30);
         let mut energy = ChartBuilder::on(&bottom)
             .caption(
                 format!("energy (drag {})", if view.drag { "on" } else { "off" }),
@@ -237,7 +236,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(56)
-            .build_cartesian_2d(0.0..t_max, (e_lo - e_pad)..(e_hi + e_pad))
+            .build_cartesian_2d(axis_range(0.0, t_max, 0.0), axis_range(e_lo, e_hi, 0.06))
             .map_err(plot_error)?;
         energy
             .configure_mesh()
@@ -349,7 +348,7 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(56)
-            .build_cartesian_2d(y0..y1, z0..z1)
+            .build_cartesian_2d(axis_range(y0, y1, 0.0), axis_range(z0, z1, 0.0))
             .map_err(plot_error)?;
         chart
             .configure_mesh()
@@ -419,6 +418,7 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
                 .map(|p| p.radius() + p.reference_pose.translation.vector.norm()),
         )
         .fold(0.0, f64::max)
+        .max(1e-12)
         * 1e6;
     let picks = snapshot_samples(response, count);
     let mut svg = String::new();
