@@ -565,3 +565,22 @@ fn extreme_solver_settings_are_refused_by_name() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("--samples") && !stderr.contains("panicked"), "{stderr}");
 }
+
+#[test]
+fn closed_scene_magnitudes_are_checked_like_a_strips() {
+    // Was: no mass or stiffness sanity check on closed scenes; a length unit of 1e300 hung.
+    let text = std::fs::read_to_string("patterns/corner_cube_step1.scene.json").unwrap();
+    let e = scene_error(common::scene_text(
+        &text.replace(r#""length_unit_um": 300"#, r#""length_unit_um": 1e300"#),
+    ));
+    assert!(e.contains("length_unit_um") && e.contains("must lie in"), "{e}");
+    // In range, but the creases come out 1e-6 µm long.
+    let e = scene_error(common::scene_text(
+        &text.replace(r#""length_unit_um": 300"#, r#""length_unit_um": 1e-6"#),
+    ));
+    assert!(e.contains("length of crease") && e.contains("must lie in"), "{e}");
+    let e = scene_error(common::scene_text(
+        &text.replace(r#""thickness_um": 0.2,"#, r#""thickness_um": 1e-300,"#),
+    ));
+    assert!(e.contains("plates.thickness_um"), "{e}");
+}

@@ -70,6 +70,9 @@ impl std::fmt::Debug for ProgressObserver {
     }
 }
 
+/// Step samples recorded at each stride before the stride doubles.
+const STEP_SAMPLE_CHUNK: usize = 10_000;
+
 /// How one diffsol run is driven.
 #[derive(Debug, Clone)]
 pub struct IntegrationOptions {
@@ -274,6 +277,7 @@ impl<P: Plant> Driver<'_, P> {
         let speed_sum = |y: &NalgebraVec<f64>| (n..2 * n).map(|i| y[i].abs()).sum::<f64>();
         let mut previous_speed: f64 = 0.0;
         let lever = plant.contact_lever();
+        let (mut step_stride, mut step_samples) = (1usize, 0usize);
         loop {
             let reason = solver.step()?;
             steps += 1;
@@ -355,12 +359,19 @@ impl<P: Plant> Driver<'_, P> {
                     solver.get_statistics().number_of_nonlinear_solver_fails,
                 ));
             }
-            // Every accepted step too: the steps resolve the fastest mode, a fixed grid may alias it.
+            // Every accepted step too: the steps resolve the fastest mode, a fixed grid may alias
+            // it. A long run thins them (the stride doubles every STEP_SAMPLE_CHUNK samples), so
+            // memory grows with the logarithm of the steps, not the steps.
             let s_now_time = s_now * self.time_unit;
-            if self.record_steps && samples.last().is_none_or(|last| last.time < s_now_time) {
+            if self.record_steps && steps % step_stride == 0 && samples.last().is_none_or(|last| last.time < s_now_time)
+            {
                 solver.interpolate_inplace(s_now, &mut state)?;
                 split(&state, &mut angles, &mut rates);
                 samples.push(plant.sample(s_now_time, &angles, &rates, &mut ws)?);
+                step_samples += 1;
+                if step_samples % STEP_SAMPLE_CHUNK == 0 {
+                    step_stride *= 2;
+                }
             }
             if let Some(progress) = self.progress {
                 (progress.0)(s_now / self.s_end, s_now * self.time_unit);

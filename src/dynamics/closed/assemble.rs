@@ -141,12 +141,14 @@ fn crease_hinges(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry) -> Resul
                 "this crease already has a hinge",
             ));
         }
-        stiffness[c] = hinge_stiffness(
-            &spec.materials,
-            i,
-            &spec_hinges[i],
-            geometry.crease_ends[c].coords.norm(),
+        let length = geometry.crease_ends[c].coords.norm();
+        within(
+            &format!("length_unit_um × the length of crease {}", hinge.crease),
+            length / MICROMETRE,
+            limits::LENGTH_UM,
+            "µm",
         )?;
+        stiffness[c] = hinge_stiffness(&spec.materials, i, &spec_hinges[i], length)?;
     }
     let of_crease = of_crease
         .iter()
@@ -367,11 +369,16 @@ fn sector_tree(
                 point: Point3::origin(),
                 stiffness: hinges.stiffness[ray_crease(r)],
             });
-            plates.push(Plate::lamina(
-                &outline_of(pattern, geometry, sector)?,
-                thickness,
-                density,
-            ));
+            let plate = Plate::lamina(&outline_of(pattern, geometry, sector)?, thickness, density);
+            let usable = |x: f64| x.is_finite() && x > 0.0;
+            if !(usable(plate.mass) && (0..3).all(|k| usable(plate.inertia[(k, k)]))) {
+                return Err(NanofoldError::invalid(
+                    format!("{}: the face of sector {sector}", pattern.name),
+                    format!("mass {:e} kg", plate.mass),
+                    "the plate's mass or inertia overflows or vanishes in double precision: check length_unit_um against the FOLD coordinates",
+                ));
+            }
+            plates.push(plate);
             parents.push(parent);
             parent = Some(joints.len() - 1);
             joint_creases.push(ray_crease(r));
