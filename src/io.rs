@@ -11,7 +11,7 @@ pub mod scene;
 
 pub use scene::{load_scene, parse_scene};
 
-use crate::error::Result;
+use crate::error::{NanofoldError, Result};
 use crate::pattern::{LoadOptions, Pattern};
 use std::path::Path;
 
@@ -47,7 +47,7 @@ pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
 }
 
 /// Does this JSON object use FOLD's keys (rather than the native vertex's)?
-fn is_fold_object(value: &serde_json::Value) -> bool {
+pub(crate) fn is_fold_object(value: &serde_json::Value) -> bool {
     const FAMILIES: [&str; 5] = ["file_", "frame_", "vertices_", "edges_", "faces_"];
     value
         .as_object()
@@ -57,10 +57,31 @@ fn is_fold_object(value: &serde_json::Value) -> bool {
 /// Parses pattern text (FOLD or native); `origin` names it in error messages.
 pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
     let value = input::parse_json(text, origin)?;
+    if !value.is_object() {
+        return Err(NanofoldError::invalid(
+            origin,
+            input::short_json(&value),
+            "a pattern file holds one JSON object (a FOLD file or a native vertex)",
+        ));
+    }
+    if is_scene_object(&value) {
+        return Err(NanofoldError::invalid(
+            origin,
+            "a scene file",
+            "this is a scene (it has materials, hinges or time): run it with `simulate` or `modes`",
+        ));
+    }
     let builder = if is_fold_object(&value) {
         fold::read_fold(&value, name)?
     } else {
         native::read_native(&value, name)?
     };
     builder.build_with(options)
+}
+
+/// Does this JSON object look like a scene file (keys only scenes have)?
+pub(crate) fn is_scene_object(value: &serde_json::Value) -> bool {
+    ["materials", "hinges", "time", "plates"]
+        .iter()
+        .any(|key| value.get(key).is_some())
 }

@@ -584,3 +584,31 @@ fn closed_scene_magnitudes_are_checked_like_a_strips() {
     ));
     assert!(e.contains("plates.thickness_um"), "{e}");
 }
+
+#[test]
+fn a_file_of_the_wrong_kind_is_told_what_it_is() {
+    // Was: "missing key `chain`" for a scene given to unfold or a top-level array, an
+    // "unknown key edges_assignment" for a pattern given to simulate, and a missing
+    // pattern file named without the scene field that points to it.
+    let scene = std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap();
+    let e = error_of(&scene);
+    assert!(e.contains("a scene file") && e.contains("simulate"), "{e}");
+    let e = error_of("[1, 2, 3]");
+    assert!(e.contains("one JSON object"), "{e}");
+    let e = error_of("{}");
+    assert!(
+        e.contains("missing key `chain`") && e.contains("vertices_coords"),
+        "{e}"
+    );
+    let fold = std::fs::read_to_string("patterns/corner_cube.fold").unwrap();
+    let e = scene_error(common::scene_text(&fold));
+    assert!(e.contains("a pattern file") && e.contains("unfold"), "{e}");
+    let closed = std::fs::read_to_string("patterns/corner_cube_step1.scene.json")
+        .unwrap()
+        .replace("corner_cube_plates.fold", "nothere.fold");
+    let e = scene_error(common::scene_text(&closed));
+    assert!(
+        e.contains("`pattern`") && e.contains("nothere.fold") && e.contains("cannot read"),
+        "{e}"
+    );
+}

@@ -32,7 +32,10 @@ struct NativeCrease {
 pub(crate) fn read_native(value: &Value, name: &str) -> Result<VertexBuilder> {
     for key in ["chain", "angle_unit", "sector_angles", "creases"] {
         if value.get(key).is_none() {
-            return Err(NanofoldError::missing(key));
+            return Err(NanofoldError::missing_with(
+                key,
+                "read as a native vertex, which needs chain, angle_unit, sector_angles and creases; a FOLD file has vertices_coords",
+            ));
         }
     }
     let vertex: NativeVertex = crate::io::input::from_value(value)?;

@@ -5,7 +5,7 @@
 
 use crate::dynamics::scene::SceneSpec;
 use crate::dynamics::spec::{ClosedSpec, StripSpec};
-use crate::error::Result;
+use crate::error::{NanofoldError, Result};
 use crate::pattern::LoadOptions;
 use std::path::Path;
 
@@ -39,10 +39,26 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec> {
 /// has no `name`, `base` is the folder a closed chain's pattern path is relative to.
 pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -> Result<SceneSpec> {
     let value = crate::io::input::parse_json(text, source)?;
+    if crate::io::is_fold_object(&value) || value.get("sector_angles").is_some() {
+        return Err(NanofoldError::invalid(
+            source,
+            "a pattern file",
+            "this is a crease pattern, not a scene: unfold it with `unfold`, or name it as a scene's `pattern`",
+        ));
+    }
     let closed = value.get("pattern").is_some();
     let mut spec = if closed {
         let file: ClosedSpec<String> = crate::io::input::from_value(&value)?;
-        let loaded = file.with_pattern(|path| crate::io::load_pattern(&base.join(path), &LoadOptions::default()))?;
+        let loaded = file.with_pattern(|path| {
+            let resolved = base.join(&path);
+            crate::io::load_pattern(&resolved, &LoadOptions::default()).map_err(|e| {
+                NanofoldError::invalid(
+                    "pattern",
+                    format!("\"{path}\" ({})", resolved.display()),
+                    full_message(&e),
+                )
+            })
+        })?;
         SceneSpec::Closed(Box::new(loaded))
     } else {
         let file: StripSpec = crate::io::input::from_value(&value)?;
@@ -57,4 +73,15 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         }
     }
     Ok(spec)
+}
+
+/// An error and its sources, joined.
+fn full_message(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut source = error.source();
+    while let Some(s) = source {
+        text += &format!(": {s}");
+        source = s.source();
+    }
+    text
 }
