@@ -645,6 +645,33 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let range = args.range.as_deref().map(parse_range).transpose()?;
     let setup = Setup::new(&pattern, driver, &locks).map_err(constraints_flags)?;
+    // A long sweep (up to 100 000 Newton solves) shows that it is working.
+    let spinner = if args.json {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new_spinner()
+    };
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    spinner.set_message(format!("sweeping {} samples", args.samples));
+    let result = constraints_after_setup(args, &pattern, &setup, range, degree, &spinner);
+    spinner.finish_and_clear();
+    let (report, dir, files) = result?;
+    print_constraints(args, &pattern, &report, &dir, &files)
+}
+
+/// Rendered output files: (file name, contents).
+type OutputFiles = Vec<(&'static str, String)>;
+
+/// The sweep, the fit and the files of `constraints`.
+fn constraints_after_setup(
+    args: &ConstraintsArgs,
+    pattern: &Pattern,
+    setup: &Setup,
+    range: Option<[f64; 2]>,
+    degree: Option<usize>,
+    spinner: &indicatif::ProgressBar,
+) -> Result<(ConstraintReport, PathBuf, OutputFiles)> {
+    let (pattern, setup, driver) = (pattern.clone(), setup.clone(), setup.driver);
     let samples = match args.source {
         SourceArg::Sweep => {
             let domain = match range {
@@ -668,6 +695,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
             .map_err(constraints_flags)?
         }
     };
+    spinner.set_message("fitting");
     let (poly, report) = match degree {
         Some(d) => {
             let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
@@ -688,8 +716,19 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         files.push(("constraints.xml", mujoco_snippet(&report).map_err(constraints_flags)?));
     }
     write_outputs(&dir, &files)?;
+    Ok((report, dir, files))
+}
+
+/// What `constraints` prints of its report.
+fn print_constraints(
+    args: &ConstraintsArgs,
+    pattern: &Pattern,
+    report: &ConstraintReport,
+    dir: &Path,
+    files: &[(&str, String)],
+) -> Result<()> {
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        println!("{}", serde_json::to_string(report)?);
         return Ok(());
     }
     println!(
@@ -724,7 +763,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         "  all curves together: loop-closure residual {:.3e} rad",
         report.max_closure_residual
     );
-    print_written(&dir, &files);
+    print_written(dir, files);
     Ok(())
 }
 
