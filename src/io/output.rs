@@ -1,5 +1,6 @@
-//! Files a run writes: `trajectory.json`, the FOLD animation `unfold.fold`, `response.json`; each written
-//! to a temporary file and renamed, so nothing is left half-written.
+//! What a run writes: `trajectory.json`, the FOLD animation `unfold.fold`, `response.json`
+//! and the other reports, rendered as values; `write_atomic` writes one file through a
+//! temporary file and a rename (a run's whole set goes through `io::folder`).
 
 use crate::dynamics::closed::modes::ClosedModes;
 use crate::dynamics::closed::ClosedChain;
