@@ -49,8 +49,20 @@ fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> 
     Ok(i as usize)
 }
 
-/// Reads the key frame of a FOLD object into a raw vertex.
-pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
+/// The arrays of a FOLD key frame, parsed and checked for shape and indices; `angle_key`
+/// names the fold-angle array the file uses.
+pub(crate) struct FoldGraph<'v> {
+    pub coords: Vec<[f64; 2]>,
+    pub edges: Vec<[usize; 2]>,
+    pub letters: Vec<String>,
+    pub angle_key: &'static str,
+    pub angles_json: &'v [Value],
+    pub locked: Vec<bool>,
+    pub faces_vertices: Option<Vec<Vec<usize>>>,
+}
+
+/// Parses a FOLD key frame's vertices, edges, assignments, fold angles, locks and faces.
+pub(crate) fn parse_graph(value: &Value) -> Result<FoldGraph<'_>> {
     // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).
     let coords_json = array(value, "vertices_coords")?;
     for (key, count, limit) in [
@@ -202,6 +214,29 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             Some(faces)
         }
     };
+    Ok(FoldGraph {
+        coords,
+        edges,
+        letters,
+        angle_key,
+        angles_json,
+        locked,
+        faces_vertices,
+    })
+}
+
+/// Reads the key frame of a FOLD object into a raw vertex.
+pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
+    let FoldGraph {
+        coords,
+        edges,
+        letters,
+        angle_key,
+        angles_json,
+        locked,
+        faces_vertices,
+    } = parse_graph(value)?;
+    let (nv, ne) = (coords.len(), edges.len());
 
     // Classify edges; B edges are boundary, the rest creases (C/J refused).
     let mut is_crease = vec![false; ne];
