@@ -1,0 +1,719 @@
+//! The crease pattern with many vertices (`docs/model.md#crease-patterns`): a planar
+//! straight-line graph on a disc of paper, its panels (faces merged across flat `F` edges),
+//! and at every interior vertex the star of creases whose loop must close. The single
+//! vertex ([`super::Pattern`]) is the special case of one interior (or boundary) vertex.
+
+use super::Assignment;
+use crate::error::{NanofoldError, Result};
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+
+/// Most edges a crease pattern may have (a 100 × 100 Miura-ori has about 20 000 creases).
+pub const MAX_EDGES: usize = 200_000;
+
+/// What an edge of the paper is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EdgeKind {
+    /// The paper's edge (FOLD's `B`).
+    Boundary,
+    /// A crease that folds (`M`, `V`, `U`).
+    Crease(Assignment),
+    /// A flat edge inside a panel (`F`: a facet line or a crease held flat); the faces on
+    /// both sides are one rigid panel.
+    Facet,
+}
+
+/// A crease pattern as read, before validation.
+#[derive(Debug, Clone, Default)]
+pub struct CreasePatternBuilder {
+    /// Names the pattern (and its output folder).
+    pub name: String,
+    /// Flat positions of the vertices.
+    pub vertices: Vec<[f64; 2]>,
+    /// Each edge's two vertices.
+    pub edges: Vec<[usize; 2]>,
+    /// Each edge's kind.
+    pub kinds: Vec<EdgeKind>,
+    /// Each edge's fold angle, rad (valley positive); 0 for boundary and facet edges.
+    pub fold_angles: Vec<f64>,
+    /// The faces as the file lists them (vertex loops), checked against the faces the
+    /// planar graph has; None to rebuild them.
+    pub faces: Option<Vec<Vec<usize>>>,
+    /// How the input names the fold-angle array (for errors), e.g. `edges_foldAngle`.
+    pub angle_field: String,
+}
+
+/// The creases around one interior vertex, counter-clockwise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VertexStar {
+    /// The vertex.
+    pub vertex: usize,
+    /// Its creases (edge indices), counter-clockwise from the first.
+    pub creases: Vec<usize>,
+    /// Sector angle after each crease (to the next one), rad; they sum to 2π.
+    pub sector_angles: Vec<f64>,
+}
+
+/// A validated crease pattern: a disc of paper cut into rigid panels by creases.
+#[derive(Debug, Clone)]
+pub struct CreasePattern {
+    /// The pattern's name.
+    pub name: String,
+    /// Flat positions of the vertices.
+    pub vertices: Vec<[f64; 2]>,
+    /// Each edge's two vertices.
+    pub edges: Vec<[usize; 2]>,
+    /// Each edge's kind.
+    pub kinds: Vec<EdgeKind>,
+    /// Each edge's fold angle in the given state, rad (0 for boundary and facet edges).
+    pub fold_angles: Vec<f64>,
+    /// The faces of the planar graph, counter-clockwise vertex loops.
+    pub faces: Vec<Vec<usize>>,
+    /// The faces on each side of each edge: [left, right] seen from edges[e][0] to
+    /// edges[e][1] (None: outside the paper).
+    pub edge_faces: Vec<[Option<usize>; 2]>,
+    /// The panel each face belongs to (faces joined across facet edges).
+    pub panel_of_face: Vec<usize>,
+    /// Number of panels.
+    pub panel_count: usize,
+    /// The creases (edge indices) in file order: the fold-angle coordinates.
+    pub creases: Vec<usize>,
+    /// Every interior vertex with at least one crease, and its star.
+    pub stars: Vec<VertexStar>,
+    /// The paper's outline, a counter-clockwise vertex loop.
+    pub outline: Vec<usize>,
+}
+
+impl CreasePatternBuilder {
+    /// Validates the graph, finds its faces, panels and vertex stars.
+    pub fn build(self) -> Result<CreasePattern> {
+        let CreasePatternBuilder {
+            name,
+            vertices,
+            edges,
+            kinds,
+            fold_angles,
+            faces: given_faces,
+            angle_field,
+        } = self;
+        let (nv, ne) = (vertices.len(), edges.len());
+        if edges.len() > MAX_EDGES {
+            return Err(NanofoldError::invalid(
+                "edges_vertices",
+                format!("{ne} edges"),
+                format!("a crease pattern has at most {MAX_EDGES}"),
+            ));
+        }
+        if kinds.len() != ne || fold_angles.len() != ne {
+            return Err(NanofoldError::invalid(
+                "edges_assignment",
+                format!("{} kinds, {} fold angles", kinds.len(), fold_angles.len()),
+                format!("expected one per edge ({ne})"),
+            ));
+        }
+        for (e, &[a, b]) in edges.iter().enumerate() {
+            if a >= nv || b >= nv || a == b {
+                return Err(NanofoldError::invalid(
+                    format!("edges_vertices[{e}]"),
+                    format!("[{a}, {b}]"),
+                    format!("an edge joins two distinct vertices of the {nv}"),
+                ));
+            }
+        }
+        for (e, (&kind, &rho)) in kinds.iter().zip(&fold_angles).enumerate() {
+            let field = || format!("{angle_field}[{e}]");
+            if !rho.is_finite() || rho.abs() > std::f64::consts::PI {
+                return Err(NanofoldError::invalid(
+                    field(),
+                    rho.to_degrees(),
+                    "must lie in [−180°, 180°]",
+                ));
+            }
+            let wrong_sign = match kind {
+                EdgeKind::Crease(Assignment::Mountain) => rho > 0.0,
+                EdgeKind::Crease(Assignment::Valley) => rho < 0.0,
+                EdgeKind::Boundary | EdgeKind::Facet => rho != 0.0,
+                EdgeKind::Crease(_) => false,
+            };
+            if wrong_sign {
+                return Err(NanofoldError::invalid(
+                    field(),
+                    format!("{:.6}°", rho.to_degrees()),
+                    format!("contradicts the edge's assignment ({kind:?})"),
+                ));
+            }
+        }
+        let duplicates = duplicate_edge(&edges);
+        if let Some((first, second)) = duplicates {
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{second}]"),
+                format!("{:?}", edges[second]),
+                format!("the same two vertices as edges_vertices[{first}]"),
+            ));
+        }
+        check_planar(&vertices, &edges)?;
+        let graph = PlanarGraph::new(&vertices, &edges)?;
+        let (faces, outer) = graph.faces(&vertices, &edges);
+        check_disc(&faces, &outer, &edges, &kinds, nv)?;
+        let outline = outer.into_iter().next().expect("check_disc found one outer loop");
+        if let Some(given) = &given_faces {
+            check_given_faces(given, &faces)?;
+        }
+        let edge_faces = graph.edge_faces(&faces, &edges);
+        let (panel_of_face, panel_count) = panels(&faces, &edge_faces, &kinds);
+        let creases: Vec<usize> = (0..ne).filter(|&e| matches!(kinds[e], EdgeKind::Crease(_))).collect();
+        let on_outline: Vec<bool> = {
+            let mut on = vec![false; nv];
+            outline.iter().for_each(|&v| on[v] = true);
+            on
+        };
+        let mut stars = Vec::new();
+        for v in (0..nv).filter(|&v| !on_outline[v]) {
+            let around: Vec<(usize, f64)> = graph.around[v]
+                .iter()
+                .filter(|&&(e, _)| matches!(kinds[e], EdgeKind::Crease(_)))
+                .map(|&(e, angle)| (e, angle))
+                .collect();
+            if around.is_empty() {
+                continue;
+            }
+            let k = around.len();
+            let sector_angles = (0..k)
+                .map(|j| {
+                    let gap = (around[(j + 1) % k].1 - around[j].1).rem_euclid(TAU);
+                    if k == 1 {
+                        TAU
+                    } else {
+                        gap
+                    }
+                })
+                .collect();
+            stars.push(VertexStar {
+                vertex: v,
+                creases: around.iter().map(|&(e, _)| e).collect(),
+                sector_angles,
+            });
+        }
+        Ok(CreasePattern {
+            name,
+            vertices,
+            edges,
+            kinds,
+            fold_angles,
+            faces,
+            edge_faces,
+            panel_of_face,
+            panel_count,
+            creases,
+            stars,
+            outline,
+        })
+    }
+}
+
+/// The first pair of edges joining the same two vertices.
+fn duplicate_edge(edges: &[[usize; 2]]) -> Option<(usize, usize)> {
+    let mut seen: HashMap<[usize; 2], usize> = HashMap::with_capacity(edges.len());
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        if let Some(&first) = seen.get(&[a.min(b), a.max(b)]) {
+            return Some((first, e));
+        }
+        seen.insert([a.min(b), a.max(b)], e);
+    }
+    None
+}
+
+/// No two edges may cross, and no vertex may lie inside an edge: the graph must be a
+/// planar straight-line graph. Edges are bucketed on a uniform grid (about one edge per
+/// cell), so the test costs O(E) for evenly spread patterns.
+fn check_planar(vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> Result<()> {
+    if edges.is_empty() {
+        return Ok(());
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for &[a, b] in edges {
+        for p in [vertices[a], vertices[b]] {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+    let cells = ((edges.len() as f64).sqrt().ceil() as usize).clamp(1, 1024);
+    let cell = |x: f64, k: usize| (((x - lo[k]) / size * cells as f64) as usize).min(cells - 1);
+    let mut buckets: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        let (p, q) = (vertices[a], vertices[b]);
+        let (i0, i1) = (cell(p[0].min(q[0]), 0), cell(p[0].max(q[0]), 0));
+        let (j0, j1) = (cell(p[1].min(q[1]), 1), cell(p[1].max(q[1]), 1));
+        for i in i0..=i1 {
+            for j in j0..=j1 {
+                buckets.entry((i, j)).or_default().push(e);
+            }
+        }
+    }
+    let tolerance = 1e-12 * size;
+    let cross = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+    let mut checked = std::collections::HashSet::new();
+    for list in buckets.values() {
+        for (x, &e) in list.iter().enumerate() {
+            for &f in &list[x + 1..] {
+                if !checked.insert((e.min(f), e.max(f))) {
+                    continue;
+                }
+                let ([a, b], [c, d]) = (edges[e], edges[f]);
+                let shared = [a, b].iter().filter(|v| [c, d].contains(v)).count();
+                let (p, q, r, t) = (vertices[a], vertices[b], vertices[c], vertices[d]);
+                let length = |u: [f64; 2], v: [f64; 2]| (v[0] - u[0]).hypot(v[1] - u[1]);
+                let (d1, d2) = (cross(p, q, r) / length(p, q), cross(p, q, t) / length(p, q));
+                let (d3, d4) = (cross(r, t, p) / length(r, t), cross(r, t, q) / length(r, t));
+                let crosses = shared == 0
+                    && ((d1 > tolerance && d2 < -tolerance) || (d1 < -tolerance && d2 > tolerance))
+                    && ((d3 > tolerance && d4 < -tolerance) || (d3 < -tolerance && d4 > tolerance));
+                // A vertex of one edge strictly inside the other (a T-junction).
+                let inside = |u: [f64; 2], from: [f64; 2], to: [f64; 2], distance: f64| {
+                    let along = ((u[0] - from[0]) * (to[0] - from[0]) + (u[1] - from[1]) * (to[1] - from[1]))
+                        / length(from, to).powi(2);
+                    distance.abs() <= tolerance && along > 1e-9 && along < 1.0 - 1e-9
+                };
+                let touches = (!([a, b].contains(&c)) && inside(r, p, q, d1))
+                    || (!([a, b].contains(&d)) && inside(t, p, q, d2))
+                    || (!([c, d].contains(&a)) && inside(p, r, t, d3))
+                    || (!([c, d].contains(&b)) && inside(q, r, t, d4));
+                if crosses || touches {
+                    return Err(NanofoldError::invalid(
+                        format!("edges_vertices[{}]", e.max(f)),
+                        format!("edges {} and {}", e.min(f), e.max(f)),
+                        if crosses {
+                            "two edges cross away from a vertex: split them at a shared vertex"
+                        } else {
+                            "a vertex lies inside another edge: split that edge at the vertex"
+                        },
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Edges around each vertex sorted by direction, and the half-edge structure.
+struct PlanarGraph {
+    /// (edge, direction angle in [0, 2π)) around each vertex, counter-clockwise.
+    around: Vec<Vec<(usize, f64)>>,
+}
+
+impl PlanarGraph {
+    fn new(vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> Result<PlanarGraph> {
+        let mut around: Vec<Vec<(usize, f64)>> = vec![Vec::new(); vertices.len()];
+        for (e, &[a, b]) in edges.iter().enumerate() {
+            for (from, to) in [(a, b), (b, a)] {
+                let (dx, dy) = (vertices[to][0] - vertices[from][0], vertices[to][1] - vertices[from][1]);
+                if dx == 0.0 && dy == 0.0 {
+                    return Err(NanofoldError::invalid(
+                        format!("edges_vertices[{e}]"),
+                        format!("[{a}, {b}]"),
+                        "the edge has zero length (its vertices coincide)",
+                    ));
+                }
+                around[from].push((e, dy.atan2(dx).rem_euclid(TAU)));
+            }
+        }
+        for (v, list) in around.iter_mut().enumerate() {
+            list.sort_by(|x, y| x.1.total_cmp(&y.1));
+            let k = list.len();
+            for j in 0..k {
+                let gap = (list[(j + 1) % k].1 - list[j].1).rem_euclid(TAU);
+                if k > 1 && gap < super::MIN_SECTOR_RAD {
+                    return Err(NanofoldError::invalid(
+                        format!("edges_vertices[{}]", list[(j + 1) % k].0),
+                        format!("edges {} and {} at vertex {v}", list[j].0, list[(j + 1) % k].0),
+                        "two edges leave the vertex in the same direction (overlapping edges)",
+                    ));
+                }
+            }
+        }
+        Ok(PlanarGraph { around })
+    }
+
+    /// The other end of edge `e` seen from `v`.
+    fn other(edges: &[[usize; 2]], e: usize, v: usize) -> usize {
+        if edges[e][0] == v {
+            edges[e][1]
+        } else {
+            edges[e][0]
+        }
+    }
+
+    /// Every face cycle of the graph: (inner faces counter-clockwise, outer loops). A face
+    /// is traced with its inside on the left: from the half-edge u → v the next leaves v
+    /// along the edge just clockwise of v → u.
+    fn faces(&self, vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> (Vec<Vec<usize>>, Vec<Vec<usize>>) {
+        // Position of each edge in the sorted list around each of its ends.
+        let mut slot: HashMap<(usize, usize), usize> = HashMap::with_capacity(2 * edges.len());
+        for (v, list) in self.around.iter().enumerate() {
+            for (j, &(e, _)) in list.iter().enumerate() {
+                slot.insert((v, e), j);
+            }
+        }
+        let mut used: std::collections::HashSet<(usize, usize)> =
+            std::collections::HashSet::with_capacity(2 * edges.len());
+        let (mut inner, mut outer) = (Vec::new(), Vec::new());
+        for (e, &[a, b]) in edges.iter().enumerate() {
+            for start in [a, b] {
+                if used.contains(&(start, e)) {
+                    continue;
+                }
+                let mut cycle = Vec::new();
+                let (mut from, mut edge) = (start, e);
+                // Each half-edge is used once, so a walk ends within 2E steps.
+                while used.insert((from, edge)) {
+                    cycle.push(from);
+                    let to = PlanarGraph::other(edges, edge, from);
+                    let list = &self.around[to];
+                    let j = slot[&(to, edge)];
+                    edge = list[(j + list.len() - 1) % list.len()].0;
+                    from = to;
+                }
+                let area: f64 = (0..cycle.len())
+                    .map(|k| {
+                        let (p, q) = (vertices[cycle[k]], vertices[cycle[(k + 1) % cycle.len()]]);
+                        p[0] * q[1] - q[0] * p[1]
+                    })
+                    .sum();
+                if area > 0.0 {
+                    inner.push(cycle);
+                } else {
+                    outer.push(cycle);
+                }
+            }
+        }
+        (inner, outer)
+    }
+
+    /// [left, right] face of each edge, seen from edges[e][0] to edges[e][1].
+    fn edge_faces(&self, faces: &[Vec<usize>], edges: &[[usize; 2]]) -> Vec<[Option<usize>; 2]> {
+        let mut index: HashMap<[usize; 2], usize> = HashMap::with_capacity(edges.len());
+        for (e, &[a, b]) in edges.iter().enumerate() {
+            index.insert([a, b], e);
+        }
+        let mut sides = vec![[None, None]; edges.len()];
+        for (f, face) in faces.iter().enumerate() {
+            for k in 0..face.len() {
+                let (u, v) = (face[k], face[(k + 1) % face.len()]);
+                // The face lies left of u → v.
+                if let Some(&e) = index.get(&[u, v]) {
+                    sides[e][0] = Some(f);
+                } else if let Some(&e) = index.get(&[v, u]) {
+                    sides[e][1] = Some(f);
+                }
+            }
+        }
+        sides
+    }
+}
+
+/// The paper must be one disc: a connected graph with one outer loop, V − E + F = 1, the
+/// outer loop made of boundary edges only and no boundary edge inside.
+fn check_disc(
+    faces: &[Vec<usize>],
+    outer: &[Vec<usize>],
+    edges: &[[usize; 2]],
+    kinds: &[EdgeKind],
+    vertex_count: usize,
+) -> Result<()> {
+    if outer.len() != 1 {
+        return Err(NanofoldError::invalid(
+            "edges_vertices",
+            format!("{} separate outlines", outer.len()),
+            "the paper must be one connected sheet (a disc): a vertex or edge lies apart from the rest",
+        ));
+    }
+    let used: usize = {
+        let mut seen = vec![false; vertex_count];
+        edges.iter().for_each(|&[a, b]| {
+            seen[a] = true;
+            seen[b] = true;
+        });
+        seen.iter().filter(|&&s| s).count()
+    };
+    let euler = used as i64 - edges.len() as i64 + faces.len() as i64;
+    if euler != 1 {
+        return Err(NanofoldError::invalid(
+            "edges_vertices",
+            format!("V − E + F = {euler}"),
+            "the paper must be a disc (V − E + F = 1): holes and cuts are not supported yet",
+        ));
+    }
+    let loop_ = &outer[0];
+    let mut on_outline: std::collections::HashSet<[usize; 2]> = std::collections::HashSet::new();
+    for k in 0..loop_.len() {
+        let (u, v) = (loop_[k], loop_[(k + 1) % loop_.len()]);
+        on_outline.insert([u.min(v), u.max(v)]);
+    }
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        let outside = on_outline.contains(&[a.min(b), a.max(b)]);
+        match (outside, kinds[e]) {
+            (true, EdgeKind::Boundary) | (false, EdgeKind::Crease(_) | EdgeKind::Facet) => {}
+            (true, _) => {
+                return Err(NanofoldError::invalid(
+                    format!("edges_assignment[{e}]"),
+                    format!("{:?}", kinds[e]),
+                    "this edge lies on the paper's outline: it must be a boundary (B) edge (a crease there is a cut)",
+                ))
+            }
+            (false, _) => {
+                return Err(NanofoldError::invalid(
+                    format!("edges_assignment[{e}]"),
+                    "B",
+                    "a boundary edge inside the paper is a cut: cuts and holes are not supported yet",
+                ))
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Given faces must be the graph's faces (each a rotation of one, either orientation).
+fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<()> {
+    let key = |face: &[usize]| {
+        let mut sorted = face.to_vec();
+        sorted.sort_unstable();
+        sorted
+    };
+    let known: std::collections::HashSet<Vec<usize>> = faces.iter().map(|f| key(f)).collect();
+    for (i, face) in given.iter().enumerate() {
+        if !known.contains(&key(face)) {
+            return Err(NanofoldError::invalid(
+                format!("faces_vertices[{i}]"),
+                format!("{face:?}"),
+                "not a face of the crease pattern's edges (faces must be the regions the edges enclose)",
+            ));
+        }
+    }
+    if given.len() != faces.len() {
+        return Err(NanofoldError::invalid(
+            "faces_vertices",
+            format!("{} faces", given.len()),
+            format!("the edges enclose {} faces", faces.len()),
+        ));
+    }
+    Ok(())
+}
+
+/// Panels: faces joined across facet edges (union–find).
+fn panels(faces: &[Vec<usize>], edge_faces: &[[Option<usize>; 2]], kinds: &[EdgeKind]) -> (Vec<usize>, usize) {
+    let mut parent: Vec<usize> = (0..faces.len()).collect();
+    fn root(parent: &mut [usize], mut f: usize) -> usize {
+        while parent[f] != f {
+            parent[f] = parent[parent[f]];
+            f = parent[f];
+        }
+        f
+    }
+    for (e, sides) in edge_faces.iter().enumerate() {
+        if let (EdgeKind::Facet, [Some(a), Some(b)]) = (kinds[e], sides) {
+            let (ra, rb) = (root(&mut parent, *a), root(&mut parent, *b));
+            if ra != rb {
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut number = HashMap::new();
+    let panel_of_face = (0..faces.len())
+        .map(|f| {
+            let r = root(&mut parent, f);
+            let next = number.len();
+            *number.entry(r).or_insert(next)
+        })
+        .collect();
+    (panel_of_face, number.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of m × n unit squares; inner edges are creases of `assignment` at 0.
+    fn grid(m: usize, n: usize, inner: EdgeKind) -> CreasePatternBuilder {
+        let id = |i: usize, j: usize| i * (n + 1) + j;
+        let mut b = CreasePatternBuilder {
+            name: "grid".into(),
+            angle_field: "edges_foldAngle".into(),
+            ..Default::default()
+        };
+        for i in 0..=m {
+            for j in 0..=n {
+                b.vertices.push([j as f64, i as f64]);
+            }
+        }
+        let mut push = |a: usize, c: usize, outline: bool| {
+            b.edges.push([a, c]);
+            b.kinds.push(if outline { EdgeKind::Boundary } else { inner });
+            b.fold_angles.push(0.0);
+        };
+        for i in 0..=m {
+            for j in 0..n {
+                push(id(i, j), id(i, j + 1), i == 0 || i == m);
+            }
+        }
+        for i in 0..m {
+            for j in 0..=n {
+                push(id(i, j), id(i + 1, j), j == 0 || j == n);
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn a_grid_has_its_faces_stars_and_outline() {
+        let cp = grid(3, 3, EdgeKind::Crease(Assignment::Unassigned)).build().unwrap();
+        assert_eq!(cp.faces.len(), 9);
+        assert_eq!(cp.panel_count, 9);
+        assert_eq!(cp.creases.len(), 12);
+        assert_eq!(cp.stars.len(), 4);
+        assert_eq!(cp.outline.len(), 12);
+        for star in &cp.stars {
+            assert_eq!(star.creases.len(), 4);
+            let sum: f64 = star.sector_angles.iter().sum();
+            assert!((sum - TAU).abs() < 1e-12);
+            assert!(star
+                .sector_angles
+                .iter()
+                .all(|a| (a - std::f64::consts::FRAC_PI_2).abs() < 1e-12));
+        }
+        // Every inner edge has a face on each side, every outline edge one.
+        for (e, sides) in cp.edge_faces.iter().enumerate() {
+            let count = sides.iter().flatten().count();
+            assert_eq!(count, if cp.kinds[e] == EdgeKind::Boundary { 1 } else { 2 });
+        }
+    }
+
+    #[test]
+    fn facet_edges_join_faces_into_panels() {
+        let cp = grid(2, 2, EdgeKind::Facet).build().unwrap();
+        assert_eq!((cp.faces.len(), cp.panel_count), (4, 1));
+        assert!(cp.stars.is_empty() && cp.creases.is_empty());
+    }
+
+    #[test]
+    fn one_crease_across_the_sheet_has_no_star() {
+        // A square with its diagonal (FOLD's diagonal-cp example).
+        let b = CreasePatternBuilder {
+            name: "diagonal".into(),
+            vertices: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            edges: vec![[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]],
+            kinds: vec![
+                EdgeKind::Boundary,
+                EdgeKind::Boundary,
+                EdgeKind::Boundary,
+                EdgeKind::Boundary,
+                EdgeKind::Crease(Assignment::Valley),
+            ],
+            fold_angles: vec![0.0, 0.0, 0.0, 0.0, 1.0],
+            faces: Some(vec![vec![0, 1, 2], vec![0, 2, 3]]),
+            angle_field: "edges_foldAngle".into(),
+        };
+        let cp = b.build().unwrap();
+        assert_eq!(
+            (cp.faces.len(), cp.panel_count, cp.creases.len(), cp.stars.len()),
+            (2, 2, 1, 0)
+        );
+    }
+
+    #[test]
+    fn papers_that_are_not_a_disc_are_refused() {
+        // A crease on the outline (a cut).
+        let mut b = grid(2, 2, EdgeKind::Crease(Assignment::Unassigned));
+        b.kinds[0] = EdgeKind::Crease(Assignment::Unassigned);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("edges_assignment[0]") && e.contains("outline"), "{e}");
+        // A boundary edge inside.
+        let mut b = grid(2, 2, EdgeKind::Crease(Assignment::Unassigned));
+        let inner = b.kinds.iter().position(|k| *k != EdgeKind::Boundary).unwrap();
+        b.kinds[inner] = EdgeKind::Boundary;
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("cut"), "{e}");
+        // Two sheets.
+        let mut b = grid(1, 1, EdgeKind::Crease(Assignment::Unassigned));
+        let offset = b.vertices.len();
+        for v in b.vertices.clone() {
+            b.vertices.push([v[0] + 5.0, v[1]]);
+        }
+        for e in b.edges.clone() {
+            b.edges.push([e[0] + offset, e[1] + offset]);
+            b.kinds.push(EdgeKind::Boundary);
+            b.fold_angles.push(0.0);
+        }
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("one connected sheet"), "{e}");
+        // A hole: a 3 × 3 grid without its middle square's inside (its four edges become
+        // an inner outline).
+        let b = grid(3, 3, EdgeKind::Crease(Assignment::Unassigned));
+        let mut holed = b.clone();
+        let middle = [[5usize, 6usize], [9, 10], [5, 9], [6, 10]];
+        for (e, edge) in holed.edges.iter().enumerate() {
+            if middle
+                .iter()
+                .any(|m| (m[0] == edge[0] && m[1] == edge[1]) || (m[0] == edge[1] && m[1] == edge[0]))
+            {
+                holed.kinds[e] = EdgeKind::Boundary;
+            }
+        }
+        assert!(holed.build().is_err());
+    }
+
+    #[test]
+    fn given_faces_must_be_the_graphs() {
+        let mut b = grid(1, 2, EdgeKind::Crease(Assignment::Unassigned));
+        b.faces = Some(vec![vec![0, 1, 4, 3], vec![1, 2, 5, 4]]);
+        assert!(b.clone().build().is_ok());
+        b.faces = Some(vec![vec![0, 1, 2, 5, 4, 3]]);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("faces_vertices[0]"), "{e}");
+    }
+
+    #[test]
+    fn crossing_edges_and_t_junctions_are_refused() {
+        // Both diagonals of a square, with no vertex where they meet.
+        let b = CreasePatternBuilder {
+            name: "x".into(),
+            vertices: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            edges: vec![[0, 1], [1, 2], [2, 3], [3, 0], [0, 2], [1, 3]],
+            kinds: vec![EdgeKind::Boundary; 4]
+                .into_iter()
+                .chain([EdgeKind::Crease(Assignment::Unassigned); 2])
+                .collect(),
+            fold_angles: vec![0.0; 6],
+            faces: None,
+            angle_field: "edges_foldAngle".into(),
+        };
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("cross"), "{e}");
+        // A crease ending in the middle of the bottom edge, which is not split there.
+        let b = CreasePatternBuilder {
+            name: "t".into(),
+            vertices: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.0]],
+            edges: vec![[0, 1], [1, 2], [2, 3], [3, 0], [4, 2]],
+            kinds: vec![EdgeKind::Boundary; 4]
+                .into_iter()
+                .chain([EdgeKind::Crease(Assignment::Unassigned)])
+                .collect(),
+            fold_angles: vec![0.0; 5],
+            faces: None,
+            angle_field: "edges_foldAngle".into(),
+        };
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("inside another edge"), "{e}");
+    }
+
+    #[test]
+    fn overlapping_and_repeated_edges_are_refused() {
+        let mut b = grid(1, 1, EdgeKind::Crease(Assignment::Unassigned));
+        b.edges.push([0, 1]);
+        b.kinds.push(EdgeKind::Boundary);
+        b.fold_angles.push(0.0);
+        assert!(b.build().unwrap_err().to_string().contains("same two vertices"));
+    }
+}
