@@ -12,6 +12,7 @@ pub mod scene;
 pub use scene::{load_scene, parse_scene};
 
 use crate::error::{NanofoldError, Result};
+use crate::pattern::crease_pattern::CreasePattern;
 use crate::pattern::{LoadOptions, Pattern};
 use std::path::Path;
 
@@ -77,6 +78,33 @@ pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions
         native::read_native(&value, name)?
     };
     builder.build_with(options)
+}
+
+/// Loads a FOLD file as a crease pattern of any number of vertices
+/// (`docs/model.md#crease-patterns`).
+///
+/// ```
+/// use nanofold::io::load_crease_pattern;
+/// let cp = load_crease_pattern("patterns/waterbomb.fold".as_ref())?;
+/// assert_eq!((cp.stars.len(), cp.creases.len()), (1, 8));
+/// # Ok::<(), nanofold::NanofoldError>(())
+/// ```
+pub fn load_crease_pattern(path: &Path) -> Result<CreasePattern> {
+    let text = input::read_text(path, input::MAX_PATTERN_BYTES)?;
+    parse_crease_pattern(&text, &pattern_name(path), &path.display().to_string())
+}
+
+/// Parses FOLD text as a crease pattern; `origin` names it in errors.
+pub fn parse_crease_pattern(text: &str, name: &str, origin: &str) -> Result<CreasePattern> {
+    let value = input::parse_json(text, origin)?;
+    if !is_fold_object(&value) {
+        return Err(NanofoldError::invalid(
+            origin,
+            "not a FOLD object",
+            "a crease pattern of many vertices is read from a FOLD file (vertices_coords, edges_vertices, edges_assignment)",
+        ));
+    }
+    fold::read_crease_pattern(&value, name)?.build()
 }
 
 /// Does this JSON object look like a scene file (keys only scenes have)?

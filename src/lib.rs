@@ -60,6 +60,7 @@
 pub mod constraints;
 pub mod dynamics;
 pub mod error;
+pub mod folding;
 pub mod geometry;
 pub mod io;
 pub mod pattern;

@@ -3,6 +3,7 @@
 //! files by the io layer ([`crate::io`]). Patterns of many vertices are [`crease_pattern`].
 
 pub mod crease_pattern;
+pub mod generate;
 
 use crate::error::{NanofoldError, Result};
 use crate::geometry::kinematics;

@@ -1,5 +1,5 @@
 //! The library's layers depend one way (README, "How it works"): geometry → pattern →
-//! unfold and constraints → dynamics → io → plot, with `error` beneath them all and the
+//! folding → unfold and constraints → dynamics → io → plot, with `error` beneath them all and the
 //! crate root and prelude above. This reads every library source file, collects the
 //! `crate::…` and `super::…` paths it uses (unit tests aside), and fails on an import of a
 //! higher layer, on unfold and constraints importing each other, and on any cycle between
@@ -14,10 +14,11 @@ fn rank(module: &str) -> Option<usize> {
         "error" => 0,
         "geometry" => 1,
         "pattern" => 2,
-        "unfold" | "constraints" => 3,
-        "dynamics" => 4,
-        "io" => 5,
-        "plot" => 6,
+        "folding" => 3,
+        "unfold" | "constraints" => 4,
+        "dynamics" => 5,
+        "io" => 6,
+        "plot" => 7,
         _ => return None,
     })
 }

@@ -4,6 +4,7 @@
 
 use crate::error::{NanofoldError, Result};
 use crate::io::input::short_json;
+use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
 use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
 use serde_json::Value;
 use std::f64::consts::TAU;
@@ -56,7 +57,8 @@ pub(crate) struct FoldGraph<'v> {
     pub edges: Vec<[usize; 2]>,
     pub letters: Vec<String>,
     pub angle_key: &'static str,
-    pub angles_json: &'v [Value],
+    /// The fold angles, degrees (None: the file gives none).
+    pub angles_json: Option<&'v [Value]>,
     pub locked: Vec<bool>,
     pub faces_vertices: Option<Vec<Vec<usize>>>,
 }
@@ -157,21 +159,18 @@ pub(crate) fn parse_graph(value: &Value) -> Result<FoldGraph<'_>> {
     }
 
     let (angle_key, angles_json) = match (value.get("edges_foldAngle"), value.get("edges_foldAngles")) {
-        (Some(_), _) => ("edges_foldAngle", array(value, "edges_foldAngle")?),
-        (None, Some(_)) => ("edges_foldAngles", array(value, "edges_foldAngles")?),
-        (None, None) => {
-            return Err(NanofoldError::missing_with(
-                "edges_foldAngle",
-                "the folded state, degrees",
-            ))
-        }
+        (Some(_), _) => ("edges_foldAngle", Some(array(value, "edges_foldAngle")?.as_slice())),
+        (None, Some(_)) => ("edges_foldAngles", Some(array(value, "edges_foldAngles")?.as_slice())),
+        (None, None) => ("edges_foldAngle", None),
     };
-    if angles_json.len() != ne {
-        return Err(NanofoldError::invalid(
-            angle_key,
-            format!("{} entries", angles_json.len()),
-            format!("expected one per edge ({ne})"),
-        ));
+    if let Some(angles) = angles_json {
+        if angles.len() != ne {
+            return Err(NanofoldError::invalid(
+                angle_key,
+                format!("{} entries", angles.len()),
+                format!("expected one per edge ({ne})"),
+            ));
+        }
     }
 
     let locked: Vec<bool> = match value.get(LOCKED_KEY) {
@@ -237,6 +236,8 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         faces_vertices,
     } = parse_graph(value)?;
     let (nv, ne) = (coords.len(), edges.len());
+    let angles_json =
+        angles_json.ok_or_else(|| NanofoldError::missing_with("edges_foldAngle", "the folded state, degrees"))?;
 
     // Classify edges; B edges are boundary, the rest creases (C/J refused).
     let mut is_crease = vec![false; ne];
@@ -409,5 +410,58 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             center,
             ray0_direction: spokes[start].direction,
         }),
+    })
+}
+
+/// Reads the key frame of a FOLD object into a crease pattern of any number of vertices
+/// (`docs/model.md#crease-patterns`). Fold angles may be absent (the flat state) or `null`
+/// on boundary and facet edges, as Origami Simulator writes them.
+pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePatternBuilder> {
+    let graph = parse_graph(value)?;
+    let mut kinds = Vec::with_capacity(graph.edges.len());
+    let mut fold_angles = Vec::with_capacity(graph.edges.len());
+    for (e, letter) in graph.letters.iter().enumerate() {
+        let field = format!("edges_assignment[{e}]");
+        let kind = match letter.as_str() {
+            "B" | "b" => EdgeKind::Boundary,
+            "F" | "f" => EdgeKind::Facet,
+            "C" | "c" => {
+                return Err(NanofoldError::invalid(
+                    field,
+                    "\"C\"",
+                    "cut edges are not supported yet: the paper must be one disc",
+                ))
+            }
+            other => EdgeKind::Crease(Assignment::from_letter(other, &field)?),
+        };
+        let angle_field = format!("{}[{e}]", graph.angle_key);
+        let degrees = match graph.angles_json.map(|a| &a[e]) {
+            None | Some(Value::Null) if !matches!(kind, EdgeKind::Crease(_)) || graph.angles_json.is_none() => 0.0,
+            None | Some(Value::Null) => {
+                return Err(NanofoldError::invalid(
+                    angle_field,
+                    "null",
+                    "a crease needs its fold angle (degrees), or the file none at all (the flat state)",
+                ))
+            }
+            Some(v) => number(v, &angle_field)?,
+        };
+        // A facet or boundary edge is flat whatever the file says of it (Origami Simulator
+        // writes its facets' target angles); a crease keeps its angle.
+        fold_angles.push(if matches!(kind, EdgeKind::Crease(_)) {
+            degrees.to_radians()
+        } else {
+            0.0
+        });
+        kinds.push(kind);
+    }
+    Ok(CreasePatternBuilder {
+        name: name.to_string(),
+        vertices: graph.coords,
+        edges: graph.edges,
+        kinds,
+        fold_angles,
+        faces: graph.faces_vertices,
+        angle_field: graph.angle_key.to_string(),
     })
 }

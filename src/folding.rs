@@ -1,0 +1,15 @@
+//! Rigid kinematics of crease patterns with many vertices (`docs/model.md#rigid-folding`):
+//! the per-vertex closure conditions and their sparse Jacobian, the degrees of freedom at
+//! a state, the panels' poses, and the test that no two panels pass through each other.
+
+pub mod closure;
+pub mod contact;
+pub mod model;
+pub mod poses;
+pub mod rank;
+
+pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};
+pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
+pub use model::{FoldingModel, Star, TreeStep};
+pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
+pub use rank::{jacobian_rank, RankReport, RANK_TOL};

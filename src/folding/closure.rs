@@ -1,0 +1,92 @@
+//! Per-vertex loop closure of a crease pattern and its sparse Jacobian
+//! (`docs/model.md#rigid-folding`): at interior vertex v the holonomy of its star,
+//! R_z(α_0) R_x(ρ_1) … R_z(α_{k−1}) R_x(ρ_0), is the identity; its rotation vector r_v is
+//! the residual, three rows of J per vertex, one column per crease.
+
+use super::model::FoldingModel;
+use crate::geometry::kinematics;
+use faer::sparse::{SparseColMat, Triplet};
+
+/// The stacked closure residual and its Jacobian at one state.
+#[derive(Debug, Clone)]
+pub struct ClosureJacobian {
+    /// Rotation vector of each star's holonomy, 3 entries per star (in `model.stars` order).
+    pub residual: Vec<f64>,
+    /// Rows (3 per star).
+    pub rows: usize,
+    /// Columns (one per crease).
+    pub cols: usize,
+    /// Non-zero entries (row, column, value): ∂r/∂ρ.
+    pub entries: Vec<(usize, usize, f64)>,
+}
+
+impl ClosureJacobian {
+    /// The Jacobian as a faer sparse matrix (duplicate entries summed).
+    pub fn to_sparse(&self) -> SparseColMat<usize, f64> {
+        let triplets: Vec<Triplet<usize, usize, f64>> =
+            self.entries.iter().map(|&(r, c, v)| Triplet::new(r, c, v)).collect();
+        SparseColMat::try_new_from_triplets(self.rows, self.cols, &triplets)
+            .expect("entries are within the matrix and few enough for usize indices")
+    }
+
+    /// y = J x.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for &(r, c, v) in &self.entries {
+            y[r] += v * x[c];
+        }
+    }
+
+    /// x = Jᵀ y.
+    pub fn apply_transpose(&self, y: &[f64], x: &mut [f64]) {
+        x.iter_mut().for_each(|v| *v = 0.0);
+        for &(r, c, v) in &self.entries {
+            x[c] += v * y[r];
+        }
+    }
+}
+
+/// Fold angles of a star's creases in ray order.
+fn star_angles(columns: &[usize], fold_angles: &[f64], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(columns.iter().map(|&c| fold_angles[c]));
+}
+
+/// The closure residual of every star, rad (`model.stars` order).
+pub fn vertex_residuals(model: &FoldingModel, fold_angles: &[f64]) -> Vec<f64> {
+    let mut by_ray = Vec::new();
+    model
+        .stars
+        .iter()
+        .map(|star| {
+            star_angles(&star.columns, fold_angles, &mut by_ray);
+            kinematics::closure_residual(&star.sector_angles, &by_ray)
+        })
+        .collect()
+}
+
+/// The stacked residual and the sparse Jacobian ∂r/∂ρ at `fold_angles` (one per crease).
+pub fn closure_jacobian(model: &FoldingModel, fold_angles: &[f64]) -> ClosureJacobian {
+    let mut residual = Vec::with_capacity(3 * model.stars.len());
+    let mut entries = Vec::with_capacity(3 * model.stars.iter().map(|s| s.columns.len()).sum::<usize>());
+    let mut by_ray = Vec::new();
+    let mut rays: Vec<usize> = Vec::new();
+    for (s, star) in model.stars.iter().enumerate() {
+        star_angles(&star.columns, fold_angles, &mut by_ray);
+        rays.clear();
+        rays.extend(0..star.columns.len());
+        let (r, jac) = kinematics::closure_jacobian(&star.sector_angles, &by_ray, &rays);
+        residual.extend(r.iter());
+        for (j, &column) in star.columns.iter().enumerate() {
+            for i in 0..3 {
+                entries.push((3 * s + i, column, jac[(i, j)]));
+            }
+        }
+    }
+    ClosureJacobian {
+        residual,
+        rows: 3 * model.stars.len(),
+        cols: model.crease_count(),
+        entries,
+    }
+}

@@ -1,0 +1,302 @@
+//! Panels that meet (`docs/model.md#panel-contact`): a sort-and-sweep broad phase on the
+//! panels' boxes, then exact triangle–triangle tests in 3D. Panels that share a vertex are
+//! left to that vertex's spherical order and not tested here.
+
+use super::model::FoldingModel;
+use super::poses::Pose;
+use crate::error::{NanofoldError, Result};
+use nalgebra::Vector3;
+
+type Point = Vector3<f64>;
+
+/// How close two panels may come before they are reported.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSettings {
+    /// Distance below which a pair is a contact, as a fraction of the pattern's size.
+    pub clearance: f64,
+    /// Pairs whose boxes come within this fraction of the size are measured (for the
+    /// smallest clearance reported).
+    pub search: f64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings {
+            clearance: 1e-9,
+            search: 0.05,
+        }
+    }
+}
+
+impl ContactSettings {
+    /// Checks the fractions.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.clearance >= 0.0 && self.clearance <= 0.1) {
+            return Err(NanofoldError::invalid(
+                "clearance",
+                self.clearance,
+                "must lie in [0, 0.1] (fraction of the pattern size)",
+            ));
+        }
+        if !(self.search >= self.clearance && self.search <= 1.0) {
+            return Err(NanofoldError::invalid(
+                "search",
+                self.search,
+                "must lie in [clearance, 1]",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Two panels that come within the clearance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PanelContact {
+    /// The two panels, smaller index first.
+    pub panels: [usize; 2],
+    /// Their distance (0 when they touch or cross).
+    pub distance: f64,
+    /// Whether one passes through the other (an edge of one crosses the other's interior).
+    pub crossing: bool,
+}
+
+/// The outcome of one contact test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactReport {
+    /// Pairs closer than the clearance, crossing ones included.
+    pub contacts: Vec<PanelContact>,
+    /// Number of pairs measured exactly.
+    pub pairs_measured: usize,
+    /// Smallest distance over the measured pairs (None: no pair within the search range).
+    pub min_clearance: Option<f64>,
+}
+
+impl ContactReport {
+    /// The pairs that pass through each other.
+    pub fn crossing(&self) -> impl Iterator<Item = &PanelContact> {
+        self.contacts.iter().filter(|c| c.crossing)
+    }
+}
+
+/// Tests every pair of panels sharing no vertex, posed by `poses`.
+pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSettings) -> ContactReport {
+    let clearance = settings.clearance * model.size;
+    let search = settings.search * model.size;
+    let pattern = &model.pattern;
+    let triangles: Vec<Vec<[Point; 3]>> = model
+        .panel_triangles
+        .iter()
+        .enumerate()
+        .map(|(p, list)| {
+            list.iter()
+                .map(|t| t.map(|v| poses[p].place(pattern.vertices[v])))
+                .collect()
+        })
+        .collect();
+    let boxes: Vec<([f64; 3], [f64; 3])> = triangles
+        .iter()
+        .map(|list| {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for x in list.iter().flatten() {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(x[k] - search / 2.0);
+                    hi[k] = hi[k].max(x[k] + search / 2.0);
+                }
+            }
+            (lo, hi)
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_unstable_by(|&a, &b| boxes[a].0[0].total_cmp(&boxes[b].0[0]));
+    let mut report = ContactReport {
+        contacts: Vec::new(),
+        pairs_measured: 0,
+        min_clearance: None,
+    };
+    for (i, &a) in order.iter().enumerate() {
+        for &b in &order[i + 1..] {
+            if boxes[b].0[0] > boxes[a].1[0] {
+                break;
+            }
+            let overlap = (1..3).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]);
+            if !overlap || share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
+                continue;
+            }
+            report.pairs_measured += 1;
+            let mut distance = f64::INFINITY;
+            let mut crossing = false;
+            for s in &triangles[a] {
+                for t in &triangles[b] {
+                    let (d, c) = triangle_distance(s, t, 1e-12 * model.size);
+                    distance = distance.min(d);
+                    crossing |= c;
+                }
+            }
+            report.min_clearance = Some(report.min_clearance.map_or(distance, |m: f64| m.min(distance)));
+            if crossing || distance <= clearance {
+                report.contacts.push(PanelContact {
+                    panels: [a.min(b), a.max(b)],
+                    distance,
+                    crossing,
+                });
+            }
+        }
+    }
+    report.contacts.sort_by_key(|c| c.panels);
+    report
+}
+
+fn share_vertex(a: &[usize], b: &[usize]) -> bool {
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Equal => return true,
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+        }
+    }
+    false
+}
+
+/// Distance between two triangles, and whether they cross: an edge of one passes through
+/// the other's interior by more than `tolerance`. Touching (coplanar overlap, an edge
+/// lying on the other) gives distance 0 without a crossing.
+pub(crate) fn triangle_distance(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> (f64, bool) {
+    let crossing = (0..3).any(|k| segment_crosses(&s[k], &s[(k + 1) % 3], t, tolerance))
+        || (0..3).any(|k| segment_crosses(&t[k], &t[(k + 1) % 3], s, tolerance));
+    if crossing {
+        return (0.0, true);
+    }
+    let mut best = f64::INFINITY;
+    for i in 0..3 {
+        for j in 0..3 {
+            best = best.min(segment_distance(&s[i], &s[(i + 1) % 3], &t[j], &t[(j + 1) % 3]));
+        }
+        best = best.min(point_triangle_distance(&s[i], t));
+        best = best.min(point_triangle_distance(&t[i], s));
+    }
+    (best, false)
+}
+
+/// Does the segment p → q pass through the triangle's interior, both ends more than
+/// `tolerance` off its plane and the crossing point more than `tolerance` inside?
+fn segment_crosses(p: &Point, q: &Point, triangle: &[Point; 3], tolerance: f64) -> bool {
+    let [a, b, c] = triangle;
+    let normal = (b - a).cross(&(c - a));
+    let area2 = normal.norm();
+    if area2 == 0.0 {
+        return false;
+    }
+    let n = normal / area2;
+    let (dp, dq) = (n.dot(&(p - a)), n.dot(&(q - a)));
+    if !((dp > tolerance && dq < -tolerance) || (dp < -tolerance && dq > tolerance)) {
+        return false;
+    }
+    let x = p + (q - p) * (dp / (dp - dq));
+    // Signed distances of x from each edge, inside positive.
+    [(a, b), (b, c), (c, a)].iter().all(|&(u, v)| {
+        let edge = v - u;
+        n.cross(&edge).normalize().dot(&(x - u)) > tolerance
+    })
+}
+
+/// Closest distance between segments p1q1 and p2q2 (clamped parameters).
+fn segment_distance(p1: &Point, q1: &Point, p2: &Point, q2: &Point) -> f64 {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
+    let (s, t) = if a <= f64::MIN_POSITIVE && e <= f64::MIN_POSITIVE {
+        (0.0, 0.0)
+    } else if a <= f64::MIN_POSITIVE {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= f64::MIN_POSITIVE {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denominator = a * e - b * b;
+            let mut s = if denominator > 0.0 {
+                ((b * f - c * e) / denominator).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+}
+
+/// Distance from a point to a triangle (closest point by Voronoi regions).
+fn point_triangle_distance(p: &Point, triangle: &[Point; 3]) -> f64 {
+    let [a, b, c] = triangle;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.norm();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.norm();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.norm();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(x: f64, y: f64, z: f64) -> Point {
+        Point::new(x, y, z)
+    }
+
+    #[test]
+    fn triangle_distances_match_hand_computed_cases() {
+        let base = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0)];
+        // Parallel copy 0.3 above: distance 0.3, no crossing.
+        let above = base.map(|x| x + p(0.0, 0.0, 0.3));
+        assert_eq!(triangle_distance(&base, &above, 1e-12), (0.3, false));
+        // A vertical triangle piercing the base's interior.
+        let pierce = [p(0.2, 0.2, -1.0), p(0.2, 0.2, 1.0), p(0.3, 0.2, 1.0)];
+        assert!(triangle_distance(&base, &pierce, 1e-12).1);
+        // Standing on the base (an edge lies in it): touching, not crossing.
+        let standing = [p(0.2, 0.2, 0.0), p(0.3, 0.2, 0.0), p(0.25, 0.2, 1.0)];
+        assert_eq!(triangle_distance(&base, &standing, 1e-12), (0.0, false));
+        // Off to the side and above: the edge-to-edge distance, sqrt(0.5^2 + 0.5^2).
+        let aside = [p(1.5, 0.0, 0.5), p(2.5, 0.0, 0.5), p(1.5, 1.0, 0.5)];
+        let (d, crossing) = triangle_distance(&base, &aside, 1e-12);
+        assert!(!crossing && (d - 0.5f64.hypot(0.5)).abs() < 1e-15, "{d}");
+        // Skew segments: edge (0,0,0)-(1,0,0) against a triangle whose nearest feature is a
+        // point above the base's interior at height 0.4.
+        let tent = [p(0.25, 0.25, 0.4), p(0.25, 0.25, 2.0), p(0.3, 0.3, 2.0)];
+        let (d, _) = triangle_distance(&base, &tent, 1e-12);
+        assert!((d - 0.4).abs() < 1e-15, "{d}");
+    }
+}

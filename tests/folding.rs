@@ -1,0 +1,247 @@
+//! Rigid kinematics of crease patterns with many vertices, against independent answers:
+//! the single-vertex engine, finite differences, an SVD, the Miura-ori's closed form and
+//! hand-computed panel geometry.
+
+use nanofold::folding::{
+    closure_jacobian, jacobian_rank, panel_contacts, panel_poses, tree_mismatch, vertex_positions, vertex_residuals,
+    ContactSettings, FoldingModel,
+};
+use nanofold::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
+use nanofold::pattern::generate::MiuraSpec;
+use nanofold::pattern::{Assignment, LoadOptions};
+use std::path::Path;
+
+fn miura(rows: usize, cols: usize, gamma_deg: f64, zigzag_deg: f64) -> FoldingModel {
+    let spec = MiuraSpec {
+        rows,
+        cols,
+        sector_angle: gamma_deg.to_radians(),
+        zigzag_fold_angle: zigzag_deg.to_radians(),
+        ..MiuraSpec::default()
+    };
+    FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap()
+}
+
+/// Numerical rank by nalgebra's SVD: a second, independent factorisation.
+fn svd_rank(model: &FoldingModel, fold_angles: &[f64]) -> usize {
+    let jac = closure_jacobian(model, fold_angles);
+    if jac.rows == 0 {
+        return 0;
+    }
+    let mut dense = nalgebra::DMatrix::<f64>::zeros(jac.rows, jac.cols);
+    for &(r, c, v) in &jac.entries {
+        dense[(r, c)] += v;
+    }
+    let singular = dense.singular_values();
+    let largest: f64 = singular.max();
+    singular.iter().filter(|&&s| s > 1e-8 * largest).count()
+}
+
+#[test]
+fn single_vertex_library_patterns_agree_with_the_vertex_engine() {
+    let mut checked = 0;
+    for entry in std::fs::read_dir("patterns").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("fold") {
+            continue;
+        }
+        let cp = nanofold::io::load_crease_pattern(&path).unwrap();
+        let vertex = nanofold::io::load_pattern(&path, &LoadOptions::default()).unwrap();
+        let name = path.display().to_string();
+        assert_eq!(cp.creases.len(), vertex.creases.len(), "{name}");
+        let model = FoldingModel::new(cp).unwrap();
+        let rho = model.given_fold_angles();
+        let residuals = vertex_residuals(&model, &rho);
+        match residuals.as_slice() {
+            [] => assert!(vertex.closure_residual == 0.0, "{name}: an open vertex has no closure"),
+            [r] => assert!(
+                (r - vertex.closure_residual).abs() <= 1e-12,
+                "{name}: {r:e} vs {:e}",
+                vertex.closure_residual
+            ),
+            more => panic!("{name}: {} stars", more.len()),
+        }
+        let report = jacobian_rank(&closure_jacobian(&model, &rho));
+        assert_eq!(report.rank, svd_rank(&model, &rho), "{name}");
+        assert_eq!(report.dof, model.crease_count() - report.rank);
+        // Every panel placed from the tree lands where the single vertex's kinematics
+        // puts it: the folded nodes keep their distances from the vertex.
+        let mut poses = Vec::new();
+        panel_poses(&model, &rho, &mut poses);
+        let positions = vertex_positions(&model, &poses);
+        for &[a, b] in &model.pattern.edges {
+            let (p, q) = (model.pattern.vertices[a], model.pattern.vertices[b]);
+            let flat = (q[0] - p[0]).hypot(q[1] - p[1]);
+            let (x, y) = (positions[a], positions[b]);
+            let folded = ((y[0] - x[0]).powi(2) + (y[1] - x[1]).powi(2) + (y[2] - x[2]).powi(2)).sqrt();
+            if residuals.iter().all(|&r| r < 1e-12) {
+                assert!((flat - folded).abs() < 1e-12, "{name}: edge length {flat} → {folded}");
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 9, "{checked} FOLD patterns");
+}
+
+#[test]
+fn the_jacobian_matches_central_differences() {
+    let model = miura(3, 4, 65.0, 70.0);
+    // Off the closure manifold, so that the residual and J^-1_l are not trivial.
+    let rho: Vec<f64> = model
+        .given_fold_angles()
+        .iter()
+        .enumerate()
+        .map(|(k, r)| r + 0.05 * ((k as f64) * 1.3).sin())
+        .collect();
+    let jac = closure_jacobian(&model, &rho);
+    let mut dense = vec![vec![0.0; jac.cols]; jac.rows];
+    for &(r, c, v) in &jac.entries {
+        dense[r][c] += v;
+    }
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for c in 0..jac.cols {
+        let (mut plus, mut minus) = (rho.clone(), rho.clone());
+        plus[c] += h;
+        minus[c] -= h;
+        let (rp, rm) = (
+            closure_jacobian(&model, &plus).residual,
+            closure_jacobian(&model, &minus).residual,
+        );
+        for r in 0..jac.rows {
+            worst = worst.max(((rp[r] - rm[r]) / (2.0 * h) - dense[r][c]).abs());
+        }
+    }
+    assert!(worst < 1e-8, "largest difference {worst:e}");
+}
+
+#[test]
+fn a_folded_miura_ori_is_rigid_with_one_degree_of_freedom() {
+    for (rows, cols, gamma, zigzag) in [
+        (2, 2, 60.0, 40.0),
+        (4, 5, 70.0, 120.0),
+        (6, 6, 45.0, 10.0),
+        (5, 3, 80.0, 170.0),
+    ] {
+        let model = miura(rows, cols, gamma, zigzag);
+        let rho = model.given_fold_angles();
+        let worst = vertex_residuals(&model, &rho).into_iter().fold(0.0, f64::max);
+        assert!(worst < 1e-12, "{rows}x{cols}: residual {worst:e}");
+        let report = jacobian_rank(&closure_jacobian(&model, &rho));
+        assert_eq!(report.dof, 1, "{rows}x{cols} γ {gamma}: {report:?}");
+        assert_eq!(svd_rank(&model, &rho), report.rank);
+        let mut poses = Vec::new();
+        panel_poses(&model, &rho, &mut poses);
+        assert!(tree_mismatch(&model, &rho, &poses) < 1e-12 * model.size);
+        // Across every crease the panels' normals make the fold angle, and a valley
+        // (positive) crease puts the far panel on the near panel's upper (+normal) side.
+        let pattern = &model.pattern;
+        for (column, &e) in pattern.creases.iter().enumerate() {
+            let [Some(l), Some(r)] = pattern.edge_faces[e] else {
+                panic!()
+            };
+            let (pl, pr) = (pattern.panel_of_face[l], pattern.panel_of_face[r]);
+            let (nl, nr) = (poses[pl].rotation.column(2), poses[pr].rotation.column(2));
+            let between = nl.dot(&nr).clamp(-1.0, 1.0).acos();
+            assert!(
+                (between - rho[column].abs()).abs() < 1e-7,
+                "crease {e}: {between} vs {}",
+                rho[column]
+            );
+            let a = poses[pl].place(pattern.vertices[pattern.edges[e][0]]);
+            let far: nalgebra::Vector3<f64> = model.panel_vertices[pr]
+                .iter()
+                .map(|&v| poses[pr].place(pattern.vertices[v]) - a)
+                .sum();
+            assert_eq!(nl.dot(&far) > 0.0, rho[column] > 0.0, "crease {e}: side");
+        }
+        let contacts = panel_contacts(&model, &poses, &ContactSettings::default());
+        assert_eq!(contacts.crossing().count(), 0, "{rows}x{cols} γ {gamma} ρ {zigzag}");
+    }
+}
+
+#[test]
+fn the_flat_miura_ori_is_singular() {
+    // At flat every vertex's axes lie in the plane: J loses a row per vertex, and first-order
+    // analysis sees more freedom than the single folding motion.
+    let model = miura(4, 4, 60.0, 0.0);
+    let rho = model.given_fold_angles();
+    let report = jacobian_rank(&closure_jacobian(&model, &rho));
+    assert_eq!(report.rank, 2 * model.stars.len());
+    assert!(report.dof > 1);
+}
+
+/// Three strips side by side, creases at x = 1 and x = 2.
+fn three_strips(first: f64, second: f64) -> FoldingModel {
+    let vertices = vec![
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [2.0, 0.0],
+        [3.0, 0.0],
+        [3.0, 1.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 1.0],
+    ];
+    let mut edges = vec![[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 6], [6, 7], [7, 0]];
+    let mut kinds = vec![EdgeKind::Boundary; 8];
+    let mut fold_angles = vec![0.0; 8];
+    for (edge, rho) in [([1, 6], first), ([2, 5], second)] {
+        edges.push(edge);
+        let assignment = if rho >= 0.0 {
+            Assignment::Valley
+        } else {
+            Assignment::Mountain
+        };
+        kinds.push(EdgeKind::Crease(assignment));
+        fold_angles.push(rho);
+    }
+    let builder = CreasePatternBuilder {
+        name: "strips".into(),
+        vertices,
+        edges,
+        kinds,
+        fold_angles,
+        angle_field: "edges_foldAngle".into(),
+        ..Default::default()
+    };
+    FoldingModel::new(builder.build().unwrap()).unwrap()
+}
+
+#[test]
+fn panels_folded_through_each_other_are_found_and_walls_are_measured() {
+    let wide = ContactSettings {
+        clearance: 1e-9,
+        search: 1.0,
+    };
+    let mut poses = Vec::new();
+    // Both outer strips up by 90°: two walls one unit apart.
+    let model = three_strips(90f64.to_radians(), 90f64.to_radians());
+    panel_poses(&model, &model.given_fold_angles(), &mut poses);
+    let report = panel_contacts(&model, &poses, &wide);
+    assert!(report.contacts.is_empty());
+    let up = vertex_positions(&model, &poses);
+    assert!(
+        (up[0][2] - 1.0).abs() < 1e-15 && (up[3][2] - 1.0).abs() < 1e-15,
+        "valleys lift: {up:?}"
+    );
+    assert!(
+        (report.min_clearance.unwrap() - 1.0).abs() < 1e-14,
+        "{:?}",
+        report.min_clearance
+    );
+    // Both up by 170°: each lies over the middle strip and they pass through each other.
+    let model = three_strips(170f64.to_radians(), 170f64.to_radians());
+    panel_poses(&model, &model.given_fold_angles(), &mut poses);
+    let report = panel_contacts(&model, &poses, &wide);
+    assert_eq!(report.crossing().count(), 1, "{report:?}");
+    // A zigzag (valley, mountain) at 170° stacks them without crossing.
+    let model = three_strips(170f64.to_radians(), -170f64.to_radians());
+    panel_poses(&model, &model.given_fold_angles(), &mut poses);
+    let report = panel_contacts(&model, &poses, &wide);
+    assert_eq!(report.crossing().count(), 0, "{report:?}");
+    // A single crease has no closure condition: two panels, one DOF per crease.
+    let rho = model.given_fold_angles();
+    assert_eq!(jacobian_rank(&closure_jacobian(&model, &rho)).dof, 2);
+    assert!(Path::new("patterns").exists());
+}
