@@ -245,3 +245,48 @@ fn panels_folded_through_each_other_are_found_and_walls_are_measured() {
     assert_eq!(jacobian_rank(&closure_jacobian(&model, &rho)).dof, 2);
     assert!(Path::new("patterns").exists());
 }
+
+#[test]
+fn a_miura_ori_folds_from_flat_along_its_closed_form() {
+    use nanofold::folding::{fold_path, Drive, FoldSettings, StopReason};
+    for (rows, cols, gamma) in [(3, 3, 60.0), (5, 4, 75.0)] {
+        let model = miura(rows, cols, gamma, 0.0);
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to: 0.95 },
+            ..FoldSettings::default()
+        };
+        let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+        assert_eq!(path.stop, StopReason::Reached, "{}", path.evidence);
+        assert!(path.max_closure_residual <= 1e-10);
+        // Every state on the path is a Miura state: the straight creases follow
+        // tan(ρ_h/2) = cos γ tan(ρ_z/2) of the zigzag ones, with the assigned signs.
+        let reference = |zigzag: f64| {
+            let spec = MiuraSpec {
+                rows,
+                cols,
+                sector_angle: gamma.to_radians(),
+                zigzag_fold_angle: zigzag,
+                ..MiuraSpec::default()
+            };
+            FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap().given_fold_angles()
+        };
+        let zigzag_column = model
+            .pattern
+            .creases
+            .iter()
+            .position(|&e| {
+                let [a, b] = model.pattern.edges[e];
+                (model.pattern.vertices[a][0] - model.pattern.vertices[b][0]).abs() < 0.99
+            })
+            .unwrap();
+        for step in &path.steps {
+            let zigzag = step.fold_angles[zigzag_column].abs();
+            let expected = reference(zigzag);
+            let error = step.fold_angles.iter().zip(&expected).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(error < 1e-9, "{rows}x{cols} at ρ_z {zigzag}: {error:e}");
+        }
+        let last = path.steps.last().unwrap();
+        let most = last.fold_angles.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        assert!((most - 0.95 * std::f64::consts::PI).abs() < 1e-8, "{most}");
+    }
+}

@@ -1,0 +1,528 @@
+//! Rigid folding motion (Tachi; `docs/model.md#folding-paths`): a desired velocity of the
+//! fold angles projected onto the null space of the closure Jacobian, a step, and Newton
+//! back onto every vertex closure; panel contact checked at every step.
+
+use super::closure::{closure_jacobian, ClosureJacobian};
+use super::contact::{panel_contacts, ContactSettings};
+use super::model::FoldingModel;
+use super::poses::{panel_poses, Pose};
+use crate::error::{NanofoldError, NumericalError, Result};
+use crate::pattern::crease_pattern::EdgeKind;
+use crate::pattern::Assignment;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Side;
+use std::f64::consts::PI;
+
+/// What drives the motion.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Drive {
+    /// Every mountain crease towards −π and every valley towards +π at equal speed, until
+    /// the most folded crease reaches `to` × π.
+    Assignment {
+        /// Fraction of full folding at which to stop, in (0, 1].
+        to: f64,
+    },
+    /// The listed creases (fold-angle columns) towards their target angles (rad).
+    Creases(Vec<(usize, f64)>),
+}
+
+/// Settings of a folding path, validated by [`FoldSettings::validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldSettings {
+    /// What drives the motion.
+    pub drive: Drive,
+    /// Largest change of any fold angle in one step, rad.
+    pub max_step: f64,
+    /// Largest closure residual accepted at any vertex after Newton, rad.
+    pub closure_tol: f64,
+    /// Most steps.
+    pub max_steps: usize,
+    /// First step out of the flat state along the projected direction, rad.
+    pub kick: f64,
+    /// Panel contact test.
+    pub contact: ContactSettings,
+}
+
+impl Default for FoldSettings {
+    fn default() -> Self {
+        FoldSettings {
+            drive: Drive::Assignment { to: 1.0 },
+            max_step: 0.05,
+            closure_tol: 1e-11,
+            max_steps: 100_000,
+            kick: 1e-3,
+            contact: ContactSettings {
+                clearance: 1e-9,
+                search: 0.01,
+            },
+        }
+    }
+}
+
+impl FoldSettings {
+    /// Checks every setting against the model.
+    pub fn validate(&self, model: &FoldingModel) -> Result<()> {
+        match &self.drive {
+            Drive::Assignment { to } => {
+                if !(*to > 0.0 && *to <= 1.0) {
+                    return Err(NanofoldError::invalid("drive.to", to, "must lie in (0, 1]"));
+                }
+            }
+            Drive::Creases(list) => {
+                if list.is_empty() {
+                    return Err(NanofoldError::invalid("drive", "[]", "name at least one crease"));
+                }
+                for &(column, target) in list {
+                    if column >= model.crease_count() {
+                        return Err(NanofoldError::invalid(
+                            "drive",
+                            column,
+                            format!("the pattern has {} creases", model.crease_count()),
+                        ));
+                    }
+                    if !(target.is_finite() && target.abs() <= PI) {
+                        return Err(NanofoldError::invalid("drive", target.to_degrees(), "a target lies in [−180°, 180°]"));
+                    }
+                }
+            }
+        }
+        if !(self.max_step > 0.0 && self.max_step <= 0.5) {
+            return Err(NanofoldError::invalid("max_step", self.max_step, "must lie in (0, 0.5] rad"));
+        }
+        if !(self.closure_tol >= 1e-14 && self.closure_tol <= 1e-3) {
+            return Err(NanofoldError::invalid("closure_tol", self.closure_tol, "must lie in [1e-14, 1e-3] rad"));
+        }
+        if !(1..=1_000_000).contains(&self.max_steps) {
+            return Err(NanofoldError::invalid("max_steps", self.max_steps, "must lie in [1, 10^6]"));
+        }
+        if !(self.kick > 0.0 && self.kick <= 0.1) {
+            return Err(NanofoldError::invalid("kick", self.kick, "must lie in (0, 0.1] rad"));
+        }
+        self.contact.validate()
+    }
+}
+
+/// Why a folding path stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StopReason {
+    /// The drive's goal was reached.
+    Reached,
+    /// Two panels would pass through each other in the next step.
+    Blocked {
+        /// The panels.
+        panels: [usize; 2],
+    },
+    /// The desired velocity has no component in the null space: no motion (0 DOF) that way.
+    Locked,
+    /// Newton found no rigid state near the next step even with small steps, or the path
+    /// left the assigned signs: a branch point or the end of this branch.
+    BranchPoint {
+        /// The creases (columns) that moved most in the failed step, or that left their
+        /// assignment.
+        creases: Vec<usize>,
+    },
+    /// The step budget ran out.
+    StepLimit,
+}
+
+impl StopReason {
+    /// The name used in reports.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            StopReason::Reached => "reached",
+            StopReason::Blocked { .. } => "blocked",
+            StopReason::Locked => "locked",
+            StopReason::BranchPoint { .. } => "branch_point",
+            StopReason::StepLimit => "step_limit",
+        }
+    }
+}
+
+/// One accepted state along the path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathStep {
+    /// Progress towards the drive's goal, 0 at the start, 1 at the goal.
+    pub progress: f64,
+    /// Fold angles, rad (one per crease).
+    pub fold_angles: Vec<f64>,
+    /// Largest vertex closure residual, rad.
+    pub max_residual: f64,
+    /// Smallest distance between panels sharing no vertex, within the search range.
+    pub min_clearance: Option<f64>,
+}
+
+/// A folding path and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldPath {
+    /// Every accepted state, the start first.
+    pub steps: Vec<PathStep>,
+    /// Why it stopped.
+    pub stop: StopReason,
+    /// The stop in words, with its evidence.
+    pub evidence: String,
+    /// How the path left the flat state (None: it did not start flat).
+    pub branch: Option<String>,
+    /// Largest closure residual over every step, rad.
+    pub max_closure_residual: f64,
+    /// Smallest panel clearance over every step (None: no pair came within the search range).
+    pub min_panel_clearance: Option<f64>,
+    /// Newton iterations over the whole path.
+    pub newton_iterations: usize,
+}
+
+/// Factorises JᵀJ + μI (symbolic structure kept between states) for the null-space
+/// projection and the least-norm Newton step.
+#[derive(Default)]
+pub struct NormalSolver {
+    symbolic: Option<SymbolicLlt<usize>>,
+}
+
+/// One factorisation and its regularisation.
+pub struct NormalFactor {
+    llt: Llt<usize, f64>,
+    /// μ.
+    pub mu: f64,
+}
+
+/// μ relative to the largest diagonal entry of JᵀJ.
+const REGULARISATION: f64 = 1e-10;
+
+impl NormalSolver {
+    /// Factorises JᵀJ + μI.
+    pub fn factor(&mut self, jac: &ClosureJacobian) -> Result<NormalFactor> {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); jac.rows];
+        for &(r, c, v) in &jac.entries {
+            rows[r].push((c, v));
+        }
+        let mut triplets: Vec<(usize, usize, f64)> = Vec::new();
+        for row in &rows {
+            for &(ci, vi) in row {
+                for &(cj, vj) in row {
+                    if ci >= cj {
+                        triplets.push((ci, cj, vi * vj));
+                    }
+                }
+            }
+        }
+        let mut diagonal = vec![0.0; jac.cols];
+        for &(i, j, v) in &triplets {
+            if i == j {
+                diagonal[i] += v;
+            }
+        }
+        let mu = REGULARISATION * diagonal.iter().fold(1.0_f64, |m, &d| m.max(d));
+        triplets.extend((0..jac.cols).map(|c| (c, c, mu)));
+        triplets.sort_unstable_by_key(|&(i, j, _)| (j, i));
+        let mut merged: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(triplets.len());
+        for (i, j, v) in triplets {
+            match merged.last_mut() {
+                Some(last) if last.row == i && last.col == j => last.val += v,
+                _ => merged.push(Triplet::new(i, j, v)),
+            }
+        }
+        let matrix = SparseColMat::try_new_from_triplets(jac.cols, jac.cols, &merged).map_err(|e| {
+            NumericalError::Singular {
+                what: "JᵀJ + μI",
+                detail: format!("{e:?}"),
+            }
+        })?;
+        if self.symbolic.is_none() {
+            self.symbolic = Some(SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).map_err(|e| {
+                NumericalError::Singular {
+                    what: "JᵀJ + μI (symbolic)",
+                    detail: format!("{e:?}"),
+                }
+            })?);
+        }
+        let symbolic = self.symbolic.clone().expect("set above");
+        let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).map_err(|e| {
+            NumericalError::NotPositiveDefinite {
+                matrix: "JᵀJ + μI",
+                at: format!("{e:?}"),
+            }
+        })?;
+        Ok(NormalFactor { llt, mu })
+    }
+}
+
+impl NormalFactor {
+    /// Solves (JᵀJ + μI) x = b in place.
+    pub fn solve(&self, b: &mut [f64]) {
+        self.llt.solve_in_place(faer::ColMut::from_slice_mut(b).as_mat_mut());
+    }
+
+    /// The desired velocity's component in the null space of J: d − Jᵀ(JJᵀ + μI)⁻¹J d,
+    /// which equals μ (JᵀJ + μI)⁻¹ d.
+    pub fn project(&self, desired: &[f64]) -> Vec<f64> {
+        let mut v = desired.to_vec();
+        self.solve(&mut v);
+        v.iter_mut().for_each(|x| *x *= self.mu);
+        v
+    }
+}
+
+fn inf_norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+fn worst_residual(jac: &ClosureJacobian) -> f64 {
+    jac.residual
+        .chunks(3)
+        .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// Newton's method (least-norm steps) back onto every closure. Returns the iterations, or
+/// None when it does not reach `tol` within 30 iterations or runs away (a fold angle beyond
+/// π + 0.5; the caller keeps accepted states within [−π, π]).
+pub fn restore_closure(
+    model: &FoldingModel,
+    fold_angles: &mut [f64],
+    tol: f64,
+    solver: &mut NormalSolver,
+) -> Result<Option<usize>> {
+    let mut previous = f64::INFINITY;
+    for iteration in 0..30 {
+        let jac = closure_jacobian(model, fold_angles);
+        let worst = worst_residual(&jac);
+        if !worst.is_finite() {
+            return Ok(None);
+        }
+        if worst <= tol {
+            return Ok(Some(iteration));
+        }
+        if iteration > 3 && worst > 0.5 * previous {
+            return Ok(None);
+        }
+        previous = worst;
+        let factor = solver.factor(&jac)?;
+        let mut step = vec![0.0; jac.cols];
+        jac.apply_transpose(&jac.residual, &mut step);
+        factor.solve(&mut step);
+        for (rho, d) in fold_angles.iter_mut().zip(&step) {
+            *rho -= d;
+        }
+        if fold_angles.iter().any(|r| r.abs() > PI + 0.5) {
+            return Ok(None);
+        }
+    }
+    Ok(None)
+}
+
+/// The sign each crease's assignment asks for (+1 valley, −1 mountain, 0 otherwise).
+fn assigned_signs(model: &FoldingModel) -> Vec<f64> {
+    model
+        .pattern
+        .creases
+        .iter()
+        .map(|&e| match model.pattern.kinds[e] {
+            EdgeKind::Crease(Assignment::Valley) => 1.0,
+            EdgeKind::Crease(Assignment::Mountain) => -1.0,
+            _ => 0.0,
+        })
+        .collect()
+}
+
+/// Progress of a state towards the drive's goal.
+fn progress(drive: &Drive, start: &[f64], rho: &[f64], signs: &[f64]) -> f64 {
+    match drive {
+        Drive::Assignment { to } => {
+            let amount = rho
+                .iter()
+                .zip(signs)
+                .filter(|(_, s)| **s != 0.0)
+                .fold(0.0_f64, |m, (r, _)| m.max(r.abs()))
+                / PI;
+            amount / to
+        }
+        Drive::Creases(list) => {
+            let span = list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - start[c]).abs()));
+            if span == 0.0 {
+                return 1.0;
+            }
+            1.0 - list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - rho[c]).abs())) / span
+        }
+    }
+}
+
+fn desired_velocity(drive: &Drive, rho: &[f64], signs: &[f64]) -> Vec<f64> {
+    match drive {
+        Drive::Assignment { .. } => signs.to_vec(),
+        Drive::Creases(list) => {
+            let mut d = vec![0.0; rho.len()];
+            for &(c, t) in list {
+                d[c] = t - rho[c];
+            }
+            d
+        }
+    }
+}
+
+/// Creases whose angle contradicts their assignment by more than `slack`.
+fn against_assignment(rho: &[f64], signs: &[f64], slack: f64) -> Vec<usize> {
+    (0..rho.len()).filter(|&c| signs[c] * rho[c] < -slack).collect()
+}
+
+/// Folds from `start` (a rigid state, or the flat one) as `settings.drive` asks.
+pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -> Result<FoldPath> {
+    settings.validate(model)?;
+    let n = model.crease_count();
+    if start.len() != n {
+        return Err(NanofoldError::invalid("start", format!("{} fold angles", start.len()), format!("one per crease ({n})")));
+    }
+    let signs = assigned_signs(model);
+    let mut solver = NormalSolver::default();
+    let mut poses: Vec<Pose> = Vec::new();
+    let mut rho = start.to_vec();
+    let mut newton_iterations = 0;
+    let start_residual = worst_residual(&closure_jacobian(model, &rho));
+    if start_residual > settings.closure_tol {
+        match restore_closure(model, &mut rho, settings.closure_tol, &mut solver)? {
+            Some(k) if start_residual <= 1e-6 => newton_iterations += k,
+            _ => {
+                return Err(NanofoldError::invalid(
+                    "start",
+                    format!("closure residual {start_residual:.3e} rad"),
+                    "the start is not a rigid state (above 1e-6 rad at some vertex)",
+                ))
+            }
+        }
+    }
+    let contact_at = |rho: &[f64], poses: &mut Vec<Pose>| {
+        panel_poses(model, rho, poses);
+        panel_contacts(model, poses, &settings.contact)
+    };
+    let first = contact_at(&rho, &mut poses);
+    let mut steps = vec![PathStep {
+        progress: progress(&settings.drive, start, &rho, &signs),
+        fold_angles: rho.clone(),
+        max_residual: worst_residual(&closure_jacobian(model, &rho)),
+        min_clearance: first.min_clearance,
+    }];
+    let finish = |steps: Vec<PathStep>, stop: StopReason, evidence: String, branch: Option<String>, newton| {
+        let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
+        let min_panel_clearance = steps.iter().filter_map(|s| s.min_clearance).reduce(f64::min);
+        Ok(FoldPath {
+            steps,
+            stop,
+            evidence,
+            branch,
+            max_closure_residual,
+            min_panel_clearance,
+            newton_iterations: newton,
+        })
+    };
+    if let Some(pair) = first.crossing().next() {
+        let panels = pair.panels;
+        return finish(steps, StopReason::Blocked { panels }, format!("panels {} and {} cross at the start", panels[0], panels[1]), None, newton_iterations);
+    }
+
+    // Leaving the flat state: a kick along the projected direction, Newton onto the nearest
+    // branch, and every crease's sign checked against its assignment.
+    let mut branch = None;
+    if inf_norm(&rho) <= 1e-12 {
+        let d = desired_velocity(&settings.drive, &rho, &signs);
+        let factor = solver.factor(&closure_jacobian(model, &rho))?;
+        let v = factor.project(&d);
+        let size = inf_norm(&v);
+        if size <= 1e-9 * inf_norm(&d).max(f64::MIN_POSITIVE) {
+            return finish(steps, StopReason::Locked, "no first-order motion from flat in the driven direction".into(), None, newton_iterations);
+        }
+        let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + settings.kick * x / size).collect();
+        let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? else {
+            return finish(steps, StopReason::BranchPoint { creases: vec![] }, format!("Newton found no rigid state {:.0e} rad from flat along the projected direction", settings.kick), None, newton_iterations);
+        };
+        newton_iterations += k;
+        let wrong = against_assignment(&trial, &signs, 1e-3 * settings.kick);
+        if !wrong.is_empty() && matches!(settings.drive, Drive::Assignment { .. }) {
+            let evidence = format!(
+                "the branch reached from flat folds creases {:?} against their assignment",
+                &wrong[..wrong.len().min(8)]
+            );
+            return finish(steps, StopReason::BranchPoint { creases: wrong }, evidence, None, newton_iterations);
+        }
+        branch = Some(format!(
+            "left flat by a kick of {:.0e} rad along the projected direction, Newton onto the closure, every crease's sign checked against its assignment",
+            settings.kick
+        ));
+        rho = trial;
+        let contacts = contact_at(&rho, &mut poses);
+        steps.push(PathStep {
+            progress: progress(&settings.drive, start, &rho, &signs),
+            fold_angles: rho.clone(),
+            max_residual: worst_residual(&closure_jacobian(model, &rho)),
+            min_clearance: contacts.min_clearance,
+        });
+    }
+
+    let mut h_scale = 1.0;
+    for _ in 0..settings.max_steps {
+        let here = progress(&settings.drive, start, &rho, &signs);
+        if here >= 1.0 - 1e-9 {
+            return finish(steps, StopReason::Reached, format!("progress {here:.9}"), branch, newton_iterations);
+        }
+        let jac = closure_jacobian(model, &rho);
+        let factor = solver.factor(&jac)?;
+        let d = desired_velocity(&settings.drive, &rho, &signs);
+        let v = factor.project(&d);
+        let size = inf_norm(&v);
+        if size <= 1e-9 * inf_norm(&d) {
+            return finish(steps, StopReason::Locked, format!("the projected velocity vanishes (|P d| = {size:.1e}): no rigid motion this way"), branch, newton_iterations);
+        }
+        let mut h = settings.max_step * h_scale / size;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + h * x).collect();
+            match restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? {
+                Some(k) if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) => {
+                    newton_iterations += k;
+                    h /= 2.0;
+                }
+                Some(k) => {
+                    newton_iterations += k;
+                    let ahead = progress(&settings.drive, start, &trial, &signs);
+                    if ahead > 1.0 + 1e-10 {
+                        // Overshoot: aim at the goal by the secant on progress.
+                        let fraction = ((1.0 - here) / (ahead - here)).clamp(0.05, 0.999_999);
+                        h *= fraction;
+                        continue;
+                    }
+                    accepted = Some(trial);
+                    break;
+                }
+                None => h /= 2.0,
+            }
+            if h * size < 1e-9 {
+                break;
+            }
+        }
+        let Some(next) = accepted else {
+            let mut creases: Vec<usize> = (0..n).collect();
+            creases.sort_by(|&a, &b| v[b].abs().total_cmp(&v[a].abs()));
+            creases.truncate(6);
+            return finish(steps, StopReason::BranchPoint { creases }, "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad".into(), branch, newton_iterations);
+        };
+        // A crease that passes through flat against its assignment has left the branch.
+        let wrong = against_assignment(&next, &signs, 1e-9);
+        if !wrong.is_empty() && matches!(settings.drive, Drive::Assignment { .. }) {
+            let evidence = format!("creases {:?} would fold against their assignment", &wrong[..wrong.len().min(8)]);
+            return finish(steps, StopReason::BranchPoint { creases: wrong }, evidence, branch, newton_iterations);
+        }
+        let contacts = contact_at(&next, &mut poses);
+        if let Some(pair) = contacts.crossing().next() {
+            let panels = pair.panels;
+            return finish(steps, StopReason::Blocked { panels }, format!("panels {} and {} would pass through each other after progress {here:.4}", panels[0], panels[1]), branch, newton_iterations);
+        }
+        h_scale = (h * size / settings.max_step * 2.0).min(1.0);
+        rho = next;
+        steps.push(PathStep {
+            progress: progress(&settings.drive, start, &rho, &signs),
+            fold_angles: rho.clone(),
+            max_residual: worst_residual(&closure_jacobian(model, &rho)),
+            min_clearance: contacts.min_clearance,
+        });
+    }
+    finish(steps, StopReason::StepLimit, format!("{} steps", settings.max_steps), branch, newton_iterations)
+}
