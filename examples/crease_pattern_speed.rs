@@ -3,8 +3,8 @@
 //! `cargo run --release --example crease_pattern_speed`
 
 use nanofold::folding::{
-    closure_jacobian, fold_path, Drive, FoldSettings, jacobian_rank, panel_contacts, panel_poses, tree_mismatch, vertex_residuals, ContactSettings,
-    FoldingModel,
+    closure_jacobian, fold_path, jacobian_rank, panel_contacts, panel_poses, tree_mismatch, vertex_residuals,
+    ContactSettings, Drive, FoldSettings, FoldingModel,
 };
 use nanofold::pattern::generate::MiuraSpec;
 use std::time::Instant;

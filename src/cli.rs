@@ -1,6 +1,8 @@
 //! Command-line interface: argument definitions and the `unfold`, `check`, `constraints`,
 //! `simulate` and `modes` commands.
 
+mod folding;
+
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{
@@ -55,7 +57,10 @@ pub enum Command {
         #[command(flatten)]
         parallel: ParallelArgs,
     },
-    /// Verdict of each pattern, one line each; writes no files.
+    /// Verdict of each pattern, one line each; writes no files. Single vertices get the
+    /// unfolding verdict; crease patterns of many vertices (or of creases that meet at no
+    /// vertex) get `rigid`, `not_rigid` or `self_intersecting` for their state, or for an
+    /// assignment alone `rigidly_foldable`, `not_rigidly_foldable` or `unknown`.
     Check {
         /// Pattern files or directories of them (searched recursively; scene files skipped).
         #[arg(required = true)]
@@ -67,6 +72,15 @@ pub enum Command {
         json: bool,
         #[command(flatten)]
         parallel: ParallelArgs,
+    },
+    /// Fold a crease pattern of any number of vertices rigidly (`docs/model.md#folding-paths`):
+    /// from flat along its assignment, or driven creases to their angles; writes fold.fold,
+    /// folded.fold, trajectory.json and fold.svg.
+    Fold(folding::FoldArgs),
+    /// Write a generated crease pattern as a FOLD file.
+    Generate {
+        #[command(subcommand)]
+        kind: folding::GenerateKind,
     },
     /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
     /// (`docs/model.md#constraint-curves`); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
@@ -550,8 +564,26 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
     let settings = solver.settings()?;
     let files = expand_patterns(patterns)?;
     parallel.all(&files, |path| {
-        let outcome = nanofold::io::load_pattern(path, &solver.load_options())
-            .and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
+        let outcome = nanofold::io::load_pattern(path, &solver.load_options());
+        if let Err(e) = &outcome {
+            if takes_many_vertices(e, path) {
+                return match folding::check_json(path, solver.closure_tol) {
+                    Ok((value, _)) if as_json => {
+                        println!("{value}");
+                        true
+                    }
+                    Ok((_, line)) => {
+                        println!("{line}");
+                        true
+                    }
+                    Err(e) => {
+                        print_failure(path, &e, as_json);
+                        false
+                    }
+                };
+            }
+        }
+        let outcome = outcome.and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
         match outcome {
             Ok((pattern, report)) if as_json => println!("{}", summary(&pattern, path, &report)),
             Ok((_, report)) => println!(
@@ -569,6 +601,14 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
         }
         true
     })
+}
+
+/// Does a pattern the single-vertex loader refused go to the crease-pattern checks? Yes
+/// when it reads as a crease pattern and the refusal was not about its folded state (a
+/// vertex that does not close keeps its single-vertex error): several vertices, creases
+/// meeting at no vertex, or no fold angles (an assignment alone).
+fn takes_many_vertices(error: &nanofold::NanofoldError, path: &Path) -> bool {
+    !matches!(error, nanofold::NanofoldError::ClosureViolated { .. }) && nanofold::io::load_crease_pattern(path).is_ok()
 }
 
 /// Parses "J=DEG" into (crease index, rad).
@@ -1150,6 +1190,8 @@ pub fn run(cli: Cli) -> Result<bool> {
             parallel,
         } => run_check(&patterns, &solver, json, &parallel),
         Command::Constraints(args) => run_constraints(&args).map(|_| true),
+        Command::Fold(args) => folding::run_fold(&args).map(|_| true),
+        Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
         Command::Modes { scene, json } => run_modes(&scene, json).map(|_| true),
     }

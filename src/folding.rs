@@ -8,6 +8,7 @@ pub mod model;
 pub mod path;
 pub mod poses;
 pub mod rank;
+pub mod verdict;
 
 pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
@@ -15,3 +16,4 @@ pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{fold_path, restore_closure, Drive, FoldPath, FoldSettings, PathStep, StopReason};
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{jacobian_rank, RankReport, RANK_TOL};
+pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, PatternVerdict};

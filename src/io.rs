@@ -4,6 +4,7 @@
 
 pub mod fold;
 pub mod folder;
+pub mod folding_output;
 pub mod input;
 pub mod native;
 pub mod output;

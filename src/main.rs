@@ -5,6 +5,13 @@ mod cli;
 use clap::Parser;
 
 fn main() {
+    // Rust ignores SIGPIPE, which turns a closed pipe into a panic in println!; a command
+    // line tool should just stop, as `head` expects.
+    #[cfg(unix)]
+    // SAFETY: setting a signal's action to its default before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let parsed = cli::Cli::parse();
     match cli::run(parsed) {
         Ok(true) => {}

@@ -1,6 +1,7 @@
 //! SVG figures drawn with plotters: the unfolding (fold angles against iteration and 3D
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
+pub mod folding;
 pub mod response;
 pub mod work_precision;
 

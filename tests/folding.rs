@@ -268,7 +268,9 @@ fn a_miura_ori_folds_from_flat_along_its_closed_form() {
                 zigzag_fold_angle: zigzag,
                 ..MiuraSpec::default()
             };
-            FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap().given_fold_angles()
+            FoldingModel::new(spec.build().unwrap().build().unwrap())
+                .unwrap()
+                .given_fold_angles()
         };
         let zigzag_column = model
             .pattern
@@ -282,7 +284,12 @@ fn a_miura_ori_folds_from_flat_along_its_closed_form() {
         for step in &path.steps {
             let zigzag = step.fold_angles[zigzag_column].abs();
             let expected = reference(zigzag);
-            let error = step.fold_angles.iter().zip(&expected).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let error = step
+                .fold_angles
+                .iter()
+                .zip(&expected)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             assert!(error < 1e-9, "{rows}x{cols} at ρ_z {zigzag}: {error:e}");
         }
         let last = path.steps.last().unwrap();

@@ -30,6 +30,9 @@ fn library_files() -> BTreeMap<Vec<String>, String> {
             let path = entry.unwrap().path();
             let name = path.file_stem().unwrap().to_str().unwrap().to_string();
             if path.is_dir() {
+                if prefix.is_empty() && name == "cli" {
+                    continue;
+                }
                 let mut next = prefix.to_vec();
                 next.push(name);
                 walk(&path, &next, out);

@@ -83,19 +83,47 @@ impl FoldSettings {
                         ));
                     }
                     if !(target.is_finite() && target.abs() <= PI) {
-                        return Err(NanofoldError::invalid("drive", target.to_degrees(), "a target lies in [−180°, 180°]"));
+                        return Err(NanofoldError::invalid(
+                            "drive",
+                            target.to_degrees(),
+                            "a target lies in [−180°, 180°]",
+                        ));
+                    }
+                    let sign = assigned_signs(model)[column];
+                    if sign * target < 0.0 {
+                        return Err(NanofoldError::invalid(
+                            "drive",
+                            format!(
+                                "crease {column} (edge {}) to {:.3}°",
+                                model.pattern.creases[column],
+                                target.to_degrees()
+                            ),
+                            "the target's sign contradicts the crease's assignment (mountain ≤ 0 ≤ valley)",
+                        ));
                     }
                 }
             }
         }
         if !(self.max_step > 0.0 && self.max_step <= 0.5) {
-            return Err(NanofoldError::invalid("max_step", self.max_step, "must lie in (0, 0.5] rad"));
+            return Err(NanofoldError::invalid(
+                "max_step",
+                self.max_step,
+                "must lie in (0, 0.5] rad",
+            ));
         }
         if !(self.closure_tol >= 1e-14 && self.closure_tol <= 1e-3) {
-            return Err(NanofoldError::invalid("closure_tol", self.closure_tol, "must lie in [1e-14, 1e-3] rad"));
+            return Err(NanofoldError::invalid(
+                "closure_tol",
+                self.closure_tol,
+                "must lie in [1e-14, 1e-3] rad",
+            ));
         }
         if !(1..=1_000_000).contains(&self.max_steps) {
-            return Err(NanofoldError::invalid("max_steps", self.max_steps, "must lie in [1, 10^6]"));
+            return Err(NanofoldError::invalid(
+                "max_steps",
+                self.max_steps,
+                "must lie in [1, 10^6]",
+            ));
         }
         if !(self.kick > 0.0 && self.kick <= 0.1) {
             return Err(NanofoldError::invalid("kick", self.kick, "must lie in (0, 0.1] rad"));
@@ -186,6 +214,9 @@ pub struct NormalFactor {
     pub mu: f64,
 }
 
+/// Steps over which progress must grow by 1e-9, or the path counts as stalled.
+const STALL_STEPS: usize = 200;
+
 /// μ relative to the largest diagonal entry of JᵀJ.
 const REGULARISATION: f64 = 1e-10;
 
@@ -222,19 +253,19 @@ impl NormalSolver {
                 _ => merged.push(Triplet::new(i, j, v)),
             }
         }
-        let matrix = SparseColMat::try_new_from_triplets(jac.cols, jac.cols, &merged).map_err(|e| {
-            NumericalError::Singular {
+        let matrix =
+            SparseColMat::try_new_from_triplets(jac.cols, jac.cols, &merged).map_err(|e| NumericalError::Singular {
                 what: "JᵀJ + μI",
                 detail: format!("{e:?}"),
-            }
-        })?;
+            })?;
         if self.symbolic.is_none() {
-            self.symbolic = Some(SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).map_err(|e| {
-                NumericalError::Singular {
-                    what: "JᵀJ + μI (symbolic)",
-                    detail: format!("{e:?}"),
-                }
-            })?);
+            self.symbolic =
+                Some(
+                    SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).map_err(|e| NumericalError::Singular {
+                        what: "JᵀJ + μI (symbolic)",
+                        detail: format!("{e:?}"),
+                    })?,
+                );
         }
         let symbolic = self.symbolic.clone().expect("set above");
         let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).map_err(|e| {
@@ -370,7 +401,11 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     settings.validate(model)?;
     let n = model.crease_count();
     if start.len() != n {
-        return Err(NanofoldError::invalid("start", format!("{} fold angles", start.len()), format!("one per crease ({n})")));
+        return Err(NanofoldError::invalid(
+            "start",
+            format!("{} fold angles", start.len()),
+            format!("one per crease ({n})"),
+        ));
     }
     let signs = assigned_signs(model);
     let mut solver = NormalSolver::default();
@@ -416,32 +451,65 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     };
     if let Some(pair) = first.crossing().next() {
         let panels = pair.panels;
-        return finish(steps, StopReason::Blocked { panels }, format!("panels {} and {} cross at the start", panels[0], panels[1]), None, newton_iterations);
+        return finish(
+            steps,
+            StopReason::Blocked { panels },
+            format!("panels {} and {} cross at the start", panels[0], panels[1]),
+            None,
+            newton_iterations,
+        );
     }
 
     // Leaving the flat state: a kick along the projected direction, Newton onto the nearest
     // branch, and every crease's sign checked against its assignment.
     let mut branch = None;
     if inf_norm(&rho) <= 1e-12 {
-        let d = desired_velocity(&settings.drive, &rho, &signs);
+        // The branch is the assignment's, whatever drives the motion afterwards (a driven
+        // crease alone would pick any branch, e.g. a straight line folded on its own).
+        let d = if signs.iter().any(|&s| s != 0.0) {
+            signs.clone()
+        } else {
+            desired_velocity(&settings.drive, &rho, &signs)
+        };
         let factor = solver.factor(&closure_jacobian(model, &rho))?;
         let v = factor.project(&d);
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d).max(f64::MIN_POSITIVE) {
-            return finish(steps, StopReason::Locked, "no first-order motion from flat in the driven direction".into(), None, newton_iterations);
+            return finish(
+                steps,
+                StopReason::Locked,
+                "no first-order motion from flat in the driven direction".into(),
+                None,
+                newton_iterations,
+            );
         }
         let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + settings.kick * x / size).collect();
         let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? else {
-            return finish(steps, StopReason::BranchPoint { creases: vec![] }, format!("Newton found no rigid state {:.0e} rad from flat along the projected direction", settings.kick), None, newton_iterations);
+            return finish(
+                steps,
+                StopReason::BranchPoint { creases: vec![] },
+                format!(
+                    "Newton found no rigid state {:.0e} rad from flat along the projected direction",
+                    settings.kick
+                ),
+                None,
+                newton_iterations,
+            );
         };
         newton_iterations += k;
         let wrong = against_assignment(&trial, &signs, 1e-3 * settings.kick);
-        if !wrong.is_empty() && matches!(settings.drive, Drive::Assignment { .. }) {
+        if !wrong.is_empty() {
             let evidence = format!(
                 "the branch reached from flat folds creases {:?} against their assignment",
                 &wrong[..wrong.len().min(8)]
             );
-            return finish(steps, StopReason::BranchPoint { creases: wrong }, evidence, None, newton_iterations);
+            return finish(
+                steps,
+                StopReason::BranchPoint { creases: wrong },
+                evidence,
+                None,
+                newton_iterations,
+            );
         }
         branch = Some(format!(
             "left flat by a kick of {:.0e} rad along the projected direction, Newton onto the closure, every crease's sign checked against its assignment",
@@ -461,7 +529,13 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     for _ in 0..settings.max_steps {
         let here = progress(&settings.drive, start, &rho, &signs);
         if here >= 1.0 - 1e-9 {
-            return finish(steps, StopReason::Reached, format!("progress {here:.9}"), branch, newton_iterations);
+            return finish(
+                steps,
+                StopReason::Reached,
+                format!("progress {here:.9}"),
+                branch,
+                newton_iterations,
+            );
         }
         let jac = closure_jacobian(model, &rho);
         let factor = solver.factor(&jac)?;
@@ -469,9 +543,23 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         let v = factor.project(&d);
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d) {
-            return finish(steps, StopReason::Locked, format!("the projected velocity vanishes (|P d| = {size:.1e}): no rigid motion this way"), branch, newton_iterations);
+            return finish(
+                steps,
+                StopReason::Locked,
+                format!("the projected velocity vanishes (|P d| = {size:.1e}): no rigid motion this way"),
+                branch,
+                newton_iterations,
+            );
         }
         let mut h = settings.max_step * h_scale / size;
+        if let Drive::Creases(list) = &settings.drive {
+            // Do not step past a driven crease's target (to first order).
+            for &(c, t) in list {
+                if v[c] * (t - rho[c]) > 0.0 {
+                    h = h.min((t - rho[c]) / v[c]);
+                }
+            }
+        }
         let mut accepted = None;
         for _ in 0..40 {
             let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + h * x).collect();
@@ -502,21 +590,55 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             let mut creases: Vec<usize> = (0..n).collect();
             creases.sort_by(|&a, &b| v[b].abs().total_cmp(&v[a].abs()));
             creases.truncate(6);
-            return finish(steps, StopReason::BranchPoint { creases }, "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad".into(), branch, newton_iterations);
+            return finish(
+                steps,
+                StopReason::BranchPoint { creases },
+                "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad".into(),
+                branch,
+                newton_iterations,
+            );
         };
         // A crease that passes through flat against its assignment has left the branch.
         let wrong = against_assignment(&next, &signs, 1e-9);
-        if !wrong.is_empty() && matches!(settings.drive, Drive::Assignment { .. }) {
-            let evidence = format!("creases {:?} would fold against their assignment", &wrong[..wrong.len().min(8)]);
-            return finish(steps, StopReason::BranchPoint { creases: wrong }, evidence, branch, newton_iterations);
+        if !wrong.is_empty() {
+            let evidence = format!(
+                "creases {:?} would fold against their assignment",
+                &wrong[..wrong.len().min(8)]
+            );
+            return finish(
+                steps,
+                StopReason::BranchPoint { creases: wrong },
+                evidence,
+                branch,
+                newton_iterations,
+            );
         }
         let contacts = contact_at(&next, &mut poses);
         if let Some(pair) = contacts.crossing().next() {
             let panels = pair.panels;
-            return finish(steps, StopReason::Blocked { panels }, format!("panels {} and {} would pass through each other after progress {here:.4}", panels[0], panels[1]), branch, newton_iterations);
+            return finish(
+                steps,
+                StopReason::Blocked { panels },
+                format!(
+                    "panels {} and {} would pass through each other after progress {here:.4}",
+                    panels[0], panels[1]
+                ),
+                branch,
+                newton_iterations,
+            );
         }
         h_scale = (h * size / settings.max_step * 2.0).min(1.0);
         rho = next;
+        let now = progress(&settings.drive, start, &rho, &signs);
+        if steps.len() > STALL_STEPS && now - steps[steps.len() - STALL_STEPS].progress < 1e-9 {
+            return finish(
+                steps,
+                StopReason::Locked,
+                format!("progress {now:.9} grew by less than 1e-9 over the last {STALL_STEPS} steps: the drive has no rigid motion left"),
+                branch,
+                newton_iterations,
+            );
+        }
         steps.push(PathStep {
             progress: progress(&settings.drive, start, &rho, &signs),
             fold_angles: rho.clone(),
@@ -524,5 +646,11 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             min_clearance: contacts.min_clearance,
         });
     }
-    finish(steps, StopReason::StepLimit, format!("{} steps", settings.max_steps), branch, newton_iterations)
+    finish(
+        steps,
+        StopReason::StepLimit,
+        format!("{} steps", settings.max_steps),
+        branch,
+        newton_iterations,
+    )
 }

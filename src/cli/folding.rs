@@ -1,0 +1,346 @@
+//! The commands for crease patterns of many vertices: `fold`, `generate`, and `check` on a
+//! pattern the single-vertex engine does not take.
+
+use super::{default_folder, print_written, write_outputs};
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use nanofold::folding::{
+    check_pattern, fold_path, CheckReport, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel,
+};
+use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
+use nanofold::io::output::{number, write_atomic};
+use nanofold::pattern::generate::MiuraSpec;
+use nanofold::plot::folding::fold_svg;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `fold`.
+#[derive(Args, Clone)]
+pub struct FoldArgs {
+    /// A FOLD crease pattern (any number of vertices): from flat, or from its state.
+    pub pattern: PathBuf,
+    /// Drive these creases (FOLD edge index) to these angles, e.g. `--drive 12=-90`;
+    /// without it, every mountain and valley folds towards ±180° as assigned.
+    #[arg(long, value_name = "EDGE=DEG", allow_negative_numbers = true)]
+    pub drive: Vec<String>,
+    /// Stop when the most folded crease reaches this percentage of 180° (assignment drive).
+    #[arg(long, default_value_t = 100.0)]
+    pub to: f64,
+    /// Number of snapshots written as FOLD frames (start and end included).
+    #[arg(long, default_value_t = 11, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1000))]
+    pub frames: usize,
+    /// Largest change of any fold angle in one step (degrees).
+    #[arg(long, default_value_t = 2.5)]
+    pub max_step: f64,
+    /// Output folder (default: output/<pattern name>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Patterns `generate` builds.
+#[derive(Subcommand, Clone)]
+pub enum GenerateKind {
+    /// Miura-ori: rows × cols parallelogram panels (`docs/model.md#pattern-generators`).
+    Miura {
+        /// Panels along y.
+        #[arg(long, default_value_t = 4)]
+        rows: usize,
+        /// Panels along x.
+        #[arg(long, default_value_t = 4)]
+        cols: usize,
+        /// The panels' acute angle (degrees).
+        #[arg(long, default_value_t = 60.0)]
+        angle: f64,
+        /// Length of the panels' horizontal sides.
+        #[arg(long, default_value_t = 1.0)]
+        width: f64,
+        /// Length of the panels' slanted sides.
+        #[arg(long, default_value_t = 1.0)]
+        slant: f64,
+        /// Also write the folded state with the zigzag creases at this angle (degrees; 0 or
+        /// absent: the crease pattern alone).
+        #[arg(long)]
+        fold: Option<f64>,
+        /// The FOLD file to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// `nanofold generate KIND ...`
+pub fn run_generate(kind: &GenerateKind) -> Result<()> {
+    match kind {
+        GenerateKind::Miura {
+            rows,
+            cols,
+            angle,
+            width,
+            slant,
+            fold,
+            out,
+        } => {
+            let spec = MiuraSpec {
+                rows: *rows,
+                cols: *cols,
+                sector_angle: angle.to_radians(),
+                width: *width,
+                slant: *slant,
+                zigzag_fold_angle: fold.unwrap_or(0.0).to_radians(),
+            };
+            let pattern = spec
+                .build()
+                .map_err(|e| {
+                    flags(
+                        e,
+                        &[
+                            ("sector_angle", "--angle"),
+                            ("zigzag_fold_angle", "--fold"),
+                            ("rows, cols", "--rows, --cols"),
+                            ("width", "--width"),
+                            ("slant", "--slant"),
+                        ],
+                    )
+                })?
+                .build()?;
+            let model = FoldingModel::new(pattern)?;
+            let state = fold.map(|_| model.given_fold_angles());
+            let note = format!(
+                "Miura-ori {rows} x {cols}, angle {angle} deg, width {width}, slant {slant}{}; written by nanofold generate",
+                fold.map_or(String::new(), |f| format!(", zigzag creases at {f} deg"))
+            );
+            let value = crease_pattern_fold(&model.pattern, state.as_deref(), &note);
+            write_file(out, &value)?;
+            println!(
+                "{}: {} vertices, {} creases, {} panels{}; wrote {}",
+                model.pattern.name,
+                model.pattern.vertices.len(),
+                model.crease_count(),
+                model.pattern.panel_count,
+                if fold.is_some() { " (folded state included)" } else { "" },
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn write_file(out: &Path, value: &Value) -> Result<()> {
+    if out.extension().and_then(|e| e.to_str()) != Some("fold") {
+        bail!("--out {}: the file name must end in .fold", out.display());
+    }
+    let text = serde_json::to_string_pretty(value)?;
+    write_atomic(out, text.as_bytes()).with_context(|| format!("writing {}", out.display()))
+}
+
+/// Maps library field names to this command's flags.
+fn flags(error: nanofold::NanofoldError, table: &[(&str, &str)]) -> anyhow::Error {
+    super::with_flags(error, table)
+}
+
+fn load_model(path: &Path) -> Result<FoldingModel> {
+    let pattern = nanofold::io::load_crease_pattern(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(FoldingModel::new(pattern)?)
+}
+
+/// Parses "EDGE=DEG" into (crease column, rad).
+fn parse_drive(model: &FoldingModel, text: &str) -> Result<(usize, f64)> {
+    let (edge, degrees) = text
+        .split_once('=')
+        .with_context(|| format!("--drive {text}: expected EDGE=DEG, e.g. 12=-90"))?;
+    let edge: usize = edge
+        .trim()
+        .parse()
+        .with_context(|| format!("--drive {text}: the edge index"))?;
+    let degrees: f64 = degrees
+        .trim()
+        .parse()
+        .with_context(|| format!("--drive {text}: the angle (degrees)"))?;
+    let Some(column) = model.column_of_edge.get(edge).copied().flatten() else {
+        bail!(
+            "--drive {text}: edge {edge} is not a crease (the pattern has {} edges; creases are M, V or U)",
+            model.pattern.edges.len()
+        );
+    };
+    if !(degrees.is_finite() && degrees.abs() <= 180.0) {
+        bail!("--drive {text}: the angle must lie in [-180, 180] degrees");
+    }
+    Ok((column, degrees.to_radians()))
+}
+
+fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, seconds: f64) -> Value {
+    let last = path.steps.last().expect("a path has its start");
+    json!({
+        "pattern": model.pattern.name,
+        "file": file.display().to_string(),
+        "stop_reason": path.stop.as_str(),
+        "evidence": path.evidence,
+        "branch": path.branch,
+        "steps": path.steps.len(),
+        "frames": 0,
+        "dof": dof,
+        "creases": model.crease_count(),
+        "vertices": model.stars.len(),
+        "panels": model.pattern.panel_count,
+        "progress": last.progress,
+        "max_closure_residual_rad": path.max_closure_residual,
+        "min_panel_clearance": path.min_panel_clearance.map_or(Value::Null, number),
+        "newton_iterations": path.newton_iterations,
+        "seconds": seconds,
+    })
+}
+
+/// `nanofold fold PATTERN`.
+pub fn run_fold(args: &FoldArgs) -> Result<()> {
+    let model = load_model(&args.pattern)?;
+    let drive = if args.drive.is_empty() {
+        Drive::Assignment { to: args.to / 100.0 }
+    } else {
+        Drive::Creases(
+            args.drive
+                .iter()
+                .map(|d| parse_drive(&model, d))
+                .collect::<Result<_>>()?,
+        )
+    };
+    let settings = FoldSettings {
+        drive,
+        max_step: args.max_step.to_radians(),
+        ..FoldSettings::default()
+    };
+    settings.validate(&model).map_err(|e| {
+        flags(
+            e,
+            &[
+                ("drive.to", "--to (as a fraction)"),
+                ("max_step", "--max-step (in rad)"),
+            ],
+        )
+    })?;
+    let start = Instant::now();
+    let path = fold_path(&model, &model.given_fold_angles(), &settings)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let end = &path.steps.last().expect("a path has its start").fold_angles;
+    let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end)).dof;
+    let chosen = evenly(path.steps.len(), args.frames);
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_folder(&model.pattern.name, &args.pattern));
+    let title = format!(
+        "{}: folding ({}, {} steps)",
+        model.pattern.name,
+        path.stop.as_str(),
+        path.steps.len()
+    );
+    let files = [
+        (
+            "fold.fold",
+            serde_json::to_string_pretty(&fold_path_fold(&model, &path, &chosen))?,
+        ),
+        (
+            "folded.fold",
+            serde_json::to_string_pretty(&crease_pattern_fold(
+                &model.pattern,
+                Some(end),
+                "end state of nanofold fold (a crease pattern with its fold angles)",
+            ))?,
+        ),
+        (
+            "trajectory.json",
+            serde_json::to_string(&fold_trajectory_json(&model, &path, 1000))?,
+        ),
+        ("fold.svg", fold_svg(&model, &path, &title)?),
+    ];
+    write_outputs(&dir, &files)?;
+    let mut summary = fold_summary(&model, &args.pattern, &path, dof, seconds);
+    summary["frames"] = json!(chosen.len());
+    summary["out"] = json!(dir.display().to_string());
+    if args.json {
+        println!("{summary}");
+        return Ok(());
+    }
+    println!(
+        "{}: {} ({}) after {} steps in {:.3} s",
+        model.pattern.name,
+        path.stop.as_str(),
+        path.evidence,
+        path.steps.len(),
+        seconds
+    );
+    if let Some(branch) = &path.branch {
+        println!("  branch: {branch}");
+    }
+    println!(
+        "  {} creases, {} interior vertices, {} panels; {} DOF at the end; progress {:.4}",
+        model.crease_count(),
+        model.stars.len(),
+        model.pattern.panel_count,
+        dof,
+        path.steps.last().map_or(0.0, |s| s.progress)
+    );
+    println!(
+        "  worst vertex closure over the path {:.2e} rad; smallest panel clearance {}",
+        path.max_closure_residual,
+        path.min_panel_clearance
+            .map_or("none within the search range".to_string(), |c| format!("{c:.3e}"))
+    );
+    print_written(&dir, &files.iter().map(|(n, c)| (*n, c.clone())).collect::<Vec<_>>());
+    Ok(())
+}
+
+/// `check` on a crease pattern of many vertices: its verdict as a JSON object.
+pub fn check_json(path: &Path, closure_tol: f64) -> Result<(Value, String)> {
+    let model = load_model(path)?;
+    let settings = CheckSettings {
+        closure_tol,
+        ..CheckSettings::default()
+    };
+    let start = Instant::now();
+    let report = check_pattern(&model, &settings)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let line = format!(
+        "{}: {} ({} DOF at the {} state, {:.3} ms) {}",
+        path.display(),
+        report.verdict.as_str(),
+        report.rank.dof,
+        if report.has_state { "given" } else { "flat" },
+        seconds * 1e3,
+        report.evidence
+    );
+    Ok((check_value(&model, path, &report, seconds), line))
+}
+
+fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds: f64) -> Value {
+    json!({
+        "pattern": model.pattern.name,
+        "file": path.display().to_string(),
+        "verdict": report.verdict.as_str(),
+        "evidence": report.evidence,
+        "state": if report.has_state { "given" } else { "flat (assignment only)" },
+        "dof": report.rank.dof,
+        "rank": report.rank.rank,
+        "rank_threshold": report.rank.threshold,
+        "creases": model.crease_count(),
+        "vertices": model.stars.len(),
+        "panels": model.pattern.panel_count,
+        "max_vertex_residual_rad": report.max_vertex_residual_rad,
+        "worst_vertices": report.worst_vertices.iter().map(|(v, r)| json!({"vertex": v, "residual_rad": r})).collect::<Vec<_>>(),
+        "intersecting_pairs": report.intersecting_pairs,
+        "contacts": report.contacts,
+        "min_panel_clearance": report.min_panel_clearance.map_or(Value::Null, number),
+        "tree_mismatch": report.tree_mismatch,
+        "witness": report.witness.as_ref().map(|w| json!({
+            "stop_reason": w.stop.as_str(),
+            "evidence": w.evidence,
+            "steps": w.steps.len(),
+            "progress": w.steps.last().map_or(0.0, |s| s.progress),
+            "max_closure_residual_rad": w.max_closure_residual,
+        })),
+        "tried": report.tried,
+        "seconds": seconds,
+    })
+}

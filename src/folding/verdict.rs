@@ -1,0 +1,351 @@
+//! What `check` says of a crease pattern (`docs/model.md#pattern-verdicts`): for a folded
+//! state, rigid / not rigid / self-intersecting with the evidence; for an assignment alone,
+//! rigidly foldable (with a witness path), not rigidly foldable (a vertex whose assignment
+//! matches none of its folding modes) or unknown.
+
+use super::closure::{closure_jacobian, vertex_residuals};
+use super::contact::{panel_contacts, ContactSettings};
+use super::model::{FoldingModel, Star};
+use super::path::{fold_path, Drive, FoldPath, FoldSettings, StopReason};
+use super::poses::{panel_poses, tree_mismatch};
+use super::rank::{jacobian_rank, RankReport};
+use crate::error::Result;
+use crate::pattern::crease_pattern::EdgeKind;
+use crate::pattern::Assignment;
+use nalgebra::Matrix2;
+
+/// The verdict on a crease pattern.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PatternVerdict {
+    /// The given state closes at every vertex and no two panels cross.
+    Rigid,
+    /// Some vertex does not close: the state needs the panels to bend.
+    NotRigid,
+    /// The state closes but panels pass through each other.
+    SelfIntersecting,
+    /// The assignment folds rigidly from flat: a witness path was found.
+    RigidlyFoldable,
+    /// The assignment cannot fold rigidly from flat.
+    NotRigidlyFoldable,
+    /// Neither could be shown.
+    Unknown,
+}
+
+impl PatternVerdict {
+    /// The name used in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PatternVerdict::Rigid => "rigid",
+            PatternVerdict::NotRigid => "not_rigid",
+            PatternVerdict::SelfIntersecting => "self_intersecting",
+            PatternVerdict::RigidlyFoldable => "rigidly_foldable",
+            PatternVerdict::NotRigidlyFoldable => "not_rigidly_foldable",
+            PatternVerdict::Unknown => "unknown",
+        }
+    }
+}
+
+/// Tolerances of a check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckSettings {
+    /// Largest vertex closure residual of a rigid state, rad.
+    pub closure_tol: f64,
+    /// Panel contact test.
+    pub contact: ContactSettings,
+    /// The witness path's settings (for assignment-only patterns).
+    pub path: FoldSettings,
+}
+
+impl Default for CheckSettings {
+    fn default() -> Self {
+        CheckSettings {
+            closure_tol: 1e-6,
+            contact: ContactSettings::default(),
+            path: FoldSettings::default(),
+        }
+    }
+}
+
+/// A check's verdict with its evidence.
+#[derive(Debug, Clone)]
+pub struct CheckReport {
+    /// The verdict.
+    pub verdict: PatternVerdict,
+    /// Why, in words.
+    pub evidence: String,
+    /// Whether the pattern carried a folded state (else its assignment was judged).
+    pub has_state: bool,
+    /// Rank of J at the state checked (the flat state for an assignment).
+    pub rank: RankReport,
+    /// Largest vertex closure residual, rad.
+    pub max_vertex_residual_rad: f64,
+    /// The worst vertices (vertex index, residual rad), at most 8, largest first.
+    pub worst_vertices: Vec<(usize, f64)>,
+    /// Pairs of panels that pass through each other.
+    pub intersecting_pairs: Vec<[usize; 2]>,
+    /// Pairs closer than the clearance (crossing ones included).
+    pub contacts: usize,
+    /// Smallest clearance between panels sharing no vertex, within the search range.
+    pub min_panel_clearance: Option<f64>,
+    /// Tree mismatch of the panel poses (a length), 0 to rounding for a rigid state.
+    pub tree_mismatch: f64,
+    /// The witness path tried for an assignment.
+    pub witness: Option<FoldPath>,
+    /// What was tried, for an `unknown`.
+    pub tried: Vec<String>,
+}
+
+/// Checks the state the pattern carries or, when it is flat, its assignment.
+pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> {
+    settings.contact.validate()?;
+    let rho = model.given_fold_angles();
+    let has_state = rho.iter().any(|&r| r != 0.0);
+    let residuals = vertex_residuals(model, &rho);
+    let mut worst: Vec<(usize, f64)> = model
+        .stars
+        .iter()
+        .map(|s| s.vertex)
+        .zip(residuals.iter().copied())
+        .collect();
+    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let max_residual = worst.first().map_or(0.0, |w| w.1);
+    worst.truncate(8);
+    let rank = jacobian_rank(&closure_jacobian(model, &rho));
+    let mut poses = Vec::new();
+    panel_poses(model, &rho, &mut poses);
+    let contacts = panel_contacts(model, &poses, &settings.contact);
+    let mut report = CheckReport {
+        verdict: PatternVerdict::Unknown,
+        evidence: String::new(),
+        has_state,
+        rank,
+        max_vertex_residual_rad: max_residual,
+        worst_vertices: worst.clone(),
+        intersecting_pairs: contacts.crossing().map(|c| c.panels).collect(),
+        contacts: contacts.contacts.len(),
+        min_panel_clearance: contacts.min_clearance,
+        tree_mismatch: tree_mismatch(model, &rho, &poses),
+        witness: None,
+        tried: Vec::new(),
+    };
+    if has_state {
+        (report.verdict, report.evidence) = if max_residual > settings.closure_tol {
+            let list: Vec<String> = worst
+                .iter()
+                .filter(|w| w.1 > settings.closure_tol)
+                .map(|(v, r)| format!("vertex {v}: {r:.3e} rad"))
+                .collect();
+            (
+                PatternVerdict::NotRigid,
+                format!(
+                    "closure fails above {:.0e} rad at {}",
+                    settings.closure_tol,
+                    list.join(", ")
+                ),
+            )
+        } else if !report.intersecting_pairs.is_empty() {
+            let list: Vec<String> = report
+                .intersecting_pairs
+                .iter()
+                .take(8)
+                .map(|p| format!("{p:?}"))
+                .collect();
+            (
+                PatternVerdict::SelfIntersecting,
+                format!(
+                    "{} panel pairs pass through each other: {}",
+                    report.intersecting_pairs.len(),
+                    list.join(", ")
+                ),
+            )
+        } else {
+            (
+                PatternVerdict::Rigid,
+                format!(
+                    "every vertex closes within {max_residual:.1e} rad, no panels cross ({} DOF at this state)",
+                    report.rank.dof
+                ),
+            )
+        };
+        return Ok(report);
+    }
+
+    // An assignment alone: first the local test at each degree-4 vertex, then a witness.
+    let mut local_checked = 0;
+    for star in &model.stars {
+        if let Some(modes) = degree4_modes(star) {
+            local_checked += 1;
+            let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+            let fits = |pattern: &[f64; 4]| pattern.iter().zip(&assigned).all(|(p, a)| *a == 0.0 || p * a > 0.0);
+            if !modes.iter().any(fits) {
+                let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
+                let options: Vec<String> = modes.iter().map(|m| m.iter().map(|&a| letter(a)).collect()).collect();
+                report.verdict = PatternVerdict::NotRigidlyFoldable;
+                report.evidence = format!(
+                    "vertex {}: its assignment {} (creases counter-clockwise) matches none of the sign patterns of its folding modes from flat ({}); a degree-4 vertex folds rigidly only along these",
+                    star.vertex,
+                    names.concat(),
+                    options.join(", ")
+                );
+                return Ok(report);
+            }
+        }
+    }
+    if local_checked > 0 {
+        report.tried.push(format!(
+            "{local_checked} degree-4 vertices: each assignment matches a folding mode"
+        ));
+    }
+    let path_settings = FoldSettings {
+        drive: Drive::Assignment { to: 1.0 },
+        ..settings.path.clone()
+    };
+    let path = fold_path(model, &rho, &path_settings)?;
+    let reached = path.steps.last().map_or(0.0, |s| s.progress);
+    let fully_assigned = model.pattern.creases.iter().all(|&e| {
+        matches!(
+            model.pattern.kinds[e],
+            EdgeKind::Crease(Assignment::Mountain) | EdgeKind::Crease(Assignment::Valley)
+        )
+    });
+    if path.steps.len() > 2 && reached > 0.0 {
+        report.verdict = PatternVerdict::RigidlyFoldable;
+        report.evidence = format!(
+            "a rigid folding path from flat with the assigned signs reaches {:.1}% of full folding ({} steps, closure ≤ {:.1e} rad, stop: {} — {})",
+            100.0 * reached,
+            path.steps.len(),
+            path.max_closure_residual,
+            path.stop.as_str(),
+            path.evidence
+        );
+    } else {
+        report.tried.push(format!(
+            "folding path from flat: {} ({})",
+            path.stop.as_str(),
+            path.evidence
+        ));
+        let verdict_by_path = matches!(path.stop, StopReason::Locked) && fully_assigned && model.stars.is_empty();
+        report.verdict = if verdict_by_path {
+            PatternVerdict::NotRigidlyFoldable
+        } else {
+            PatternVerdict::Unknown
+        };
+        report.evidence = format!("no witness found; tried: {}", report.tried.join("; "));
+    }
+    report.witness = Some(path);
+    Ok(report)
+}
+
+fn sign_of(model: &FoldingModel, column: usize) -> f64 {
+    match model.pattern.kinds[model.pattern.creases[column]] {
+        EdgeKind::Crease(Assignment::Valley) => 1.0,
+        EdgeKind::Crease(Assignment::Mountain) => -1.0,
+        _ => 0.0,
+    }
+}
+
+fn letter(sign: f64) -> &'static str {
+    if sign > 0.0 {
+        "V"
+    } else if sign < 0.0 {
+        "M"
+    } else {
+        "U"
+    }
+}
+
+/// The sign patterns of a degree-4 vertex's folding modes from flat: the first-order
+/// velocities keep the star closed in the plane (Σ ρ̇_j u_j = 0, a plane of velocities) and
+/// the second-order term of the holonomy out of the plane vanishes,
+/// Σ_{i<j} ρ̇_i ρ̇_j (u_i × u_j)·z = 0: two lines in that plane, each run both ways. None
+/// when the vertex is not degree 4 or a mode has a crease that does not move to first
+/// order (the signs would then be decided at higher order).
+pub fn degree4_modes(star: &Star) -> Option<Vec<[f64; 4]>> {
+    if star.columns.len() != 4 {
+        return None;
+    }
+    let mut direction = 0.0_f64;
+    let mut u = [[0.0; 2]; 4];
+    for (j, slot) in u.iter_mut().enumerate() {
+        *slot = [direction.cos(), direction.sin()];
+        direction += star.sector_angles[j];
+    }
+    // The first-order velocities are the complement of the span of the rows (u_jx) and
+    // (u_jy): Gram–Schmidt over those two rows, then over e_0 … e_3 for the complement.
+    let mut span: Vec<[f64; 4]> = Vec::new();
+    let mut basis: Vec<[f64; 4]> = Vec::new();
+    let rows = [
+        [u[0][0], u[1][0], u[2][0], u[3][0]],
+        [u[0][1], u[1][1], u[2][1], u[3][1]],
+    ];
+    let unit = |k: usize| {
+        let mut e = [0.0; 4];
+        e[k] = 1.0;
+        e
+    };
+    for (k, candidate) in rows.into_iter().chain((0..4).map(unit)).enumerate() {
+        let mut e = candidate;
+        for s in &span {
+            let dot: f64 = (0..4).map(|i| s[i] * e[i]).sum();
+            (0..4).for_each(|i| e[i] -= dot * s[i]);
+        }
+        let norm = e.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm > 1e-6 {
+            let e = e.map(|x| x / norm);
+            span.push(e);
+            if k >= 2 {
+                basis.push(e);
+            }
+        } else if k < 2 {
+            return None;
+        }
+    }
+    if basis.len() != 2 {
+        return None;
+    }
+    let cross = |i: usize, j: usize| u[i][0] * u[j][1] - u[i][1] * u[j][0];
+    let mut q = Matrix2::zeros();
+    for a in 0..2 {
+        for b in 0..2 {
+            let mut sum = 0.0;
+            for i in 0..4 {
+                for j in (i + 1)..4 {
+                    sum += 0.5 * (basis[a][i] * basis[b][j] + basis[b][i] * basis[a][j]) * cross(i, j);
+                }
+            }
+            q[(a, b)] = sum;
+        }
+    }
+    // Lines s·b1 + t·b2 with q = 0: q11 s² + 2 q12 s t + q22 t² = 0.
+    let (q11, q12, q22) = (q[(0, 0)], q[(0, 1)], q[(1, 1)]);
+    let discriminant = q12 * q12 - q11 * q22;
+    let scale = q11.abs().max(q12.abs()).max(q22.abs());
+    if discriminant <= 1e-12 * scale * scale {
+        return Some(Vec::new());
+    }
+    let root = discriminant.sqrt();
+    let directions: Vec<(f64, f64)> = if q11.abs() >= q22.abs() {
+        // s = t (−q12 ± √D) / q11
+        [(-q12 + root) / q11, (-q12 - root) / q11]
+            .iter()
+            .map(|&s| (s, 1.0))
+            .collect()
+    } else {
+        [(-q12 + root) / q22, (-q12 - root) / q22]
+            .iter()
+            .map(|&t| (1.0, t))
+            .collect()
+    };
+    let mut modes = Vec::new();
+    for (s, t) in directions {
+        let velocity: Vec<f64> = (0..4).map(|k| s * basis[0][k] + t * basis[1][k]).collect();
+        let size = velocity.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if velocity.iter().any(|v| v.abs() < 1e-9 * size) {
+            return None;
+        }
+        let signs = [0, 1, 2, 3].map(|k| velocity[k].signum());
+        modes.push(signs);
+        modes.push(signs.map(|x| -x));
+    }
+    Some(modes)
+}

@@ -1,0 +1,141 @@
+//! FOLD and JSON written for crease patterns of many vertices (`docs/model.md#folding-paths`):
+//! the crease pattern (with or without a state), the folding path as FOLD frames over the
+//! crease pattern, and its trajectory.
+
+use crate::folding::{panel_poses, vertex_positions, FoldPath, FoldingModel};
+use crate::io::output::number;
+use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
+use crate::pattern::Assignment;
+use serde_json::{json, Value};
+
+/// FOLD's letter for an edge, the assignment following the angle's sign (M < 0 < V) when
+/// the crease is folded; a crease at 0 keeps its assignment.
+fn letter(kind: EdgeKind, angle: f64) -> &'static str {
+    match kind {
+        EdgeKind::Boundary => "B",
+        EdgeKind::Facet => "F",
+        EdgeKind::Crease(_) if angle > 0.0 => "V",
+        EdgeKind::Crease(_) if angle < 0.0 => "M",
+        EdgeKind::Crease(assignment) => match assignment {
+            Assignment::Mountain => "M",
+            Assignment::Valley => "V",
+            Assignment::Flat => "F",
+            Assignment::Unassigned => "U",
+        },
+    }
+}
+
+/// Per-edge fold angles (degrees) and letters for a state given per crease column.
+fn edge_arrays(pattern: &CreasePattern, fold_angles: &[f64]) -> (Vec<f64>, Vec<&'static str>) {
+    let mut angles = vec![0.0; pattern.edges.len()];
+    for (column, &e) in pattern.creases.iter().enumerate() {
+        angles[e] = fold_angles[column].to_degrees();
+    }
+    let letters = pattern
+        .kinds
+        .iter()
+        .zip(&angles)
+        .map(|(&kind, &angle)| letter(kind, angle))
+        .collect();
+    (angles, letters)
+}
+
+/// The crease pattern as a FOLD object (2D, `creasePattern`), with `edges_foldAngle` when a
+/// state is given (one angle per crease column, rad), so that `check`, `fold` and `unfold`
+/// read it back.
+pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>, creator_note: &str) -> Value {
+    let zero = vec![0.0; pattern.creases.len()];
+    let (angles, letters) = edge_arrays(pattern, fold_angles.unwrap_or(&zero));
+    let mut root = json!({
+        "file_spec": 1.1,
+        "file_creator": "nanofold",
+        "file_title": pattern.name,
+        "file_description": creator_note,
+        "file_classes": ["singleModel"],
+        "frame_classes": ["creasePattern"],
+        "frame_attributes": ["2D"],
+        "frame_unit": "unit",
+        "vertices_coords": pattern.vertices,
+        "edges_vertices": pattern.edges,
+        "edges_assignment": letters,
+        "faces_vertices": pattern.faces,
+    });
+    if fold_angles.is_some() {
+        root["edges_foldAngle"] = json!(angles);
+    }
+    root
+}
+
+/// The folding path as FOLD: the crease pattern (flat, 2D) is the key frame; each chosen
+/// step is a 3D `foldedForm` frame with its fold angles and the assignments they imply.
+pub fn fold_path_fold(model: &FoldingModel, path: &FoldPath, chosen: &[usize]) -> Value {
+    let pattern = &model.pattern;
+    let mut root = crease_pattern_fold(pattern, None, "folding path written by nanofold fold");
+    root["file_classes"] = json!(["animation"]);
+    root["frame_title"] = json!(format!("{}: crease pattern", pattern.name));
+    let mut poses = Vec::new();
+    let frames: Vec<Value> = chosen
+        .iter()
+        .map(|&i| {
+            let step = &path.steps[i];
+            panel_poses(model, &step.fold_angles, &mut poses);
+            let (angles, letters) = edge_arrays(pattern, &step.fold_angles);
+            json!({
+                "frame_title": format!("progress {:.4} (step {i})", step.progress),
+                "frame_classes": ["foldedForm"],
+                "frame_attributes": ["3D"],
+                "frame_parent": 0,
+                "frame_inherit": true,
+                "vertices_coords": vertex_positions(model, &poses),
+                "edges_assignment": letters,
+                "edges_foldAngle": angles,
+            })
+        })
+        .collect();
+    root["file_frames"] = json!(frames);
+    root
+}
+
+/// `trajectory.json` of a folding path: every step (thinned evenly to at most `max_steps`).
+pub fn fold_trajectory_json(model: &FoldingModel, path: &FoldPath, max_steps: usize) -> Value {
+    let chosen = evenly(path.steps.len(), max_steps);
+    let steps: Vec<Value> = chosen
+        .iter()
+        .map(|&i| {
+            let s = &path.steps[i];
+            json!({
+                "step": i,
+                "progress": s.progress,
+                "fold_angles_rad": s.fold_angles,
+                "max_closure_residual_rad": s.max_residual,
+                "min_panel_clearance": s.min_clearance.map_or(Value::Null, number),
+            })
+        })
+        .collect();
+    json!({
+        "pattern": model.pattern.name,
+        "units": {"angles": "rad", "lengths": "the pattern's own"},
+        "creases_edge_index": model.pattern.creases,
+        "stop_reason": path.stop.as_str(),
+        "evidence": path.evidence,
+        "branch": path.branch,
+        "recorded_steps": path.steps.len(),
+        "steps_written": steps.len(),
+        "steps": steps,
+    })
+}
+
+/// `count` indices spread evenly over 0..total, first and last kept.
+pub fn evenly(total: usize, count: usize) -> Vec<usize> {
+    if total == 0 {
+        return Vec::new();
+    }
+    if total <= count {
+        return (0..total).collect();
+    }
+    let mut out: Vec<usize> = (0..count.max(2))
+        .map(|k| k * (total - 1) / (count.max(2) - 1))
+        .collect();
+    out.dedup();
+    out
+}

@@ -1,0 +1,130 @@
+//! The folding path's figure: fold angles against progress, and 3D views of the panels at
+//! four moments.
+
+use super::{axis_range, plot_error};
+use crate::error::Result;
+use crate::folding::{panel_poses, FoldPath, FoldingModel};
+use crate::io::folding_output::evenly;
+use crate::pattern::crease_pattern::EdgeKind;
+use crate::pattern::Assignment;
+use plotters::prelude::*;
+
+/// Renders `fold.svg` to a string.
+pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<String> {
+    let pattern = &model.pattern;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let (top, bottom) = root.split_vertically(400);
+        let first = path.steps.first().map_or(0.0, |s| s.progress);
+        let last = path.steps.last().map_or(1.0, |s| s.progress);
+        let mut chart = ChartBuilder::on(&top)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(52)
+            .build_cartesian_2d(axis_range(first.min(0.0), last.max(1e-9), 0.02), -180.0..180.0)
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("progress (fraction of the goal)")
+            .y_desc("fold angle (deg)")
+            .draw()
+            .map_err(plot_error)?;
+        // Creases that fold alike draw one line over another; colour says the assignment.
+        let shown = evenly(pattern.creases.len(), 400);
+        for &column in &shown {
+            let colour = match pattern.kinds[pattern.creases[column]] {
+                EdgeKind::Crease(Assignment::Valley) => RGBColor(31, 119, 180),
+                EdgeKind::Crease(Assignment::Mountain) => RGBColor(214, 39, 40),
+                _ => RGBColor(127, 127, 127),
+            };
+            chart
+                .draw_series(LineSeries::new(
+                    path.steps
+                        .iter()
+                        .map(|s| (s.progress, s.fold_angles[column].to_degrees())),
+                    colour.stroke_width(1),
+                ))
+                .map_err(plot_error)?;
+        }
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!(
+                    "{} of {} creases drawn; blue valley, red mountain",
+                    shown.len(),
+                    pattern.creases.len()
+                ),
+                (first.min(0.0), 170.0),
+                ("sans-serif", 13),
+            )))
+            .map_err(plot_error)?;
+
+        // 3D views at four moments, one scale for all.
+        let picks = evenly(path.steps.len(), 4);
+        let mut poses_at = Vec::new();
+        for &i in &picks {
+            let mut poses = Vec::new();
+            panel_poses(model, &path.steps[i].fold_angles, &mut poses);
+            poses_at.push(poses);
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for poses in &poses_at {
+            for (f, face) in pattern.faces.iter().enumerate() {
+                let pose = &poses[pattern.panel_of_face[f]];
+                for &v in face {
+                    let x = pose.place(pattern.vertices[v]);
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(x[k]);
+                        hi[k] = hi[k].max(x[k]);
+                    }
+                }
+            }
+        }
+        let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+        let half = (0..3).map(|k| 0.5 * (hi[k] - lo[k])).fold(1e-12, f64::max);
+        let views = bottom.split_evenly((1, 4));
+        for ((area, poses), &i) in views.iter().zip(&poses_at).zip(&picks) {
+            let mut view = ChartBuilder::on(area)
+                .caption(format!("progress {:.2}", path.steps[i].progress), ("sans-serif", 16))
+                .margin(6)
+                .build_cartesian_3d(-1.05..1.05, -1.05..1.05, -1.05..1.05)
+                .map_err(plot_error)?;
+            view.with_projection(|mut p| {
+                p.yaw = 0.6;
+                p.pitch = 0.45;
+                p.scale = 1.2;
+                p.into_matrix()
+            });
+            // plotters' 3D y axis is vertical: plot (x, z, y) so the pattern's z is up.
+            let to_plot = |x: nalgebra::Vector3<f64>| {
+                (
+                    (x[0] - centre[0]) / half,
+                    (x[2] - centre[2]) / half,
+                    (x[1] - centre[1]) / half,
+                )
+            };
+            for (f, face) in pattern.faces.iter().enumerate() {
+                let panel = pattern.panel_of_face[f];
+                let pose = &poses[panel];
+                let outline: Vec<(f64, f64, f64)> =
+                    face.iter().map(|&v| to_plot(pose.place(pattern.vertices[v]))).collect();
+                let shade = if panel.is_multiple_of(2) {
+                    RGBColor(120, 160, 220)
+                } else {
+                    RGBColor(230, 200, 120)
+                };
+                view.draw_series(std::iter::once(Polygon::new(outline.clone(), shade.mix(0.45).filled())))
+                    .map_err(plot_error)?;
+                let mut closed = outline;
+                closed.push(closed[0]);
+                view.draw_series(std::iter::once(PathElement::new(closed, BLACK.stroke_width(1))))
+                    .map_err(plot_error)?;
+            }
+        }
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
