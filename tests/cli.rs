@@ -151,8 +151,9 @@ fn check_of_a_directory_runs_every_pattern_in_parallel_one_line_each() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let lines = json_lines(&out);
     // Every pattern file of the library, scene files skipped, each once.
-    let mut expected: Vec<String> = std::fs::read_dir("patterns")
-        .unwrap()
+    let mut expected: Vec<String> = ["patterns", "patterns/many"]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(dir).unwrap())
         .map(|e| e.unwrap().path().display().to_string())
         .filter(|p| (p.ends_with(".fold") || p.ends_with(".json")) && !p.ends_with(".scene.json"))
         .collect();
@@ -161,6 +162,12 @@ fn check_of_a_directory_runs_every_pattern_in_parallel_one_line_each() {
     assert_eq!(lines["patterns/degree4_locked.fold"]["verdict"], "locked");
     assert_eq!(lines["patterns/cone.json"]["verdict"], "not_flat_foldable");
     assert_eq!(lines["patterns/symmetric16.fold"]["verdict"], "flat");
+    // Crease patterns of many vertices get their own verdicts in the same run.
+    assert_eq!(lines["patterns/many/miura_4x4_folded.fold"]["verdict"], "rigid");
+    assert_eq!(
+        lines["patterns/many/square_twist.fold"]["verdict"],
+        "not_rigidly_foldable"
+    );
     // The same answers one at a time: parallel runs do not disturb each other.
     let serial = nanofold()
         .args(["check", "--json", "--jobs", "1", "patterns"])
@@ -515,4 +522,117 @@ fn a_bad_scene_fails_clearly_and_writes_nothing() {
     );
     assert!(!dir.exists(), "nothing may be written for a bad scene");
     let _ = std::fs::remove_file(&scene);
+}
+
+#[test]
+fn fold_writes_frames_that_check_and_read_back() {
+    let dir = temp_dir("fold");
+    let (_, summary) = json_run(
+        nanofold()
+            .args([
+                "fold",
+                "patterns/many/miura_4x4.fold",
+                "--to",
+                "80",
+                "--frames",
+                "6",
+                "--json",
+                "--out",
+            ])
+            .arg(&dir),
+    );
+    for key in [
+        "stop_reason",
+        "frames",
+        "dof",
+        "max_closure_residual_rad",
+        "min_panel_clearance",
+        "seconds",
+    ] {
+        assert!(summary.get(key).is_some(), "missing {key}: {summary}");
+    }
+    assert_eq!(summary["stop_reason"], "reached");
+    assert_eq!(summary["frames"], 6);
+    assert_eq!(summary["dof"], 1);
+    assert!(summary["max_closure_residual_rad"].as_f64().unwrap() <= 1e-10);
+    // The animation: the crease pattern (2D) as key frame, 3D folded frames whose
+    // assignments follow their angles' signs.
+    let animation: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fold.fold")).unwrap()).unwrap();
+    assert_eq!(animation["frame_classes"][0], "creasePattern");
+    assert!(animation["vertices_coords"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|p| p.as_array().unwrap().len() == 2));
+    let frames = animation["file_frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 6);
+    for frame in frames {
+        assert_eq!(frame["frame_classes"][0], "foldedForm");
+        let angles = frame["edges_foldAngle"].as_array().unwrap();
+        let letters = frame["edges_assignment"].as_array().unwrap();
+        for (angle, letter) in angles.iter().zip(letters) {
+            let (angle, letter) = (angle.as_f64().unwrap(), letter.as_str().unwrap());
+            assert!(
+                (angle <= 0.0 || letter == "V") && (angle >= 0.0 || letter == "M"),
+                "{angle} {letter}"
+            );
+        }
+    }
+    // The end state reads back as a rigid state, and the last frame's 3D edge lengths are
+    // the crease pattern's.
+    let (_, check) = json_run(nanofold().args(["check", "--json"]).arg(dir.join("folded.fold")));
+    assert_eq!(check["verdict"], "rigid", "{check}");
+    assert!(check["max_vertex_residual_rad"].as_f64().unwrap() <= 1e-10);
+    assert_eq!(check["intersecting_pairs"].as_array().unwrap().len(), 0);
+    let flat = animation["vertices_coords"].as_array().unwrap();
+    let last = frames.last().unwrap()["vertices_coords"].as_array().unwrap();
+    for edge in animation["edges_vertices"].as_array().unwrap() {
+        let (a, b) = (edge[0].as_u64().unwrap() as usize, edge[1].as_u64().unwrap() as usize);
+        let length = |points: &Vec<serde_json::Value>| {
+            let p: Vec<f64> = points[a]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            let q: Vec<f64> = points[b]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            p.iter().zip(&q).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+        };
+        assert!((length(flat) - length(last)).abs() < 1e-12);
+    }
+    for file in ["fold.svg", "trajectory.json"] {
+        assert!(dir.join(file).exists(), "{file}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn generate_and_fold_refuse_bad_values_by_flag() {
+    let dir = temp_dir("generate");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = nanofold()
+        .args(["generate", "miura", "--angle", "95", "--out"])
+        .arg(dir.join("m.fold"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(text.contains("--angle") && text.contains("95"), "{text}");
+    assert!(!dir.join("m.fold").exists());
+    let out = nanofold()
+        .args(["fold", "patterns/many/miura_4x4.fold", "--drive", "0=30"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && text.contains("edge 0 is not a crease"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

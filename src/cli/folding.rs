@@ -9,7 +9,8 @@ use nanofold::folding::{
 };
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
-use nanofold::pattern::generate::MiuraSpec;
+use nanofold::pattern::crease_pattern::CreasePatternBuilder;
+use nanofold::pattern::generate::{MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -69,6 +70,37 @@ pub enum GenerateKind {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Square twist: a central square and four pleats turned by the twist angle.
+    SquareTwist {
+        /// Side of the central square.
+        #[arg(long, default_value_t = 1.0)]
+        side: f64,
+        /// Half the side of the square sheet.
+        #[arg(long, default_value_t = 1.5)]
+        half_sheet: f64,
+        /// Twist angle (degrees, 1 to 45).
+        #[arg(long, default_value_t = 30.0)]
+        twist: f64,
+        /// Flip each corner's crease after its smallest sector (breaks big-little-big: no
+        /// longer flat-foldable) instead of the classic assignment.
+        #[arg(long)]
+        flip_pleats: bool,
+        /// The FOLD file to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Waterbomb tessellation: rows of triangles, degree-6 vertices.
+    Waterbomb {
+        /// Rows of triangles.
+        #[arg(long, default_value_t = 4)]
+        rows: usize,
+        /// Units across (the sheet is twice as wide).
+        #[arg(long, default_value_t = 4)]
+        cols: usize,
+        /// The FOLD file to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 /// `nanofold generate KIND ...`
@@ -114,18 +146,68 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
             );
             let value = crease_pattern_fold(&model.pattern, state.as_deref(), &note);
             write_file(out, &value)?;
-            println!(
-                "{}: {} vertices, {} creases, {} panels{}; wrote {}",
-                model.pattern.name,
-                model.pattern.vertices.len(),
-                model.crease_count(),
-                model.pattern.panel_count,
-                if fold.is_some() { " (folded state included)" } else { "" },
-                out.display()
+            report(&model, fold.is_some(), out);
+        }
+        GenerateKind::SquareTwist {
+            side,
+            half_sheet,
+            twist,
+            flip_pleats,
+            out,
+        } => {
+            let spec = SquareTwistSpec {
+                side: *side,
+                half_sheet: *half_sheet,
+                twist: twist.to_radians(),
+                flip_pleats: *flip_pleats,
+            };
+            let builder = spec.build().map_err(|e| {
+                flags(
+                    e,
+                    &[("side", "--side"), ("half_sheet", "--half-sheet"), ("twist", "--twist")],
+                )
+            })?;
+            let note = format!(
+                "square twist, side {side}, sheet half-side {half_sheet}, twist {twist} deg, {} assignment; written by nanofold generate",
+                if *flip_pleats { "pleats flipped" } else { "classic" }
             );
+            write_pattern(builder, &note, out)?;
+        }
+        GenerateKind::Waterbomb { rows, cols, out } => {
+            let builder = WaterbombSpec {
+                rows: *rows,
+                cols: *cols,
+            }
+            .build()
+            .map_err(|e| flags(e, &[("rows, cols", "--rows, --cols")]))?;
+            write_pattern(
+                builder,
+                &format!("waterbomb tessellation {rows} x {cols}; written by nanofold generate"),
+                out,
+            )?;
         }
     }
     Ok(())
+}
+
+fn write_pattern(builder: CreasePatternBuilder, note: &str, out: &Path) -> Result<()> {
+    let model = FoldingModel::new(builder.build()?)?;
+    write_file(out, &crease_pattern_fold(&model.pattern, None, note))?;
+    report(&model, false, out);
+    Ok(())
+}
+
+fn report(model: &FoldingModel, folded: bool, out: &Path) {
+    println!(
+        "{}: {} vertices, {} creases, {} interior vertices, {} panels{}; wrote {}",
+        model.pattern.name,
+        model.pattern.vertices.len(),
+        model.crease_count(),
+        model.stars.len(),
+        model.pattern.panel_count,
+        if folded { " (folded state included)" } else { "" },
+        out.display()
+    );
 }
 
 fn write_file(out: &Path, value: &Value) -> Result<()> {

@@ -170,31 +170,57 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
         return Ok(report);
     }
 
-    // An assignment alone: first the local test at each degree-4 vertex, then a witness.
+    // An assignment alone: first the local test at each degree-4 vertex, then the modes'
+    // agreement across shared creases, then a witness.
     let mut local_checked = 0;
+    let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
     for star in &model.stars {
-        if let Some(modes) = degree4_modes(star) {
-            local_checked += 1;
-            let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
-            let fits = |pattern: &[f64; 4]| pattern.iter().zip(&assigned).all(|(p, a)| *a == 0.0 || p * a > 0.0);
-            if !modes.iter().any(fits) {
-                let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
-                let options: Vec<String> = modes.iter().map(|m| m.iter().map(|&a| letter(a)).collect()).collect();
-                report.verdict = PatternVerdict::NotRigidlyFoldable;
-                report.evidence = format!(
-                    "vertex {}: its assignment {} (creases counter-clockwise) matches none of the sign patterns of its folding modes from flat ({}); a degree-4 vertex folds rigidly only along these",
-                    star.vertex,
-                    names.concat(),
-                    options.join(", ")
-                );
-                return Ok(report);
-            }
+        let Some(modes) = degree4_modes(star) else {
+            chosen.push(None);
+            continue;
+        };
+        local_checked += 1;
+        let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+        // A mode's zero entry: at a flat-foldable vertex the branches keep exact ratios of
+        // tan(ρ/2), so that crease stays flat and cannot be a mountain or valley; elsewhere
+        // its sign is decided at higher order and matches anything.
+        let alternating = star
+            .sector_angles
+            .iter()
+            .enumerate()
+            .map(|(k, a)| if k % 2 == 0 { *a } else { -a })
+            .sum::<f64>();
+        let flat_foldable = alternating.abs() < 1e-9;
+        let fits = |mode: &&[f64; 4]| {
+            mode.iter()
+                .zip(&assigned)
+                .all(|(p, a)| *a == 0.0 || (*p == 0.0 && !flat_foldable) || p * a > 0.0)
+        };
+        let matching: Vec<&[f64; 4]> = modes.iter().filter(fits).collect();
+        if matching.is_empty() {
+            let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
+            let options: Vec<String> = modes.iter().map(|m| m.iter().map(|&a| letter(a)).collect()).collect();
+            report.verdict = PatternVerdict::NotRigidlyFoldable;
+            report.evidence = format!(
+                "vertex {}: its assignment {} (creases counter-clockwise; 0 unassigned) matches none of the sign patterns of its folding modes from flat ({}; 0: the crease stays flat); a degree-4 vertex leaves flat only along these",
+                star.vertex,
+                names.concat(),
+                if options.is_empty() { "none: the vertex cannot leave flat".to_string() } else { options.join(", ") }
+            );
+            return Ok(report);
         }
+        let decided = matching.len() == 1 && matching[0].iter().all(|&m| m != 0.0);
+        chosen.push(if decided { Some(*matching[0]) } else { None });
     }
     if local_checked > 0 {
         report.tried.push(format!(
             "{local_checked} degree-4 vertices: each assignment matches a folding mode"
         ));
+    }
+    if let Some(conflict) = mode_conflict(model, &chosen) {
+        report.verdict = PatternVerdict::NotRigidlyFoldable;
+        report.evidence = conflict;
+        return Ok(report);
     }
     let path_settings = FoldSettings {
         drive: Drive::Assignment { to: 1.0 },
@@ -236,6 +262,67 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
     Ok(report)
 }
 
+/// When every star is a degree-4 vertex whose assignment picks exactly one mode (all four
+/// creases moving), and the
+/// stars are joined through shared creases: any rigid motion from flat starts (at its
+/// lowest order) along each vertex's mode with a positive speed t_v, so a crease shared by
+/// v and w needs t_v·m_v = t_w·m_w. The ratios are propagated over the stars; a cycle whose
+/// ratios disagree leaves only t = 0, and the assignment cannot fold rigidly. Returns the
+/// evidence of such a disagreement.
+fn mode_conflict(model: &FoldingModel, chosen: &[Option<[f64; 4]>]) -> Option<String> {
+    if chosen.is_empty() || chosen.iter().any(Option::is_none) {
+        return None;
+    }
+    let modes: Vec<[f64; 4]> = chosen.iter().map(|m| m.expect("checked above")).collect();
+    // (star, slot) of each crease column.
+    let mut owners: Vec<Vec<(usize, usize)>> = vec![Vec::new(); model.crease_count()];
+    for (s, star) in model.stars.iter().enumerate() {
+        for (slot, &c) in star.columns.iter().enumerate() {
+            owners[c].push((s, slot));
+        }
+    }
+    let mut speed: Vec<Option<f64>> = vec![None; modes.len()];
+    let mut worst: Option<(f64, usize, usize, usize)> = None;
+    for root in 0..modes.len() {
+        if speed[root].is_some() {
+            continue;
+        }
+        speed[root] = Some(1.0);
+        let mut queue = std::collections::VecDeque::from([root]);
+        while let Some(v) = queue.pop_front() {
+            let tv = speed[v].expect("queued stars have a speed");
+            for (slot, &c) in model.stars[v].columns.iter().enumerate() {
+                for &(w, other) in &owners[c] {
+                    if w == v {
+                        continue;
+                    }
+                    let tw = tv * modes[v][slot] / modes[w][other];
+                    match speed[w] {
+                        None => {
+                            speed[w] = Some(tw);
+                            queue.push_back(w);
+                        }
+                        Some(existing) => {
+                            let disagreement = (existing / tw).ln().abs();
+                            if disagreement > 1e-9 && worst.is_none_or(|(d, ..)| disagreement > d) {
+                                worst = Some((disagreement, c, v, w));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let (disagreement, column, v, w) = worst?;
+    Some(format!(
+        "every vertex is degree 4 with one folding mode that fits its assignment, but the modes disagree: around a cycle of vertices through crease {} (vertices {} and {}) the speeds they ask for differ by a factor {:.6}, so no motion leaves flat with these signs (only degree-4 vertices, each moving along its mode at its lowest order)",
+        model.pattern.creases[column],
+        model.stars[v].vertex,
+        model.stars[w].vertex,
+        disagreement.exp()
+    ))
+}
+
 fn sign_of(model: &FoldingModel, column: usize) -> f64 {
     match model.pattern.kinds[model.pattern.creases[column]] {
         EdgeKind::Crease(Assignment::Valley) => 1.0,
@@ -244,17 +331,19 @@ fn sign_of(model: &FoldingModel, column: usize) -> f64 {
     }
 }
 
+/// M, V, or 0 for a crease that does not move (a U crease in an assignment).
 fn letter(sign: f64) -> &'static str {
     if sign > 0.0 {
         "V"
     } else if sign < 0.0 {
         "M"
     } else {
-        "U"
+        "0"
     }
 }
 
-/// The sign patterns of a degree-4 vertex's folding modes from flat: the first-order
+/// The folding modes of a degree-4 vertex from flat, as velocities of its creases in ray
+/// order (largest entry ±1), each line run both ways: the first-order
 /// velocities keep the star closed in the plane (Σ ρ̇_j u_j = 0, a plane of velocities) and
 /// the second-order term of the holonomy out of the plane vanishes,
 /// Σ_{i<j} ρ̇_i ρ̇_j (u_i × u_j)·z = 0: two lines in that plane, each run both ways. None
@@ -340,12 +429,17 @@ pub fn degree4_modes(star: &Star) -> Option<Vec<[f64; 4]>> {
     for (s, t) in directions {
         let velocity: Vec<f64> = (0..4).map(|k| s * basis[0][k] + t * basis[1][k]).collect();
         let size = velocity.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        if velocity.iter().any(|v| v.abs() < 1e-9 * size) {
-            return None;
-        }
-        let signs = [0, 1, 2, 3].map(|k| velocity[k].signum());
-        modes.push(signs);
-        modes.push(signs.map(|x| -x));
+        // A crease that does not move to first order (the straight fold through a pair of
+        // collinear creases) gets 0: its sign is not decided here.
+        let unit = [0, 1, 2, 3].map(|k| {
+            if velocity[k].abs() < 1e-9 * size {
+                0.0
+            } else {
+                velocity[k] / size
+            }
+        });
+        modes.push(unit);
+        modes.push(unit.map(|x| -x));
     }
     Some(modes)
 }

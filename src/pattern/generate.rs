@@ -144,3 +144,225 @@ impl MiuraSpec {
         Ok(builder)
     }
 }
+
+/// A square twist: a central square whose four corners are degree-4 vertices, each sending
+/// two creases 90° apart to the edge of a square sheet; adjacent corners' creases pair up
+/// into four parallel pleats turned by the twist angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SquareTwistSpec {
+    /// Side of the central square.
+    pub side: f64,
+    /// Half the side of the sheet (centred on the square).
+    pub half_sheet: f64,
+    /// Twist angle θ, rad, in (0, π/4]: the pleats' turn from the square's sides.
+    pub twist: f64,
+    /// Flip each corner's crease after its smallest sector: the classic assignment (square
+    /// mountain, each pleat a mountain–valley pair; flat-foldable) turned into one that breaks
+    /// big-little-big at every corner.
+    pub flip_pleats: bool,
+}
+
+impl Default for SquareTwistSpec {
+    fn default() -> Self {
+        SquareTwistSpec {
+            side: 1.0,
+            half_sheet: 1.5,
+            twist: 30f64.to_radians(),
+            flip_pleats: false,
+        }
+    }
+}
+
+impl SquareTwistSpec {
+    /// Checks every parameter.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.side.is_finite() && self.side > 0.0 && self.side <= 1e6) {
+            return Err(NanofoldError::invalid("side", self.side, "must lie in (0, 1e6]"));
+        }
+        if !(self.half_sheet.is_finite() && self.half_sheet >= self.side && self.half_sheet <= 1e6) {
+            return Err(NanofoldError::invalid(
+                "half_sheet",
+                self.half_sheet,
+                "must lie in [side, 1e6]",
+            ));
+        }
+        if !(self.twist >= 1f64.to_radians() && self.twist <= 45f64.to_radians()) {
+            return Err(NanofoldError::invalid(
+                "twist",
+                self.twist.to_degrees(),
+                "must lie in [1°, 45°]",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The pattern (flat, assignment only). Corner k of the square sits at angle 45° + 90°k;
+    /// its outgoing creases leave at θ + 90°k and 90° + θ + 90°k, so the sectors around it
+    /// are 90° + θ, 90°, 90° − θ and 90° (the square's corner): Kawasaki holds. In the classic
+    /// assignment the creases bounding the smallest sector (90° − θ) differ, so the crease at
+    /// 90° + θ + 90°k is the valley of its corner.
+    pub fn build(&self) -> Result<CreasePatternBuilder> {
+        self.validate()?;
+        let h = self.side / 2.0;
+        let corners = [[h, h], [-h, h], [-h, -h], [h, -h]];
+        let mut vertices: Vec<[f64; 2]> = corners.to_vec();
+        let mut segments: Vec<([usize; 2], EdgeKind)> = Vec::new();
+        let mountain = EdgeKind::Crease(Assignment::Mountain);
+        let valley = EdgeKind::Crease(Assignment::Valley);
+        for k in 0..4 {
+            segments.push(([k, (k + 1) % 4], mountain));
+        }
+        let mut rim: Vec<usize> = Vec::new();
+        for (k, corner) in corners.iter().enumerate() {
+            let turn = std::f64::consts::FRAC_PI_2 * k as f64;
+            for (j, direction) in [self.twist + turn, std::f64::consts::FRAC_PI_2 + self.twist + turn]
+                .into_iter()
+                .enumerate()
+            {
+                let end = to_sheet_edge(*corner, direction, self.half_sheet);
+                vertices.push(end);
+                rim.push(vertices.len() - 1);
+                let odd_one = j == 1;
+                let kind = if odd_one != self.flip_pleats { valley } else { mountain };
+                segments.push(([k, vertices.len() - 1], kind));
+            }
+        }
+        Ok(on_rectangle(
+            format!("square_twist_{:.0}deg", self.twist.to_degrees()),
+            vertices,
+            segments,
+            rim,
+            [-self.half_sheet, -self.half_sheet],
+            [self.half_sheet, self.half_sheet],
+        ))
+    }
+}
+
+/// Where the ray from `from` at `direction` leaves the square [−half, half]².
+fn to_sheet_edge(from: [f64; 2], direction: f64, half: f64) -> [f64; 2] {
+    let (dx, dy) = (direction.cos(), direction.sin());
+    let mut t = f64::INFINITY;
+    for (d, p) in [(dx, from[0]), (dy, from[1])] {
+        if d > 1e-15 {
+            t = t.min((half - p) / d);
+        } else if d < -1e-15 {
+            t = t.min((-half - p) / d);
+        }
+    }
+    [from[0] + t * dx, from[1] + t * dy]
+}
+
+/// Closes a set of creases with the rectangle [lo, hi] as the sheet's edge: its corners
+/// and the `rim` vertices that lie on it, joined in counter-clockwise order by boundary edges.
+fn on_rectangle(
+    name: String,
+    mut vertices: Vec<[f64; 2]>,
+    segments: Vec<([usize; 2], EdgeKind)>,
+    mut rim: Vec<usize>,
+    lo: [f64; 2],
+    hi: [f64; 2],
+) -> CreasePatternBuilder {
+    for corner in [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]] {
+        let close = |p: &[f64; 2]| (p[0] - corner[0]).abs() < 1e-12 && (p[1] - corner[1]).abs() < 1e-12;
+        if !rim.iter().any(|&v| close(&vertices[v])) {
+            vertices.push(corner);
+            rim.push(vertices.len() - 1);
+        }
+    }
+    // Position along the outline, counter-clockwise from (lo, lo).
+    let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
+    let along = |p: [f64; 2]| {
+        let (x, y) = (p[0] - lo[0], p[1] - lo[1]);
+        if y.abs() < 1e-9 * h {
+            x
+        } else if (x - w).abs() < 1e-9 * w {
+            w + y
+        } else if (y - h).abs() < 1e-9 * h {
+            w + h + (w - x)
+        } else {
+            2.0 * w + h + (h - y)
+        }
+    };
+    rim.sort_by(|&a, &b| along(vertices[a]).total_cmp(&along(vertices[b])));
+    rim.dedup();
+    let mut builder = CreasePatternBuilder {
+        name,
+        vertices,
+        angle_field: "edges_foldAngle".into(),
+        ..Default::default()
+    };
+    for k in 0..rim.len() {
+        builder.edges.push([rim[k], rim[(k + 1) % rim.len()]]);
+        builder.kinds.push(EdgeKind::Boundary);
+        builder.fold_angles.push(0.0);
+    }
+    for (edge, kind) in segments {
+        builder.edges.push(edge);
+        builder.kinds.push(kind);
+        builder.fold_angles.push(0.0);
+    }
+    builder
+}
+
+/// The waterbomb tessellation: rows of isosceles right triangles between horizontal
+/// mountain lines, degree-6 vertices (sectors 45°, 90°, 45°, 45°, 90°, 45°) where four
+/// valley diagonals meet a horizontal line, alternating rows shifted by one unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WaterbombSpec {
+    /// Rows of triangles (the sheet is `rows` high).
+    pub rows: usize,
+    /// Units across (the sheet is 2·cols wide).
+    pub cols: usize,
+}
+
+impl WaterbombSpec {
+    /// The pattern (flat, assignment only). Vertex (x, y) for integer x in 0..=2·cols and y in
+    /// 0..=rows; where x + y is even, diagonals run to (x ± 1, y ± 1); every horizontal line
+    /// inside the sheet is a mountain crease, every diagonal a valley.
+    pub fn build(&self) -> Result<CreasePatternBuilder> {
+        let (rows, cols) = (self.rows, self.cols);
+        if rows < 1 || cols < 1 || 6 * (rows + 1) * (2 * cols + 1) > MAX_EDGES {
+            return Err(NanofoldError::invalid(
+                "rows, cols",
+                format!("{rows} × {cols}"),
+                format!("at least 1 × 1, and at most {MAX_EDGES} edges"),
+            ));
+        }
+        let width = 2 * cols;
+        let index = |x: usize, y: usize| y * (width + 1) + x;
+        let vertices: Vec<[f64; 2]> = (0..=rows)
+            .flat_map(|y| (0..=width).map(move |x| [x as f64, y as f64]))
+            .collect();
+        let mut segments = Vec::new();
+        for y in 1..rows {
+            for x in 0..width {
+                segments.push(([index(x, y), index(x + 1, y)], EdgeKind::Crease(Assignment::Mountain)));
+            }
+        }
+        for y in 0..rows {
+            for x in 0..=width {
+                if (x + y) % 2 == 0 {
+                    if x < width {
+                        segments.push(([index(x, y), index(x + 1, y + 1)], EdgeKind::Crease(Assignment::Valley)));
+                    }
+                    if x > 0 {
+                        segments.push(([index(x, y), index(x - 1, y + 1)], EdgeKind::Crease(Assignment::Valley)));
+                    }
+                }
+            }
+        }
+        // The sheet's edge: bottom and top rows and the two sides, through every vertex on them.
+        let mut rim: Vec<usize> = (0..=width).map(|x| index(x, 0)).collect();
+        rim.extend((0..=width).map(|x| index(x, rows)));
+        rim.extend((1..rows).flat_map(|y| [index(0, y), index(width, y)]));
+        // Horizontal lines end on the sides: drop their segments' duplicates with the rim.
+        Ok(on_rectangle(
+            format!("waterbomb_{rows}x{cols}"),
+            vertices,
+            segments,
+            rim,
+            [0.0, 0.0],
+            [width as f64, rows as f64],
+        ))
+    }
+}
