@@ -1,10 +1,11 @@
 //! Times the rigid-kinematics pieces on folded Miura-ori of growing size, with the error
-//! beside each time: closure residual (worst vertex), tree mismatch, and the rank's gap.
+//! beside each time: closure residual (worst vertex), tree mismatch, and the DOF found by
+//! the dense pivoted QR and by the sparse count. Then folding paths from flat.
 //! `cargo run --release --example crease_pattern_speed`
 
 use nanofold::folding::{
-    closure_jacobian, fold_path, jacobian_rank, panel_contacts, panel_poses, tree_mismatch, vertex_residuals,
-    ContactSettings, Drive, FoldSettings, FoldingModel,
+    closure_jacobian, fold_path, jacobian_rank_dense, jacobian_rank_sparse, panel_contacts, panel_poses, tree_mismatch,
+    vertex_residuals, ContactSettings, Drive, FoldSettings, FoldingModel,
 };
 use nanofold::pattern::generate::MiuraSpec;
 use std::time::Instant;
@@ -21,65 +22,82 @@ fn best_of<T>(runs: usize, mut work: impl FnMut() -> T) -> (f64, T) {
     (best, out.expect("runs ≥ 1"))
 }
 
+fn miura(n: usize, zigzag_deg: f64) -> FoldingModel {
+    let spec = MiuraSpec {
+        rows: n,
+        cols: n,
+        zigzag_fold_angle: zigzag_deg.to_radians(),
+        ..MiuraSpec::default()
+    };
+    FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap()
+}
+
 fn main() {
-    println!("Miura-ori, γ = 60°, zigzag creases at 90°; best of 3 runs, milliseconds");
+    println!("Miura-ori n x n, γ = 60°, zigzag creases at 90°; best of 3 runs, milliseconds");
     println!(
-        "{:>7} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>4} {:>10} {:>10} {:>10}",
-        "panels", "creases", "model", "J+r", "rank", "poses", "contact", "dof", "residual", "mismatch", "R gap"
+        "{:>4} {:>6} {:>8} {:>7} {:>9} {:>9} {:>7} {:>8} {:>5} {:>5} {:>9} {:>9}",
+        "n",
+        "creases",
+        "model",
+        "J+r",
+        "QR rank",
+        "sparse",
+        "poses",
+        "contact",
+        "dofQR",
+        "dofSp",
+        "residual",
+        "mismatch"
     );
-    for n in [4, 8, 16, 24, 32] {
-        let spec = MiuraSpec {
-            rows: n,
-            cols: n,
-            zigzag_fold_angle: 90f64.to_radians(),
-            ..MiuraSpec::default()
-        };
-        let (t_model, model) = best_of(3, || FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap());
+    for n in [4, 8, 16, 24, 32, 64, 100] {
+        let (t_model, model) = best_of(3, || miura(n, 90.0));
         let rho = model.given_fold_angles();
         let (t_jac, jac) = best_of(3, || closure_jacobian(&model, &rho));
-        let (t_rank, rank) = best_of(3, || jacobian_rank(&jac));
+        let dense = (model.crease_count() <= 2000).then(|| best_of(3, || jacobian_rank_dense(&jac)));
+        let (t_sparse, sparse) = best_of(3, || jacobian_rank_sparse(&jac).unwrap());
         let mut poses = Vec::new();
         let (t_poses, _) = best_of(3, || panel_poses(&model, &rho, &mut poses));
         let (t_contact, contacts) = best_of(3, || panel_contacts(&model, &poses, &ContactSettings::default()));
         let residual = vertex_residuals(&model, &rho).into_iter().fold(0.0, f64::max);
         let mismatch = tree_mismatch(&model, &rho, &poses) / model.size;
         println!(
-            "{:>7} {:>7} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>4} {:>10.1e} {:>10.1e} {:>10.1e}",
-            n * n,
+            "{:>4} {:>6} {:>8.2} {:>7.2} {:>9} {:>9.2} {:>7.3} {:>8.2} {:>5} {:>5} {:>9.1e} {:>9.1e}",
+            n,
             model.crease_count(),
             1e3 * t_model,
             1e3 * t_jac,
-            1e3 * t_rank,
+            dense
+                .as_ref()
+                .map_or("-".to_string(), |(t, _)| format!("{:.2}", 1e3 * t)),
+            1e3 * t_sparse,
             1e3 * t_poses,
             1e3 * t_contact,
-            rank.dof,
+            dense.as_ref().map_or("-".to_string(), |(_, r)| r.dof.to_string()),
+            sparse.dof,
             residual,
             mismatch,
-            rank.smallest_kept / rank.largest_dropped.max(f64::MIN_POSITIVE),
         );
         assert_eq!(contacts.crossing().count(), 0);
     }
     println!();
     println!("Folding the flat Miura-ori to 95% (max step 0.05 rad); best of 3 runs");
     println!(
-        "{:>7} {:>7} {:>9} {:>6} {:>7} {:>12} {:>12}",
-        "panels", "creases", "seconds", "steps", "newton", "residual", "clearance"
+        "{:>4} {:>7} {:>9} {:>6} {:>7} {:>12} {:>12}",
+        "n", "creases", "seconds", "steps", "newton", "residual", "clearance"
     );
-    for n in [8, 16, 32] {
-        let spec = MiuraSpec {
-            rows: n,
-            cols: n,
-            ..MiuraSpec::default()
-        };
-        let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
+    for n in [8, 16, 32, 64] {
+        let model = miura(n, 0.0);
         let settings = FoldSettings {
             drive: Drive::Assignment { to: 0.95 },
             ..FoldSettings::default()
         };
-        let (t, path) = best_of(3, || fold_path(&model, &model.given_fold_angles(), &settings).unwrap());
+        let runs = if n >= 64 { 1 } else { 3 };
+        let (t, path) = best_of(runs, || {
+            fold_path(&model, &model.given_fold_angles(), &settings).unwrap()
+        });
         println!(
-            "{:>7} {:>7} {:>9.3} {:>6} {:>7} {:>12.1e} {:>12.3e}  {}",
-            n * n,
+            "{:>4} {:>7} {:>9.3} {:>6} {:>7} {:>12.1e} {:>12.3e}  {}",
+            n,
             model.crease_count(),
             t,
             path.steps.len(),

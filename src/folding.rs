@@ -5,6 +5,7 @@
 pub mod closure;
 pub mod contact;
 pub mod model;
+pub mod normal;
 pub mod path;
 pub mod poses;
 pub mod rank;
@@ -15,5 +16,7 @@ pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{fold_path, restore_closure, Drive, FoldPath, FoldSettings, PathStep, StopReason};
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
-pub use rank::{jacobian_rank, RankReport, RANK_TOL};
+pub use rank::{
+    jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, RankMethod, RankReport, DENSE_RANK_LIMIT, RANK_TOL,
+};
 pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, PatternVerdict};

@@ -306,7 +306,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     let path = fold_path(&model, &model.given_fold_angles(), &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     let end = &path.steps.last().expect("a path has its start").fold_angles;
-    let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end)).dof;
+    let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end))?.dof;
     let chosen = evenly(path.steps.len(), args.frames);
     let dir = args
         .out

@@ -1,4 +1,4 @@
-//! Panels that meet (`docs/model.md#panel-contact`): a sort-and-sweep broad phase on the
+//! Panels that meet (`docs/model.md#panel-contact`): a uniform-grid broad phase on the
 //! panels' boxes, then exact triangle–triangle tests in 3D. Panels that share a vertex are
 //! left to that vertex's spherical order and not tested here.
 
@@ -14,8 +14,8 @@ type Point = Vector3<f64>;
 pub struct ContactSettings {
     /// Distance below which a pair is a contact, as a fraction of the pattern's size.
     pub clearance: f64,
-    /// Pairs whose boxes come within this fraction of the size are measured (for the
-    /// smallest clearance reported).
+    /// Pairs whose boxes come within this many median panel sizes of each other are
+    /// measured (for the smallest clearance reported); the cost grows with its square.
     pub search: f64,
 }
 
@@ -23,7 +23,7 @@ impl Default for ContactSettings {
     fn default() -> Self {
         ContactSettings {
             clearance: 1e-9,
-            search: 0.05,
+            search: 0.5,
         }
     }
 }
@@ -38,11 +38,11 @@ impl ContactSettings {
                 "must lie in [0, 0.1] (fraction of the pattern size)",
             ));
         }
-        if !(self.search >= self.clearance && self.search <= 1.0) {
+        if !(self.search >= 0.0 && self.search <= 10.0) {
             return Err(NanofoldError::invalid(
                 "search",
                 self.search,
-                "must lie in [clearance, 1]",
+                "must lie in [0, 10] (median panel sizes)",
             ));
         }
         Ok(())
@@ -81,7 +81,7 @@ impl ContactReport {
 /// Tests every pair of panels sharing no vertex, posed by `poses`.
 pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSettings) -> ContactReport {
     let clearance = settings.clearance * model.size;
-    let search = settings.search * model.size;
+    let search = settings.search * median_panel_size(model);
     let pattern = &model.pattern;
     let triangles: Vec<Vec<[Point; 3]>> = model
         .panel_triangles
@@ -90,6 +90,18 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
         .map(|(p, list)| {
             list.iter()
                 .map(|t| t.map(|v| poses[p].place(pattern.vertices[v])))
+                .collect()
+        })
+        .collect();
+    let triangle_boxes: Vec<Vec<([f64; 3], [f64; 3])>> = triangles
+        .iter()
+        .map(|list| {
+            list.iter()
+                .map(|t| {
+                    let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
+                    let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+                    (lo, hi)
+                })
                 .collect()
         })
         .collect();
@@ -107,44 +119,126 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
             (lo, hi)
         })
         .collect();
-    let mut order: Vec<usize> = (0..boxes.len()).collect();
-    order.sort_unstable_by(|&a, &b| boxes[a].0[0].total_cmp(&boxes[b].0[0]));
     let mut report = ContactReport {
         contacts: Vec::new(),
         pairs_measured: 0,
         min_clearance: None,
     };
-    for (i, &a) in order.iter().enumerate() {
-        for &b in &order[i + 1..] {
-            if boxes[b].0[0] > boxes[a].1[0] {
-                break;
-            }
-            let overlap = (1..3).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]);
-            if !overlap || share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
-                continue;
-            }
-            report.pairs_measured += 1;
-            let mut distance = f64::INFINITY;
-            let mut crossing = false;
-            for s in &triangles[a] {
-                for t in &triangles[b] {
-                    let (d, c) = triangle_distance(s, t, 1e-12 * model.size);
-                    distance = distance.min(d);
-                    crossing |= c;
+    for (a, b) in candidate_pairs(&boxes) {
+        if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
+            continue;
+        }
+        report.pairs_measured += 1;
+        let mut distance = f64::INFINITY;
+        let mut crossing = false;
+        for (s, s_box) in triangles[a].iter().zip(&triangle_boxes[a]) {
+            for (t, t_box) in triangles[b].iter().zip(&triangle_boxes[b]) {
+                // Boxes farther apart than the search range: the distance cannot matter.
+                let gap = (0..3)
+                    .map(|k| (s_box.0[k] - t_box.1[k]).max(t_box.0[k] - s_box.1[k]))
+                    .fold(0.0_f64, f64::max);
+                if gap > search.max(clearance) {
+                    distance = distance.min(gap);
+                    continue;
                 }
+                let (d, c) = triangle_distance(s, t, 1e-12 * model.size);
+                distance = distance.min(d);
+                crossing |= c;
             }
-            report.min_clearance = Some(report.min_clearance.map_or(distance, |m: f64| m.min(distance)));
-            if crossing || distance <= clearance {
-                report.contacts.push(PanelContact {
-                    panels: [a.min(b), a.max(b)],
-                    distance,
-                    crossing,
-                });
-            }
+        }
+        report.min_clearance = Some(report.min_clearance.map_or(distance, |m: f64| m.min(distance)));
+        if crossing || distance <= clearance {
+            report.contacts.push(PanelContact {
+                panels: [a.min(b), a.max(b)],
+                distance,
+                crossing,
+            });
         }
     }
     report.contacts.sort_by_key(|c| c.panels);
     report
+}
+
+/// Pairs of boxes that overlap, smaller index first, from a uniform grid of cells about
+/// the size of the median box: each box is entered in the cells it covers, and a pair is
+/// reported from the first cell the two share, so each once. For panels of similar size
+/// this costs O(panels), where a sweep along one axis grows faster once a folded pattern
+/// stacks its panels.
+fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
+    if boxes.len() < 2 {
+        return Vec::new();
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (l, h) in boxes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(l[k]);
+            hi[k] = hi[k].max(h[k]);
+        }
+    }
+    let mut sizes: Vec<f64> = boxes
+        .iter()
+        .map(|(l, h)| (0..3).map(|k| h[k] - l[k]).fold(0.0, f64::max))
+        .collect();
+    sizes.sort_by(f64::total_cmp);
+    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    // At most 128 cells a side: memory stays bounded whatever the boxes.
+    let cell = sizes[sizes.len() / 2].max(extent / 128.0).max(f64::MIN_POSITIVE);
+    let index = |x: f64, k: usize| (((x - lo[k]) / cell) as i64).clamp(0, 127);
+    let mut cells: std::collections::HashMap<(i64, i64, i64), Vec<usize>> = std::collections::HashMap::new();
+    let ranges: Vec<[(i64, i64); 3]> = boxes
+        .iter()
+        .map(|(l, h)| [0, 1, 2].map(|k| (index(l[k], k), index(h[k], k))))
+        .collect();
+    for (b, r) in ranges.iter().enumerate() {
+        for i in r[0].0..=r[0].1 {
+            for j in r[1].0..=r[1].1 {
+                for k in r[2].0..=r[2].1 {
+                    cells.entry((i, j, k)).or_default().push(b);
+                }
+            }
+        }
+    }
+    let overlap = |a: usize, b: usize| (0..3).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]);
+    let mut pairs = Vec::new();
+    for (&(i, j, k), list) in &cells {
+        for (x, &a) in list.iter().enumerate() {
+            for &b in &list[x + 1..] {
+                // Report from the first cell both cover (the corner of their overlap).
+                let (ra, rb) = (ranges[a], ranges[b]);
+                let first = (ra[0].0.max(rb[0].0), ra[1].0.max(rb[1].0), ra[2].0.max(rb[2].0));
+                if first == (i, j, k) && overlap(a, b) {
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
+}
+
+/// The median over panels of their flat bounding boxes' larger side.
+fn median_panel_size(model: &FoldingModel) -> f64 {
+    let vertices = &model.pattern.vertices;
+    let mut sizes: Vec<f64> = model
+        .panel_vertices
+        .iter()
+        .map(|list| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for &v in list {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(vertices[v][k]);
+                    hi[k] = hi[k].max(vertices[v][k]);
+                }
+            }
+            (hi[0] - lo[0]).max(hi[1] - lo[1])
+        })
+        .collect();
+    if sizes.is_empty() {
+        return 0.0;
+    }
+    sizes.sort_by(f64::total_cmp);
+    sizes[sizes.len() / 2]
 }
 
 fn share_vertex(a: &[usize], b: &[usize]) -> bool {

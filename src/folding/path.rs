@@ -5,14 +5,11 @@
 use super::closure::{closure_jacobian, ClosureJacobian};
 use super::contact::{panel_contacts, ContactSettings};
 use super::model::FoldingModel;
+use super::normal::NormalSolver;
 use super::poses::{panel_poses, Pose};
-use crate::error::{NanofoldError, NumericalError, Result};
+use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::EdgeKind;
 use crate::pattern::Assignment;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::Side;
 use std::f64::consts::PI;
 
 /// What drives the motion.
@@ -53,10 +50,7 @@ impl Default for FoldSettings {
             closure_tol: 1e-11,
             max_steps: 100_000,
             kick: 1e-3,
-            contact: ContactSettings {
-                clearance: 1e-9,
-                search: 0.01,
-            },
+            contact: ContactSettings::default(),
         }
     }
 }
@@ -200,100 +194,6 @@ pub struct FoldPath {
     pub newton_iterations: usize,
 }
 
-/// Factorises JᵀJ + μI (symbolic structure kept between states) for the null-space
-/// projection and the least-norm Newton step.
-#[derive(Default)]
-pub struct NormalSolver {
-    symbolic: Option<SymbolicLlt<usize>>,
-}
-
-/// One factorisation and its regularisation.
-pub struct NormalFactor {
-    llt: Llt<usize, f64>,
-    /// μ.
-    pub mu: f64,
-}
-
-/// Steps over which progress must grow by 1e-9, or the path counts as stalled.
-const STALL_STEPS: usize = 200;
-
-/// μ relative to the largest diagonal entry of JᵀJ.
-const REGULARISATION: f64 = 1e-10;
-
-impl NormalSolver {
-    /// Factorises JᵀJ + μI.
-    pub fn factor(&mut self, jac: &ClosureJacobian) -> Result<NormalFactor> {
-        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); jac.rows];
-        for &(r, c, v) in &jac.entries {
-            rows[r].push((c, v));
-        }
-        let mut triplets: Vec<(usize, usize, f64)> = Vec::new();
-        for row in &rows {
-            for &(ci, vi) in row {
-                for &(cj, vj) in row {
-                    if ci >= cj {
-                        triplets.push((ci, cj, vi * vj));
-                    }
-                }
-            }
-        }
-        let mut diagonal = vec![0.0; jac.cols];
-        for &(i, j, v) in &triplets {
-            if i == j {
-                diagonal[i] += v;
-            }
-        }
-        let mu = REGULARISATION * diagonal.iter().fold(1.0_f64, |m, &d| m.max(d));
-        triplets.extend((0..jac.cols).map(|c| (c, c, mu)));
-        triplets.sort_unstable_by_key(|&(i, j, _)| (j, i));
-        let mut merged: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(triplets.len());
-        for (i, j, v) in triplets {
-            match merged.last_mut() {
-                Some(last) if last.row == i && last.col == j => last.val += v,
-                _ => merged.push(Triplet::new(i, j, v)),
-            }
-        }
-        let matrix =
-            SparseColMat::try_new_from_triplets(jac.cols, jac.cols, &merged).map_err(|e| NumericalError::Singular {
-                what: "JᵀJ + μI",
-                detail: format!("{e:?}"),
-            })?;
-        if self.symbolic.is_none() {
-            self.symbolic =
-                Some(
-                    SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).map_err(|e| NumericalError::Singular {
-                        what: "JᵀJ + μI (symbolic)",
-                        detail: format!("{e:?}"),
-                    })?,
-                );
-        }
-        let symbolic = self.symbolic.clone().expect("set above");
-        let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).map_err(|e| {
-            NumericalError::NotPositiveDefinite {
-                matrix: "JᵀJ + μI",
-                at: format!("{e:?}"),
-            }
-        })?;
-        Ok(NormalFactor { llt, mu })
-    }
-}
-
-impl NormalFactor {
-    /// Solves (JᵀJ + μI) x = b in place.
-    pub fn solve(&self, b: &mut [f64]) {
-        self.llt.solve_in_place(faer::ColMut::from_slice_mut(b).as_mat_mut());
-    }
-
-    /// The desired velocity's component in the null space of J: d − Jᵀ(JJᵀ + μI)⁻¹J d,
-    /// which equals μ (JᵀJ + μI)⁻¹ d.
-    pub fn project(&self, desired: &[f64]) -> Vec<f64> {
-        let mut v = desired.to_vec();
-        self.solve(&mut v);
-        v.iter_mut().for_each(|x| *x *= self.mu);
-        v
-    }
-}
-
 fn inf_norm(x: &[f64]) -> f64 {
     x.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
@@ -341,6 +241,12 @@ pub fn restore_closure(
     }
     Ok(None)
 }
+
+/// Steps over which progress must grow by 1e-9, or the path counts as stalled.
+const STALL_STEPS: usize = 200;
+
+/// μ of the projection and Newton steps, relative to the largest diagonal entry of JᵀJ.
+const PATH_REGULARISATION: f64 = 1e-10;
 
 /// The sign each crease's assignment asks for (+1 valley, −1 mountain, 0 otherwise).
 fn assigned_signs(model: &FoldingModel) -> Vec<f64> {
@@ -408,7 +314,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         ));
     }
     let signs = assigned_signs(model);
-    let mut solver = NormalSolver::default();
+    let mut solver = NormalSolver::new(PATH_REGULARISATION);
     let mut poses: Vec<Pose> = Vec::new();
     let mut rho = start.to_vec();
     let mut newton_iterations = 0;

@@ -110,7 +110,7 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
     worst.sort_by(|a, b| b.1.total_cmp(&a.1));
     let max_residual = worst.first().map_or(0.0, |w| w.1);
     worst.truncate(8);
-    let rank = jacobian_rank(&closure_jacobian(model, &rho));
+    let rank = jacobian_rank(&closure_jacobian(model, &rho))?;
     let mut poses = Vec::new();
     panel_poses(model, &rho, &mut poses);
     let contacts = panel_contacts(model, &poses, &settings.contact);
