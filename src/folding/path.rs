@@ -50,7 +50,11 @@ impl Default for FoldSettings {
             closure_tol: 1e-11,
             max_steps: 100_000,
             kick: 1e-3,
-            contact: ContactSettings::default(),
+            // A narrower search than `check`'s: tested at every step, it must stay cheap.
+            contact: ContactSettings {
+                search: 0.1,
+                ..ContactSettings::default()
+            },
         }
     }
 }

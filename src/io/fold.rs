@@ -15,6 +15,33 @@ pub const MAX_FOLD_VERTICES: usize = 4096;
 /// Most edges (and faces) a FOLD file may have.
 pub const MAX_FOLD_EDGES: usize = 8192;
 
+/// Most vertices of a crease pattern of many vertices (a 100 × 100 Miura-ori has 10 201).
+pub const MAX_PATTERN_VERTICES: usize = 100_000;
+/// Most edges (and faces) of a crease pattern of many vertices.
+pub const MAX_PATTERN_EDGES: usize = crate::pattern::crease_pattern::MAX_EDGES;
+
+/// How large a FOLD key frame may be, and why.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GraphLimits {
+    vertices: usize,
+    edges: usize,
+    why: &'static str,
+}
+
+/// A single vertex: its outputs repeat the mesh in every frame.
+pub(crate) const VERTEX_LIMITS: GraphLimits = GraphLimits {
+    vertices: MAX_FOLD_VERTICES,
+    edges: MAX_FOLD_EDGES,
+    why: "a single-vertex pattern (its outputs repeat the mesh in every frame) has at most",
+};
+
+/// A crease pattern of many vertices.
+pub(crate) const PATTERN_LIMITS: GraphLimits = GraphLimits {
+    vertices: MAX_PATTERN_VERTICES,
+    edges: MAX_PATTERN_EDGES,
+    why: "a crease pattern has at most",
+};
+
 /// Custom FOLD key for creases held at their folded angle.
 pub const LOCKED_KEY: &str = "edges_nanofold:locked";
 
@@ -64,18 +91,18 @@ pub(crate) struct FoldGraph<'v> {
 }
 
 /// Parses a FOLD key frame's vertices, edges, assignments, fold angles, locks and faces.
-pub(crate) fn parse_graph(value: &Value) -> Result<FoldGraph<'_>> {
+pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGraph<'_>> {
     // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).
     let coords_json = array(value, "vertices_coords")?;
     for (key, count, limit) in [
-        ("vertices_coords", coords_json.len(), MAX_FOLD_VERTICES),
+        ("vertices_coords", coords_json.len(), limits.vertices),
         (
             "edges_vertices",
             value
                 .get("edges_vertices")
                 .and_then(Value::as_array)
                 .map_or(0, Vec::len),
-            MAX_FOLD_EDGES,
+            limits.edges,
         ),
         (
             "faces_vertices",
@@ -83,14 +110,14 @@ pub(crate) fn parse_graph(value: &Value) -> Result<FoldGraph<'_>> {
                 .get("faces_vertices")
                 .and_then(Value::as_array)
                 .map_or(0, Vec::len),
-            MAX_FOLD_EDGES,
+            limits.edges,
         ),
     ] {
         if count > limit {
             return Err(NanofoldError::invalid(
                 key,
                 format!("{count} entries"),
-                format!("a single-vertex pattern has at most {limit} (its outputs repeat the mesh in every frame)"),
+                format!("{} {limit}", limits.why),
             ));
         }
     }
@@ -234,7 +261,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         angles_json,
         locked,
         faces_vertices,
-    } = parse_graph(value)?;
+    } = parse_graph(value, VERTEX_LIMITS)?;
     let (nv, ne) = (coords.len(), edges.len());
     let angles_json =
         angles_json.ok_or_else(|| NanofoldError::missing_with("edges_foldAngle", "the folded state, degrees"))?;
@@ -417,7 +444,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
 /// (`docs/model.md#crease-patterns`). Fold angles may be absent (the flat state) or `null`
 /// on boundary and facet edges, as Origami Simulator writes them.
 pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePatternBuilder> {
-    let graph = parse_graph(value)?;
+    let graph = parse_graph(value, PATTERN_LIMITS)?;
     let mut kinds = Vec::with_capacity(graph.edges.len());
     let mut fold_angles = Vec::with_capacity(graph.edges.len());
     for (e, letter) in graph.letters.iter().enumerate() {
