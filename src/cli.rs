@@ -150,9 +150,10 @@ pub enum MethodArg {
 /// FOLD input, position in `creases` for the native schema. Angles are in degrees.
 #[derive(Args)]
 pub struct ConstraintsArgs {
-    /// A FOLD file (.fold) or a native vertex (.json).
+    /// A FOLD file (.fold) or a native vertex (.json); or a folded crease pattern of many
+    /// vertices with one degree of freedom (e.g. folded.fold from `nanofold fold`).
     pub pattern: PathBuf,
-    /// The driving crease.
+    /// The driving crease (a crease pattern of many vertices: its FOLD edge index).
     #[arg(long)]
     pub drive: usize,
     /// Hold crease J at DEG degrees (repeatable), e.g. --lock 1=0.
@@ -167,7 +168,8 @@ pub struct ConstraintsArgs {
     /// Where the samples come from: an exact sweep or an unfolding trajectory.
     #[arg(long, value_enum, default_value_t = SourceArg::Sweep)]
     pub source: SourceArg,
-    /// Driving-angle range A:B in degrees (default: flat to the folded angle).
+    /// Driving-angle range A:B in degrees (default: flat to the folded angle; for many
+    /// vertices from 5% of the folded angle, as the flat state is a branch point).
     #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
     pub range: Option<String>,
     /// Number of sweep samples.
@@ -676,7 +678,11 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         ..LoadOptions::default()
     };
     options.validate().map_err(constraints_flags)?;
-    let pattern = nanofold::io::load_pattern(&args.pattern, &options)?;
+    let pattern = match nanofold::io::load_pattern(&args.pattern, &options) {
+        Ok(pattern) => pattern,
+        Err(e) if takes_many_vertices(&e, &args.pattern) => return folding::run_network_constraints(args, degree),
+        Err(e) => return Err(e.into()),
+    };
     let driver = crease_index(&pattern, args.drive, "--drive")?;
     let locks = args
         .locks

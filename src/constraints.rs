@@ -5,6 +5,7 @@
 
 pub mod chebyshev;
 pub mod exact;
+pub mod network;
 pub mod sweep;
 
 use crate::error::{NanofoldError, NumericalError, Result};

@@ -636,3 +636,39 @@ fn generate_and_fold_refuse_bad_values_by_flag() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn constraints_of_a_folded_crease_pattern_fit_every_crease_against_the_driver() {
+    let dir = temp_dir("network-constraints");
+    let (_, report) = json_run(
+        nanofold()
+            .args([
+                "constraints",
+                "patterns/many/miura_4x4_folded.fold",
+                "--drive",
+                "28",
+                "--degree",
+                "4",
+                "--format",
+                "mujoco",
+                "--json",
+                "--out",
+            ])
+            .arg(&dir),
+    );
+    assert_eq!(report["driver_edge"], 28);
+    assert_eq!(report["curves"].as_array().unwrap().len(), 23);
+    assert!(report["max_closure_residual_rad"].as_f64().unwrap() <= 1e-12);
+    assert!(report["max_fit_error_rad"].as_f64().unwrap() < 1e-3);
+    let xml = std::fs::read_to_string(dir.join("constraints.xml")).unwrap();
+    assert_eq!(xml.matches("joint2=\"crease_28\"").count(), 23);
+    // A flat pattern has no state to sweep from: refused, nothing written.
+    let out = nanofold()
+        .args(["constraints", "patterns/many/miura_4x4.fold", "--drive", "28", "--out"])
+        .arg(dir.join("flat"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("folded state"));
+    assert!(!dir.join("flat").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

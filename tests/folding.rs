@@ -517,3 +517,46 @@ fn the_sparse_dof_count_agrees_with_the_pivoted_qr() {
         assert!(sparse.smallest_kept > 100.0 * sparse.threshold, "{name}: {sparse:?}");
     }
 }
+
+/// Constraint curves of a Miura-ori: the exact sweep is the closed form at every point, and
+/// the fit's error, measured at points it did not see, falls with the degree.
+#[test]
+fn miura_constraint_curves_follow_the_closed_form() {
+    use nanofold::constraints::network::{fit_network, fit_network_to_tolerance, network_mujoco, network_sweep};
+    let model = miura(4, 4, 60.0, 100.0);
+    let rho = model.given_fold_angles();
+    // Drive a valley zigzag crease (positive, |dx| < width).
+    let driver = (0..model.crease_count())
+        .find(|&c| {
+            let [a, b] = model.pattern.edges[model.pattern.creases[c]];
+            (model.pattern.vertices[a][0] - model.pattern.vertices[b][0]).abs() < 0.99 && rho[c] > 0.0
+        })
+        .unwrap();
+    let domain = [5f64.to_radians(), 120f64.to_radians()];
+    let sweep = network_sweep(&model, &rho, driver, domain, 60).unwrap();
+    assert!(sweep.max_closure_residual <= 1e-12);
+    for (theta, state) in sweep.driver_values.iter().zip(&sweep.states) {
+        let expected = miura(4, 4, 60.0, theta.to_degrees()).given_fold_angles();
+        let error = state
+            .iter()
+            .zip(&expected)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(error < 1e-10, "at {:.3}°: {error:e}", theta.to_degrees());
+    }
+    let errors: Vec<f64> = [2, 4, 8]
+        .iter()
+        .map(|&d| fit_network(&model, &sweep, d).unwrap().max_fit_error_rad)
+        .collect();
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+    let auto = fit_network_to_tolerance(&model, &sweep, 1e-6).unwrap();
+    assert!(auto.max_fit_error_rad <= 1e-6 && auto.degree <= 20);
+    let quartic = fit_network(&model, &sweep, 4).unwrap();
+    let xml = network_mujoco(&quartic).unwrap();
+    assert_eq!(xml.matches("<joint ").count(), model.crease_count() - 1);
+    assert!(network_mujoco(&fit_network(&model, &sweep, 5).unwrap()).is_err());
+    // A flat start has many degrees of freedom: refused with the reason.
+    let flat = miura(4, 4, 60.0, 0.0);
+    let error = network_sweep(&flat, &flat.given_fold_angles(), driver, domain, 60).unwrap_err();
+    assert!(error.to_string().contains("degrees of freedom"), "{error}");
+}

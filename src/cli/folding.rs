@@ -426,3 +426,85 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
         "seconds": seconds,
     })
 }
+
+/// `constraints` on a crease pattern of many vertices with one degree of freedom.
+pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usize>) -> Result<()> {
+    use nanofold::constraints::network::{fit_network, fit_network_to_tolerance, network_mujoco, network_sweep};
+    if !args.locks.is_empty() {
+        bail!("--lock is not supported yet for crease patterns of many vertices");
+    }
+    if args.source != super::SourceArg::Sweep {
+        bail!("--source unfold is for single vertices; a crease pattern of many vertices is swept exactly");
+    }
+    let model = load_model(&args.pattern)?;
+    let rho = model.given_fold_angles();
+    let driver = model.column_of_edge.get(args.drive).copied().flatten().with_context(|| {
+        format!(
+            "invalid --drive {}: edge {} is not a crease of {} (for a crease pattern of many vertices --drive is a FOLD edge index)",
+            args.drive, args.drive, model.pattern.name
+        )
+    })?;
+    if rho.iter().all(|&r| r == 0.0) {
+        bail!(
+            "{}: constraint curves of many vertices start from a folded state (e.g. folded.fold written by `nanofold fold`); this pattern is flat",
+            args.pattern.display()
+        );
+    }
+    let domain = match args.range.as_deref() {
+        Some(text) => super::parse_range(text)?,
+        None => {
+            let theta = rho[driver];
+            let (a, b) = (0.05 * theta, theta);
+            [a.min(b), a.max(b)]
+        }
+    };
+    let samples = args.samples.div_ceil(2).max(2);
+    let sweep = network_sweep(&model, &rho, driver, domain, samples).map_err(|e| {
+        flags(
+            e,
+            &[("domain", "--range"), ("samples", "--samples"), ("driver", "--drive")],
+        )
+    })?;
+    let curves = match degree {
+        Some(d) => fit_network(&model, &sweep, d),
+        None => fit_network_to_tolerance(&model, &sweep, args.tol.unwrap_or_default()),
+    }
+    .map_err(|e| flags(e, &[("degree", "--degree"), ("tolerance", "--tol")]))?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_folder(&model.pattern.name, &args.pattern));
+    let mut files = vec![
+        ("constraints.json", serde_json::to_string_pretty(&curves)?),
+        (
+            "constraints.svg",
+            nanofold::plot::folding::network_constraints_svg(&sweep, &curves)?,
+        ),
+    ];
+    if args.format == super::ExportFormat::Mujoco {
+        files.push((
+            "constraints.xml",
+            network_mujoco(&curves).map_err(|e| flags(e, &[("degree", "--degree")]))?,
+        ));
+    }
+    write_outputs(&dir, &files)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&curves)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {} curves of crease {} over [{:.4}°, {:.4}°], degree {}, {} fitted points and {} checked between them; largest fit error {:.3e} rad, closure residual of the sweep {:.1e} rad",
+        model.pattern.name,
+        curves.curves.len(),
+        curves.driver_edge,
+        curves.domain_deg[0],
+        curves.domain_deg[1],
+        curves.degree,
+        curves.samples,
+        curves.samples - 1,
+        curves.max_fit_error_rad,
+        curves.max_closure_residual_rad
+    );
+    print_written(&dir, &files);
+    Ok(())
+}

@@ -128,3 +128,82 @@ pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<St
     }
     Ok(svg)
 }
+
+/// Renders `constraints.svg` for a crease pattern of many vertices: every crease's exact
+/// sweep (dots) and its fit (line) against the driver.
+pub fn network_constraints_svg(
+    sweep: &crate::constraints::network::NetworkSweep,
+    curves: &crate::constraints::network::NetworkCurves,
+) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_error)?;
+        let [a, b] = curves.domain_deg;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "{}: fold angles against crease {} (degree {}, largest error {:.2e} rad)",
+                    curves.pattern, curves.driver_edge, curves.degree, curves.max_fit_error_rad
+                ),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(52)
+            .build_cartesian_2d(axis_range(a, b, 0.02), -180.0..180.0)
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .x_desc(format!("driver: crease {} (deg)", curves.driver_edge))
+            .y_desc("fold angle (deg)")
+            .draw()
+            .map_err(plot_error)?;
+        let shown = evenly(curves.curves.len(), 200);
+        let driver = sweep.driver;
+        let columns: Vec<usize> = (0..sweep.states.first().map_or(0, Vec::len))
+            .filter(|&c| c != driver)
+            .collect();
+        for &i in &shown {
+            let curve = &curves.curves[i];
+            let colour = if curve.assignment == "V" {
+                RGBColor(31, 119, 180)
+            } else {
+                RGBColor(214, 39, 40)
+            };
+            let column = columns[i];
+            chart
+                .draw_series(
+                    sweep
+                        .driver_values
+                        .iter()
+                        .zip(&sweep.states)
+                        .step_by(4)
+                        .map(|(t, s)| Circle::new((t.to_degrees(), s[column].to_degrees()), 2, colour.filled())),
+                )
+                .map_err(plot_error)?;
+            chart
+                .draw_series(LineSeries::new(
+                    (0..=200).map(|k| {
+                        let t = curves.domain_rad[0] + (curves.domain_rad[1] - curves.domain_rad[0]) * k as f64 / 200.0;
+                        (t.to_degrees(), curve.chebyshev.eval(t).to_degrees())
+                    }),
+                    colour.stroke_width(1),
+                ))
+                .map_err(plot_error)?;
+        }
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!(
+                    "{} of {} curves; dots: exact sweep (every 4th point), lines: fits; blue valley, red mountain",
+                    shown.len(),
+                    curves.curves.len()
+                ),
+                (a, 170.0),
+                ("sans-serif", 13),
+            )))
+            .map_err(plot_error)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(svg)
+}
