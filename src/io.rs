@@ -3,6 +3,7 @@
 //! written atomically. Loaders parse and validate; they run no numerics.
 
 pub mod fold;
+pub mod folded_form;
 pub mod folder;
 pub mod folding_output;
 pub mod input;

@@ -560,3 +560,152 @@ fn miura_constraint_curves_follow_the_closed_form() {
     let error = network_sweep(&flat, &flat.given_fold_angles(), driver, domain, 60).unwrap_err();
     assert!(error.to_string().contains("degrees of freedom"), "{error}");
 }
+
+/// Creases that meet at no interior vertex: one diagonal across a square sheet (as FOLD's
+/// own `diagonal-cp.fold` example), and parallel pleats. Each crease is a free hinge.
+#[test]
+fn patterns_without_interior_vertices_fold_crease_by_crease() {
+    use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
+    let diagonal = r#"{"file_spec": 1.1, "vertices_coords": [[0,0],[1,0],[1,1],[0,1]],
+        "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[0,2]],
+        "edges_assignment": ["B","B","B","B","V"]}"#;
+    let cp = nanofold::io::parse_crease_pattern(diagonal, "diagonal", "test").unwrap();
+    assert_eq!((cp.stars.len(), cp.creases.len(), cp.panel_count), (0, 1, 2));
+    let model = FoldingModel::new(cp).unwrap();
+    let report = check_pattern(&model, &CheckSettings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::RigidlyFoldable, "{}", report.evidence);
+    assert_eq!(report.rank.dof, 1);
+    // Folded all the way, the two triangles lie on each other (touching, not crossing).
+    let witness = report.witness.unwrap();
+    let last = witness.steps.last().unwrap();
+    assert!(
+        (last.fold_angles[0] - std::f64::consts::PI).abs() < 1e-9,
+        "{:?}",
+        last.fold_angles
+    );
+    // Pleats: two parallel creases, mountain and valley, folded to ±90°: rigid, 2 DOF.
+    let pleats = r#"{"file_spec": 1.1, "vertices_coords": [[0,0],[1,0],[2,0],[3,0],[3,1],[2,1],[1,1],[0,1]],
+        "edges_vertices": [[0,1],[1,2],[2,3],[3,4],[4,5],[5,6],[6,7],[7,0],[1,6],[2,5]],
+        "edges_assignment": ["B","B","B","B","B","B","B","B","M","V"],
+        "edges_foldAngle": [0,0,0,0,0,0,0,0,-90,90]}"#;
+    let model = FoldingModel::new(nanofold::io::parse_crease_pattern(pleats, "pleats", "test").unwrap()).unwrap();
+    let report = check_pattern(&model, &CheckSettings::default()).unwrap();
+    assert_eq!(
+        (report.verdict, report.rank.dof),
+        (PatternVerdict::Rigid, 2),
+        "{}",
+        report.evidence
+    );
+}
+
+/// A folded form in Origami Simulator's layout (3D vertices with y up, triangulated faces
+/// with F facet edges, `edges_foldAngle` holding ±180 targets or null) built from a rigid
+/// Miura-ori state: developed back, it is the same crease pattern (every edge length) with
+/// the same fold angles; moved off rigidity, it is `not_rigid` with the bend reported.
+fn simulator_export(model: &FoldingModel, rho: &[f64], nudge: f64, clockwise: bool) -> String {
+    let mut poses = Vec::new();
+    panel_poses(model, rho, &mut poses);
+    let mut points = vertex_positions(model, &poses);
+    points[model.stars[0].vertex][2] += nudge;
+    let pattern = &model.pattern;
+    let mut edges: Vec<[usize; 2]> = pattern.edges.clone();
+    let mut letters: Vec<String> = pattern
+        .kinds
+        .iter()
+        .map(|k| match k {
+            EdgeKind::Boundary => "B".into(),
+            EdgeKind::Facet => "F".into(),
+            EdgeKind::Crease(a) => a.letter().into(),
+        })
+        .collect();
+    let mut targets: Vec<serde_json::Value> = pattern
+        .kinds
+        .iter()
+        .map(|k| match k {
+            EdgeKind::Crease(Assignment::Valley) => serde_json::json!(180),
+            EdgeKind::Crease(Assignment::Mountain) => serde_json::json!(-180),
+            _ => serde_json::Value::Null,
+        })
+        .collect();
+    // Every quadrilateral face cut by a facet edge into two triangles.
+    let mut faces = Vec::new();
+    for face in &pattern.faces {
+        assert_eq!(face.len(), 4);
+        for mut triangle in [vec![face[0], face[1], face[2]], vec![face[0], face[2], face[3]]] {
+            if clockwise {
+                triangle.reverse();
+            }
+            faces.push(triangle);
+        }
+        edges.push([face[0], face[2]]);
+        letters.push("F".into());
+        targets.push(serde_json::Value::Null);
+    }
+    // y up: the sheet's (x, y, z) written as (x, z, −y), an orientation-keeping rotation.
+    let coords: Vec<[f64; 3]> = points.iter().map(|p| [p[0], p[2], -p[1]]).collect();
+    serde_json::json!({
+        "file_spec": 1.1,
+        "file_creator": "a test, in Origami Simulator's layout",
+        "file_classes": ["singleModel"],
+        "frame_classes": ["foldedForm"],
+        "frame_attributes": ["3D"],
+        "frame_unit": "unit",
+        "vertices_coords": coords,
+        "edges_vertices": edges,
+        "edges_assignment": letters,
+        "edges_foldAngle": targets,
+        "faces_vertices": faces,
+    })
+    .to_string()
+}
+
+#[test]
+fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
+    use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
+    let model = miura(3, 4, 65.0, 110.0);
+    let rho = model.given_fold_angles();
+    let text = simulator_export(&model, &rho, 0.0, false);
+    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "exported", "test").unwrap()).unwrap();
+    let fit = developed.pattern.folded_form.unwrap();
+    assert!(fit.development_error < 1e-12 && fit.max_facet_angle < 1e-12, "{fit:?}");
+    // The same creases (file order kept) with the same angles, and every edge its length.
+    assert_eq!(developed.pattern.creases, model.pattern.creases);
+    let angles = developed.given_fold_angles();
+    let worst = angles.iter().zip(&rho).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-12, "fold angles differ by {worst:e}");
+    for (e, &[a, b]) in model.pattern.edges.iter().enumerate() {
+        let length = |p: &[[f64; 2]]| (p[a][0] - p[b][0]).hypot(p[a][1] - p[b][1]);
+        assert!(
+            (length(&developed.pattern.vertices) - length(&model.pattern.vertices)).abs() < 1e-12,
+            "edge {e}"
+        );
+    }
+    let report = check_pattern(&developed, &CheckSettings::default()).unwrap();
+    assert_eq!(
+        (report.verdict, report.rank.dof),
+        (PatternVerdict::Rigid, 1),
+        "{}",
+        report.evidence
+    );
+    // Faces listed clockwise: the development is mirrored, and the assignments turn it back.
+    let text = simulator_export(&model, &rho, 0.0, true);
+    let mirrored = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "cw", "test").unwrap()).unwrap();
+    assert!(mirrored.pattern.folded_form.unwrap().mirrored);
+    let worst = mirrored
+        .given_fold_angles()
+        .iter()
+        .zip(&rho)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-12, "mirrored: fold angles differ by {worst:e}");
+    // A compliant simulator's state: one interior vertex lifted by 1e-3.
+    let text = simulator_export(&model, &rho, 1e-3, false);
+    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
+    let report = check_pattern(&developed, &CheckSettings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::NotRigid, "{}", report.evidence);
+    assert!(
+        report.folded_form.unwrap().max_facet_angle > 1e-4,
+        "{:?}",
+        report.folded_form
+    );
+}

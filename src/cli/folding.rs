@@ -423,6 +423,12 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
             "max_closure_residual_rad": w.max_closure_residual,
         })),
         "tried": report.tried,
+        "folded_form": report.folded_form.map(|f| json!({
+            "development_error": f.development_error,
+            "face_nonplanarity": f.face_nonplanarity,
+            "max_facet_angle_rad": f.max_facet_angle,
+            "mirrored": f.mirrored,
+        })),
         "seconds": seconds,
     })
 }

@@ -93,6 +93,8 @@ pub struct CheckReport {
     pub witness: Option<FoldPath>,
     /// What was tried, for an `unknown`.
     pub tried: Vec<String>,
+    /// For a 3D folded form: how far its faces were from a developable, rigid sheet.
+    pub folded_form: Option<crate::pattern::crease_pattern::FoldedFormFit>,
 }
 
 /// Checks the state the pattern carries or, when it is flat, its assignment.
@@ -127,9 +129,28 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
         tree_mismatch: tree_mismatch(model, &rho, &poses),
         witness: None,
         tried: Vec::new(),
+        folded_form: model.pattern.folded_form,
     };
-    if has_state {
-        (report.verdict, report.evidence) = if max_residual > settings.closure_tol {
+    // A folded form whose facets bend or whose faces do not develop into one flat sheet.
+    let bent = model.pattern.folded_form.and_then(|fit| {
+        let facets = (fit.max_facet_angle > settings.closure_tol)
+            .then(|| format!("facets (F edges) bend by up to {:.3e} rad", fit.max_facet_angle));
+        let development = (fit.development_error > settings.closure_tol * model.size).then(|| {
+            format!(
+                "the faces develop with a mismatch of {:.3e} (lengths)",
+                fit.development_error
+            )
+        });
+        let parts: Vec<String> = facets.into_iter().chain(development).collect();
+        (!parts.is_empty()).then(|| parts.join("; "))
+    });
+    if has_state || bent.is_some() {
+        (report.verdict, report.evidence) = if let Some(bent) = bent {
+            (
+                PatternVerdict::NotRigid,
+                format!("the folded form is not rigid: {bent}; worst vertex closure {max_residual:.3e} rad"),
+            )
+        } else if max_residual > settings.closure_tol {
             let list: Vec<String> = worst
                 .iter()
                 .filter(|w| w.1 > settings.closure_tol)

@@ -4,7 +4,7 @@
 
 use crate::error::{NanofoldError, Result};
 use crate::io::input::short_json;
-use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
+use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind, FoldedFormFit};
 use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
 use serde_json::Value;
 use std::f64::consts::TAU;
@@ -81,6 +81,10 @@ fn index(value: &Value, field: &str, bound: usize, what: &str) -> Result<usize> 
 /// names the fold-angle array the file uses.
 pub(crate) struct FoldGraph<'v> {
     pub coords: Vec<[f64; 2]>,
+    /// The coordinates as given, z = 0 for 2D files.
+    pub coords3: Vec<[f64; 3]>,
+    /// Whether some vertex has z ≠ 0 (a folded form, not a crease pattern).
+    pub is_3d: bool,
     pub edges: Vec<[usize; 2]>,
     pub letters: Vec<String>,
     pub angle_key: &'static str,
@@ -122,6 +126,7 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
         }
     }
     let mut coords = Vec::with_capacity(coords_json.len());
+    let mut coords3 = Vec::with_capacity(coords_json.len());
     for (i, c) in coords_json.iter().enumerate() {
         let field = format!("vertices_coords[{i}]");
         let items = c
@@ -136,15 +141,15 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
         }
         let x = number(&items[0], &field)?;
         let y = number(&items[1], &field)?;
-        if items.len() == 3 && number(&items[2], &field)? != 0.0 {
-            return Err(NanofoldError::invalid(
-                &field,
-                short_json(c),
-                "z must be 0: nanofold reads the flat crease pattern and takes the folded state from edges_foldAngle",
-            ));
-        }
+        let z = if items.len() == 3 {
+            number(&items[2], &field)?
+        } else {
+            0.0
+        };
         coords.push([x, y]);
+        coords3.push([x, y, z]);
     }
+    let is_3d = coords3.iter().any(|p| p[2] != 0.0);
     let nv = coords.len();
 
     let edges_json = array(value, "edges_vertices")?;
@@ -242,6 +247,8 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
     };
     Ok(FoldGraph {
         coords,
+        coords3,
+        is_3d,
         edges,
         letters,
         angle_key,
@@ -255,6 +262,8 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
 pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
     let FoldGraph {
         coords,
+        coords3,
+        is_3d,
         edges,
         letters,
         angle_key,
@@ -262,6 +271,14 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         locked,
         faces_vertices,
     } = parse_graph(value, VERTEX_LIMITS)?;
+    if is_3d {
+        let i = coords3.iter().position(|p| p[2] != 0.0).expect("is_3d");
+        return Err(NanofoldError::invalid(
+            format!("vertices_coords[{i}]"),
+            format!("{:?}", coords3[i]),
+            "a single vertex is read from its flat crease pattern (z = 0) with edges_foldAngle; 3D folded forms are read as crease patterns of many vertices (`check`, `fold`)",
+        ));
+    }
     let (nv, ne) = (coords.len(), edges.len());
     let angles_json =
         angles_json.ok_or_else(|| NanofoldError::missing_with("edges_foldAngle", "the folded state, degrees"))?;
@@ -446,10 +463,9 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
 pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePatternBuilder> {
     let graph = parse_graph(value, PATTERN_LIMITS)?;
     let mut kinds = Vec::with_capacity(graph.edges.len());
-    let mut fold_angles = Vec::with_capacity(graph.edges.len());
     for (e, letter) in graph.letters.iter().enumerate() {
         let field = format!("edges_assignment[{e}]");
-        let kind = match letter.as_str() {
+        kinds.push(match letter.as_str() {
             "B" | "b" => EdgeKind::Boundary,
             "F" | "f" => EdgeKind::Facet,
             "C" | "c" => {
@@ -460,7 +476,13 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
                 ))
             }
             other => EdgeKind::Crease(Assignment::from_letter(other, &field)?),
-        };
+        });
+    }
+    if graph.is_3d {
+        return read_folded_form(graph, kinds, name);
+    }
+    let mut fold_angles = Vec::with_capacity(graph.edges.len());
+    for (e, &kind) in kinds.iter().enumerate() {
         let angle_field = format!("{}[{e}]", graph.angle_key);
         let degrees = match graph.angles_json.map(|a| &a[e]) {
             None | Some(Value::Null) if !matches!(kind, EdgeKind::Crease(_)) || graph.angles_json.is_none() => 0.0,
@@ -480,7 +502,6 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
         } else {
             0.0
         });
-        kinds.push(kind);
     }
     Ok(CreasePatternBuilder {
         name: name.to_string(),
@@ -490,5 +511,64 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
         fold_angles,
         faces: graph.faces_vertices,
         angle_field: graph.angle_key.to_string(),
+        folded_form: None,
+    })
+}
+
+/// A 3D folded form: the crease pattern developed from its faces, the state from its
+/// dihedral angles (`edges_foldAngle` is ignored: Origami Simulator writes the targets there).
+fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> Result<CreasePatternBuilder> {
+    let Some(faces) = graph.faces_vertices else {
+        return Err(NanofoldError::missing_with(
+            "faces_vertices",
+            "a 3D folded form is developed into its crease pattern face by face",
+        ));
+    };
+    let development = crate::io::folded_form::develop(&graph.coords3, &graph.edges, &faces)?;
+    // Faces listed clockwise give a mirrored development with every angle's sign flipped:
+    // the assignments say which way round the file is.
+    let (mut agree, mut disagree) = (0usize, 0usize);
+    for (kind, &rho) in kinds.iter().zip(&development.fold_angles) {
+        let sign = match kind {
+            EdgeKind::Crease(Assignment::Valley) => 1.0,
+            EdgeKind::Crease(Assignment::Mountain) => -1.0,
+            _ => 0.0,
+        };
+        if sign * rho > 0.0 {
+            agree += 1;
+        } else if sign * rho < 0.0 {
+            disagree += 1;
+        }
+    }
+    let mirrored = disagree > agree;
+    let flip = if mirrored { -1.0 } else { 1.0 };
+    let vertices = development.vertices.iter().map(|p| [flip * p[0], p[1]]).collect();
+    let mut max_facet_angle: f64 = 0.0;
+    let fold_angles = kinds
+        .iter()
+        .zip(&development.fold_angles)
+        .map(|(kind, &rho)| match kind {
+            EdgeKind::Crease(_) => flip * rho,
+            EdgeKind::Facet => {
+                max_facet_angle = max_facet_angle.max(rho.abs());
+                0.0
+            }
+            EdgeKind::Boundary => 0.0,
+        })
+        .collect();
+    Ok(CreasePatternBuilder {
+        name: name.to_string(),
+        vertices,
+        edges: graph.edges,
+        kinds,
+        fold_angles,
+        faces: None,
+        angle_field: "dihedral angle of the 3D faces".into(),
+        folded_form: Some(FoldedFormFit {
+            development_error: development.development_error,
+            face_nonplanarity: development.face_nonplanarity,
+            max_facet_angle,
+            mirrored,
+        }),
     })
 }

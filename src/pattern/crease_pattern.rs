@@ -41,6 +41,25 @@ pub struct CreasePatternBuilder {
     pub faces: Option<Vec<Vec<usize>>>,
     /// How the input names the fold-angle array (for errors), e.g. `edges_foldAngle`.
     pub angle_field: String,
+    /// How far a folded form's faces were from a rigid, developable sheet (None for a
+    /// crease pattern read flat).
+    pub folded_form: Option<FoldedFormFit>,
+}
+
+/// What developing a 3D folded form into its crease pattern measured
+/// (`docs/model.md#folded-forms`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FoldedFormFit {
+    /// Largest distance between two placements of one vertex by different faces (0 for a
+    /// developable form), in the file's length unit.
+    pub development_error: f64,
+    /// Largest distance of a vertex from its face's plane.
+    pub face_nonplanarity: f64,
+    /// Largest |dihedral angle| across a facet (F) edge: how much the panels bend, rad.
+    pub max_facet_angle: f64,
+    /// Whether the faces were listed clockwise (the development was mirrored so that
+    /// valleys come out positive).
+    pub mirrored: bool,
 }
 
 /// The creases around one interior vertex, counter-clockwise.
@@ -82,6 +101,8 @@ pub struct CreasePattern {
     pub stars: Vec<VertexStar>,
     /// The paper's outline, a counter-clockwise vertex loop.
     pub outline: Vec<usize>,
+    /// For a 3D folded form: how far it was from rigid and developable.
+    pub folded_form: Option<FoldedFormFit>,
 }
 
 impl CreasePatternBuilder {
@@ -95,6 +116,7 @@ impl CreasePatternBuilder {
             fold_angles,
             faces: given_faces,
             angle_field,
+            folded_form,
         } = self;
         let (nv, ne) = (vertices.len(), edges.len());
         if edges.len() > MAX_EDGES {
@@ -207,6 +229,7 @@ impl CreasePatternBuilder {
             creases,
             stars,
             outline,
+            folded_form,
         })
     }
 }
@@ -614,6 +637,7 @@ mod tests {
             fold_angles: vec![0.0, 0.0, 0.0, 0.0, 1.0],
             faces: Some(vec![vec![0, 1, 2], vec![0, 2, 3]]),
             angle_field: "edges_foldAngle".into(),
+            folded_form: None,
         };
         let cp = b.build().unwrap();
         assert_eq!(
@@ -688,6 +712,7 @@ mod tests {
             fold_angles: vec![0.0; 6],
             faces: None,
             angle_field: "edges_foldAngle".into(),
+            folded_form: None,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("cross"), "{e}");
@@ -703,6 +728,7 @@ mod tests {
             fold_angles: vec![0.0; 5],
             faces: None,
             angle_field: "edges_foldAngle".into(),
+            folded_form: None,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("inside another edge"), "{e}");
