@@ -672,3 +672,17 @@ fn constraints_of_a_folded_crease_pattern_fit_every_crease_against_the_driver() 
     assert!(!dir.join("flat").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn check_reads_a_folded_form_exported_by_origami_simulator() {
+    let (_, value) = json_run(nanofold().args(["check", "--json", "tests/fixtures/origami-simulator/simple_50.fold"]));
+    // Three creases that end on the sheet's edge: no vertex closure, each a free hinge.
+    assert_eq!(value["verdict"], "rigid", "{value}");
+    assert_eq!(value["creases"], 3);
+    assert_eq!(value["dof"], 3);
+    let form = &value["folded_form"];
+    assert!(form["development_error"].as_f64().unwrap() < 1e-9, "{form}");
+    assert!(form["max_facet_angle_rad"].as_f64().unwrap() < 1e-9, "{form}");
+    // Valleys came out positive without mirroring: the faces are counter-clockwise.
+    assert_eq!(form["mirrored"], false);
+}

@@ -709,3 +709,17 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
         report.folded_form
     );
 }
+
+/// The Origami Simulator export folded "to 50%": every crease near ±90°, with its sign.
+#[test]
+fn the_simulator_fixture_is_half_folded() {
+    let cp = nanofold::io::load_crease_pattern(Path::new("tests/fixtures/origami-simulator/simple_50.fold")).unwrap();
+    for &e in &cp.creases {
+        let degrees = cp.fold_angles[e].to_degrees();
+        let sign = match cp.kinds[e] {
+            EdgeKind::Crease(Assignment::Valley) => 1.0,
+            _ => -1.0,
+        };
+        assert!(sign * degrees > 60.0 && sign * degrees < 120.0, "edge {e}: {degrees}°");
+    }
+}
