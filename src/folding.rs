@@ -19,4 +19,4 @@ pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{
     jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, RankMethod, RankReport, DENSE_RANK_LIMIT, RANK_TOL,
 };
-pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, PatternVerdict};
+pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, FlatFoldability, PatternVerdict};

@@ -723,3 +723,37 @@ fn the_simulator_fixture_is_half_folded() {
         assert!(sign * degrees > 60.0 && sign * degrees < 120.0, "edge {e}: {degrees}°");
     }
 }
+
+/// Kawasaki and Maekawa, counted by hand: every Miura vertex satisfies both; flipping a
+/// crease that only one vertex holds breaks Maekawa there and nowhere else.
+#[test]
+fn flat_foldability_conditions_are_reported_per_vertex() {
+    use nanofold::folding::FlatFoldability;
+    let spec = MiuraSpec {
+        rows: 3,
+        cols: 3,
+        sector_angle: 70f64.to_radians(),
+        ..MiuraSpec::default()
+    };
+    let mut builder = spec.build().unwrap();
+    let model = FoldingModel::new(builder.clone().build().unwrap()).unwrap();
+    let conditions = FlatFoldability::of(&model);
+    assert!(conditions.worst_kawasaki.unwrap().1 < 1e-12);
+    assert!(conditions.maekawa_failures.is_empty());
+    let (vertex, edge) = model
+        .stars
+        .iter()
+        .find_map(|star| {
+            star.columns
+                .iter()
+                .find(|&&c| model.stars.iter().filter(|s| s.columns.contains(&c)).count() == 1)
+                .map(|&c| (star.vertex, model.pattern.creases[c]))
+        })
+        .unwrap();
+    builder.kinds[edge] = match builder.kinds[edge] {
+        EdgeKind::Crease(Assignment::Valley) => EdgeKind::Crease(Assignment::Mountain),
+        _ => EdgeKind::Crease(Assignment::Valley),
+    };
+    let flipped = FoldingModel::new(builder.build().unwrap()).unwrap();
+    assert_eq!(FlatFoldability::of(&flipped).maekawa_failures, vec![vertex]);
+}

@@ -423,6 +423,10 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
             "max_closure_residual_rad": w.max_closure_residual,
         })),
         "tried": report.tried,
+        "flat_foldability": json!({
+            "worst_kawasaki": report.flat_foldability.worst_kawasaki.map(|(v, r)| json!({"vertex": v, "residual_rad": number(r)})),
+            "maekawa_failures": report.flat_foldability.maekawa_failures,
+        }),
         "folded_form": report.folded_form.map(|f| json!({
             "development_error": f.development_error,
             "face_nonplanarity": f.face_nonplanarity,

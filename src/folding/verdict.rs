@@ -95,6 +95,69 @@ pub struct CheckReport {
     pub tried: Vec<String>,
     /// For a 3D folded form: how far its faces were from a developable, rigid sheet.
     pub folded_form: Option<crate::pattern::crease_pattern::FoldedFormFit>,
+    /// The local flat-foldability conditions at every interior vertex.
+    pub flat_foldability: FlatFoldability,
+}
+
+/// Kawasaki's and Maekawa's conditions, necessary for a vertex to fold flat: alternate
+/// sector angles sum to π, and mountains and valleys differ by two.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlatFoldability {
+    /// The vertex farthest from Kawasaki's condition and its |Σ alternate sectors − π|, rad.
+    pub worst_kawasaki: Option<(usize, f64)>,
+    /// Vertices whose assignment breaks Maekawa's condition (vertices with a U crease are
+    /// not judged).
+    pub maekawa_failures: Vec<usize>,
+}
+
+impl FlatFoldability {
+    /// The conditions at every star of the model.
+    pub fn of(model: &FoldingModel) -> FlatFoldability {
+        let mut worst_kawasaki: Option<(usize, f64)> = None;
+        let mut maekawa_failures = Vec::new();
+        for star in &model.stars {
+            let alternating: f64 = star.sector_angles.iter().step_by(2).sum();
+            let residual = if star.sector_angles.len() % 2 == 0 {
+                (alternating - std::f64::consts::PI).abs()
+            } else {
+                f64::INFINITY
+            };
+            if worst_kawasaki.is_none_or(|(_, r)| residual > r) {
+                worst_kawasaki = Some((star.vertex, residual));
+            }
+            let signs: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+            if signs.iter().all(|&x| x != 0.0) {
+                let valleys = signs.iter().filter(|&&x| x > 0.0).count() as i64;
+                let mountains = signs.len() as i64 - valleys;
+                if (valleys - mountains).abs() != 2 {
+                    maekawa_failures.push(star.vertex);
+                }
+            }
+        }
+        FlatFoldability {
+            worst_kawasaki,
+            maekawa_failures,
+        }
+    }
+
+    /// One line for the evidence.
+    pub fn summary(&self, vertices: usize) -> String {
+        let kawasaki = match self.worst_kawasaki {
+            None => "no interior vertex".to_string(),
+            Some((_, r)) if r <= 1e-9 => format!("Kawasaki holds at all {vertices} vertices"),
+            Some((v, r)) => format!("Kawasaki fails by up to {r:.3e} rad (vertex {v})"),
+        };
+        let maekawa = if self.maekawa_failures.is_empty() {
+            "Maekawa holds".to_string()
+        } else {
+            format!(
+                "Maekawa fails at {} vertices (first {:?})",
+                self.maekawa_failures.len(),
+                &self.maekawa_failures[..self.maekawa_failures.len().min(5)]
+            )
+        };
+        format!("{kawasaki}; {maekawa}")
+    }
 }
 
 /// Checks the state the pattern carries or, when it is flat, its assignment.
@@ -130,6 +193,7 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
         witness: None,
         tried: Vec::new(),
         folded_form: model.pattern.folded_form,
+        flat_foldability: FlatFoldability::of(model),
     };
     // A folded form whose facets bend or whose faces do not develop into one flat sheet.
     let bent = model.pattern.folded_form.and_then(|fit| {
@@ -247,6 +311,10 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
         drive: Drive::Assignment { to: 1.0 },
         ..settings.path.clone()
     };
+    report.tried.push(format!(
+        "flat-foldability at the vertices: {}",
+        report.flat_foldability.summary(model.stars.len())
+    ));
     let path = fold_path(model, &rho, &path_settings)?;
     let reached = path.steps.last().map_or(0.0, |s| s.progress);
     let fully_assigned = model.pattern.creases.iter().all(|&e| {
