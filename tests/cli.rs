@@ -686,3 +686,53 @@ fn check_reads_a_folded_form_exported_by_origami_simulator() {
     // Valleys came out positive without mirroring: the faces are counter-clockwise.
     assert_eq!(form["mirrored"], false);
 }
+
+#[test]
+fn unfold_fold_reads_back_as_its_input_and_its_frames_follow_the_sign_rule() {
+    use nanofold::pattern::LoadOptions;
+    for name in [
+        "corner_cube.fold",
+        "degree4_locked.fold",
+        "degree4_native.json",
+        "symmetric16.fold",
+    ] {
+        let dir = temp_dir(&format!("roundtrip-{name}"));
+        let out = nanofold()
+            .args(["unfold", &format!("patterns/{name}"), "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let original =
+            nanofold::io::load_pattern(&std::path::Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
+        let again = nanofold::io::load_pattern(&dir.join("unfold.fold"), &LoadOptions::default()).unwrap();
+        assert_eq!(original.sector_angles.len(), again.sector_angles.len(), "{name}");
+        for (a, b) in original.sector_angles.iter().zip(&again.sector_angles) {
+            assert!((a - b).abs() < 1e-12, "{name}: sector {a} vs {b}");
+        }
+        for (a, b) in original.creases.iter().zip(&again.creases) {
+            assert!(
+                (a.folded_angle - b.folded_angle).abs() < 1e-9,
+                "{name}: {} vs {}",
+                a.folded_angle,
+                b.folded_angle
+            );
+            assert_eq!((a.assignment, a.locked), (b.assignment, b.locked), "{name}");
+        }
+        let fold: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("unfold.fold")).unwrap()).unwrap();
+        assert_eq!(fold["frame_classes"][0], "creasePattern");
+        for frame in fold["file_frames"].as_array().unwrap() {
+            let angles = frame["edges_foldAngle"].as_array().unwrap();
+            let letters = frame["edges_assignment"].as_array().unwrap();
+            for (angle, letter) in angles.iter().zip(letters) {
+                let (angle, letter) = (angle.as_f64().unwrap(), letter.as_str().unwrap());
+                assert!(
+                    (angle <= 0.0 || letter == "V") && (angle >= 0.0 || letter == "M"),
+                    "{name}: {angle} {letter}"
+                );
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

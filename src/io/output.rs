@@ -187,40 +187,44 @@ fn edge_angles_degrees(mesh: &ExportMesh, crease_angles: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Builds the FOLD animation: the key frame is the first snapshot, `file_frames` the rest.
+/// FOLD letters of a frame: a crease folded one way is written as that way (M < 0 < V,
+/// FOLD's sign rule), whatever its assignment; a crease at 0 and every other edge keep
+/// their letters.
+fn frame_letters(mesh: &ExportMesh, angles_degrees: &[f64]) -> Vec<String> {
+    mesh.edges_assignment
+        .iter()
+        .zip(&mesh.edge_crease)
+        .zip(angles_degrees)
+        .map(|((letter, crease), &angle)| match crease {
+            Some(_) if angle > 0.0 => "V".to_string(),
+            Some(_) if angle < 0.0 => "M".to_string(),
+            _ => letter.clone(),
+        })
+        .collect()
+}
+
+/// Builds the FOLD animation: the key frame is the crease pattern (2D, `creasePattern`,
+/// the input's assignments) with the folded state it started from in `edges_foldAngle`, so
+/// nanofold reads the file back as its input; `file_frames` are the snapshots, 3D `foldedForm` frames whose
+/// assignments follow their angles.
 pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldReport) -> Value {
     let mesh = export_mesh(pattern);
     let picks = snapshot_indices(report, 11);
-    let frame = |index: usize| {
-        let step = &report.trajectory[index];
-        (
-            place_vertices(pattern, &mesh, &step.nodes),
-            edge_angles_degrees(&mesh, &model.crease_angles(&step.nodes)),
-            step.iteration,
-        )
-    };
-    let (coords0, angles0, _) = if picks.is_empty() {
-        let nodes = model.folded_nodes();
-        (
-            place_vertices(pattern, &mesh, &nodes),
-            edge_angles_degrees(&mesh, &model.crease_angles(&nodes)),
-            0,
-        )
-    } else {
-        frame(picks[0])
-    };
+    let start_nodes = model.folded_nodes();
+    let start_angles = edge_angles_degrees(&mesh, &model.crease_angles(&start_nodes));
     let frames: Vec<Value> = picks
         .iter()
-        .skip(1)
         .map(|&i| {
-            let (coords, angles, iteration) = frame(i);
+            let step = &report.trajectory[i];
+            let angles = edge_angles_degrees(&mesh, &model.crease_angles(&step.nodes));
             json!({
-                "frame_title": format!("iteration {iteration}"),
+                "frame_title": format!("iteration {}", step.iteration),
                 "frame_classes": ["foldedForm"],
                 "frame_attributes": ["3D"],
                 "frame_parent": 0,
                 "frame_inherit": true,
-                "vertices_coords": coords,
+                "vertices_coords": place_vertices(pattern, &mesh, &step.nodes),
+                "edges_assignment": frame_letters(&mesh, &angles),
                 "edges_foldAngle": angles,
             })
         })
@@ -229,15 +233,23 @@ pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldRep
         "file_spec": 1.1,
         "file_creator": "nanofold",
         "file_classes": ["animation"],
-        "frame_title": format!("{}: unfolding, iteration 0 (verdict {})", pattern.name, report.verdict.as_str()),
-        "frame_classes": ["foldedForm"],
-        "frame_attributes": ["3D"],
-        "vertices_coords": coords0,
+        "frame_title": format!("{}: crease pattern and folded state (unfolding verdict {})", pattern.name, report.verdict.as_str()),
+        "frame_classes": ["creasePattern"],
+        "frame_attributes": ["2D"],
+        "vertices_coords": mesh.coords_2d,
         "edges_vertices": mesh.edges_vertices,
         "edges_assignment": mesh.edges_assignment,
-        "edges_foldAngle": angles0,
+        "edges_foldAngle": start_angles,
         "file_frames": frames,
     });
+    if pattern.creases.iter().any(|c| c.locked) {
+        let locked: Vec<bool> = mesh
+            .edge_crease
+            .iter()
+            .map(|c| c.is_some_and(|i| pattern.creases[i].locked))
+            .collect();
+        root[crate::io::fold::LOCKED_KEY] = json!(locked);
+    }
     if let Some(faces) = mesh.faces_vertices {
         root["faces_vertices"] = json!(faces);
     }
