@@ -13,6 +13,7 @@ pub mod checks;
 pub mod energy;
 pub mod manifold;
 pub mod model;
+pub mod network;
 pub mod observe;
 pub mod qp;
 pub mod settings;

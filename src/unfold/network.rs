@@ -1,0 +1,404 @@
+//! Energy unfolding of crease patterns with many vertices
+//! (`docs/model.md#energy-unfolding-of-many-vertices`): the state is the fold angles on the
+//! manifold where every vertex closes; the energy is the sum of every vertex's own spherical
+//! energy; the direction is the negative gradient projected onto the null space of the
+//! closure Jacobian; each step is restored by Newton and refused if panels cross.
+
+use crate::error::{NanofoldError, Result};
+use crate::folding::normal::NormalSolver;
+use crate::folding::{
+    closure_jacobian, jacobian_rank, panel_contacts, panel_poses, restore_closure, vertex_residuals, ContactSettings,
+    FoldingModel,
+};
+use crate::geometry::kinematics::forward;
+use crate::geometry::sphere::Vec3;
+use crate::unfold::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
+use std::f64::consts::PI;
+
+/// One vertex's spherical linkage for the energy: its rays (creases and the flat rays that
+/// split sectors of π or more, as the single vertex does) and their arcs.
+#[derive(Debug, Clone)]
+struct EnergyStar {
+    /// Sector angles after splitting.
+    sector_angles: Vec<f64>,
+    /// The fold-angle column of each ray (None: a flat splitting ray).
+    columns: Vec<Option<usize>>,
+    arcs: Vec<Arc>,
+}
+
+/// Σ_v U_v(ρ) over the vertices, with its gradient in fold-angle coordinates.
+pub struct NetworkEnergy {
+    energy: Box<dyn Energy>,
+    stars: Vec<EnergyStar>,
+}
+
+impl NetworkEnergy {
+    /// The energy `kind` (exponent `p`, or its default) at every vertex of `model`.
+    pub fn new(model: &FoldingModel, kind: EnergyKind, p: Option<f64>) -> NetworkEnergy {
+        let stars = model
+            .stars
+            .iter()
+            .map(|star| {
+                let mut sector_angles = Vec::new();
+                let mut columns = Vec::new();
+                for (k, &alpha) in star.sector_angles.iter().enumerate() {
+                    let pieces = if alpha >= PI {
+                        (alpha / (PI / 2.0)).ceil() as usize
+                    } else {
+                        1
+                    };
+                    for piece in 0..pieces {
+                        columns.push(if piece == 0 { Some(star.columns[k]) } else { None });
+                        sector_angles.push(alpha / pieces as f64);
+                    }
+                }
+                let n = sector_angles.len();
+                let arcs = (0..n)
+                    .map(|k| Arc {
+                        a: k,
+                        b: (k + 1) % n,
+                        length: sector_angles[k],
+                    })
+                    .collect();
+                EnergyStar {
+                    sector_angles,
+                    columns,
+                    arcs,
+                }
+            })
+            .collect();
+        NetworkEnergy {
+            energy: kind.build(p),
+            stars,
+        }
+    }
+
+    fn nodes(star: &EnergyStar, fold_angles: &[f64]) -> Vec<Vec3> {
+        let by_ray: Vec<f64> = star.columns.iter().map(|c| c.map_or(0.0, |c| fold_angles[c])).collect();
+        forward(&star.sector_angles, &by_ray)
+    }
+
+    /// U(ρ); infinite when some vertex's sectors touch.
+    pub fn value(&self, fold_angles: &[f64], ws: &mut EnergyWorkspace) -> f64 {
+        self.stars
+            .iter()
+            .map(|star| self.energy.value(&Self::nodes(star, fold_angles), &star.arcs, ws))
+            .sum()
+    }
+
+    /// U(ρ) and ∂U/∂ρ (overwrites `gradient`). Node k of a vertex turns about the axis of
+    /// every ray j < k by that ray's fold angle, ∂x_k/∂ρ_j = x_j × x_k, so
+    /// ∂U_v/∂ρ_j = x_j · Σ_{k>j} x_k × ∂U_v/∂x_k (ray 0's angle closes the loop and moves no
+    /// node: on the manifold it follows the others).
+    pub fn value_and_gradient(&self, fold_angles: &[f64], ws: &mut EnergyWorkspace, gradient: &mut [f64]) -> f64 {
+        gradient.iter_mut().for_each(|g| *g = 0.0);
+        let mut total = 0.0;
+        let mut node_gradient: Vec<Vec3> = Vec::new();
+        for star in &self.stars {
+            let nodes = Self::nodes(star, fold_angles);
+            node_gradient.clear();
+            node_gradient.resize(nodes.len(), Vec3::zeros());
+            total += self
+                .energy
+                .value_and_gradient(&nodes, &star.arcs, ws, &mut node_gradient);
+            let mut suffix = Vec3::zeros();
+            for j in (1..nodes.len()).rev() {
+                if let Some(c) = star.columns[j] {
+                    gradient[c] += nodes[j].dot(&suffix);
+                }
+                suffix += nodes[j].cross(&node_gradient[j]);
+            }
+        }
+        total
+    }
+}
+
+/// A step towards flat goes at most this fraction of the way to the first crease's zero.
+const FLAT_APPROACH: f64 = 0.9;
+
+/// A line search that stalls within this of flat (max |ρ|, rad) ends the descent there.
+const STALL_TOL: f64 = 1e-4;
+
+/// Settings of a many-vertex unfolding.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkUnfoldSettings {
+    /// Which energy.
+    pub energy: EnergyKind,
+    /// Its exponent (None: the energy's default).
+    pub p: Option<f64>,
+    /// Flat when every |fold angle| is at most this, rad.
+    pub flat_tol: f64,
+    /// Most descent steps.
+    pub max_iterations: usize,
+    /// Largest change of any fold angle in one step, rad.
+    pub max_step: f64,
+    /// Closure tolerance after every step, rad per vertex.
+    pub closure_tol: f64,
+    /// Panel contact test at every step.
+    pub contact: ContactSettings,
+}
+
+impl Default for NetworkUnfoldSettings {
+    fn default() -> Self {
+        NetworkUnfoldSettings {
+            energy: EnergyKind::Separable,
+            p: None,
+            flat_tol: 1e-6,
+            max_iterations: 20_000,
+            max_step: 0.1,
+            closure_tol: 1e-11,
+            contact: ContactSettings {
+                search: 0.1,
+                ..ContactSettings::default()
+            },
+        }
+    }
+}
+
+/// The verdict of a many-vertex unfolding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NetworkVerdict {
+    /// Every fold angle reached the flat tolerance along a rigid path.
+    Flat,
+    /// No rigid motion at the start (0 degrees of freedom).
+    Locked,
+    /// The projected gradient vanished away from flat.
+    LocalMinimum,
+    /// Every step the line search tried put panels through each other.
+    Blocked,
+    /// The iteration budget ran out.
+    IterationLimit,
+}
+
+impl NetworkVerdict {
+    /// The name used in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NetworkVerdict::Flat => "flat",
+            NetworkVerdict::Locked => "locked",
+            NetworkVerdict::LocalMinimum => "local_minimum",
+            NetworkVerdict::Blocked => "blocked",
+            NetworkVerdict::IterationLimit => "iteration_limit",
+        }
+    }
+}
+
+/// One accepted state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkStep {
+    /// Energy.
+    pub energy: f64,
+    /// Fold angles, rad.
+    pub fold_angles: Vec<f64>,
+    /// Largest vertex closure residual, rad.
+    pub max_residual: f64,
+}
+
+/// What a many-vertex unfolding found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkReport {
+    /// The verdict.
+    pub verdict: NetworkVerdict,
+    /// Its evidence in words.
+    pub evidence: String,
+    /// Descent steps taken.
+    pub iterations: usize,
+    /// Every accepted state, the start first (the last is the flat state for `Flat`).
+    pub steps: Vec<NetworkStep>,
+    /// Largest vertex closure residual over the path, rad.
+    pub max_closure_residual: f64,
+    /// Trial steps refused because panels would cross.
+    pub crossings_refused: usize,
+}
+
+/// Unfolds a rigid state of `model` by projected gradient descent on the summed vertex
+/// energies.
+pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> Result<NetworkReport> {
+    settings.contact.validate()?;
+    if !(settings.flat_tol > 0.0 && settings.flat_tol <= 0.1) {
+        return Err(NanofoldError::invalid(
+            "flat_tol",
+            settings.flat_tol,
+            "must lie in (0, 0.1] rad",
+        ));
+    }
+    if !(settings.max_step > 0.0 && settings.max_step <= 1.0) {
+        return Err(NanofoldError::invalid(
+            "max_step",
+            settings.max_step,
+            "must lie in (0, 1] rad",
+        ));
+    }
+    let n = model.crease_count();
+    if start.len() != n {
+        return Err(NanofoldError::invalid(
+            "start",
+            format!("{} fold angles", start.len()),
+            format!("one per crease ({n})"),
+        ));
+    }
+    let residual = vertex_residuals(model, start).into_iter().fold(0.0, f64::max);
+    if residual > 1e-6 {
+        return Err(NanofoldError::invalid(
+            "start",
+            format!("closure residual {residual:.3e} rad"),
+            "the start is not a rigid state (a vertex is more than 1e-6 rad from closing)",
+        ));
+    }
+    let energy = NetworkEnergy::new(model, settings.energy, settings.p);
+    let mut solver = NormalSolver::new(1e-10);
+    let mut ws = EnergyWorkspace::default();
+    let mut rho = start.to_vec();
+    if restore_closure(model, &mut rho, settings.closure_tol, &mut solver)?.is_none() {
+        return Err(NanofoldError::invalid(
+            "start",
+            format!("closure residual {residual:.3e} rad"),
+            "Newton could not close every vertex from it",
+        ));
+    }
+    let worst = |rho: &[f64]| vertex_residuals(model, rho).into_iter().fold(0.0, f64::max);
+    let mut gradient = vec![0.0; n];
+    let mut u = energy.value_and_gradient(&rho, &mut ws, &mut gradient);
+    let mut steps = vec![NetworkStep {
+        energy: u,
+        fold_angles: rho.clone(),
+        max_residual: worst(&rho),
+    }];
+    let mut crossings_refused = 0;
+    let mut poses = Vec::new();
+    let mut scale = 1.0;
+    let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused| {
+        let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
+        Ok(NetworkReport {
+            verdict,
+            evidence,
+            iterations,
+            steps,
+            max_closure_residual,
+            crossings_refused,
+        })
+    };
+    if jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
+        return finish(
+            NetworkVerdict::Locked,
+            "0 degrees of freedom at the start: no rigid motion".into(),
+            0,
+            steps,
+            0,
+        );
+    }
+    for iteration in 0..settings.max_iterations {
+        let largest = rho.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        if largest <= settings.flat_tol {
+            let mut flat = steps.last().expect("the start").clone();
+            flat.fold_angles.iter_mut().for_each(|r| *r = 0.0);
+            flat.energy = energy.value(&flat.fold_angles, &mut ws);
+            flat.max_residual = 0.0;
+            steps.push(flat);
+            return finish(
+                NetworkVerdict::Flat,
+                format!("every fold angle within {:.0e} rad after {iteration} steps (max |ρ| = {largest:.1e}), then set to 0", settings.flat_tol),
+                iteration,
+                steps,
+                crossings_refused,
+            );
+        }
+        let factor = solver.factor(&closure_jacobian(model, &rho))?;
+        let descent: Vec<f64> = factor.project(&gradient.iter().map(|g| -g).collect::<Vec<_>>());
+        let size = descent.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        let slope: f64 = gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
+        if size <= 1e-14 || slope >= 0.0 {
+            return finish(
+                NetworkVerdict::LocalMinimum,
+                format!("the projected gradient vanishes (|d| = {size:.1e}) with max |ρ| = {largest:.3e} rad"),
+                iteration,
+                steps,
+                crossings_refused,
+            );
+        }
+        let mut t = (settings.max_step / size) * scale;
+        // No crease may pass through flat in one step: the flat state is where the branches
+        // of the folding motion cross, and beyond it lies the mirrored state, not progress.
+        for (r, d) in rho.iter().zip(&descent) {
+            if r * d < 0.0 && r.abs() > settings.flat_tol {
+                t = t.min(FLAT_APPROACH * (r / d).abs());
+            }
+        }
+        let mut accepted = None;
+        let mut refused_for_crossing = false;
+        for _ in 0..50 {
+            let mut trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
+            if restore_closure(model, &mut trial, settings.closure_tol, &mut solver)?.is_some() {
+                let mut trial_gradient = vec![0.0; n];
+                let u_trial = energy.value_and_gradient(&trial, &mut ws, &mut trial_gradient);
+                if u_trial.is_finite() && u_trial <= u + 1e-4 * t * slope {
+                    panel_poses(model, &trial, &mut poses);
+                    if panel_contacts(model, &poses, &settings.contact)
+                        .crossing()
+                        .next()
+                        .is_none()
+                    {
+                        accepted = Some((trial, u_trial, trial_gradient));
+                        break;
+                    }
+                    crossings_refused += 1;
+                    refused_for_crossing = true;
+                }
+            }
+            t /= 2.0;
+        }
+        // Within STALL_TOL of flat a step that does not lower the energy at all is lost in
+        // its rounding: count it as the line search stalling.
+        let accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
+        let Some((next, u_next, g_next)) = accepted else {
+            if largest <= STALL_TOL && !refused_for_crossing {
+                // The energy's changes are below its rounding this close to flat; the flat
+                // state is rigid and the descent was heading there.
+                let mut flat = steps.last().expect("the start").clone();
+                flat.fold_angles.iter_mut().for_each(|r| *r = 0.0);
+                flat.energy = energy.value(&flat.fold_angles, &mut ws);
+                flat.max_residual = 0.0;
+                steps.push(flat);
+                return finish(
+                    NetworkVerdict::Flat,
+                    format!("the line search stalled {largest:.1e} rad from flat (within {STALL_TOL:.0e}, where the energy's changes are at its rounding), then set to 0"),
+                    iteration,
+                    steps,
+                    crossings_refused,
+                );
+            }
+            let (verdict, why) = if refused_for_crossing {
+                (
+                    NetworkVerdict::Blocked,
+                    "every shorter step still puts panels through each other",
+                )
+            } else {
+                (NetworkVerdict::LocalMinimum, "the line search found no decrease")
+            };
+            return finish(
+                verdict,
+                format!("{why} (max |ρ| = {largest:.3e} rad)"),
+                iteration,
+                steps,
+                crossings_refused,
+            );
+        };
+        // Next time try twice the fraction of the largest step this one used.
+        scale = (2.0 * t * size / settings.max_step).clamp(1e-6, 1.0);
+        rho = next;
+        u = u_next;
+        gradient = g_next;
+        steps.push(NetworkStep {
+            energy: u,
+            fold_angles: rho.clone(),
+            max_residual: worst(&rho),
+        });
+    }
+    finish(
+        NetworkVerdict::IterationLimit,
+        format!("{} steps", settings.max_iterations),
+        settings.max_iterations,
+        steps,
+        crossings_refused,
+    )
+}
