@@ -427,7 +427,13 @@ fn unfold_one(
 ) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
-    let pattern = nanofold::io::load_pattern(pattern_path, &solver.load_options())?;
+    let pattern = match nanofold::io::load_pattern(pattern_path, &solver.load_options()) {
+        Ok(pattern) => pattern,
+        Err(e) if takes_many_vertices(&e, pattern_path) => {
+            return folding::unfold_network_one(pattern_path, solver, dir)
+        }
+        Err(e) => return Err(e.into()),
+    };
     let report = unfold_observed(&pattern, &settings, progress)?;
     let model = UnfoldModel::new(&pattern);
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);

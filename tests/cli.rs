@@ -736,3 +736,51 @@ fn unfold_fold_reads_back_as_its_input_and_its_frames_follow_the_sign_rule() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn unfold_takes_a_folded_crease_pattern_of_many_vertices() {
+    let dir = temp_dir("unfold-network");
+    let (_, summary) = json_run(
+        nanofold()
+            .args(["unfold", "patterns/many/miura_4x4_folded.fold", "--json", "--out"])
+            .arg(&dir),
+    );
+    assert_eq!(summary["verdict"], "flat", "{summary}");
+    for key in [
+        "iterations",
+        "seconds",
+        "energy_initial",
+        "energy_final",
+        "final_fold_angles_rad",
+        "max_closure_residual_rad",
+        "flat_layout_error",
+    ] {
+        assert!(summary.get(key).is_some(), "missing {key}");
+    }
+    assert!(summary["max_closure_residual_rad"].as_f64().unwrap() <= 1e-10);
+    assert!(summary["flat_layout_error"].as_f64().unwrap() <= 1e-12);
+    // The animation's key frame is the folded input: read back, it is the same state.
+    let (_, check) = json_run(nanofold().args(["check", "--json"]).arg(dir.join("unfold.fold")));
+    assert_eq!(check["verdict"], "rigid", "{check}");
+    let original: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/many/miura_4x4_folded.fold").unwrap()).unwrap();
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("unfold.fold")).unwrap()).unwrap();
+    for (a, b) in original["edges_foldAngle"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(written["edges_foldAngle"].as_array().unwrap())
+    {
+        assert!((a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-9);
+    }
+    assert_eq!(original["edges_assignment"], written["edges_assignment"]);
+    // A state that needs bending gets its verdict, not an error.
+    let (_, bent) = json_run(
+        nanofold()
+            .args(["unfold", "patterns/many/miura_4x4_bent.fold", "--json", "--out"])
+            .arg(dir.join("bent")),
+    );
+    assert_eq!(bent["verdict"], "not_rigid", "{bent}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

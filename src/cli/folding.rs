@@ -518,3 +518,139 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
     print_written(&dir, &files);
     Ok(())
 }
+
+/// `unfold` of a crease pattern of many vertices (`docs/model.md#energy-unfolding-of-many-vertices`):
+/// returns the JSON summary and the human-readable lines.
+pub fn unfold_network_one(
+    pattern_path: &Path,
+    solver: &super::SolverArgs,
+    dir: Option<&Path>,
+) -> Result<(Value, String)> {
+    use nanofold::io::folding_output::states_fold;
+    use nanofold::plot::folding::angles_svg;
+    use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
+    use std::fmt::Write as _;
+    let model = load_model(pattern_path)?;
+    let settings = NetworkUnfoldSettings {
+        energy: solver.energy.into(),
+        p: solver.p,
+        flat_tol: solver.flat_tol,
+        max_iterations: solver.max_iter,
+        ..NetworkUnfoldSettings::default()
+    };
+    let start_state = model.given_fold_angles();
+    let clock = Instant::now();
+    let report = unfold_network(&model, &start_state, &settings)
+        .map_err(|e| flags(e, &[("flat_tol", "--flat-tol"), ("start", "edges_foldAngle")]))?;
+    let seconds = clock.elapsed().as_secs_f64();
+    let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);
+    let last = report.steps.last().expect("the start is recorded");
+    // How far the end lies from the flat crease pattern and from the plane.
+    let mut poses = Vec::new();
+    nanofold::folding::panel_poses(&model, &last.fold_angles, &mut poses);
+    let placed = nanofold::folding::vertex_positions(&model, &poses);
+    let flat_layout_error = placed
+        .iter()
+        .zip(&model.pattern.vertices)
+        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + p[2] * p[2]).sqrt())
+        .fold(0.0, f64::max);
+    let planarity = placed.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+    // Outputs: 11 snapshots, the trajectory thinned to 1000 steps.
+    let snapshots = evenly(report.steps.len(), 11);
+    let frames: Vec<(String, &[f64])> = snapshots
+        .iter()
+        .map(|&i| {
+            (
+                format!("step {i}, energy {:.6e}", report.steps[i].energy),
+                report.steps[i].fold_angles.as_slice(),
+            )
+        })
+        .collect();
+    let fold = states_fold(
+        &model,
+        Some(&start_state),
+        &frames,
+        "unfolding written by nanofold unfold",
+    );
+    let written = evenly(report.steps.len(), 1000);
+    let trajectory = json!({
+        "pattern": model.pattern.name,
+        "units": {"angles": "rad"},
+        "creases_edge_index": model.pattern.creases,
+        "verdict": report.verdict.as_str(),
+        "evidence": report.evidence,
+        "recorded_steps": report.steps.len(),
+        "steps_written": written.len(),
+        "steps": written.iter().map(|&i| json!({
+            "step": i,
+            "energy": number(report.steps[i].energy),
+            "fold_angles_rad": report.steps[i].fold_angles,
+            "max_closure_residual_rad": report.steps[i].max_residual,
+        })).collect::<Vec<_>>(),
+    });
+    let xs: Vec<f64> = (0..report.steps.len()).map(|i| i as f64).collect();
+    let states: Vec<&[f64]> = report.steps.iter().map(|s| s.fold_angles.as_slice()).collect();
+    let title = format!(
+        "{}: fold angles while unfolding ({}, {} steps)",
+        model.pattern.name,
+        report.verdict.as_str(),
+        report.iterations
+    );
+    let svg = angles_svg(&model, &xs, &states, "step", "step", &title)?;
+    let files = [
+        ("trajectory.json", serde_json::to_string(&trajectory)?),
+        ("unfold.fold", serde_json::to_string_pretty(&fold)?),
+        ("unfold.svg", svg),
+    ];
+    write_outputs(&dir, &files)?;
+    let summary = json!({
+        "pattern": model.pattern.name,
+        "file": pattern_path.display().to_string(),
+        "verdict": report.verdict.as_str(),
+        "evidence": report.evidence,
+        "iterations": report.iterations,
+        "seconds": seconds,
+        "energy_initial": number(report.steps[0].energy),
+        "energy_final": number(last.energy),
+        "initial_fold_angles_rad": start_state,
+        "final_fold_angles_rad": last.fold_angles,
+        "crease_labels": model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect::<Vec<_>>(),
+        "max_arc_residual": Value::Null,
+        "planarity_residual": planarity,
+        "flat_layout_error": flat_layout_error,
+        "restarts_used": 0,
+        "crossings_refused": report.crossings_refused,
+        "adjustments": Vec::<String>::new(),
+        "max_closure_residual_rad": report.max_closure_residual,
+        "out": dir.display().to_string(),
+    });
+    let mut text = String::new();
+    writeln!(
+        text,
+        "{}: {} ({})",
+        model.pattern.name,
+        report.verdict.as_str(),
+        report.evidence
+    )?;
+    writeln!(
+        text,
+        "  {} creases at {} vertices: {} steps in {:.3} s; energy {:.6e} -> {:.6e}",
+        model.crease_count(),
+        model.stars.len(),
+        report.iterations,
+        seconds,
+        report.steps[0].energy,
+        last.energy
+    )?;
+    writeln!(
+        text,
+        "  worst vertex closure over the path {:.2e} rad; flat layout error {:.2e}; {} steps refused for crossing panels",
+        report.max_closure_residual, flat_layout_error, report.crossings_refused
+    )?;
+    write!(
+        text,
+        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold}}",
+        dir.display()
+    )?;
+    Ok((summary, text))
+}

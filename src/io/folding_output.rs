@@ -69,19 +69,45 @@ pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>,
 /// The folding path as FOLD: the crease pattern (flat, 2D) is the key frame; each chosen
 /// step is a 3D `foldedForm` frame with its fold angles and the assignments they imply.
 pub fn fold_path_fold(model: &FoldingModel, path: &FoldPath, chosen: &[usize]) -> Value {
-    let pattern = &model.pattern;
-    let mut root = crease_pattern_fold(pattern, None, "folding path written by nanofold fold");
-    root["file_classes"] = json!(["animation"]);
-    root["frame_title"] = json!(format!("{}: crease pattern", pattern.name));
-    let mut poses = Vec::new();
-    let frames: Vec<Value> = chosen
+    let frames: Vec<(String, &[f64])> = chosen
         .iter()
         .map(|&i| {
             let step = &path.steps[i];
-            panel_poses(model, &step.fold_angles, &mut poses);
-            let (angles, letters) = edge_arrays(pattern, &step.fold_angles);
+            (
+                format!("progress {:.4} (step {i})", step.progress),
+                step.fold_angles.as_slice(),
+            )
+        })
+        .collect();
+    states_fold(model, None, &frames, "folding path written by nanofold fold")
+}
+
+/// A FOLD animation over the crease pattern: the key frame is the pattern (2D,
+/// `creasePattern`; with `key_state`, that state's fold angles, so the file reads back as
+/// that state), then one 3D `foldedForm` frame per (title, fold angles) with the
+/// assignments its angles imply.
+pub fn states_fold(
+    model: &FoldingModel,
+    key_state: Option<&[f64]>,
+    frames: &[(String, &[f64])],
+    description: &str,
+) -> Value {
+    let pattern = &model.pattern;
+    let mut root = crease_pattern_fold(pattern, key_state, description);
+    if key_state.is_some() {
+        // The key frame keeps the input's own assignments.
+        root["edges_assignment"] = json!(pattern.kinds.iter().map(|&kind| letter(kind, 0.0)).collect::<Vec<_>>());
+    }
+    root["file_classes"] = json!(["animation"]);
+    root["frame_title"] = json!(format!("{}: crease pattern", pattern.name));
+    let mut poses = Vec::new();
+    let frames: Vec<Value> = frames
+        .iter()
+        .map(|(title, fold_angles)| {
+            panel_poses(model, fold_angles, &mut poses);
+            let (angles, letters) = edge_arrays(pattern, fold_angles);
             json!({
-                "frame_title": format!("progress {:.4} (step {i})", step.progress),
+                "frame_title": title,
                 "frame_classes": ["foldedForm"],
                 "frame_attributes": ["3D"],
                 "frame_parent": 0,

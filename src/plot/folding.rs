@@ -11,24 +11,46 @@ use plotters::prelude::*;
 
 /// Renders `fold.svg` to a string.
 pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<String> {
+    let xs: Vec<f64> = path.steps.iter().map(|s| s.progress).collect();
+    let states: Vec<&[f64]> = path.steps.iter().map(|s| s.fold_angles.as_slice()).collect();
+    angles_svg(
+        model,
+        &xs,
+        &states,
+        "progress (fraction of the goal)",
+        "progress",
+        title,
+    )
+}
+
+/// Fold angles of every crease against `xs` (one state per x), and 3D views of the panels
+/// at four of the states; `x_label` names the axis, `x_name` the views' captions.
+pub fn angles_svg(
+    model: &FoldingModel,
+    xs: &[f64],
+    states: &[&[f64]],
+    x_label: &str,
+    x_name: &str,
+    title: &str,
+) -> Result<String> {
     let pattern = &model.pattern;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
         let (top, bottom) = root.split_vertically(400);
-        let first = path.steps.first().map_or(0.0, |s| s.progress);
-        let last = path.steps.last().map_or(1.0, |s| s.progress);
+        let first = xs.iter().copied().fold(f64::INFINITY, f64::min);
+        let last = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let mut chart = ChartBuilder::on(&top)
             .caption(title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(52)
-            .build_cartesian_2d(axis_range(first.min(0.0), last.max(1e-9), 0.02), -180.0..180.0)
+            .build_cartesian_2d(axis_range(first, last, 0.02), -180.0..180.0)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
-            .x_desc("progress (fraction of the goal)")
+            .x_desc(x_label)
             .y_desc("fold angle (deg)")
             .draw()
             .map_err(plot_error)?;
@@ -42,9 +64,7 @@ pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<St
             };
             chart
                 .draw_series(LineSeries::new(
-                    path.steps
-                        .iter()
-                        .map(|s| (s.progress, s.fold_angles[column].to_degrees())),
+                    xs.iter().zip(states).map(|(x, s)| (*x, s[column].to_degrees())),
                     colour.stroke_width(1),
                 ))
                 .map_err(plot_error)?;
@@ -56,17 +76,17 @@ pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<St
                     shown.len(),
                     pattern.creases.len()
                 ),
-                (first.min(0.0), 170.0),
+                (first, 170.0),
                 ("sans-serif", 13),
             )))
             .map_err(plot_error)?;
 
         // 3D views at four moments, one scale for all.
-        let picks = evenly(path.steps.len(), 4);
+        let picks = evenly(states.len(), 4);
         let mut poses_at = Vec::new();
         for &i in &picks {
             let mut poses = Vec::new();
-            panel_poses(model, &path.steps[i].fold_angles, &mut poses);
+            panel_poses(model, states[i], &mut poses);
             poses_at.push(poses);
         }
         let mut lo = [f64::INFINITY; 3];
@@ -88,7 +108,7 @@ pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<St
         let views = bottom.split_evenly((1, 4));
         for ((area, poses), &i) in views.iter().zip(&poses_at).zip(&picks) {
             let mut view = ChartBuilder::on(area)
-                .caption(format!("progress {:.2}", path.steps[i].progress), ("sans-serif", 16))
+                .caption(format!("{x_name} {:.4}", xs[i]), ("sans-serif", 16))
                 .margin(6)
                 .build_cartesian_3d(-1.05..1.05, -1.05..1.05, -1.05..1.05)
                 .map_err(plot_error)?;

@@ -168,6 +168,8 @@ pub enum NetworkVerdict {
     Blocked,
     /// The iteration budget ran out.
     IterationLimit,
+    /// The start is not a rigid state (a vertex does not close): nothing to unfold rigidly.
+    NotRigid,
 }
 
 impl NetworkVerdict {
@@ -179,6 +181,7 @@ impl NetworkVerdict {
             NetworkVerdict::LocalMinimum => "local_minimum",
             NetworkVerdict::Blocked => "blocked",
             NetworkVerdict::IterationLimit => "iteration_limit",
+            NetworkVerdict::NotRigid => "not_rigid",
         }
     }
 }
@@ -203,7 +206,8 @@ pub struct NetworkReport {
     pub evidence: String,
     /// Descent steps taken.
     pub iterations: usize,
-    /// Every accepted state, the start first (the last is the flat state for `Flat`).
+    /// Every accepted state, the start first (the last is the flat state for `Flat`; for
+    /// `NotRigid` only the start, with its energy not evaluated: NaN).
     pub steps: Vec<NetworkStep>,
     /// Largest vertex closure residual over the path, rad.
     pub max_closure_residual: f64,
@@ -237,13 +241,28 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             format!("one per crease ({n})"),
         ));
     }
-    let residual = vertex_residuals(model, start).into_iter().fold(0.0, f64::max);
+    let residuals = vertex_residuals(model, start);
+    let residual = residuals.iter().copied().fold(0.0, f64::max);
     if residual > 1e-6 {
-        return Err(NanofoldError::invalid(
-            "start",
-            format!("closure residual {residual:.3e} rad"),
-            "the start is not a rigid state (a vertex is more than 1e-6 rad from closing)",
-        ));
+        let worst = residuals
+            .iter()
+            .position(|&r| r == residual)
+            .expect("the largest is one of them");
+        return Ok(NetworkReport {
+            verdict: NetworkVerdict::NotRigid,
+            evidence: format!(
+                "the start is not a rigid state: vertex {} is {residual:.3e} rad from closing (above 1e-6)",
+                model.stars[worst].vertex
+            ),
+            iterations: 0,
+            steps: vec![NetworkStep {
+                energy: f64::NAN,
+                fold_angles: start.to_vec(),
+                max_residual: residual,
+            }],
+            max_closure_residual: residual,
+            crossings_refused: 0,
+        });
     }
     let energy = NetworkEnergy::new(model, settings.energy, settings.p);
     let mut solver = NormalSolver::new(1e-10);
