@@ -308,6 +308,26 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     }
     for iteration in 0..settings.max_iterations {
         let largest = rho.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        if largest <= STALL_TOL && largest > settings.flat_tol {
+            // The flat finish: this close, the energy's changes are at its rounding and
+            // descent crawls. The flat state is rigid; it is taken if its energy is no higher.
+            let flat_angles = vec![0.0; n];
+            let u_flat = energy.value(&flat_angles, &mut ws);
+            if u_flat <= u * (1.0 + 1e-12) {
+                steps.push(NetworkStep {
+                    energy: u_flat,
+                    fold_angles: flat_angles,
+                    max_residual: 0.0,
+                });
+                return finish(
+                    NetworkVerdict::Flat,
+                    format!("descended to max |ρ| = {largest:.1e} rad after {iteration} steps, then finished onto the flat state (within {STALL_TOL:.0e}; energy {u:.9e} → {u_flat:.9e})"),
+                    iteration,
+                    steps,
+                    crossings_refused,
+                );
+            }
+        }
         if largest <= settings.flat_tol {
             let mut flat = steps.last().expect("the start").clone();
             flat.fold_angles.iter_mut().for_each(|r| *r = 0.0);
