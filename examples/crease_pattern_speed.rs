@@ -8,6 +8,7 @@ use nanofold::folding::{
     vertex_residuals, ContactSettings, Drive, FoldSettings, FoldingModel,
 };
 use nanofold::pattern::generate::MiuraSpec;
+use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
 use std::time::Instant;
 
 fn best_of<T>(runs: usize, mut work: impl FnMut() -> T) -> (f64, T) {
@@ -107,4 +108,38 @@ fn main() {
             path.stop.as_str()
         );
     }
+    println!();
+    println!("Unfolding the Miura-ori from 90% folded (zigzag creases at 162°) by energy; best of 3 runs (n = 64 once)");
+    println!(
+        "{:>4} {:>7} {:>9} {:>6} {:>12} {:>14}  {}",
+        "n", "creases", "seconds", "steps", "residual", "finish from", "verdict"
+    );
+    let mut points = Vec::new();
+    for n in [8, 16, 32, 64] {
+        let model = miura(n, 162.0);
+        let runs = if n >= 64 { 1 } else { 3 };
+        let (t, report) = best_of(runs, || {
+            unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap()
+        });
+        let before_finish = report.steps[report.steps.len().saturating_sub(2)]
+            .fold_angles
+            .iter()
+            .fold(0.0_f64, |m, r| m.max(r.abs()));
+        println!(
+            "{:>4} {:>7} {:>9.3} {:>6} {:>12.1e} {:>14.1e}  {}",
+            n,
+            model.crease_count(),
+            t,
+            report.steps.len(),
+            report.max_closure_residual,
+            before_finish,
+            report.verdict.as_str()
+        );
+        points.push((model.crease_count() as f64, t));
+    }
+    let (first, last) = (points[1], points[points.len() - 1]);
+    println!(
+        "time grows as creases^{:.2} (n = 16 to 64)",
+        (last.1 / first.1).ln() / (last.0 / first.0).ln()
+    );
 }
