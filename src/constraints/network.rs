@@ -178,6 +178,13 @@ pub fn network_sweep(
             "needs a < b within [−180°, 180°]",
         ));
     }
+    if model.locked_columns[driver] {
+        return Err(NanofoldError::invalid(
+            "driver",
+            format!("edge {}", model.pattern.creases[driver]),
+            "the crease is locked (edges_nanofold:locked): it cannot drive",
+        ));
+    }
     let mut solver = NormalSolver::new(SWEEP_REGULARISATION);
     let mut rho = start.to_vec();
     let start_residual = vertex_residuals(model, &rho).into_iter().fold(0.0, f64::max);

@@ -16,8 +16,11 @@ pub struct ClosureJacobian {
     pub rows: usize,
     /// Columns (one per crease).
     pub cols: usize,
-    /// Non-zero entries (row, column, value): ∂r/∂ρ.
+    /// Non-zero entries (row, column, value): ∂r/∂ρ. A locked crease's entries are 0 (kept
+    /// in the structure): it does not move.
     pub entries: Vec<(usize, usize, f64)>,
+    /// Number of locked columns (zeroed above).
+    pub held: usize,
 }
 
 impl ClosureJacobian {
@@ -78,8 +81,9 @@ pub fn closure_jacobian(model: &FoldingModel, fold_angles: &[f64]) -> ClosureJac
         let (r, jac) = kinematics::closure_jacobian(&star.sector_angles, &by_ray, &rays);
         residual.extend(r.iter());
         for (j, &column) in star.columns.iter().enumerate() {
+            let scale = if model.locked_columns[column] { 0.0 } else { 1.0 };
             for i in 0..3 {
-                entries.push((3 * s + i, column, jac[(i, j)]));
+                entries.push((3 * s + i, column, scale * jac[(i, j)]));
             }
         }
     }
@@ -88,5 +92,6 @@ pub fn closure_jacobian(model: &FoldingModel, fold_angles: &[f64]) -> ClosureJac
         rows: 3 * model.stars.len(),
         cols: model.crease_count(),
         entries,
+        held: model.locked_columns.iter().filter(|&&l| l).count(),
     }
 }

@@ -56,6 +56,8 @@ pub struct FoldingModel {
     pub panel_of_vertex: Vec<usize>,
     /// The diagonal of the pattern's bounding box: the length scale of tolerances.
     pub size: f64,
+    /// Whether each fold-angle column is held at its angle (`edges_nanofold:locked`).
+    pub locked_columns: Vec<bool>,
 }
 
 impl FoldingModel {
@@ -174,7 +176,9 @@ impl FoldingModel {
                 .count()
                 == pattern.creases.len()
         );
+        let locked_columns = pattern.creases.iter().map(|&e| pattern.locked[e]).collect();
         Ok(FoldingModel {
+            locked_columns,
             pattern,
             stars,
             column_of_edge,
@@ -191,6 +195,15 @@ impl FoldingModel {
     /// Number of fold-angle coordinates (creases).
     pub fn crease_count(&self) -> usize {
         self.pattern.creases.len()
+    }
+
+    /// Zeroes the locked creases' entries of a velocity or gradient (they do not move).
+    pub fn hold_locked(&self, velocity: &mut [f64]) {
+        for (v, &locked) in velocity.iter_mut().zip(&self.locked_columns) {
+            if locked {
+                *v = 0.0;
+            }
+        }
     }
 
     /// The fold angles the pattern was read with, one per crease column, rad.

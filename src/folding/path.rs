@@ -87,6 +87,13 @@ impl FoldSettings {
                             "a target lies in [−180°, 180°]",
                         ));
                     }
+                    if model.locked_columns[column] {
+                        return Err(NanofoldError::invalid(
+                            "drive",
+                            format!("crease {column} (edge {})", model.pattern.creases[column]),
+                            "the crease is locked (edges_nanofold:locked): it cannot be driven",
+                        ));
+                    }
                     let sign = assigned_signs(model)[column];
                     if sign * target < 0.0 {
                         return Err(NanofoldError::invalid(
@@ -376,11 +383,12 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     if inf_norm(&rho) <= 1e-12 {
         // The branch is the assignment's, whatever drives the motion afterwards (a driven
         // crease alone would pick any branch, e.g. a straight line folded on its own).
-        let d = if signs.iter().any(|&s| s != 0.0) {
+        let mut d = if signs.iter().any(|&s| s != 0.0) {
             signs.clone()
         } else {
             desired_velocity(&settings.drive, &rho, &signs)
         };
+        model.hold_locked(&mut d);
         let factor = solver.factor(&closure_jacobian(model, &rho))?;
         let v = factor.project(&d);
         let size = inf_norm(&v);
@@ -449,7 +457,8 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         }
         let jac = closure_jacobian(model, &rho);
         let factor = solver.factor(&jac)?;
-        let d = desired_velocity(&settings.drive, &rho, &signs);
+        let mut d = desired_velocity(&settings.drive, &rho, &signs);
+        model.hold_locked(&mut d);
         let v = factor.project(&d);
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d) {

@@ -47,7 +47,7 @@ impl RankMethod {
 pub struct RankReport {
     /// Numerical rank of J.
     pub rank: usize,
-    /// Degrees of freedom: creases − rank.
+    /// Degrees of freedom: creases − locked creases − rank.
     pub dof: usize,
     /// The threshold applied (to |R_ii| for the QR, to σ for the sparse count).
     pub threshold: f64,
@@ -77,7 +77,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
     if rows == 0 || cols == 0 {
         return RankReport {
             rank: 0,
-            dof: cols,
+            dof: cols - jacobian.held,
             threshold: 0.0,
             smallest_kept: f64::INFINITY,
             largest_dropped: 0.0,
@@ -92,7 +92,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
     let rank = diagonal.iter().take_while(|&&d| d > threshold && d > 0.0).count();
     RankReport {
         rank,
-        dof: cols - rank,
+        dof: cols - jacobian.held - rank,
         threshold,
         smallest_kept: if rank > 0 { diagonal[rank - 1] } else { f64::INFINITY },
         largest_dropped: diagonal.get(rank).copied().unwrap_or(0.0),
@@ -120,7 +120,8 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
             let sigma = |l: f64| l.max(0.0).sqrt();
             return Ok(RankReport {
                 rank: n - count,
-                dof: count,
+                // A locked column is zero, so it is in the null space without being a motion.
+                dof: count.saturating_sub(jacobian.held),
                 threshold: RANK_TOL * scale.sqrt(),
                 smallest_kept: ritz.get(count).map_or(f64::INFINITY, |&l| sigma(l)),
                 largest_dropped: if count > 0 { sigma(ritz[count - 1]) } else { 0.0 },

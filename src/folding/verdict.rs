@@ -260,6 +260,11 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
     let mut local_checked = 0;
     let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
     for star in &model.stars {
+        // A locked crease stays flat: the vertex's modes from flat do not apply as computed.
+        if star.columns.iter().any(|&c| model.locked_columns[c]) {
+            chosen.push(None);
+            continue;
+        }
         let Some(modes) = degree4_modes(star) else {
             chosen.push(None);
             continue;

@@ -512,6 +512,7 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
         faces: graph.faces_vertices,
         angle_field: graph.angle_key.to_string(),
         folded_form: None,
+        locked: graph.locked,
     })
 }
 
@@ -564,6 +565,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
         fold_angles,
         faces: None,
         angle_field: "dihedral angle of the 3D faces".into(),
+        locked: graph.locked,
         folded_form: Some(FoldedFormFit {
             development_error: development.development_error,
             face_nonplanarity: development.face_nonplanarity,

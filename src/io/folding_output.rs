@@ -63,6 +63,9 @@ pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>,
     if fold_angles.is_some() {
         root["edges_foldAngle"] = json!(angles);
     }
+    if pattern.locked.iter().any(|&l| l) {
+        root[crate::io::fold::LOCKED_KEY] = json!(pattern.locked);
+    }
     root
 }
 

@@ -44,6 +44,8 @@ pub struct CreasePatternBuilder {
     /// How far a folded form's faces were from a rigid, developable sheet (None for a
     /// crease pattern read flat).
     pub folded_form: Option<FoldedFormFit>,
+    /// Creases held at their fold angle (one per edge, or empty for none).
+    pub locked: Vec<bool>,
 }
 
 /// What developing a 3D folded form into its crease pattern measured
@@ -103,6 +105,8 @@ pub struct CreasePattern {
     pub outline: Vec<usize>,
     /// For a 3D folded form: how far it was from rigid and developable.
     pub folded_form: Option<FoldedFormFit>,
+    /// Whether each edge is a crease held at its fold angle.
+    pub locked: Vec<bool>,
 }
 
 impl CreasePatternBuilder {
@@ -117,6 +121,7 @@ impl CreasePatternBuilder {
             faces: given_faces,
             angle_field,
             folded_form,
+            locked,
         } = self;
         let (nv, ne) = (vertices.len(), edges.len());
         if edges.len() > MAX_EDGES {
@@ -164,6 +169,21 @@ impl CreasePatternBuilder {
                     format!("contradicts the edge's assignment ({kind:?})"),
                 ));
             }
+        }
+        let locked = if locked.is_empty() { vec![false; ne] } else { locked };
+        if locked.len() != ne {
+            return Err(NanofoldError::invalid(
+                "edges_nanofold:locked",
+                format!("{} entries", locked.len()),
+                format!("expected one per edge ({ne})"),
+            ));
+        }
+        if let Some(e) = (0..ne).find(|&e| locked[e] && !matches!(kinds[e], EdgeKind::Crease(_))) {
+            return Err(NanofoldError::invalid(
+                format!("edges_nanofold:locked[{e}]"),
+                "true",
+                "only a crease (M, V, U) can be locked",
+            ));
         }
         let duplicates = duplicate_edge(&edges);
         if let Some((first, second)) = duplicates {
@@ -230,6 +250,7 @@ impl CreasePatternBuilder {
             stars,
             outline,
             folded_form,
+            locked,
         })
     }
 }
@@ -638,6 +659,7 @@ mod tests {
             faces: Some(vec![vec![0, 1, 2], vec![0, 2, 3]]),
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
+            locked: Vec::new(),
         };
         let cp = b.build().unwrap();
         assert_eq!(
@@ -713,6 +735,7 @@ mod tests {
             faces: None,
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
+            locked: Vec::new(),
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("cross"), "{e}");
@@ -729,6 +752,7 @@ mod tests {
             faces: None,
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
+            locked: Vec::new(),
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("inside another edge"), "{e}");

@@ -343,7 +343,9 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             );
         }
         let factor = solver.factor(&closure_jacobian(model, &rho))?;
-        let descent: Vec<f64> = factor.project(&gradient.iter().map(|g| -g).collect::<Vec<_>>());
+        let mut downhill: Vec<f64> = gradient.iter().map(|g| -g).collect();
+        model.hold_locked(&mut downhill);
+        let descent: Vec<f64> = factor.project(&downhill);
         let size = descent.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         let slope: f64 = gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
         if size <= 1e-14 || slope >= 0.0 {
