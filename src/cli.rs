@@ -156,7 +156,8 @@ pub struct ConstraintsArgs {
     /// The driving crease (a crease pattern of many vertices: its FOLD edge index).
     #[arg(long)]
     pub drive: usize,
-    /// Hold crease J at DEG degrees (repeatable), e.g. --lock 1=0.
+    /// Hold crease J at DEG degrees (repeatable), e.g. --lock 1=0 (a crease pattern of many
+    /// vertices: J is a FOLD edge index).
     #[arg(long = "lock", value_name = "J=DEG", allow_hyphen_values = true)]
     pub locks: Vec<String>,
     /// Polynomial degree 1..=20, or `auto` with --tol.

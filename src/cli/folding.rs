@@ -440,14 +440,27 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
 pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usize>) -> Result<()> {
     use nanofold::constraints::network::{fit_network, fit_network_to_tolerance, network_mujoco, network_sweep};
-    if !args.locks.is_empty() {
-        bail!("--lock is not supported yet for crease patterns of many vertices");
-    }
     if args.source != super::SourceArg::Sweep {
         bail!("--source unfold is for single vertices; a crease pattern of many vertices is swept exactly");
     }
-    let model = load_model(&args.pattern)?;
-    let rho = model.given_fold_angles();
+    let mut model = load_model(&args.pattern)?;
+    let mut rho = model.given_fold_angles();
+    // --lock EDGE=DEG: hold that crease at that angle, and close every vertex around it.
+    for text in &args.locks {
+        let (column, angle) =
+            parse_drive(&model, text).map_err(|e| anyhow::anyhow!("{}", e.to_string().replace("--drive", "--lock")))?;
+        model.locked_columns[column] = true;
+        rho[column] = angle;
+    }
+    if !args.locks.is_empty() {
+        let mut solver = nanofold::folding::normal::NormalSolver::new(1e-10);
+        if nanofold::folding::restore_closure(&model, &mut rho, 1e-12, &mut solver)?.is_none() {
+            bail!(
+                "--lock {}: no rigid state near the file's with these creases held",
+                args.locks.join(" ")
+            );
+        }
+    }
     let driver = model.column_of_edge.get(args.drive).copied().flatten().with_context(|| {
         format!(
             "invalid --drive {}: edge {} is not a crease of {} (for a crease pattern of many vertices --drive is a FOLD edge index)",
