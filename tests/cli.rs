@@ -164,6 +164,11 @@ fn check_of_a_directory_runs_every_pattern_in_parallel_one_line_each() {
     assert_eq!(lines["patterns/symmetric16.fold"]["verdict"], "flat");
     // Crease patterns of many vertices get their own verdicts in the same run.
     assert_eq!(lines["patterns/many/miura_4x4_folded.fold"]["verdict"], "rigid");
+    // A rigid folded state is unfolded too.
+    assert_eq!(
+        lines["patterns/many/miura_4x4_folded.fold"]["unfold"]["verdict"],
+        "flat"
+    );
     assert_eq!(
         lines["patterns/many/square_twist.fold"]["verdict"],
         "not_rigidly_foldable"

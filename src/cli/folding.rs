@@ -383,8 +383,19 @@ pub fn check_json(path: &Path, closure_tol: f64) -> Result<(Value, String)> {
     };
     let start = Instant::now();
     let report = check_pattern(&model, &settings)?;
+    // A rigid folded state is also unfolded by energy (docs/model.md#energy-unfolding-of-many-vertices).
+    let unfolding = if report.has_state && report.verdict == nanofold::folding::PatternVerdict::Rigid {
+        use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
+        Some(unfold_network(
+            &model,
+            &model.given_fold_angles(),
+            &NetworkUnfoldSettings::default(),
+        )?)
+    } else {
+        None
+    };
     let seconds = start.elapsed().as_secs_f64();
-    let line = format!(
+    let mut line = format!(
         "{}: {} ({} DOF at the {} state, {:.3} ms) {}",
         path.display(),
         report.verdict.as_str(),
@@ -393,7 +404,21 @@ pub fn check_json(path: &Path, closure_tol: f64) -> Result<(Value, String)> {
         seconds * 1e3,
         report.evidence
     );
-    Ok((check_value(&model, path, &report, seconds), line))
+    let mut value = check_value(&model, path, &report, seconds);
+    if let Some(unfolding) = &unfolding {
+        line.push_str(&format!(
+            "; unfolding by energy: {} ({})",
+            unfolding.verdict.as_str(),
+            unfolding.evidence
+        ));
+        value["unfold"] = json!({
+            "verdict": unfolding.verdict.as_str(),
+            "evidence": unfolding.evidence,
+            "iterations": unfolding.iterations,
+            "max_closure_residual_rad": unfolding.max_closure_residual,
+        });
+    }
+    Ok((value, line))
 }
 
 fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds: f64) -> Value {
