@@ -95,11 +95,7 @@ fn restore_held(
     let mut worst = f64::INFINITY;
     for _ in 0..40 {
         let mut jac = closure_jacobian(model, fold_angles);
-        worst = jac
-            .residual
-            .chunks(3)
-            .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
-            .fold(0.0, f64::max);
+        worst = jac.worst_residual();
         if !worst.is_finite() {
             break;
         }

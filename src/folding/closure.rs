@@ -32,6 +32,14 @@ impl ClosureJacobian {
             .expect("entries are within the matrix and few enough for usize indices")
     }
 
+    /// The largest vertex residual |r_v|, rad.
+    pub fn worst_residual(&self) -> f64 {
+        self.residual
+            .chunks(3)
+            .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
+            .fold(0.0, f64::max)
+    }
+
     /// y = J x.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);

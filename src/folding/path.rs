@@ -2,7 +2,7 @@
 //! fold angles projected onto the null space of the closure Jacobian, a step, and Newton
 //! back onto every vertex closure; panel contact checked at every step.
 
-use super::closure::{closure_jacobian, ClosureJacobian};
+use super::closure::closure_jacobian;
 use super::contact::{panel_contacts, ContactSettings};
 use super::model::FoldingModel;
 use super::normal::NormalSolver;
@@ -209,13 +209,6 @@ fn inf_norm(x: &[f64]) -> f64 {
     x.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
-fn worst_residual(jac: &ClosureJacobian) -> f64 {
-    jac.residual
-        .chunks(3)
-        .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
-        .fold(0.0, f64::max)
-}
-
 /// Newton's method (least-norm steps) back onto every closure. Returns the iterations, or
 /// None when it does not reach `tol` within 30 iterations or runs away (a fold angle beyond
 /// π + 0.5; the caller keeps accepted states within [−π, π]).
@@ -228,7 +221,7 @@ pub fn restore_closure(
     let mut previous = f64::INFINITY;
     for iteration in 0..30 {
         let jac = closure_jacobian(model, fold_angles);
-        let worst = worst_residual(&jac);
+        let worst = jac.worst_residual();
         if !worst.is_finite() {
             return Ok(None);
         }
@@ -329,7 +322,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     let mut poses: Vec<Pose> = Vec::new();
     let mut rho = start.to_vec();
     let mut newton_iterations = 0;
-    let start_residual = worst_residual(&closure_jacobian(model, &rho));
+    let start_residual = closure_jacobian(model, &rho).worst_residual();
     if start_residual > settings.closure_tol {
         match restore_closure(model, &mut rho, settings.closure_tol, &mut solver)? {
             Some(k) if start_residual <= 1e-6 => newton_iterations += k,
@@ -350,7 +343,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     let mut steps = vec![PathStep {
         progress: progress(&settings.drive, start, &rho, &signs),
         fold_angles: rho.clone(),
-        max_residual: worst_residual(&closure_jacobian(model, &rho)),
+        max_residual: closure_jacobian(model, &rho).worst_residual(),
         min_clearance: first.min_clearance,
     }];
     let finish = |steps: Vec<PathStep>, stop: StopReason, evidence: String, branch: Option<String>, newton| {
@@ -438,7 +431,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         steps.push(PathStep {
             progress: progress(&settings.drive, start, &rho, &signs),
             fold_angles: rho.clone(),
-            max_residual: worst_residual(&closure_jacobian(model, &rho)),
+            max_residual: closure_jacobian(model, &rho).worst_residual(),
             min_clearance: contacts.min_clearance,
         });
     }
@@ -561,7 +554,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         steps.push(PathStep {
             progress: progress(&settings.drive, start, &rho, &signs),
             fold_angles: rho.clone(),
-            max_residual: worst_residual(&closure_jacobian(model, &rho)),
+            max_residual: closure_jacobian(model, &rho).worst_residual(),
             min_clearance: contacts.min_clearance,
         });
     }

@@ -215,6 +215,16 @@ pub struct NetworkReport {
     pub crossings_refused: usize,
 }
 
+/// The flat state (rigid, every vertex closed exactly) as the path's last step.
+fn flat_step(energy: &NetworkEnergy, creases: usize, ws: &mut EnergyWorkspace) -> NetworkStep {
+    let fold_angles = vec![0.0; creases];
+    NetworkStep {
+        energy: energy.value(&fold_angles, ws),
+        fold_angles,
+        max_residual: 0.0,
+    }
+}
+
 /// Unfolds a rigid state of `model` by projected gradient descent on the summed vertex
 /// energies.
 pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> Result<NetworkReport> {
@@ -311,14 +321,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         if largest <= STALL_TOL && largest > settings.flat_tol {
             // The flat finish: this close, the energy's changes are at its rounding and
             // descent crawls. The flat state is rigid; it is taken if its energy is no higher.
-            let flat_angles = vec![0.0; n];
-            let u_flat = energy.value(&flat_angles, &mut ws);
+            let flat = flat_step(&energy, n, &mut ws);
+            let u_flat = flat.energy;
             if u_flat <= u * (1.0 + 1e-12) {
-                steps.push(NetworkStep {
-                    energy: u_flat,
-                    fold_angles: flat_angles,
-                    max_residual: 0.0,
-                });
+                steps.push(flat);
                 return finish(
                     NetworkVerdict::Flat,
                     format!("descended to max |ρ| = {largest:.1e} rad after {iteration} steps, then finished onto the flat state (within {STALL_TOL:.0e}; energy {u:.9e} → {u_flat:.9e})"),
@@ -329,11 +335,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             }
         }
         if largest <= settings.flat_tol {
-            let mut flat = steps.last().expect("the start").clone();
-            flat.fold_angles.iter_mut().for_each(|r| *r = 0.0);
-            flat.energy = energy.value(&flat.fold_angles, &mut ws);
-            flat.max_residual = 0.0;
-            steps.push(flat);
+            steps.push(flat_step(&energy, n, &mut ws));
             return finish(
                 NetworkVerdict::Flat,
                 format!("every fold angle within {:.0e} rad after {iteration} steps (max |ρ| = {largest:.1e}), then set to 0", settings.flat_tol),
@@ -395,11 +397,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             if largest <= STALL_TOL && !refused_for_crossing {
                 // The energy's changes are below its rounding this close to flat; the flat
                 // state is rigid and the descent was heading there.
-                let mut flat = steps.last().expect("the start").clone();
-                flat.fold_angles.iter_mut().for_each(|r| *r = 0.0);
-                flat.energy = energy.value(&flat.fold_angles, &mut ws);
-                flat.max_residual = 0.0;
-                steps.push(flat);
+                steps.push(flat_step(&energy, n, &mut ws));
                 return finish(
                     NetworkVerdict::Flat,
                     format!("the line search stalled {largest:.1e} rad from flat (within {STALL_TOL:.0e}, where the energy's changes are at its rounding), then set to 0"),
