@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 #[command(
     name = "nanofold",
     version,
-    about = "Rigid origami: unfold single-vertex crease patterns to flat, extract their constraint curves, simulate folding dynamics of plate chains"
+    about = "Rigid origami: check, fold and unfold crease patterns (single vertices and many), extract their constraint curves, simulate folding dynamics of plate chains"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -39,7 +39,9 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Unfold patterns; write trajectory.json, unfold.svg and unfold.fold for each.
+    /// Unfold patterns; write trajectory.json, unfold.svg and unfold.fold for each. Single
+    /// vertices by the single-vertex engine; folded crease patterns of many vertices by the
+    /// summed vertex energies (`docs/model.md#energy-unfolding-of-many-vertices`).
     Unfold {
         /// FOLD files (.fold), native vertices (.json) or directories of them (searched
         /// recursively; scene files are skipped). Several run in parallel.
@@ -83,7 +85,9 @@ pub enum Command {
         kind: folding::GenerateKind,
     },
     /// Holonomic constraint curves: every free crease as a polynomial of one driving crease
-    /// (`docs/model.md#constraint-curves`); writes constraints.json, constraints.svg (and constraints.xml for MuJoCo).
+    /// (`docs/model.md#constraint-curves`), for a single vertex or a folded crease pattern of
+    /// many vertices with one degree of freedom; writes constraints.json, constraints.svg (and
+    /// constraints.xml for MuJoCo).
     Constraints(ConstraintsArgs),
     /// Response of a scene (a chain of plates) to its actuation: writes response.json,
     /// response.svg and snapshots.svg (`docs/model.md#dynamics`).
