@@ -127,3 +127,94 @@ fn a_folded_miura_ori_unfolds_flat_along_its_closed_form() {
     }
     assert!(Path::new("patterns").exists());
 }
+
+/// A small fixed pseudo-random generator (the suite must not depend on the run).
+fn uniform(seed: &mut u64) -> f64 {
+    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Random Miura-ori variants (size, angle, panel sides) folded by `fold` to random depths
+/// from flat, then unfolded by energy: every one flat, every state closed along the way, no
+/// step refused for crossing panels.
+#[test]
+fn random_miura_states_folded_by_fold_unfold_flat() {
+    use nanofold::folding::{fold_path, Drive, FoldSettings};
+    let mut seed = 0x5EED_u64;
+    for case in 0..12 {
+        let rows = 2 + (uniform(&mut seed) * 6.0) as usize;
+        let cols = 2 + (uniform(&mut seed) * 6.0) as usize;
+        let spec = MiuraSpec {
+            rows,
+            cols,
+            sector_angle: (35.0 + 50.0 * uniform(&mut seed)).to_radians(),
+            width: 0.5 + uniform(&mut seed),
+            slant: 0.5 + uniform(&mut seed),
+            ..MiuraSpec::default()
+        };
+        let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
+        let depth = 0.1 + 0.85 * uniform(&mut seed);
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to: depth },
+            ..FoldSettings::default()
+        };
+        let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+        let start = folded.steps.last().unwrap().fold_angles.clone();
+        let report = unfold_network(&model, &start, &NetworkUnfoldSettings::default()).unwrap();
+        let name = format!(
+            "case {case}: {rows}x{cols}, γ {:.1}°, depth {depth:.2}",
+            spec.sector_angle.to_degrees()
+        );
+        assert_eq!(report.verdict, NetworkVerdict::Flat, "{name}: {}", report.evidence);
+        assert!(report.max_closure_residual <= 1e-10, "{name}");
+        assert_eq!(report.crossings_refused, 0, "{name}");
+        for step in &report.steps {
+            assert!(
+                vertex_residuals(&model, &step.fold_angles)
+                    .into_iter()
+                    .fold(0.0, f64::max)
+                    <= 1e-10,
+                "{name}"
+            );
+        }
+    }
+}
+
+/// Hard cases: a start at the flat state, a start next to it (a branch point), a pattern
+/// with a tiny panel, and a pattern with no degree of freedom.
+#[test]
+fn hard_starts_get_their_verdicts() {
+    // At flat: nothing to do.
+    let model = miura(4, 0.0);
+    let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!((report.verdict, report.iterations), (NetworkVerdict::Flat, 0));
+    // One degree from flat, beside the branch point: flat without leaving the branch.
+    let model = miura(4, 1.0);
+    let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::Flat, "{}", report.evidence);
+    for step in &report.steps {
+        let signs_kept = step
+            .fold_angles
+            .iter()
+            .zip(&model.given_fold_angles())
+            .all(|(now, then)| now * then >= 0.0);
+        assert!(signs_kept, "a crease passed through flat");
+    }
+    // A tiny panel: slanted sides 1e-3 of the horizontal ones.
+    let spec = MiuraSpec {
+        rows: 3,
+        cols: 3,
+        slant: 1e-3,
+        zigzag_fold_angle: 120f64.to_radians(),
+        ..MiuraSpec::default()
+    };
+    let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
+    let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::Flat, "{}", report.evidence);
+    assert!(report.max_closure_residual <= 1e-10);
+    // No degree of freedom: the library's locked single vertex.
+    let path = Path::new("patterns/degree4_locked.fold");
+    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::Locked, "{}", report.evidence);
+}
