@@ -616,12 +616,24 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
     })
 }
 
-/// Does a pattern the single-vertex loader refused go to the crease-pattern checks? Yes
-/// when it reads as a crease pattern and the refusal was not about its folded state (a
-/// vertex that does not close keeps its single-vertex error): several vertices, creases
-/// meeting at no vertex, or no fold angles (an assignment alone).
+/// Does a pattern the single-vertex loader refused go to the crease-pattern commands? Yes
+/// when the refusal says it is not a single vertex (several vertices or none, a 3D folded
+/// form, no fold angles, a mesh larger than a vertex's): then the crease-pattern reader's
+/// own errors are the ones to show. Otherwise (a vertex whose folded state does not close,
+/// say) only if it reads as a crease pattern.
 fn takes_many_vertices(error: &nanofold::NanofoldError, path: &Path) -> bool {
-    !matches!(error, nanofold::NanofoldError::ClosureViolated { .. }) && nanofold::io::load_crease_pattern(path).is_ok()
+    use nanofold::NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
+    let not_a_vertex = match error {
+        MultipleVertices { .. } => true,
+        MissingField { field, .. } => field == "edges_foldAngle",
+        InvalidField { value, reason, .. } => {
+            value == "no vertex with two or more creases"
+                || reason.contains("3D folded forms are read as crease patterns")
+                || reason.contains("a single-vertex pattern (its outputs repeat the mesh")
+        }
+        _ => false,
+    };
+    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && nanofold::io::load_crease_pattern(path).is_ok())
 }
 
 /// Parses "J=DEG" into (crease index, rad).

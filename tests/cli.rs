@@ -789,3 +789,28 @@ fn unfold_takes_a_folded_crease_pattern_of_many_vertices() {
     assert_eq!(bent["verdict"], "not_rigid", "{bent}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_bad_crease_pattern_of_many_vertices_gets_the_crease_pattern_error() {
+    let dir = temp_dir("bad-network");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/many/miura_4x4_folded.fold").unwrap()).unwrap();
+    value["faces_vertices"][0] = serde_json::json!([0, 1, 2]);
+    let bad_face = dir.join("bad_face.fold");
+    std::fs::write(&bad_face, value.to_string()).unwrap();
+    value.as_object_mut().unwrap().remove("faces_vertices");
+    value["vertices_coords"][7] = serde_json::json!([1e300, 0.0]);
+    let far = dir.join("far.fold");
+    std::fs::write(&far, value.to_string()).unwrap();
+    for (file, expected) in [(&bad_face, "faces_vertices[0]"), (&far, "vertices_coords[7]")] {
+        let out = nanofold().arg("check").arg(file).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(!out.status.success(), "{text}");
+        assert!(
+            text.contains(expected) && !text.contains("only single-vertex"),
+            "{text}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

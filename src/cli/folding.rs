@@ -457,6 +457,7 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
             "face_nonplanarity": f.face_nonplanarity,
             "max_facet_angle_rad": f.max_facet_angle,
             "mirrored": f.mirrored,
+            "assignment_conflicts": f.assignment_conflicts,
         })),
         "seconds": seconds,
     })

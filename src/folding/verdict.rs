@@ -205,7 +205,13 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
                 fit.development_error
             )
         });
-        let parts: Vec<String> = facets.into_iter().chain(development).collect();
+        let warped = (fit.face_nonplanarity > settings.closure_tol * model.size).then(|| {
+            format!(
+                "faces are warped out of their planes by up to {:.3e} (lengths)",
+                fit.face_nonplanarity
+            )
+        });
+        let parts: Vec<String> = facets.into_iter().chain(development).chain(warped).collect();
         (!parts.is_empty()).then(|| parts.join("; "))
     });
     if has_state || bent.is_some() {

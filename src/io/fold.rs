@@ -20,6 +20,9 @@ pub const MAX_PATTERN_VERTICES: usize = 100_000;
 /// Most edges (and faces) of a crease pattern of many vertices.
 pub const MAX_PATTERN_EDGES: usize = crate::pattern::crease_pattern::MAX_EDGES;
 
+/// Largest |coordinate| of a crease pattern of many vertices.
+pub const MAX_COORDINATE: f64 = 1e9;
+
 /// How large a FOLD key frame may be, and why.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct GraphLimits {
@@ -462,6 +465,18 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
 /// on boundary and facet edges, as Origami Simulator writes them.
 pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePatternBuilder> {
     let graph = parse_graph(value, PATTERN_LIMITS)?;
+    // Lengths far from 1 leave no digits for the planarity tolerances (1e-12 of the size).
+    if let Some(i) = graph
+        .coords3
+        .iter()
+        .position(|p| p.iter().any(|x| x.abs() > MAX_COORDINATE))
+    {
+        return Err(NanofoldError::invalid(
+            format!("vertices_coords[{i}]"),
+            format!("{:?}", graph.coords3[i]),
+            format!("coordinates of a crease pattern lie within ±{MAX_COORDINATE:e} (rescale the file)"),
+        ));
+    }
     let mut kinds = Vec::with_capacity(graph.edges.len());
     for (e, letter) in graph.letters.iter().enumerate() {
         let field = format!("edges_assignment[{e}]");
@@ -545,7 +560,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
     let flip = if mirrored { -1.0 } else { 1.0 };
     let vertices = development.vertices.iter().map(|p| [flip * p[0], p[1]]).collect();
     let mut max_facet_angle: f64 = 0.0;
-    let fold_angles = kinds
+    let fold_angles: Vec<f64> = kinds
         .iter()
         .zip(&development.fold_angles)
         .map(|(kind, &rho)| match kind {
@@ -557,6 +572,20 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
             EdgeKind::Boundary => 0.0,
         })
         .collect();
+    // A folded form's assignment is the target; a crease the state folds the other way (a
+    // compliant simulator's start, say) keeps its angle and becomes unassigned.
+    let mut kinds = kinds;
+    let mut assignment_conflicts = 0;
+    for (kind, &rho) in kinds.iter_mut().zip(&fold_angles) {
+        let contradicts = matches!(
+            (*kind, rho),
+            (EdgeKind::Crease(Assignment::Mountain), r) if r > 0.0
+        ) || matches!((*kind, rho), (EdgeKind::Crease(Assignment::Valley), r) if r < 0.0);
+        if contradicts {
+            *kind = EdgeKind::Crease(Assignment::Unassigned);
+            assignment_conflicts += 1;
+        }
+    }
     Ok(CreasePatternBuilder {
         name: name.to_string(),
         vertices,
@@ -571,6 +600,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
             face_nonplanarity: development.face_nonplanarity,
             max_facet_angle,
             mirrored,
+            assignment_conflicts,
         }),
     })
 }

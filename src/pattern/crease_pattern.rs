@@ -62,6 +62,9 @@ pub struct FoldedFormFit {
     /// Whether the faces were listed clockwise (the development was mirrored so that
     /// valleys come out positive).
     pub mirrored: bool,
+    /// Creases whose dihedral angle has the sign opposite to their assignment (read as
+    /// unassigned: the file's assignment is the target, the angle the state).
+    pub assignment_conflicts: usize,
 }
 
 /// The creases around one interior vertex, counter-clockwise.
