@@ -690,9 +690,9 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     if degree.is_none() && args.tol.is_none() {
         anyhow::bail!("--degree auto needs --tol RAD (the largest accepted fit error)");
     }
-    if args.format == ExportFormat::Mujoco && degree.is_none_or(|d| d > 4) {
+    if args.format == ExportFormat::Mujoco && degree.is_some_and(|d| d > 4) {
         anyhow::bail!(
-            "invalid --degree {}: MuJoCo's polycoef holds a quartic at most; use --degree 1..=4 with --format mujoco",
+            "invalid --degree {}: MuJoCo's polycoef holds a quartic at most; use --degree 1..=4 (or auto, capped at 4) with --format mujoco",
             args.degree
         );
     }
@@ -769,6 +769,29 @@ fn constraints_after_setup(
         Some(d) => {
             let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
             let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
+            (poly, report)
+        }
+        None if args.format == ExportFormat::Mujoco => {
+            // MuJoCo takes a quartic at most: the smallest degree ≤ 4 meeting --tol, else 4
+            // with the error it has.
+            let tol = args.tol.unwrap_or_default();
+            let mut chosen = None;
+            for d in 1..=4 {
+                let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
+                let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
+                let met = report.max_fit_error() <= tol;
+                chosen = Some((poly, report));
+                if met {
+                    break;
+                }
+            }
+            let (poly, report) = chosen.expect("degrees 1 to 4 were fitted");
+            if report.max_fit_error() > tol {
+                eprintln!(
+                    "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
+                    report.max_fit_error()
+                );
+            }
             (poly, report)
         }
         None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default()).map_err(constraints_flags)?,

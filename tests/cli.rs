@@ -814,3 +814,34 @@ fn a_bad_crease_pattern_of_many_vertices_gets_the_crease_pattern_error() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn degree_auto_for_mujoco_is_capped_at_four_with_its_error_stated() {
+    let dir = temp_dir("auto-mujoco");
+    let out = nanofold()
+        .args([
+            "constraints",
+            "patterns/corner_cube.fold",
+            "--drive",
+            "0",
+            "--lock",
+            "1=0",
+            "--degree",
+            "auto",
+            "--tol",
+            "1e-9",
+            "--format",
+            "mujoco",
+            "--json",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["degree"], 4);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("capped at 4"));
+    assert!(dir.join("constraints.xml").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -514,8 +514,29 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
             &[("domain", "--range"), ("samples", "--samples"), ("driver", "--drive")],
         )
     })?;
+    let mujoco = args.format == super::ExportFormat::Mujoco;
     let curves = match degree {
         Some(d) => fit_network(&model, &sweep, d),
+        // MuJoCo takes a quartic at most: the smallest degree ≤ 4 meeting --tol, else 4.
+        None if mujoco => {
+            let tol = args.tol.unwrap_or_default();
+            let mut chosen = fit_network(&model, &sweep, 1);
+            for d in 2..=4 {
+                if chosen.as_ref().is_ok_and(|c| c.max_fit_error_rad <= tol) {
+                    break;
+                }
+                chosen = fit_network(&model, &sweep, d);
+            }
+            if let Ok(c) = &chosen {
+                if c.max_fit_error_rad > tol {
+                    eprintln!(
+                        "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
+                        c.max_fit_error_rad
+                    );
+                }
+            }
+            chosen
+        }
         None => fit_network_to_tolerance(&model, &sweep, args.tol.unwrap_or_default()),
     }
     .map_err(|e| flags(e, &[("degree", "--degree"), ("tolerance", "--tol")]))?;
