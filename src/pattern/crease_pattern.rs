@@ -93,8 +93,8 @@ pub struct CreasePattern {
     pub fold_angles: Vec<f64>,
     /// The faces of the planar graph, counter-clockwise vertex loops.
     pub faces: Vec<Vec<usize>>,
-    /// The faces on each side of each edge: [left, right] seen from edges[e][0] to
-    /// edges[e][1] (None: outside the paper).
+    /// The faces on each side of each edge: `[left, right]` seen from `edges[e][0]` to
+    /// `edges[e][1]` (None: outside the paper).
     pub edge_faces: Vec<[Option<usize>; 2]>,
     /// The panel each face belongs to (faces joined across facet edges).
     pub panel_of_face: Vec<usize>,
