@@ -32,12 +32,12 @@ fn mutate(value: &mut Value, seed: &mut u64, depth: u64) {
         }
         Value::Array(items) => {
             for item in items.iter_mut() {
-                if next(seed) % (8 + 8 * depth) == 0 || (depth < 3 && next(seed) % 20 == 0) {
+                if next(seed).is_multiple_of(8 + 8 * depth) || (depth < 3 && next(seed).is_multiple_of(20)) {
                     mutate(item, seed, depth + 1);
                 }
             }
         }
-        Value::String(s) if next(seed) % 3 == 0 => {
+        Value::String(s) if next(seed).is_multiple_of(3) => {
             *s = ["M", "V", "F", "B", "U", "C"][(next(seed) % 6) as usize].to_string();
         }
         _ => {}
@@ -73,7 +73,7 @@ fn mutated_crease_patterns_are_refused_or_run_without_panicking() {
             "faces_vertices",
         ] {
             if let Some(field) = value.get_mut(key) {
-                if next(&mut seed) % 2 == 0 {
+                if next(&mut seed).is_multiple_of(2) {
                     mutate(field, &mut seed, 0);
                 }
             }
