@@ -34,16 +34,40 @@ fn random_vertex(n: usize, weights: &[f64], drive: &[f64]) -> Option<(Vec<f64>, 
     );
     let mut rho = vec![0.0; n];
     let free = [0, 1, 2];
+    let mut before = nanofold::geometry::kinematics::forward(&sectors, &rho);
     for s in 1..=30 {
         for k in 3..n {
             rho[k] = drive[k] * s as f64 / 30.0;
         }
         solve_closure(&sectors, &mut rho, &free, 1e-14, 60).ok()?;
+        // A move that carries a node through a sector makes a self-intersecting state, which
+        // no rigid unfolding may undo (such a draw once came out `local_minimum`): redraw.
+        let after = nanofold::geometry::kinematics::forward(&sectors, &rho);
+        if passes_through_a_sector(&sectors, &before, &after) {
+            return None;
+        }
+        before = after;
     }
     if rho.iter().any(|r| r.abs() > 0.97 * PI) {
         return None;
     }
     Some((sectors, rho))
+}
+
+/// Does some node change sides of a sector's great circle between two states while within
+/// 0.05 rad of that sector (farther than a step of the generator moves it)?
+fn passes_through_a_sector(sectors: &[f64], before: &[Vec3], after: &[Vec3]) -> bool {
+    let n = sectors.len();
+    let angle = |x: &Vec3, y: &Vec3| x.cross(y).norm().atan2(x.dot(y));
+    (0..n).any(|k| {
+        let (a, b) = (k, (k + 1) % n);
+        (0..n).filter(|&v| v != a && v != b).any(|v| {
+            let side_before = before[a].cross(&before[b]).dot(&before[v]);
+            let side_after = after[a].cross(&after[b]).dot(&after[v]);
+            side_before * side_after < 0.0
+                && angle(&after[v], &after[a]) + angle(&after[v], &after[b]) - sectors[k] < 0.05
+        })
+    })
 }
 
 fn fd_check(f: impl Fn(&Vec3) -> f64, x: &Vec3, grad: &Vec3, tol: f64) -> Result<(), TestCaseError> {
