@@ -845,3 +845,45 @@ fn degree_auto_for_mujoco_is_capped_at_four_with_its_error_stated() {
     assert!(dir.join("constraints.xml").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn new_crease_pattern_inputs_are_refused_by_name() {
+    let dir = temp_dir("crease-inputs");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A lock on a boundary edge.
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/many/miura_4x4.fold").unwrap()).unwrap();
+    let edges = value["edges_vertices"].as_array().unwrap().len();
+    let mut locked = vec![false; edges];
+    locked[0] = true;
+    value["edges_nanofold:locked"] = serde_json::json!(locked);
+    let file = dir.join("locked_boundary.fold");
+    std::fs::write(&file, value.to_string()).unwrap();
+    let out = nanofold().arg("check").arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !out.status.success() && text.contains("edges_nanofold:locked[0]"),
+        "{text}"
+    );
+    // Generator and fold flags out of range: each named, nothing written.
+    for (args, flag) in [
+        (vec!["generate", "square-twist", "--twist", "60"], "--twist"),
+        (vec!["generate", "waterbomb", "--rows", "0"], "--rows"),
+        (vec!["generate", "miura", "--slant", "-1"], "--slant"),
+    ] {
+        let target = dir.join("out.fold");
+        let out = nanofold().args(&args).arg("--out").arg(&target).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && text.contains(flag), "{args:?}: {text}");
+        assert!(!target.exists());
+    }
+    let out = nanofold()
+        .args(["fold", "patterns/many/miura_4x4.fold", "--to", "150", "--out"])
+        .arg(dir.join("fold"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && text.contains("--to"), "{text}");
+    assert!(!dir.join("fold").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -54,17 +54,17 @@ pub enum GenerateKind {
         #[arg(long, default_value_t = 4)]
         cols: usize,
         /// The panels' acute angle (degrees).
-        #[arg(long, default_value_t = 60.0)]
+        #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
         angle: f64,
         /// Length of the panels' horizontal sides.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         width: f64,
         /// Length of the panels' slanted sides.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         slant: f64,
         /// Also write the folded state with the zigzag creases at this angle (degrees; 0 or
         /// absent: the crease pattern alone).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         fold: Option<f64>,
         /// The FOLD file to write.
         #[arg(long)]
@@ -73,13 +73,13 @@ pub enum GenerateKind {
     /// Square twist: a central square and four pleats turned by the twist angle.
     SquareTwist {
         /// Side of the central square.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         side: f64,
         /// Half the side of the square sheet.
-        #[arg(long, default_value_t = 1.5)]
+        #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
         half_sheet: f64,
         /// Twist angle (degrees, 1 to 45).
-        #[arg(long, default_value_t = 30.0)]
+        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
         twist: f64,
         /// Flip each corner's crease after its smallest sector (breaks big-little-big: no
         /// longer flat-foldable) instead of the classic assignment.
