@@ -6,7 +6,7 @@
 use nanofold::folding::{degree4_modes, FoldingModel};
 use nanofold::io::folding_output::crease_pattern_fold;
 use nanofold::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
-use nanofold::pattern::generate::{MiuraSpec, SquareTwistSpec, WaterbombSpec};
+use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::pattern::Assignment;
 
 fn write(name: &str, builder: CreasePatternBuilder, with_state: bool, note: &str) {
@@ -176,9 +176,33 @@ fn main() {
     );
     write(
         "waterbomb_4x3",
-        WaterbombSpec { rows: 4, cols: 3 }.build().unwrap(),
+        WaterbombSpec {
+            rows: 4,
+            cols: 3,
+            row_height: 1.0,
+        }
+        .build()
+        .unwrap(),
         false,
         "waterbomb tessellation 4 x 3",
+    );
+    write(
+        "huffman_waterbomb_6x4",
+        WaterbombSpec {
+            rows: 6,
+            cols: 4,
+            row_height: 0.6,
+        }
+        .build()
+        .unwrap(),
+        false,
+        "Huffman-style rectangular waterbomb 6 x 4, rows 0.6 high (diagonals at 31 deg)",
+    );
+    write(
+        "bird_base",
+        BirdBaseSpec::default().build().unwrap(),
+        false,
+        "bird base, flat-foldable assignment, square of side 2",
     );
 
     // Three strips, both outer ones folded up by 170 degrees: they pass through each other

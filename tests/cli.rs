@@ -869,6 +869,8 @@ fn new_crease_pattern_inputs_are_refused_by_name() {
     for (args, flag) in [
         (vec!["generate", "square-twist", "--twist", "60"], "--twist"),
         (vec!["generate", "waterbomb", "--rows", "0"], "--rows"),
+        (vec!["generate", "waterbomb", "--row-height", "0"], "--row-height"),
+        (vec!["generate", "bird-base", "--half-side", "-2"], "--half-side"),
         (vec!["generate", "miura", "--slant", "-1"], "--slant"),
     ] {
         let target = dir.join("out.fold");

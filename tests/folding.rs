@@ -421,6 +421,10 @@ fn every_crease_pattern_in_the_library_gets_its_expected_verdict() {
         ("strips_crossing", SelfIntersecting),
         // A witness path, checked below step by step.
         ("waterbomb_4x3", RigidlyFoldable),
+        // The same with rectangular cells (rows 0.6 high): a witness path, checked below.
+        ("huffman_waterbomb_6x4", RigidlyFoldable),
+        // A witness path, checked below, and the petal points' closed form in the next test.
+        ("bird_base", RigidlyFoldable),
     ];
     let mut seen = 0;
     for (name, verdict) in expected {
@@ -795,4 +799,75 @@ fn a_locked_sweep_agrees_with_the_single_vertex_sweep() {
         }
     }
     assert!(worst < 1e-9, "largest difference {worst:e} rad");
+}
+
+/// The bird base's four petal points are symmetric flat-foldable degree-4 vertices (sectors
+/// 67.5°, 112.5°, 112.5°, 67.5°), the same kind as a Miura-ori vertex with γ = 67.5°: along
+/// any rigid folding the kites fold equally, the two midline creases equally and oppositely,
+/// and tan(ρ_midline/2) = cos γ · tan(ρ_kite/2) (docs/model.md#pattern-generators). Checked on
+/// every frame of the witness path that `check` finds.
+#[test]
+fn the_bird_base_folds_with_the_flat_foldable_vertex_closed_form() {
+    use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
+    let path = Path::new("patterns/many/bird_base.fold");
+    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let report = check_pattern(&model, &CheckSettings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::RigidlyFoldable, "{}", report.evidence);
+    let witness = report.witness.unwrap();
+    let pattern = &model.pattern;
+    let half = pattern.vertices.iter().map(|p| p[0].abs()).fold(0.0, f64::max);
+    let petal_distance = (2.0 - 2f64.sqrt()) * half;
+    let gamma = 67.5f64.to_radians();
+    let mut petals = 0;
+    for (v, p) in pattern.vertices.iter().enumerate() {
+        let r = p[0].hypot(p[1]);
+        if (r - petal_distance).abs() > 1e-9 || p[0].abs().min(p[1].abs()) > 1e-9 {
+            continue;
+        }
+        petals += 1;
+        // Its creases: the two on the midline (radial) and the two kites.
+        let mut midline = Vec::new();
+        let mut kites = Vec::new();
+        // Fold angles are indexed by crease (column), not by edge.
+        for (column, &e) in pattern.creases.iter().enumerate() {
+            let [a, b] = pattern.edges[e];
+            if a != v && b != v {
+                continue;
+            }
+            let other = pattern.vertices[if a == v { b } else { a }];
+            let cross = p[0] * other[1] - p[1] * other[0];
+            if cross.abs() < 1e-9 {
+                midline.push(column);
+            } else {
+                kites.push(column);
+            }
+        }
+        assert_eq!((midline.len(), kites.len()), (2, 2), "petal point {v}");
+        for step in witness.steps.iter().filter(|s| s.progress < 0.999) {
+            let rho = &step.fold_angles;
+            let (k0, k1) = (rho[kites[0]], rho[kites[1]]);
+            let (m0, m1) = (rho[midline[0]], rho[midline[1]]);
+            // Near flat a closure residual r pins the fold angles only to about r / |ρ|.
+            let tol = 1e-9 + 10.0 * step.max_residual / m0.abs().min(k0.abs());
+            assert!((k0 - k1).abs() < tol, "kites {k0} {k1}");
+            assert!((m0 + m1).abs() < tol, "midline {m0} {m1}");
+            let expected = gamma.cos() * (k0 / 2.0).tan().abs();
+            assert!(
+                ((m0 / 2.0).tan().abs() - expected).abs() < tol * (1.0 + expected),
+                "petal point {v} at progress {}: {} against {expected}",
+                step.progress,
+                (m0 / 2.0).tan().abs()
+            );
+        }
+    }
+    assert_eq!(petals, 4);
+    // And it reaches the flat-folded base: every crease at ±π in the last frame.
+    let last = witness.steps.last().unwrap();
+    assert!(last.progress > 0.999, "{}", last.progress);
+    for (column, angle) in last.fold_angles.iter().enumerate() {
+        assert!(
+            (angle.abs() - std::f64::consts::PI).abs() < 1e-6,
+            "crease {column}: {angle}"
+        );
+    }
 }

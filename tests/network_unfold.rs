@@ -218,3 +218,63 @@ fn hard_starts_get_their_verdicts() {
     let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
     assert_eq!(report.verdict, NetworkVerdict::Locked, "{}", report.evidence);
 }
+
+/// Waterbomb tessellations (square cells and the Huffman-style rectangular cells) and the bird
+/// base, folded from flat by `fold` to part of the way, unfold to flat: many degrees of
+/// freedom and degree-6 vertices, where minor creases change sign on the way and the last
+/// stretch runs along the ray to flat. Every recorded state closes and no panels cross.
+#[test]
+fn waterbombs_and_the_bird_base_folded_by_fold_unfold_flat() {
+    use nanofold::folding::{fold_path, panel_contacts, panel_poses, ContactSettings, Drive, FoldSettings};
+    use nanofold::pattern::generate::{BirdBaseSpec, WaterbombSpec};
+    let cases = [
+        (
+            "waterbomb 4x3",
+            WaterbombSpec {
+                rows: 4,
+                cols: 3,
+                row_height: 1.0,
+            }
+            .build()
+            .unwrap(),
+            0.4,
+        ),
+        (
+            "waterbomb 6x4, rows 0.6",
+            WaterbombSpec {
+                rows: 6,
+                cols: 4,
+                row_height: 0.6,
+            }
+            .build()
+            .unwrap(),
+            0.3,
+        ),
+        ("bird base", BirdBaseSpec::default().build().unwrap(), 0.5),
+    ];
+    for (name, builder, depth) in cases {
+        let model = FoldingModel::new(builder.build().unwrap()).unwrap();
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to: depth },
+            ..FoldSettings::default()
+        };
+        let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+        let start = folded.steps.last().unwrap().fold_angles.clone();
+        let largest = start.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        assert!(largest > 0.3, "{name}: folded only to {largest}");
+        let report = unfold_network(&model, &start, &NetworkUnfoldSettings::default()).unwrap();
+        assert_eq!(report.verdict, NetworkVerdict::Flat, "{name}: {}", report.evidence);
+        assert!(report.max_closure_residual <= 1e-10, "{name}");
+        let mut poses = Vec::new();
+        let contact = ContactSettings::default();
+        for step in &report.steps {
+            let worst = vertex_residuals(&model, &step.fold_angles)
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!(worst <= 1e-10, "{name}: {worst:e}");
+            panel_poses(&model, &step.fold_angles, &mut poses);
+            assert_eq!(panel_contacts(&model, &poses, &contact).crossing().count(), 0, "{name}");
+        }
+        assert!(report.steps.last().unwrap().fold_angles.iter().all(|&r| r == 0.0));
+    }
+}

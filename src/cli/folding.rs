@@ -10,7 +10,7 @@ use nanofold::folding::{
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
 use nanofold::pattern::crease_pattern::CreasePatternBuilder;
-use nanofold::pattern::generate::{MiuraSpec, SquareTwistSpec, WaterbombSpec};
+use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -89,7 +89,8 @@ pub enum GenerateKind {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Waterbomb tessellation: rows of triangles, degree-6 vertices.
+    /// Waterbomb tessellation: rows of triangles, degree-6 vertices; with --row-height other
+    /// than 1, the Huffman-style rectangular waterbomb.
     Waterbomb {
         /// Rows of triangles.
         #[arg(long, default_value_t = 4)]
@@ -97,6 +98,18 @@ pub enum GenerateKind {
         /// Units across (the sheet is twice as wide).
         #[arg(long, default_value_t = 4)]
         cols: usize,
+        /// Height of a row in half-cell widths (1: square cells; 0.1 to 10).
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        row_height: f64,
+        /// The FOLD file to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Bird base: the flat-foldable crease pattern (midlines, kites, one diagonal).
+    BirdBase {
+        /// Half the side of the square sheet.
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        half_side: f64,
         /// The FOLD file to write.
         #[arg(long)]
         out: PathBuf,
@@ -173,16 +186,34 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
             );
             write_pattern(builder, &note, out)?;
         }
-        GenerateKind::Waterbomb { rows, cols, out } => {
+        GenerateKind::Waterbomb {
+            rows,
+            cols,
+            row_height,
+            out,
+        } => {
             let builder = WaterbombSpec {
                 rows: *rows,
                 cols: *cols,
+                row_height: *row_height,
             }
             .build()
-            .map_err(|e| flags(e, &[("rows, cols", "--rows, --cols")]))?;
+            .map_err(|e| flags(e, &[("rows, cols", "--rows, --cols"), ("row_height", "--row-height")]))?;
             write_pattern(
                 builder,
-                &format!("waterbomb tessellation {rows} x {cols}; written by nanofold generate"),
+                &format!(
+                    "waterbomb tessellation {rows} x {cols}, row height {row_height}; written by nanofold generate"
+                ),
+                out,
+            )?;
+        }
+        GenerateKind::BirdBase { half_side, out } => {
+            let builder = BirdBaseSpec { half_side: *half_side }
+                .build()
+                .map_err(|e| flags(e, &[("half_side", "--half-side")]))?;
+            write_pattern(
+                builder,
+                &format!("bird base, half side {half_side}; written by nanofold generate"),
                 out,
             )?;
         }
@@ -680,6 +711,7 @@ pub fn unfold_network_one(
         "flat_layout_error": flat_layout_error,
         "restarts_used": 0,
         "crossings_refused": report.crossings_refused,
+        "radial_steps": report.radial_steps,
         "adjustments": Vec::<String>::new(),
         "max_closure_residual_rad": report.max_closure_residual,
         "out": dir.display().to_string(),
@@ -704,8 +736,8 @@ pub fn unfold_network_one(
     )?;
     writeln!(
         text,
-        "  worst vertex closure over the path {:.2e} rad; flat layout error {:.2e}; {} steps refused for crossing panels",
-        report.max_closure_residual, flat_layout_error, report.crossings_refused
+        "  worst vertex closure over the path {:.2e} rad; flat layout error {:.2e}; {} steps refused for crossing panels; {} steps along the ray to flat",
+        report.max_closure_residual, flat_layout_error, report.crossings_refused, report.radial_steps
     )?;
     write!(
         text,

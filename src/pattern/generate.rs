@@ -304,21 +304,37 @@ fn on_rectangle(
     builder
 }
 
-/// The waterbomb tessellation: rows of isosceles right triangles between horizontal
-/// mountain lines, degree-6 vertices (sectors 45°, 90°, 45°, 45°, 90°, 45°) where four
-/// valley diagonals meet a horizontal line, alternating rows shifted by one unit.
+/// The waterbomb tessellation: rows of triangles between horizontal mountain lines,
+/// degree-6 vertices where four valley diagonals meet a horizontal line, alternating rows
+/// shifted by one unit. With row height 1 the triangles are isosceles right triangles
+/// (sectors 45°, 90°, 45°, 45°, 90°, 45°); another row height stretches the cells into
+/// rectangles (sectors θ, π − 2θ, θ, θ, π − 2θ, θ with tan θ = height), the Huffman-style
+/// variant. Three straight lines cross at every vertex, so Kawasaki holds for any height.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WaterbombSpec {
-    /// Rows of triangles (the sheet is `rows` high).
+    /// Rows of triangles (the sheet is `rows · row_height` high).
     pub rows: usize,
     /// Units across (the sheet is 2·cols wide).
     pub cols: usize,
+    /// Height of a row, in units of the half-cell width; 1 for the square waterbomb.
+    pub row_height: f64,
+}
+
+impl Default for WaterbombSpec {
+    fn default() -> Self {
+        WaterbombSpec {
+            rows: 4,
+            cols: 4,
+            row_height: 1.0,
+        }
+    }
 }
 
 impl WaterbombSpec {
-    /// The pattern (flat, assignment only). Vertex (x, y) for integer x in 0..=2·cols and y in
-    /// 0..=rows; where x + y is even, diagonals run to (x ± 1, y ± 1); every horizontal line
-    /// inside the sheet is a mountain crease, every diagonal a valley.
+    /// The pattern (flat, assignment only). Vertex (x, y) at (x, y · row_height) for integer
+    /// x in 0..=2·cols and y in 0..=rows; where x + y is even, diagonals run to
+    /// (x ± 1, y ± 1); every horizontal line inside the sheet is a mountain crease, every
+    /// diagonal a valley.
     pub fn build(&self) -> Result<CreasePatternBuilder> {
         let (rows, cols) = (self.rows, self.cols);
         if rows < 1 || cols < 1 || 6 * (rows + 1) * (2 * cols + 1) > MAX_EDGES {
@@ -328,10 +344,18 @@ impl WaterbombSpec {
                 format!("at least 1 × 1, and at most {MAX_EDGES} edges"),
             ));
         }
+        let height = self.row_height;
+        if !(0.1..=10.0).contains(&height) {
+            return Err(NanofoldError::invalid(
+                "row_height",
+                height,
+                "a number in [0.1, 10] (units of the half-cell width)",
+            ));
+        }
         let width = 2 * cols;
         let index = |x: usize, y: usize| y * (width + 1) + x;
         let vertices: Vec<[f64; 2]> = (0..=rows)
-            .flat_map(|y| (0..=width).map(move |x| [x as f64, y as f64]))
+            .flat_map(|y| (0..=width).map(move |x| [x as f64, y as f64 * height]))
             .collect();
         let mut segments = Vec::new();
         for y in 1..rows {
@@ -357,12 +381,77 @@ impl WaterbombSpec {
         rim.extend((1..rows).flat_map(|y| [index(0, y), index(width, y)]));
         // Horizontal lines end on the sides: drop their segments' duplicates with the rim.
         Ok(on_rectangle(
-            format!("waterbomb_{rows}x{cols}"),
+            if height == 1.0 {
+                format!("waterbomb_{rows}x{cols}")
+            } else {
+                format!("waterbomb_{rows}x{cols}_h{height}")
+            },
             vertices,
             segments,
             rim,
             [0.0, 0.0],
-            [width as f64, rows as f64],
+            [width as f64, rows as f64 * height],
+        ))
+    }
+}
+
+/// The bird base as a flat-foldable crease pattern on the square [−s, s]²: the four
+/// midlines (mountain from the centre to the four petal points at (2 − √2)·s, valley beyond),
+/// eight kite creases (mountain) from the petal points to the corners beside them, and the
+/// diagonal through (−s, s) and (s, −s) (valley). The other diagonal and the petal folds'
+/// horizontal guide creases are flat in the finished base, so they are not creases here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BirdBaseSpec {
+    /// Half the side s of the square sheet.
+    pub half_side: f64,
+}
+
+impl Default for BirdBaseSpec {
+    fn default() -> Self {
+        BirdBaseSpec { half_side: 1.0 }
+    }
+}
+
+impl BirdBaseSpec {
+    /// The pattern (flat, assignment only). Around the centre the sectors are 90°, 45°, 45°,
+    /// 90°, 45°, 45° (four mountains, two valleys); around a petal point 67.5°, 112.5°,
+    /// 112.5°, 67.5° (three mountains, one valley): Kawasaki and Maekawa hold at all five.
+    pub fn build(&self) -> Result<CreasePatternBuilder> {
+        let s = self.half_side;
+        if !(s > 0.0 && s <= 1e6) {
+            return Err(NanofoldError::invalid("half_side", s, "a length in (0, 1e6]"));
+        }
+        let d = (2.0 - std::f64::consts::SQRT_2) * s;
+        let axes = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]];
+        // 0: centre; 1..=4 petal points; 5..=8 edge midpoints; 9..=12 corners, corner k
+        // between axes k and k + 1.
+        let mut vertices = vec![[0.0, 0.0]];
+        vertices.extend(axes.iter().map(|a| [d * a[0], d * a[1]]));
+        vertices.extend(axes.iter().map(|a| [s * a[0], s * a[1]]));
+        vertices.extend((0..4).map(|k| {
+            let (a, b) = (axes[k], axes[(k + 1) % 4]);
+            [s * (a[0] + b[0]), s * (a[1] + b[1])]
+        }));
+        let mountain = EdgeKind::Crease(Assignment::Mountain);
+        let valley = EdgeKind::Crease(Assignment::Valley);
+        let mut segments = Vec::new();
+        for k in 0..4 {
+            let petal = 1 + k;
+            segments.push(([0, petal], mountain));
+            segments.push(([petal, 5 + k], valley));
+            segments.push(([petal, 9 + k], mountain));
+            segments.push(([petal, 9 + (k + 3) % 4], mountain));
+        }
+        // The valley diagonal: corners 1 (−s, s) and 3 (s, −s).
+        segments.push(([0, 10], valley));
+        segments.push(([0, 12], valley));
+        Ok(on_rectangle(
+            "bird_base".into(),
+            vertices,
+            segments,
+            (5..=12).collect(),
+            [-s, -s],
+            [s, s],
         ))
     }
 }

@@ -213,6 +213,31 @@ pub struct NetworkReport {
     pub max_closure_residual: f64,
     /// Trial steps refused because panels would cross.
     pub crossings_refused: usize,
+    /// Steps taken along the ray to flat, ρ → (1 − f)ρ, where the projected gradient's
+    /// line search found none.
+    pub radial_steps: usize,
+}
+
+/// A crease is a major crease of a vertex when its |ρ| is at least this share of the
+/// largest |ρ| there.
+const MAJOR_SHARE: f64 = 0.25;
+
+/// Marks the creases that are major at one of their vertices, or have no interior vertex.
+fn major_crease(model: &FoldingModel, rho: &[f64], major: &mut [bool]) {
+    major.fill(false);
+    let mut starred = vec![false; rho.len()];
+    for star in &model.stars {
+        let largest = star.columns.iter().map(|&c| rho[c].abs()).fold(0.0, f64::max);
+        for &c in &star.columns {
+            starred[c] = true;
+            if rho[c].abs() >= MAJOR_SHARE * largest {
+                major[c] = true;
+            }
+        }
+    }
+    for (m, s) in major.iter_mut().zip(&starred) {
+        *m |= !s;
+    }
 }
 
 /// The flat state (rigid, every vertex closed exactly) as the path's last step.
@@ -272,6 +297,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             }],
             max_closure_residual: residual,
             crossings_refused: 0,
+            radial_steps: 0,
         });
     }
     let energy = NetworkEnergy::new(model, settings.energy, settings.p);
@@ -295,8 +321,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     }];
     let mut crossings_refused = 0;
     let mut poses = Vec::new();
+    let mut major = vec![true; n];
+    let mut radial_steps = 0usize;
     let mut scale = 1.0;
-    let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused| {
+    let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused, radial_steps| {
         let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
         Ok(NetworkReport {
             verdict,
@@ -305,6 +333,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             steps,
             max_closure_residual,
             crossings_refused,
+            radial_steps,
         })
     };
     if jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
@@ -313,6 +342,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             "0 degrees of freedom at the start: no rigid motion".into(),
             0,
             steps,
+            0,
             0,
         );
     }
@@ -331,6 +361,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     iteration,
                     steps,
                     crossings_refused,
+                    radial_steps,
                 );
             }
         }
@@ -342,6 +373,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 iteration,
                 steps,
                 crossings_refused,
+                radial_steps,
             );
         }
         let factor = solver.factor(&closure_jacobian(model, &rho))?;
@@ -357,19 +389,25 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 iteration,
                 steps,
                 crossings_refused,
+                radial_steps,
             );
         }
         let mut t = (settings.max_step / size) * scale;
-        // No crease may pass through flat in one step: the flat state is where the branches
-        // of the folding motion cross, and beyond it lies the mirrored state, not progress.
-        for (r, d) in rho.iter().zip(&descent) {
-            if r * d < 0.0 && r.abs() > settings.flat_tol {
+        // No vertex may pass through its flat state in one step: there the branches of its
+        // folding motion cross, and beyond lies the mirrored state, not progress. A vertex
+        // heads there when one of its major creases (|ρ| within MAJOR_SHARE of its largest)
+        // heads to 0; a minor crease of a vertex that stays folded may change sign.
+        major_crease(model, &rho, &mut major);
+        for ((r, d), &is_major) in rho.iter().zip(&descent).zip(&major) {
+            if is_major && r * d < 0.0 && r.abs() > settings.flat_tol {
                 t = t.min(FLAT_APPROACH * (r / d).abs());
             }
         }
         let mut accepted = None;
         let mut refused_for_crossing = false;
-        for _ in 0..50 {
+        let mut halvings = 0;
+        // Steps shorter than this are lost in the closure tolerance.
+        while t * size > 1e-13 {
             let mut trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
             if restore_closure(model, &mut trial, settings.closure_tol, &mut solver)?.is_some() {
                 let mut trial_gradient = vec![0.0; n];
@@ -389,10 +427,40 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 }
             }
             t /= 2.0;
+            halvings += 1;
         }
         // Within STALL_TOL of flat a step that does not lower the energy at all is lost in
         // its rounding: count it as the line search stalling.
-        let accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
+        let mut accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
+        if accepted.is_none() {
+            // Near the flat state the closure manifold is close to a cone with its apex
+            // there, where Newton from a tangent step converges slowly or not at all; a step
+            // along the cone's ray, ρ → (1 − f)ρ, stays nearly on it. Taken when it lowers
+            // the energy and puts no panels through each other.
+            let mut f = 0.5;
+            while f > 1e-4 {
+                let mut trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
+                if restore_closure(model, &mut trial, settings.closure_tol, &mut solver)?.is_some() {
+                    let mut trial_gradient = vec![0.0; n];
+                    let u_trial = energy.value_and_gradient(&trial, &mut ws, &mut trial_gradient);
+                    if u_trial.is_finite() && u_trial < u {
+                        panel_poses(model, &trial, &mut poses);
+                        if panel_contacts(model, &poses, &settings.contact)
+                            .crossing()
+                            .next()
+                            .is_none()
+                        {
+                            accepted = Some((trial, u_trial, trial_gradient));
+                            radial_steps += 1;
+                            break;
+                        }
+                        crossings_refused += 1;
+                        refused_for_crossing = true;
+                    }
+                }
+                f /= 2.0;
+            }
+        }
         let Some((next, u_next, g_next)) = accepted else {
             if largest <= STALL_TOL && !refused_for_crossing {
                 // The energy's changes are below its rounding this close to flat; the flat
@@ -404,6 +472,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     iteration,
                     steps,
                     crossings_refused,
+                    radial_steps,
                 );
             }
             let (verdict, why) = if refused_for_crossing {
@@ -420,10 +489,13 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 iteration,
                 steps,
                 crossings_refused,
+                radial_steps,
             );
         };
-        // Next time try twice the fraction of the largest step this one used.
-        scale = (2.0 * t * size / settings.max_step).clamp(1e-6, 1.0);
+        // The line search's memory: twice the largest step if this one needed no halving,
+        // fewer halvings than this one next time otherwise. A step cut short by the flat
+        // approach says nothing about the energy's curvature, so it leaves the memory alone.
+        scale = (scale * 2f64.powi(1 - halvings)).clamp(1e-6, 1.0);
         rho = next;
         u = u_next;
         gradient = g_next;
@@ -439,5 +511,6 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         settings.max_iterations,
         steps,
         crossings_refused,
+        radial_steps,
     )
 }
