@@ -92,6 +92,12 @@ pub enum Command {
     /// Response of a scene (a chain of plates) to its actuation: writes response.json,
     /// response.svg and snapshots.svg (`docs/model.md#dynamics`).
     Simulate(SimulateArgs),
+    /// Write a scene in another tool's format: `export mujoco SCENE` writes one complete MJCF
+    /// model (`docs/model.md#mujoco-scenes`).
+    Export {
+        #[command(subcommand)]
+        format: ExportKind,
+    },
     /// Natural frequencies, mode shapes and stability at the folded equilibrium of a scene.
     Modes {
         /// A scene file (.scene.json).
@@ -99,6 +105,26 @@ pub enum Command {
         /// Print one JSON object on stdout instead of a table.
         #[arg(long)]
         json: bool,
+    },
+}
+
+/// `nanofold export FORMAT ...`
+#[derive(clap::Subcommand)]
+pub enum ExportKind {
+    /// A scene as a MuJoCo MJCF model: a body per plate (mass, inertia), a hinge per crease
+    /// (stiffness, springref 0), the step torque as an actuator, the substrate, a closed
+    /// loop closed by `connect` equalities; units µm, pg, µs. Drag is in custom numerics for
+    /// a passive callback (tests/mujoco/nanofold_mujoco.py).
+    Mujoco {
+        /// A scene file (.scene.json), strip or closed chain, step actuation.
+        scene: PathBuf,
+        /// The MJCF file to write (default: output/<scene name>/<scene name>.xml).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// RK4 time step in seconds (default: 1e-9; at most a twentieth of the scene's
+        /// fastest natural period).
+        #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
+        timestep: f64,
     },
 }
 
@@ -1101,6 +1127,38 @@ fn simulate_flags(error: nanofold::NanofoldError) -> anyhow::Error {
     with_flags(error, SIMULATE_FLAGS)
 }
 
+fn run_export(format: &ExportKind) -> Result<()> {
+    let ExportKind::Mujoco { scene, out, timestep } = format;
+    let built = load_scene(scene)?;
+    let scales = match &built.system {
+        System::Strip(chain) => chain.time_scales()?,
+        System::Closed(chain) => chain.time_scales()?,
+    };
+    let settings = nanofold::io::mujoco::MujocoSettings { timestep: *timestep };
+    settings
+        .validate(scales.fastest_period_s)
+        .map_err(|e| with_flags(e, &[("timestep", "--timestep")]))?;
+    let text = nanofold::io::mujoco::scene_mjcf(&built, &settings)?;
+    let out = out.clone().unwrap_or_else(|| {
+        PathBuf::from("output")
+            .join(&built.name)
+            .join(format!("{}.xml", built.name))
+    });
+    if out.extension().and_then(|e| e.to_str()) != Some("xml") {
+        anyhow::bail!("--out {}: the file name must end in .xml", out.display());
+    }
+    nanofold::io::output::write_atomic(&out, text.as_bytes()).with_context(|| format!("writing {}", out.display()))?;
+    println!(
+        "{}: wrote {} (MJCF, units µm, pg, µs; RK4 step {:e} s, a {:.0}th of the fastest period {:.3e} s)",
+        built.name,
+        out.display(),
+        timestep,
+        scales.fastest_period_s / timestep,
+        scales.fastest_period_s
+    );
+    Ok(())
+}
+
 fn run_modes(path: &Path, json: bool) -> Result<()> {
     let scene = load_scene(path)?;
     let chain = match &scene.system {
@@ -1246,5 +1304,6 @@ pub fn run(cli: Cli) -> Result<bool> {
         Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
         Command::Modes { scene, json } => run_modes(&scene, json).map(|_| true),
+        Command::Export { format } => run_export(&format).map(|_| true),
     }
 }

@@ -7,6 +7,7 @@ pub mod folded_form;
 pub mod folder;
 pub mod folding_output;
 pub mod input;
+pub mod mujoco;
 pub mod native;
 pub mod output;
 pub mod scene;

@@ -1,0 +1,641 @@
+//! MuJoCo scenes (`docs/model.md#mujoco-scenes`): a dynamics [`Scene`] written as one complete
+//! MJCF model — a body per plate with its mass and inertia, a hinge per crease with its
+//! stiffness, the step torque as an actuator, the substrate, and a closed loop closed by
+//! `connect` equalities — in scaled units (µm, pg, µs) that keep MuJoCo's numbers near 1.
+
+use crate::dynamics::closed::ClosedChain;
+use crate::dynamics::forcing::{Actuation, Forcing};
+use crate::dynamics::model::{Model, Plate};
+use crate::dynamics::scene::{Scene, System};
+use crate::dynamics::strip::StripChain;
+use crate::error::{NanofoldError, Result};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+use std::fmt::Write as _;
+
+/// Length unit of the MJCF, m (1 µm).
+pub const LENGTH_UNIT: f64 = 1e-6;
+/// Mass unit of the MJCF, kg (1 pg).
+pub const MASS_UNIT: f64 = 1e-12;
+/// Time unit of the MJCF, s (1 µs).
+pub const TIME_UNIT: f64 = 1e-6;
+/// Torque (and hinge stiffness per rad) unit, N·m: MASS · LENGTH² / TIME².
+pub const TORQUE_UNIT: f64 = MASS_UNIT * LENGTH_UNIT * LENGTH_UNIT / (TIME_UNIT * TIME_UNIT);
+
+/// The mass of the auxiliary body that carries a closed loop's cut crease, as a share of the
+/// lightest plate's (its inertia likewise).
+pub const CUT_BODY_SHARE: f64 = 1e-6;
+
+/// How to write a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MujocoSettings {
+    /// Integrator time step, s (RK4).
+    pub timestep: f64,
+}
+
+impl Default for MujocoSettings {
+    fn default() -> Self {
+        MujocoSettings { timestep: 1e-9 }
+    }
+}
+
+impl MujocoSettings {
+    /// Checks the time step against the scene's fastest natural period: RK4 needs it well
+    /// below, and MuJoCo's equality constraints relax over two steps.
+    pub fn validate(&self, fastest_period: f64) -> Result<()> {
+        let limit = fastest_period / 20.0;
+        if !(self.timestep > 0.0 && self.timestep <= limit) {
+            return Err(NanofoldError::invalid(
+                "timestep",
+                format!("{:e} s", self.timestep),
+                format!(
+                    "must lie in (0, {limit:.3e}] s, a twentieth of the fastest natural period {fastest_period:.3e} s"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One body of the MJCF tree: a plate and the joint that carries it.
+struct BodySpec {
+    name: String,
+    pose: Isometry3<f64>,
+    parent: Option<usize>,
+    joint: Option<JointSpec>,
+    mass: f64,
+    /// Inertia at the centre of mass in body axes, kg·m².
+    inertia: [f64; 6],
+    /// Outline in the body frame, m (None: no geometry, the cut crease's body).
+    outline: Option<Vec<Point3<f64>>>,
+    thickness: f64,
+    drag_area: f64,
+    collide: bool,
+}
+
+struct JointSpec {
+    name: String,
+    axis: Vector3<f64>,
+    point: Point3<f64>,
+    stiffness: f64,
+    /// Step torque of its stressed layer, N·m (None: passive).
+    step_torque: Option<f64>,
+}
+
+fn step_torques(forcing: &Forcing, stiffness: &[f64], what: &str) -> Result<Vec<Option<f64>>> {
+    if let Actuation::Ramp { .. } = forcing.actuation {
+        return Err(NanofoldError::invalid(
+            "actuation",
+            "ramp",
+            format!("{what}: the MuJoCo export writes step actuation only (a ramp's torque changes with time; drive the actuator's ctrl with K θ_drive(t) yourself)"),
+        ));
+    }
+    Ok(forcing
+        .hinges
+        .iter()
+        .zip(stiffness)
+        .map(|(h, k)| h.actuated.then_some(k * h.target))
+        .collect())
+}
+
+/// The structural thickness of a lamina from its inertia: I_xx + I_yy − I_zz = m t²/6.
+fn lamina_thickness(plate: &Plate) -> f64 {
+    let i = &plate.inertia;
+    (6.0 * (i[(0, 0)] + i[(1, 1)] - i[(2, 2)]) / plate.mass).max(0.0).sqrt()
+}
+
+fn inertia6(plate: &Plate) -> [f64; 6] {
+    let i = &plate.inertia;
+    [i[(0, 0)], i[(1, 1)], i[(2, 2)], i[(0, 1)], i[(0, 2)], i[(1, 2)]]
+}
+
+fn plate_body(model: &Model, j: usize, name: String, joint: JointSpec, collide: bool) -> BodySpec {
+    let plate = &model.plates()[j];
+    BodySpec {
+        name,
+        pose: plate.reference_pose,
+        parent: model.parent(j),
+        joint: Some(joint),
+        mass: plate.mass,
+        inertia: inertia6(plate),
+        outline: Some(plate.outline.clone()),
+        thickness: lamina_thickness(plate),
+        drag_area: plate.area,
+        collide,
+    }
+}
+
+fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
+    let model = &chain.model;
+    let stiffness: Vec<f64> = model.joints().iter().map(|j| j.stiffness).collect();
+    let torques = step_torques(&chain.forcing, &stiffness, "the strip")?;
+    Ok((0..model.dof())
+        .map(|j| {
+            let joint = &model.joints()[j];
+            plate_body(
+                model,
+                j,
+                format!("plate_{j}"),
+                JointSpec {
+                    name: format!("hinge_{j}"),
+                    axis: joint.axis.into_inner(),
+                    point: joint.point,
+                    stiffness: joint.stiffness,
+                    step_torque: torques[j],
+                },
+                true,
+            )
+        })
+        .collect())
+}
+
+/// A closed chain's bodies: the sector plates on their tree, and a light body that turns
+/// about the cut crease from one neighbour and is joined to the other by two `connect`
+/// equalities, so the cut crease is a hinge with its own stiffness.
+/// A closed chain's bodies, the body the cut body must meet, and the two connect anchors.
+type ClosedBodies = (Vec<BodySpec>, Vec<String>, Vec<Point3<f64>>);
+
+fn closed_bodies(chain: &ClosedChain) -> Result<ClosedBodies> {
+    let model = &chain.model;
+    let torques = step_torques(&chain.forcing, &chain.crease_stiffness, "the closed chain")?;
+    let label = |c: usize| format!("crease_{}", chain.crease_user_indices[c]);
+    let mut bodies: Vec<BodySpec> = (0..model.dof())
+        .map(|j| {
+            let c = chain.joint_creases[j];
+            let joint = &model.joints()[j];
+            plate_body(
+                model,
+                j,
+                format!("sector_{}", chain.joint_sectors[j]),
+                JointSpec {
+                    name: label(c),
+                    axis: joint.axis.into_inner(),
+                    point: joint.point,
+                    stiffness: chain.crease_stiffness[c],
+                    step_torque: torques[c],
+                },
+                false,
+            )
+        })
+        .collect();
+    // The cut crease: between sector ray−1 (the clockwise side) and sector ray.
+    let cut = chain.cut_crease;
+    let rays = chain.sector_angles.len();
+    let ray = chain.crease_rays[cut];
+    let (before, after) = ((ray + rays - 1) % rays, ray);
+    let body_of = |s: usize| chain.body_of_sector(s);
+    // The light body hangs from the sector before the cut and turns about +r̂; `after` is
+    // the sector it must coincide with. If that sector is the ground, swap roles.
+    let (carrier, target, sign) = match (body_of(before), body_of(after)) {
+        (Some(b), a) => (Some(b), a, 1.0),
+        (None, a) => (a, None, -1.0),
+    };
+    let end = chain.crease_ends[cut];
+    let axis = end.coords.normalize() * sign;
+    let lightest = model.plates().iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
+    let smallest = model
+        .plates()
+        .iter()
+        .map(|p| p.inertia[(2, 2)])
+        .fold(f64::INFINITY, f64::min);
+    let target_pose = target.map_or(Isometry3::identity(), |b| bodies[b].pose);
+    let share = CUT_BODY_SHARE;
+    bodies.push(BodySpec {
+        name: format!("cut_{}", label(cut)),
+        pose: target_pose,
+        parent: carrier,
+        joint: Some(JointSpec {
+            name: label(cut),
+            axis,
+            point: Point3::origin(),
+            stiffness: chain.crease_stiffness[cut],
+            step_torque: torques[cut],
+        }),
+        mass: share * lightest,
+        inertia: [share * smallest, share * smallest, share * smallest, 0.0, 0.0, 0.0],
+        outline: None,
+        thickness: 0.0,
+        drag_area: 0.0,
+        collide: false,
+    });
+    let target_name = target.map_or("world".to_string(), |b| bodies[b].name.clone());
+    // Anchors (world, flat): the target's centroid moved onto the plane normal to the cut
+    // crease through the vertex, and the crease's far end.
+    let centroid = match target {
+        Some(b) => bodies[b].pose.translation.vector,
+        None => chain.ground.iter().map(|p| p.coords).sum::<Vector3<f64>>() / chain.ground.len() as f64,
+    };
+    let unit = end.coords.normalize();
+    let mut off_axis = centroid - unit * unit.dot(&centroid);
+    if off_axis.norm() < 1e-6 * end.coords.norm() {
+        off_axis = unit.cross(&Vector3::z()) * end.coords.norm();
+    }
+    let anchors = vec![Point3::from(off_axis), end];
+    Ok((bodies, vec![target_name], anchors))
+}
+
+/// How far along its branch a closed chain that starts flat is started, degrees of the driver.
+pub const BRANCH_START_DEG: f64 = 1.0;
+
+/// The driver's angle in the keyframe: the scene's start, or, when that is the flat state (a
+/// branch point), [`BRANCH_START_DEG`] towards the target.
+pub fn keyframe_driver_angle(chain: &ClosedChain) -> f64 {
+    if chain.start.abs() > 1e-9 {
+        return chain.start;
+    }
+    BRANCH_START_DEG.to_radians().copysign(chain.target() - chain.start)
+}
+
+fn fmt(x: f64) -> String {
+    let s = format!("{x:.12e}");
+    // Trim the mantissa's trailing zeros: 1.000000000000e0 → 1e0.
+    if let Some((mantissa, exponent)) = s.split_once('e') {
+        let mantissa = if mantissa.contains('.') {
+            mantissa.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mantissa
+        };
+        if exponent == "0" {
+            return mantissa.to_string();
+        }
+        return format!("{mantissa}e{exponent}");
+    }
+    s
+}
+
+fn vec3(v: &Vector3<f64>, scale: f64) -> String {
+    format!("{} {} {}", fmt(v.x * scale), fmt(v.y * scale), fmt(v.z * scale))
+}
+
+fn quat(q: &UnitQuaternion<f64>) -> String {
+    format!("{} {} {} {}", fmt(q.w), fmt(q.i), fmt(q.j), fmt(q.k))
+}
+
+/// The MJCF text of `scene`.
+pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
+    let (bodies, connect_targets, connect_anchors, substrate_edge, drag, description) = match &scene.system {
+        System::Strip(chain) => (
+            strip_bodies(chain)?,
+            Vec::new(),
+            Vec::new(),
+            Some(chain.substrate_edge_y),
+            chain.model.drag(),
+            "a strip: plate i hangs from plate i − 1 by hinge i; the substrate is the box under z = 0 for y ≤ the edge"
+                .to_string(),
+        ),
+        System::Closed(chain) => {
+            let (bodies, targets, anchors) = closed_bodies(chain)?;
+            (
+                bodies,
+                targets,
+                anchors,
+                None,
+                chain.model.drag(),
+                format!(
+                    "a closed vertex: the anchored sector is the world's geom `ground`; the loop is cut at crease_{} and closed by two connect equalities",
+                    chain.crease_user_indices[chain.cut_crease]
+                ),
+            )
+        }
+    };
+    let l = 1.0 / LENGTH_UNIT;
+    let m = 1.0 / MASS_UNIT;
+    let inertia_scale = 1.0 / (MASS_UNIT * LENGTH_UNIT * LENGTH_UNIT);
+    let torque_scale = 1.0 / TORQUE_UNIT;
+    let dt = settings.timestep / TIME_UNIT;
+    let mut x = String::new();
+    let w = &mut x;
+    writeln!(w, "<mujoco model=\"{}\">", xml_escape(&scene.name)).unwrap();
+    writeln!(
+        w,
+        "  <!-- Written by nanofold export mujoco. Units: length µm, mass pg (1e-12 kg), time µs;"
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "       so force µN, torque and hinge stiffness 1e-12 N·m (per rad), density 1e6 kg/m³."
+    )
+    .unwrap();
+    writeln!(w, "       {} -->", xml_escape(&description)).unwrap();
+    writeln!(
+        w,
+        "  <!-- Hinges: a positive angle folds valley, right-handed about the joint axis; springref 0 is flat."
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "       Drag (nanofold's F = -1/2 C_D rho A |v|^2 sgn(v.n) n at each plate's centre of mass, n its body z)"
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "       is not a MuJoCo force: its parameters are the custom numerics below, applied by a passive"
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "       callback (tests/mujoco/nanofold_mujoco.py). MuJoCo's own fluid model is off (density 0). -->"
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "  <compiler angle=\"radian\" inertiafromgeom=\"false\" autolimits=\"true\"/>"
+    )
+    .unwrap();
+    writeln!(
+        w,
+        "  <option timestep=\"{}\" integrator=\"RK4\" gravity=\"0 0 0\" density=\"0\" viscosity=\"0\"/>",
+        fmt(dt)
+    )
+    .unwrap();
+    // Meshes: each plate a thin prism of its structural thickness.
+    writeln!(w, "  <asset>").unwrap();
+    for body in &bodies {
+        if let Some(outline) = &body.outline {
+            let half = 0.5 * body.thickness.max(1e-3 * LENGTH_UNIT);
+            let mut vertex = Vec::new();
+            for dz in [-half, half] {
+                for p in outline {
+                    vertex.push(vec3(&Vector3::new(p.x, p.y, p.z + dz), l));
+                }
+            }
+            writeln!(w, "    <mesh name=\"{}\" vertex=\"{}\"/>", body.name, vertex.join("  ")).unwrap();
+        }
+    }
+    if let System::Closed(chain) = &scene.system {
+        let half = 0.5
+            * bodies
+                .iter()
+                .map(|b| b.thickness)
+                .fold(0.0, f64::max)
+                .max(1e-3 * LENGTH_UNIT);
+        let mut vertex = Vec::new();
+        for dz in [-half, half] {
+            for p in &chain.ground {
+                vertex.push(vec3(&Vector3::new(p.x, p.y, p.z + dz), l));
+            }
+        }
+        writeln!(w, "    <mesh name=\"ground\" vertex=\"{}\"/>", vertex.join("  ")).unwrap();
+    }
+    writeln!(w, "  </asset>").unwrap();
+    writeln!(w, "  <custom>").unwrap();
+    writeln!(
+        w,
+        "    <text name=\"nanofold:units\" data=\"length um, mass pg, time us\"/>"
+    )
+    .unwrap();
+    if let Some(drag) = drag {
+        writeln!(
+            w,
+            "    <numeric name=\"nanofold:drag_coefficient\" data=\"{}\"/>",
+            fmt(drag.drag_coefficient)
+        )
+        .unwrap();
+        writeln!(
+            w,
+            "    <numeric name=\"nanofold:air_density\" data=\"{}\"/>",
+            fmt(drag.air_density * LENGTH_UNIT.powi(3) / MASS_UNIT)
+        )
+        .unwrap();
+        for body in bodies.iter().filter(|b| b.drag_area > 0.0) {
+            writeln!(
+                w,
+                "    <numeric name=\"nanofold:drag_area:{}\" data=\"{}\"/>",
+                body.name,
+                fmt(body.drag_area * l * l)
+            )
+            .unwrap();
+        }
+    }
+    if let Some(edge) = substrate_edge {
+        writeln!(
+            w,
+            "    <numeric name=\"nanofold:substrate_edge_y\" data=\"{}\"/>",
+            fmt(edge * l)
+        )
+        .unwrap();
+    }
+    writeln!(w, "  </custom>").unwrap();
+    writeln!(w, "  <worldbody>").unwrap();
+    // The substrate (strip) or the anchored sector (closed).
+    let extent = bodies
+        .iter()
+        .filter_map(|b| b.outline.as_ref().map(|o| (b, o)))
+        .flat_map(|(b, o)| o.iter().map(move |p| (b.pose * p).coords.norm()))
+        .fold(0.0, f64::max);
+    if let Some(edge) = substrate_edge {
+        let depth = 10.0 * LENGTH_UNIT;
+        writeln!(
+            w,
+            "    <geom name=\"substrate\" type=\"box\" pos=\"0 {} {}\" size=\"{} {} {}\" rgba=\"0.55 0.55 0.6 1\"/>",
+            fmt((edge - extent) * l),
+            fmt(-0.5 * depth * l),
+            fmt(extent * l),
+            fmt(extent * l),
+            fmt(0.5 * depth * l)
+        )
+        .unwrap();
+    }
+    if matches!(scene.system, System::Closed(_)) {
+        writeln!(w, "    <geom name=\"ground\" type=\"mesh\" mesh=\"ground\" contype=\"0\" conaffinity=\"0\" rgba=\"0.55 0.55 0.6 1\"/>").unwrap();
+    }
+    let mut joint_order = Vec::new();
+    write_children(
+        w,
+        &bodies,
+        None,
+        &Isometry3::identity(),
+        2,
+        l,
+        m,
+        inertia_scale,
+        torque_scale,
+        &mut joint_order,
+    );
+    writeln!(w, "  </worldbody>").unwrap();
+    // The first plate of a strip lies on the substrate edge at its hinge.
+    if substrate_edge.is_some() {
+        writeln!(w, "  <contact>").unwrap();
+        writeln!(w, "    <exclude body1=\"world\" body2=\"{}\"/>", bodies[0].name).unwrap();
+        writeln!(w, "  </contact>").unwrap();
+    }
+    if !connect_targets.is_empty() {
+        let cut = bodies.last().expect("the cut crease's body");
+        writeln!(w, "  <equality>").unwrap();
+        // Two points of the cut body: one off its hinge axis, one on it away from the vertex
+        // (the vertex itself is shared through the tree), so the three fix it to its target.
+        for (k, anchor) in connect_anchors.iter().enumerate() {
+            let local = cut.pose.inverse_transform_point(anchor);
+            writeln!(
+                w,
+                "    <connect name=\"close_{}_{}\" body1=\"{}\" body2=\"{}\" anchor=\"{}\" solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001\"/>",
+                cut.name,
+                ["a", "b"][k],
+                cut.name,
+                connect_targets[0],
+                vec3(&local.coords, l),
+                fmt(2.0 * dt)
+            )
+            .unwrap();
+        }
+        if let System::Closed(chain) = &scene.system {
+            for &(c, value) in &chain.locked {
+                writeln!(
+                    w,
+                    "    <joint name=\"lock_crease_{}\" joint1=\"crease_{}\" polycoef=\"{} 0 0 0 0\" solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001\"/>",
+                    chain.crease_user_indices[c],
+                    chain.crease_user_indices[c],
+                    fmt(value),
+                    fmt(2.0 * dt)
+                )
+                .unwrap();
+            }
+        }
+        writeln!(w, "  </equality>").unwrap();
+    }
+    writeln!(w, "  <actuator>").unwrap();
+    for body in &bodies {
+        if let Some(joint) = body.joint.as_ref().filter(|j| j.step_torque.is_some()) {
+            writeln!(
+                w,
+                "    <general name=\"stress_{}\" joint=\"{}\" gainprm=\"1\" biastype=\"affine\" biasprm=\"{} 0 0\"/>",
+                joint.name,
+                joint.name,
+                fmt(joint.step_torque.unwrap_or(0.0) * torque_scale)
+            )
+            .unwrap();
+        }
+    }
+    writeln!(w, "  </actuator>").unwrap();
+    // The state at t = 0: flat for a strip; for a closed chain the driver's start with the
+    // locks and the dependents (the cut crease included) on the closure.
+    let mut start = vec![0.0; joint_order.len()];
+    if let System::Closed(chain) = &scene.system {
+        let mut ws = chain.workspace();
+        chain.update_creases(keyframe_driver_angle(chain), &mut ws)?;
+        for (slot, name) in start.iter_mut().zip(&joint_order) {
+            if let Some(c) =
+                (0..chain.crease_labels.len()).find(|&c| *name == format!("crease_{}", chain.crease_user_indices[c]))
+            {
+                *slot = ws.crease_angles[c];
+            }
+        }
+    }
+    if let System::Closed(chain) = &scene.system {
+        if keyframe_driver_angle(chain) != chain.start {
+            writeln!(
+                w,
+                "  <!-- The scene starts flat, a branch point where the loop's constraint forces hold the driver still in MuJoCo. The keyframe starts {}° along the branch nanofold follows, at rest. -->",
+                BRANCH_START_DEG
+            )
+            .unwrap();
+        }
+    }
+    writeln!(w, "  <keyframe>").unwrap();
+    writeln!(
+        w,
+        "    <key name=\"start\" qpos=\"{}\"/>",
+        start.iter().map(|&q| fmt(q)).collect::<Vec<_>>().join(" ")
+    )
+    .unwrap();
+    writeln!(w, "  </keyframe>").unwrap();
+    writeln!(w, "</mujoco>").unwrap();
+    Ok(x)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_children(
+    w: &mut String,
+    bodies: &[BodySpec],
+    parent: Option<usize>,
+    parent_pose: &Isometry3<f64>,
+    depth: usize,
+    l: f64,
+    m: f64,
+    inertia_scale: f64,
+    torque_scale: f64,
+    joint_order: &mut Vec<String>,
+) {
+    let pad = "  ".repeat(depth);
+    for (index, body) in bodies.iter().enumerate().filter(|(_, b)| b.parent == parent) {
+        let relative = parent_pose.inverse() * body.pose;
+        writeln!(
+            w,
+            "{pad}<body name=\"{}\" pos=\"{}\" quat=\"{}\">",
+            body.name,
+            vec3(&relative.translation.vector, l),
+            quat(&relative.rotation)
+        )
+        .unwrap();
+        let i = body.inertia;
+        writeln!(
+            w,
+            "{pad}  <inertial pos=\"0 0 0\" mass=\"{}\" fullinertia=\"{} {} {} {} {} {}\"/>",
+            fmt(body.mass * m),
+            fmt(i[0] * inertia_scale),
+            fmt(i[1] * inertia_scale),
+            fmt(i[2] * inertia_scale),
+            fmt(i[3] * inertia_scale),
+            fmt(i[4] * inertia_scale),
+            fmt(i[5] * inertia_scale)
+        )
+        .unwrap();
+        if let Some(joint) = &body.joint {
+            joint_order.push(joint.name.clone());
+            let local_point = body.pose.inverse_transform_point(&joint.point);
+            let local_axis = body.pose.rotation.inverse_transform_vector(&joint.axis);
+            writeln!(
+                w,
+                "{pad}  <joint name=\"{}\" type=\"hinge\" pos=\"{}\" axis=\"{}\" stiffness=\"{}\" springref=\"0\"/>",
+                joint.name,
+                vec3(&local_point.coords, l),
+                vec3(&local_axis, 1.0),
+                fmt(joint.stiffness * torque_scale)
+            )
+            .unwrap();
+        }
+        if let Some(outline) = &body.outline {
+            let collide = if body.collide {
+                ""
+            } else {
+                " contype=\"0\" conaffinity=\"0\""
+            };
+            writeln!(
+                w,
+                "{pad}  <geom name=\"{}\" type=\"mesh\" mesh=\"{}\"{collide}/>",
+                body.name, body.name
+            )
+            .unwrap();
+            for (k, p) in outline.iter().enumerate() {
+                writeln!(
+                    w,
+                    "{pad}  <site name=\"{}:corner_{k}\" pos=\"{}\" size=\"{}\"/>",
+                    body.name,
+                    vec3(&p.coords, l),
+                    fmt(1.0)
+                )
+                .unwrap();
+            }
+        }
+        write_children(
+            w,
+            bodies,
+            Some(index),
+            &body.pose,
+            depth + 1,
+            l,
+            m,
+            inertia_scale,
+            torque_scale,
+            joint_order,
+        );
+        writeln!(w, "{pad}</body>").unwrap();
+    }
+}
+
+fn xml_escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace("--", "- -")
+}
