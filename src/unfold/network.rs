@@ -250,6 +250,48 @@ fn flat_step(energy: &NetworkEnergy, creases: usize, ws: &mut EnergyWorkspace) -
     }
 }
 
+/// What a trial state came to.
+enum Trial {
+    /// Closed, energy accepted, no panels crossing: (fold angles, energy, gradient).
+    Accepted((Vec<f64>, f64, Vec<f64>)),
+    /// Closed and energy accepted, but panels cross.
+    Crossing,
+    /// Newton could not close it, or its energy was not accepted.
+    Refused,
+}
+
+/// Restores `trial` onto the closure and judges it: its energy must be finite and pass
+/// `accept`, and no two panels may cross.
+#[allow(clippy::too_many_arguments)]
+fn try_state(
+    model: &FoldingModel,
+    energy: &NetworkEnergy,
+    settings: &NetworkUnfoldSettings,
+    solver: &mut NormalSolver,
+    ws: &mut EnergyWorkspace,
+    poses: &mut Vec<crate::folding::Pose>,
+    mut trial: Vec<f64>,
+    accept: impl Fn(f64) -> bool,
+) -> Result<Trial> {
+    if restore_closure(model, &mut trial, settings.closure_tol, solver)?.is_none() {
+        return Ok(Trial::Refused);
+    }
+    let mut gradient = vec![0.0; trial.len()];
+    let value = energy.value_and_gradient(&trial, ws, &mut gradient);
+    if !(value.is_finite() && accept(value)) {
+        return Ok(Trial::Refused);
+    }
+    panel_poses(model, &trial, poses);
+    if panel_contacts(model, poses, &settings.contact)
+        .crossing()
+        .next()
+        .is_some()
+    {
+        return Ok(Trial::Crossing);
+    }
+    Ok(Trial::Accepted((trial, value, gradient)))
+}
+
 /// Unfolds a rigid state of `model` by projected gradient descent on the summed vertex
 /// energies.
 pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> Result<NetworkReport> {
@@ -408,23 +450,20 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let mut halvings = 0;
         // Steps shorter than this are lost in the closure tolerance.
         while t * size > 1e-13 {
-            let mut trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
-            if restore_closure(model, &mut trial, settings.closure_tol, &mut solver)?.is_some() {
-                let mut trial_gradient = vec![0.0; n];
-                let u_trial = energy.value_and_gradient(&trial, &mut ws, &mut trial_gradient);
-                if u_trial.is_finite() && u_trial <= u + 1e-4 * t * slope {
-                    panel_poses(model, &trial, &mut poses);
-                    if panel_contacts(model, &poses, &settings.contact)
-                        .crossing()
-                        .next()
-                        .is_none()
-                    {
-                        accepted = Some((trial, u_trial, trial_gradient));
-                        break;
-                    }
+            let trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
+            let armijo = u + 1e-4 * t * slope;
+            match try_state(model, &energy, settings, &mut solver, &mut ws, &mut poses, trial, |v| {
+                v <= armijo
+            })? {
+                Trial::Accepted(state) => {
+                    accepted = Some(state);
+                    break;
+                }
+                Trial::Crossing => {
                     crossings_refused += 1;
                     refused_for_crossing = true;
                 }
+                Trial::Refused => {}
             }
             t /= 2.0;
             halvings += 1;
@@ -439,24 +478,20 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             // the energy and puts no panels through each other.
             let mut f = 0.5;
             while f > 1e-4 {
-                let mut trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
-                if restore_closure(model, &mut trial, settings.closure_tol, &mut solver)?.is_some() {
-                    let mut trial_gradient = vec![0.0; n];
-                    let u_trial = energy.value_and_gradient(&trial, &mut ws, &mut trial_gradient);
-                    if u_trial.is_finite() && u_trial < u {
-                        panel_poses(model, &trial, &mut poses);
-                        if panel_contacts(model, &poses, &settings.contact)
-                            .crossing()
-                            .next()
-                            .is_none()
-                        {
-                            accepted = Some((trial, u_trial, trial_gradient));
-                            radial_steps += 1;
-                            break;
-                        }
+                let trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
+                match try_state(model, &energy, settings, &mut solver, &mut ws, &mut poses, trial, |v| {
+                    v < u
+                })? {
+                    Trial::Accepted(state) => {
+                        accepted = Some(state);
+                        radial_steps += 1;
+                        break;
+                    }
+                    Trial::Crossing => {
                         crossings_refused += 1;
                         refused_for_crossing = true;
                     }
+                    Trial::Refused => {}
                 }
                 f /= 2.0;
             }
