@@ -136,6 +136,8 @@ pub struct NetworkUnfoldSettings {
     pub closure_tol: f64,
     /// Panel contact test at every step.
     pub contact: ContactSettings,
+    /// Curvature pairs the L-BFGS direction remembers (0: the projected gradient alone).
+    pub memory: usize,
 }
 
 impl Default for NetworkUnfoldSettings {
@@ -151,6 +153,7 @@ impl Default for NetworkUnfoldSettings {
                 search: 0.1,
                 ..ContactSettings::default()
             },
+            memory: 8,
         }
     }
 }
@@ -218,6 +221,50 @@ pub struct NetworkReport {
     pub radial_steps: usize,
 }
 
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(a: &[f64]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Below this largest |ρ|, rad, a step along the ray to flat is tried before the line search.
+const NEAR_FLAT: f64 = 0.05;
+
+/// A step along the ray to flat, ρ → (1 − f)ρ for f = 1/2, 1/4, …, 1e-4: near the flat state
+/// the closure manifold is close to a cone with its apex there, where Newton from a tangent
+/// step converges slowly or not at all, while the cone's ray stays nearly on it. Taken when it
+/// lowers the energy and puts no panels through each other.
+#[allow(clippy::too_many_arguments)]
+fn radial_step(
+    model: &FoldingModel,
+    energy: &NetworkEnergy,
+    settings: &NetworkUnfoldSettings,
+    solver: &mut NormalSolver,
+    ws: &mut EnergyWorkspace,
+    poses: &mut Vec<crate::folding::Pose>,
+    rho: &[f64],
+    u: f64,
+    crossings_refused: &mut usize,
+    refused_for_crossing: &mut bool,
+) -> Result<Option<Accepted>> {
+    let mut f = 0.5;
+    while f > 1e-4 {
+        let trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
+        match try_state(model, energy, settings, solver, ws, poses, trial, |v| v < u)? {
+            Trial::Accepted(state) => return Ok(Some(state)),
+            Trial::Crossing => {
+                *crossings_refused += 1;
+                *refused_for_crossing = true;
+            }
+            Trial::Refused => {}
+        }
+        f /= 2.0;
+    }
+    Ok(None)
+}
+
 /// A crease is a major crease of a vertex when its |ρ| is at least this share of the
 /// largest |ρ| there.
 const MAJOR_SHARE: f64 = 0.25;
@@ -250,10 +297,13 @@ fn flat_step(energy: &NetworkEnergy, creases: usize, ws: &mut EnergyWorkspace) -
     }
 }
 
+/// An accepted state: fold angles, energy, gradient.
+type Accepted = (Vec<f64>, f64, Vec<f64>);
+
 /// What a trial state came to.
 enum Trial {
-    /// Closed, energy accepted, no panels crossing: (fold angles, energy, gradient).
-    Accepted((Vec<f64>, f64, Vec<f64>)),
+    /// Closed, energy accepted, no panels crossing.
+    Accepted(Accepted),
     /// Closed and energy accepted, but panels cross.
     Crossing,
     /// Newton could not close it, or its energy was not accepted.
@@ -365,6 +415,9 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     let mut poses = Vec::new();
     let mut major = vec![true; n];
     let mut radial_steps = 0usize;
+    let mut history: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::new();
+    let mut pending: Option<(Vec<f64>, Vec<f64>)> = None;
+    let mut quasi_newton_scale = 1.0;
     let mut scale = 1.0;
     let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused, radial_steps| {
         let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
@@ -421,7 +474,56 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let factor = solver.factor(&closure_jacobian(model, &rho))?;
         let mut downhill: Vec<f64> = gradient.iter().map(|g| -g).collect();
         model.hold_locked(&mut downhill);
-        let descent: Vec<f64> = factor.project(&downhill);
+        let steepest: Vec<f64> = factor.project(&downhill);
+        let steepest_size = steepest.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        if steepest_size <= 1e-14 {
+            return finish(
+                NetworkVerdict::LocalMinimum,
+                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad"),
+                iteration,
+                steps,
+                crossings_refused,
+                radial_steps,
+            );
+        }
+        // The L-BFGS direction on the manifold: curvature pairs of steps and changes of the
+        // projected gradient, the result projected onto the tangent space again.
+        if let Some((previous_rho, previous_steepest)) = pending.take() {
+            let s_pair: Vec<f64> = rho.iter().zip(&previous_rho).map(|(a, b)| a - b).collect();
+            let y_pair: Vec<f64> = previous_steepest.iter().zip(&steepest).map(|(a, b)| a - b).collect();
+            let sy = dot(&s_pair, &y_pair);
+            if sy > 1e-12 * norm(&s_pair) * norm(&y_pair) && sy > 0.0 {
+                history.push((s_pair, y_pair, 1.0 / sy));
+                if history.len() > settings.memory {
+                    history.remove(0);
+                }
+            }
+        }
+        let mut descent = steepest.clone();
+        if settings.memory > 0 && !history.is_empty() {
+            let mut q: Vec<f64> = steepest.iter().map(|d| -d).collect();
+            let mut alphas = vec![0.0; history.len()];
+            for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate().rev() {
+                alphas[k] = rho_pair * dot(s_pair, &q);
+                q.iter_mut().zip(y_pair).for_each(|(q, y)| *q -= alphas[k] * y);
+            }
+            let (s_last, y_last, _) = history.last().expect("not empty");
+            let gamma = dot(s_last, y_last) / dot(y_last, y_last);
+            q.iter_mut().for_each(|q| *q *= gamma);
+            for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate() {
+                let beta = rho_pair * dot(y_pair, &q);
+                q.iter_mut().zip(s_pair).for_each(|(q, s)| *q += (alphas[k] - beta) * s);
+            }
+            let mut candidate: Vec<f64> = q.iter().map(|q| -q).collect();
+            model.hold_locked(&mut candidate);
+            let candidate = factor.project(&candidate);
+            if dot(&gradient, &candidate) < 0.0 {
+                descent = candidate;
+            } else {
+                history.clear();
+            }
+        }
+        pending = Some((rho.clone(), steepest));
         let size = descent.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         let slope: f64 = gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
         if size <= 1e-14 || slope >= 0.0 {
@@ -434,7 +536,15 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 radial_steps,
             );
         }
-        let mut t = (settings.max_step / size) * scale;
+        // A quasi-Newton step is tried whole first (within max_step); the gradient's length
+        // says nothing of the step, so there the line search remembers its last share.
+        let quasi_newton = settings.memory > 0 && !history.is_empty();
+        let mut t = if quasi_newton {
+            (settings.max_step / size).min(quasi_newton_scale)
+        } else {
+            (settings.max_step / size) * scale
+        };
+        let t_planned = t;
         // No vertex may pass through its flat state in one step: there the branches of its
         // folding motion cross, and beyond lies the mirrored state, not progress. A vertex
         // heads there when one of its major creases (|ρ| within MAJOR_SHARE of its largest)
@@ -445,11 +555,29 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                 t = t.min(FLAT_APPROACH * (r / d).abs());
             }
         }
-        let mut accepted = None;
+        let t_before_search = t;
         let mut refused_for_crossing = false;
         let mut halvings = 0;
+        // Near flat the ray to flat is tried first: the cheapest step that keeps the branch.
+        let radial_first = largest <= NEAR_FLAT;
+        let mut accepted = None;
+        if radial_first {
+            accepted = radial_step(
+                model,
+                &energy,
+                settings,
+                &mut solver,
+                &mut ws,
+                &mut poses,
+                &rho,
+                u,
+                &mut crossings_refused,
+                &mut refused_for_crossing,
+            )?;
+            radial_steps += usize::from(accepted.is_some());
+        }
         // Steps shorter than this are lost in the closure tolerance.
-        while t * size > 1e-13 {
+        while accepted.is_none() && t * size > 1e-13 {
             let trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
             let armijo = u + 1e-4 * t * slope;
             match try_state(model, &energy, settings, &mut solver, &mut ws, &mut poses, trial, |v| {
@@ -471,30 +599,20 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // Within STALL_TOL of flat a step that does not lower the energy at all is lost in
         // its rounding: count it as the line search stalling.
         let mut accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
-        if accepted.is_none() {
-            // Near the flat state the closure manifold is close to a cone with its apex
-            // there, where Newton from a tangent step converges slowly or not at all; a step
-            // along the cone's ray, ρ → (1 − f)ρ, stays nearly on it. Taken when it lowers
-            // the energy and puts no panels through each other.
-            let mut f = 0.5;
-            while f > 1e-4 {
-                let trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
-                match try_state(model, &energy, settings, &mut solver, &mut ws, &mut poses, trial, |v| {
-                    v < u
-                })? {
-                    Trial::Accepted(state) => {
-                        accepted = Some(state);
-                        radial_steps += 1;
-                        break;
-                    }
-                    Trial::Crossing => {
-                        crossings_refused += 1;
-                        refused_for_crossing = true;
-                    }
-                    Trial::Refused => {}
-                }
-                f /= 2.0;
-            }
+        if accepted.is_none() && !radial_first {
+            accepted = radial_step(
+                model,
+                &energy,
+                settings,
+                &mut solver,
+                &mut ws,
+                &mut poses,
+                &rho,
+                u,
+                &mut crossings_refused,
+                &mut refused_for_crossing,
+            )?;
+            radial_steps += usize::from(accepted.is_some());
         }
         let Some((next, u_next, g_next)) = accepted else {
             if largest <= STALL_TOL && !refused_for_crossing {
@@ -530,7 +648,15 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // The line search's memory: twice the largest step if this one needed no halving,
         // fewer halvings than this one next time otherwise. A step cut short by the flat
         // approach says nothing about the energy's curvature, so it leaves the memory alone.
-        scale = (scale * 2f64.powi(1 - halvings)).clamp(1e-6, 1.0);
+        if quasi_newton {
+            // The step multiple to try next: doubled after a step taken whole, the one taken
+            // otherwise; a step cut by the flat approach leaves it alone.
+            if t_before_search >= t_planned {
+                quasi_newton_scale = if halvings == 0 { 2.0 * t } else { t }.max(1e-6);
+            }
+        } else {
+            scale = (scale * 2f64.powi(1 - halvings)).clamp(1e-6, 1.0);
+        }
         rho = next;
         u = u_next;
         gradient = g_next;
