@@ -9,6 +9,7 @@
 //! `Executor` drives it with [`observe`]rs recording the trajectory and progress, and
 //! [`unfold`] turns its termination into a [`Verdict`] with evidence.
 
+pub mod barrier;
 pub mod checks;
 pub mod energy;
 pub mod manifold;

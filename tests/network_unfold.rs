@@ -278,3 +278,124 @@ fn waterbombs_and_the_bird_base_folded_by_fold_unfold_flat() {
         assert!(report.steps.last().unwrap().fold_angles.iter().all(|&r| r == 0.0));
     }
 }
+
+/// Three unit strips side by side; the outer two folded (valley) about x = 1 and x = 2. Folded
+/// by α and β their far edges sit at x = 1 − cos α and x = 2 + cos β, both at height sin.
+fn three_strips(alpha: f64, beta: f64) -> FoldingModel {
+    use nanofold::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
+    use nanofold::pattern::Assignment;
+    let vertices = vec![
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [2.0, 0.0],
+        [3.0, 0.0],
+        [3.0, 1.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 1.0],
+    ];
+    let mut edges = vec![[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 6], [6, 7], [7, 0]];
+    let mut kinds = vec![EdgeKind::Boundary; 8];
+    let mut fold_angles = vec![0.0; 8];
+    for (edge, angle) in [([1, 6], alpha), ([2, 5], beta)] {
+        edges.push(edge);
+        kinds.push(EdgeKind::Crease(Assignment::Valley));
+        fold_angles.push(angle);
+    }
+    let builder = CreasePatternBuilder {
+        name: "three_strips".into(),
+        vertices,
+        edges,
+        kinds,
+        fold_angles,
+        angle_field: "edges_foldAngle".into(),
+        ..Default::default()
+    };
+    FoldingModel::new(builder.build().unwrap()).unwrap()
+}
+
+/// The barrier b(x) = −(x − 1)² ln x: zero with zero slope and curvature at x = 1 (C²),
+/// unbounded as x → 0; and its gradient in fold angles, through the panels' poses, equals
+/// central differences of its value.
+#[test]
+fn the_panel_barrier_is_c2_and_its_gradient_matches_central_differences() {
+    use nanofold::folding::panel_poses;
+    use nanofold::unfold::barrier::{barrier_function, BarrierSettings, PanelBarrier};
+    assert_eq!(barrier_function(1.0), (0.0, 0.0));
+    for h in [1e-2, 1e-3, 1e-4] {
+        let (value, slope) = barrier_function(1.0 - h);
+        // b ≈ h³ and b′ ≈ −3h² near 1: curvature b″ ≈ 6h → 0.
+        assert!(value > 0.0 && value < 2.0 * h * h * h, "{h}: {value}");
+        assert!(slope < 0.0 && slope.abs() < 4.0 * h * h, "{h}: {slope}");
+    }
+    assert!(barrier_function(1e-12).0 > 20.0);
+    // Far edges about 0.0075 apart, within d̂ = 0.01 (1% of the unit panels).
+    let model = three_strips(119.8f64.to_radians(), 119.7f64.to_radians());
+    let barrier = PanelBarrier::new(&model, &BarrierSettings::default()).unwrap();
+    assert!((barrier.activation() - 0.01).abs() < 1e-12);
+    let rho = model.given_fold_angles();
+    let mut poses = Vec::new();
+    let value_at = |rho: &[f64], poses: &mut Vec<_>| {
+        panel_poses(&model, rho, poses);
+        let mut scratch = vec![0.0; rho.len()];
+        barrier.value_and_gradient(&model, poses, &mut scratch)
+    };
+    panel_poses(&model, &rho, &mut poses);
+    let mut gradient = vec![0.0; rho.len()];
+    let value = barrier.value_and_gradient(&model, &poses, &mut gradient);
+    assert!(value > 0.0, "{value}");
+    for c in 0..rho.len() {
+        let h = 1e-7;
+        let (mut up, mut down) = (rho.clone(), rho.clone());
+        up[c] += h;
+        down[c] -= h;
+        let numeric = (value_at(&up, &mut poses) - value_at(&down, &mut poses)) / (2.0 * h);
+        assert!(
+            (numeric - gradient[c]).abs() <= 1e-5 * gradient[c].abs().max(1e-3),
+            "column {c}: analytic {} numeric {numeric}",
+            gradient[c]
+        );
+    }
+}
+
+/// A hard case: two panels that share no vertex start 1e-6 apart. With the barrier the descent
+/// pushes them apart along a rigid path (no step crosses) until they are beyond d̂; without it
+/// nothing moves them (the strips have no vertex energy), so the barrier did the work.
+#[test]
+fn panels_a_micrometre_apart_are_pushed_beyond_the_barrier() {
+    use nanofold::folding::{panel_contacts, panel_poses, ContactSettings};
+    // Far edges at x = 1 − cos α and 2 + cos α: 1 + 2 cos α = 1e-6 apart.
+    let alpha = (-0.5 + 0.5e-6f64).acos();
+    let model = three_strips(alpha, alpha);
+    let contact = ContactSettings {
+        search: 1.0,
+        ..ContactSettings::default()
+    };
+    let clearance = |rho: &[f64]| {
+        let mut poses = Vec::new();
+        panel_poses(&model, rho, &mut poses);
+        panel_contacts(&model, &poses, &contact).min_clearance.unwrap()
+    };
+    let start = model.given_fold_angles();
+    assert!((clearance(&start) - 1e-6).abs() < 1e-9, "{}", clearance(&start));
+    let report = unfold_network(&model, &start, &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::LocalMinimum, "{}", report.evidence);
+    assert_eq!(report.crossings_refused, 0);
+    let mut previous = 0.0;
+    for step in &report.steps {
+        let now = clearance(&step.fold_angles);
+        assert!(now >= previous - 1e-12, "clearance fell from {previous} to {now}");
+        previous = now;
+    }
+    assert!(previous >= 0.99 * 0.01, "ended {previous} apart");
+    let without = unfold_network(
+        &model,
+        &start,
+        &NetworkUnfoldSettings {
+            barrier: None,
+            ..NetworkUnfoldSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((without.verdict, without.iterations), (NetworkVerdict::LocalMinimum, 0));
+}

@@ -164,7 +164,7 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
 /// reported from the first cell the two share, so each once. For panels of similar size
 /// this costs O(panels), where a sweep along one axis grows faster once a folded pattern
 /// stacks its panels.
-fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
+pub(crate) fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
     if boxes.len() < 2 {
         return Vec::new();
     }
@@ -218,7 +218,7 @@ fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
 }
 
 /// The median over panels of their flat bounding boxes' larger side.
-fn median_panel_size(model: &FoldingModel) -> f64 {
+pub(crate) fn median_panel_size(model: &FoldingModel) -> f64 {
     let vertices = &model.pattern.vertices;
     let mut sizes: Vec<f64> = model
         .panel_vertices
@@ -241,7 +241,7 @@ fn median_panel_size(model: &FoldingModel) -> f64 {
     sizes[sizes.len() / 2]
 }
 
-fn share_vertex(a: &[usize], b: &[usize]) -> bool {
+pub(crate) fn share_vertex(a: &[usize], b: &[usize]) -> bool {
     let (mut i, mut j) = (0, 0);
     while i < a.len() && j < b.len() {
         match a[i].cmp(&b[j]) {

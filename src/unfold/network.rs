@@ -8,10 +8,11 @@ use crate::error::{NanofoldError, Result};
 use crate::folding::normal::NormalSolver;
 use crate::folding::{
     closure_jacobian, jacobian_rank, panel_contacts, panel_poses, restore_closure, vertex_residuals, ContactSettings,
-    FoldingModel,
+    FoldingModel, Pose,
 };
 use crate::geometry::kinematics::forward;
 use crate::geometry::sphere::Vec3;
+use crate::unfold::barrier::{BarrierSettings, PanelBarrier};
 use crate::unfold::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
 use std::f64::consts::PI;
 
@@ -138,6 +139,8 @@ pub struct NetworkUnfoldSettings {
     pub contact: ContactSettings,
     /// Curvature pairs the L-BFGS direction remembers (0: the projected gradient alone).
     pub memory: usize,
+    /// The barrier between panels that share no vertex (None: crossings are only refused).
+    pub barrier: Option<BarrierSettings>,
 }
 
 impl Default for NetworkUnfoldSettings {
@@ -154,6 +157,7 @@ impl Default for NetworkUnfoldSettings {
                 ..ContactSettings::default()
             },
             memory: 8,
+            barrier: Some(BarrierSettings::default()),
         }
     }
 }
@@ -239,11 +243,11 @@ const NEAR_FLAT: f64 = 0.05;
 #[allow(clippy::too_many_arguments)]
 fn radial_step(
     model: &FoldingModel,
-    energy: &NetworkEnergy,
+    objective: &Objective,
     settings: &NetworkUnfoldSettings,
     solver: &mut NormalSolver,
     ws: &mut EnergyWorkspace,
-    poses: &mut Vec<crate::folding::Pose>,
+    poses: &mut Vec<Pose>,
     rho: &[f64],
     u: f64,
     crossings_refused: &mut usize,
@@ -252,7 +256,7 @@ fn radial_step(
     let mut f = 0.5;
     while f > 1e-4 {
         let trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
-        match try_state(model, energy, settings, solver, ws, poses, trial, |v| v < u)? {
+        match try_state(model, objective, settings, solver, ws, poses, trial, |v| v < u)? {
             Trial::Accepted(state) => return Ok(Some(state)),
             Trial::Crossing => {
                 *crossings_refused += 1;
@@ -287,11 +291,33 @@ fn major_crease(model: &FoldingModel, rho: &[f64], major: &mut [bool]) {
     }
 }
 
+/// What the descent minimises: the summed vertex energies and, if asked, the barrier between
+/// panels that share no vertex.
+struct Objective<'m> {
+    model: &'m FoldingModel,
+    energy: NetworkEnergy,
+    barrier: Option<PanelBarrier>,
+}
+
+impl Objective<'_> {
+    /// U(ρ) + B(ρ), its gradient into `gradient`, the panel poses into `poses`.
+    fn evaluate(&self, rho: &[f64], ws: &mut EnergyWorkspace, poses: &mut Vec<Pose>, gradient: &mut [f64]) -> f64 {
+        let value = self.energy.value_and_gradient(rho, ws, gradient);
+        panel_poses(self.model, rho, poses);
+        match &self.barrier {
+            Some(barrier) if value.is_finite() => value + barrier.value_and_gradient(self.model, poses, gradient),
+            _ => value,
+        }
+    }
+}
+
 /// The flat state (rigid, every vertex closed exactly) as the path's last step.
-fn flat_step(energy: &NetworkEnergy, creases: usize, ws: &mut EnergyWorkspace) -> NetworkStep {
+fn flat_step(objective: &Objective, creases: usize, ws: &mut EnergyWorkspace) -> NetworkStep {
     let fold_angles = vec![0.0; creases];
+    let mut poses = Vec::new();
+    let mut gradient = vec![0.0; creases];
     NetworkStep {
-        energy: energy.value(&fold_angles, ws),
+        energy: objective.evaluate(&fold_angles, ws, &mut poses, &mut gradient),
         fold_angles,
         max_residual: 0.0,
     }
@@ -315,11 +341,11 @@ enum Trial {
 #[allow(clippy::too_many_arguments)]
 fn try_state(
     model: &FoldingModel,
-    energy: &NetworkEnergy,
+    objective: &Objective,
     settings: &NetworkUnfoldSettings,
     solver: &mut NormalSolver,
     ws: &mut EnergyWorkspace,
-    poses: &mut Vec<crate::folding::Pose>,
+    poses: &mut Vec<Pose>,
     mut trial: Vec<f64>,
     accept: impl Fn(f64) -> bool,
 ) -> Result<Trial> {
@@ -327,11 +353,10 @@ fn try_state(
         return Ok(Trial::Refused);
     }
     let mut gradient = vec![0.0; trial.len()];
-    let value = energy.value_and_gradient(&trial, ws, &mut gradient);
+    let value = objective.evaluate(&trial, ws, poses, &mut gradient);
     if !(value.is_finite() && accept(value)) {
         return Ok(Trial::Refused);
     }
-    panel_poses(model, &trial, poses);
     if panel_contacts(model, poses, &settings.contact)
         .crossing()
         .next()
@@ -392,7 +417,11 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             radial_steps: 0,
         });
     }
-    let energy = NetworkEnergy::new(model, settings.energy, settings.p);
+    let objective = Objective {
+        model,
+        energy: NetworkEnergy::new(model, settings.energy, settings.p),
+        barrier: settings.barrier.map(|b| PanelBarrier::new(model, &b)).transpose()?,
+    };
     let mut solver = NormalSolver::new(1e-10);
     let mut ws = EnergyWorkspace::default();
     let mut rho = start.to_vec();
@@ -405,14 +434,14 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     }
     let worst = |rho: &[f64]| vertex_residuals(model, rho).into_iter().fold(0.0, f64::max);
     let mut gradient = vec![0.0; n];
-    let mut u = energy.value_and_gradient(&rho, &mut ws, &mut gradient);
+    let mut poses = Vec::new();
+    let mut u = objective.evaluate(&rho, &mut ws, &mut poses, &mut gradient);
     let mut steps = vec![NetworkStep {
         energy: u,
         fold_angles: rho.clone(),
         max_residual: worst(&rho),
     }];
     let mut crossings_refused = 0;
-    let mut poses = Vec::new();
     let mut major = vec![true; n];
     let mut radial_steps = 0usize;
     let mut history: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::new();
@@ -446,7 +475,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         if largest <= STALL_TOL && largest > settings.flat_tol {
             // The flat finish: this close, the energy's changes are at its rounding and
             // descent crawls. The flat state is rigid; it is taken if its energy is no higher.
-            let flat = flat_step(&energy, n, &mut ws);
+            let flat = flat_step(&objective, n, &mut ws);
             let u_flat = flat.energy;
             if u_flat <= u * (1.0 + 1e-12) {
                 steps.push(flat);
@@ -461,7 +490,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             }
         }
         if largest <= settings.flat_tol {
-            steps.push(flat_step(&energy, n, &mut ws));
+            steps.push(flat_step(&objective, n, &mut ws));
             return finish(
                 NetworkVerdict::Flat,
                 format!("every fold angle within {:.0e} rad after {iteration} steps (max |ρ| = {largest:.1e}), then set to 0", settings.flat_tol),
@@ -564,7 +593,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         if radial_first {
             accepted = radial_step(
                 model,
-                &energy,
+                &objective,
                 settings,
                 &mut solver,
                 &mut ws,
@@ -580,9 +609,16 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         while accepted.is_none() && t * size > 1e-13 {
             let trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
             let armijo = u + 1e-4 * t * slope;
-            match try_state(model, &energy, settings, &mut solver, &mut ws, &mut poses, trial, |v| {
-                v <= armijo
-            })? {
+            match try_state(
+                model,
+                &objective,
+                settings,
+                &mut solver,
+                &mut ws,
+                &mut poses,
+                trial,
+                |v| v <= armijo,
+            )? {
                 Trial::Accepted(state) => {
                     accepted = Some(state);
                     break;
@@ -602,7 +638,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         if accepted.is_none() && !radial_first {
             accepted = radial_step(
                 model,
-                &energy,
+                &objective,
                 settings,
                 &mut solver,
                 &mut ws,
@@ -618,7 +654,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             if largest <= STALL_TOL && !refused_for_crossing {
                 // The energy's changes are below its rounding this close to flat; the flat
                 // state is rigid and the descent was heading there.
-                steps.push(flat_step(&energy, n, &mut ws));
+                steps.push(flat_step(&objective, n, &mut ws));
                 return finish(
                     NetworkVerdict::Flat,
                     format!("the line search stalled {largest:.1e} rad from flat (within {STALL_TOL:.0e}, where the energy's changes are at its rounding), then set to 0"),
