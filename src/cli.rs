@@ -288,6 +288,10 @@ pub struct SolverArgs {
     /// Flat when every |fold angle| ≤ this (rad).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub flat_tol: f64,
+    /// A crease pattern of many vertices (or a folded form) whose state does not close, as a
+    /// compliant simulator exports it: move it to the nearest rigid state first and say how far.
+    #[arg(long)]
+    pub project: bool,
     /// Weight κ of the bending metric of the direction (0: the plain QP, M = I).
     #[arg(long, default_value_t = UnfoldSettings::default().bending_metric, allow_negative_numbers = true)]
     pub bending_metric: f64,
@@ -606,7 +610,7 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
         let outcome = nanofold::io::load_pattern(path, &solver.load_options());
         if let Err(e) = &outcome {
             if takes_many_vertices(e, path) {
-                return match folding::check_json(path, solver.closure_tol) {
+                return match folding::check_json(path, solver.closure_tol, solver.project) {
                     Ok((value, _)) if as_json => {
                         println!("{value}");
                         true

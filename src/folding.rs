@@ -14,7 +14,9 @@ pub mod verdict;
 pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
 pub use model::{FoldingModel, Star, TreeStep};
-pub use path::{fold_path, restore_closure, Drive, FoldPath, FoldSettings, PathStep, StopReason};
+pub use path::{
+    fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep, Projection, StopReason,
+};
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{
     jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, RankMethod, RankReport, DENSE_RANK_LIMIT, RANK_TOL,

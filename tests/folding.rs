@@ -640,19 +640,24 @@ fn simulator_export(model: &FoldingModel, rho: &[f64], nudge: f64, clockwise: bo
             _ => serde_json::Value::Null,
         })
         .collect();
-    // Every quadrilateral face cut by a facet edge into two triangles.
+    // Every quadrilateral face cut by a facet edge into two triangles; triangles kept.
     let mut faces = Vec::new();
     for face in &pattern.faces {
-        assert_eq!(face.len(), 4);
-        for mut triangle in [vec![face[0], face[1], face[2]], vec![face[0], face[2], face[3]]] {
+        assert!(face.len() == 3 || face.len() == 4);
+        let pieces = if face.len() == 3 {
+            vec![face.clone()]
+        } else {
+            edges.push([face[0], face[2]]);
+            letters.push("F".into());
+            targets.push(serde_json::Value::Null);
+            vec![vec![face[0], face[1], face[2]], vec![face[0], face[2], face[3]]]
+        };
+        for mut triangle in pieces {
             if clockwise {
                 triangle.reverse();
             }
             faces.push(triangle);
         }
-        edges.push([face[0], face[2]]);
-        letters.push("F".into());
-        targets.push(serde_json::Value::Null);
     }
     // y up: the sheet's (x, y, z) written as (x, z, −y), an orientation-keeping rotation.
     let coords: Vec<[f64; 3]> = points.iter().map(|p| [p[0], p[2], -p[1]]).collect();
@@ -721,6 +726,81 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
         "{:?}",
         report.folded_form
     );
+    // Projected (`--project`)? Lifting one vertex changes the developed crease pattern, and a
+    // Miura-ori's rigid folding needs its exact sector angles: no rigid state is near, and
+    // the projection says so by name.
+    let error = nanofold::folding::project_to_rigid(&developed, &developed.given_fold_angles(), 1e-11).unwrap_err();
+    assert!(error.to_string().contains("no rigid state near"), "{error}");
+}
+
+/// A compliant export of a pattern with freedom to spare (the bird base, folded to 30% by
+/// `fold`, one interior vertex lifted by 1e-3): `check` calls it not_rigid; projected, it is a
+/// rigid state near the source, and `check --project` and `unfold --project` take it, say how
+/// far they moved it, and unfold it flat.
+#[test]
+fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
+    use nanofold::folding::{check_pattern, fold_path, CheckSettings, Drive, FoldSettings, PatternVerdict};
+    let model =
+        FoldingModel::new(nanofold::io::load_crease_pattern(Path::new("patterns/many/bird_base.fold")).unwrap())
+            .unwrap();
+    let settings = FoldSettings {
+        drive: Drive::Assignment { to: 0.3 },
+        ..FoldSettings::default()
+    };
+    let rho = fold_path(&model, &model.given_fold_angles(), &settings)
+        .unwrap()
+        .steps
+        .last()
+        .unwrap()
+        .fold_angles
+        .clone();
+    let text = simulator_export(&model, &rho, 1e-3, false);
+    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
+    let report = check_pattern(&developed, &CheckSettings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::NotRigid, "{}", report.evidence);
+    let projection = nanofold::folding::project_to_rigid(&developed, &developed.given_fold_angles(), 1e-11).unwrap();
+    assert!(projection.residual_before > 1e-5, "{projection:?}");
+    let closed = vertex_residuals(&developed, &projection.fold_angles)
+        .into_iter()
+        .fold(0.0, f64::max);
+    assert!(closed <= 1e-11, "{closed:e}");
+    // Near the state the export came from (the lift is 1e-3 of the sheet's half side).
+    let from_source = projection
+        .fold_angles
+        .iter()
+        .zip(&rho)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        from_source < 1e-2 && projection.max_change < 1e-2,
+        "{from_source} {projection:?}"
+    );
+    let projected = developed.with_fold_angles(&projection.fold_angles);
+    let report = check_pattern(&projected, &CheckSettings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::Rigid, "{}", report.evidence);
+    // The same from the command line.
+    let dir = std::env::temp_dir().join(format!("nanofold-project-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bent.fold");
+    std::fs::write(&file, &text).unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_nanofold"))
+            .args(args)
+            .arg(&file)
+            .output()
+            .unwrap();
+        serde_json::from_slice::<serde_json::Value>(&out.stdout)
+            .unwrap_or_else(|_| panic!("{}", String::from_utf8_lossy(&out.stderr)))
+    };
+    assert_eq!(run(&["check", "--json"])["verdict"], "not_rigid");
+    let checked = run(&["check", "--json", "--project"]);
+    assert_eq!(checked["verdict"], "rigid", "{checked}");
+    assert!(checked["projection"]["max_change_rad"].as_f64().unwrap() > 0.0);
+    let out_dir = dir.join("out");
+    let unfolded = run(&["unfold", "--project", "--json", "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(unfolded["verdict"], "flat", "{unfolded}");
+    assert!(unfolded["adjustments"][0].as_str().unwrap().contains("projected"));
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The Origami Simulator export folded "to 50%": every crease near ±90°, with its sign.

@@ -254,6 +254,41 @@ fn flags(error: nanofold::NanofoldError, table: &[(&str, &str)]) -> anyhow::Erro
     super::with_flags(error, table)
 }
 
+/// The model of `path`; with `project`, a state that does not close (or a folded form that
+/// bends) moved to the nearest rigid state, with a note and its JSON.
+fn load_projected(path: &Path, project: bool) -> Result<(FoldingModel, Option<(String, Value)>)> {
+    let model = load_model(path)?;
+    if !project {
+        return Ok((model, None));
+    }
+    let rho = model.given_fold_angles();
+    let projection = nanofold::folding::project_to_rigid(&model, &rho, 1e-11)
+        .map_err(|e| flags(e, &[("fold_angles", "--project")]))?;
+    let fit = model.pattern.folded_form;
+    let mut note = format!(
+        "projected onto the rigid states: fold angles moved by up to {:.3e} rad (RMS {:.3e}), worst vertex closure {:.3e} rad before",
+        projection.max_change, projection.rms_change, projection.residual_before
+    );
+    if let Some(fit) = fit {
+        note.push_str(&format!(
+            ", folded form with facets bent by up to {:.3e} rad and faces developing with a mismatch of {:.3e}",
+            fit.max_facet_angle, fit.development_error
+        ));
+    }
+    let json = json!({
+        "max_change_rad": projection.max_change,
+        "rms_change_rad": projection.rms_change,
+        "residual_before_rad": projection.residual_before,
+        "newton_iterations": projection.iterations,
+        "folded_form": fit.map(|f| json!({
+            "max_facet_angle_rad": f.max_facet_angle,
+            "development_error": f.development_error,
+            "face_nonplanarity": f.face_nonplanarity,
+        })),
+    });
+    Ok((model.with_fold_angles(&projection.fold_angles), Some((note, json))))
+}
+
 fn load_model(path: &Path) -> Result<FoldingModel> {
     let pattern = nanofold::io::load_crease_pattern(path).with_context(|| format!("reading {}", path.display()))?;
     Ok(FoldingModel::new(pattern)?)
@@ -406,8 +441,8 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
 }
 
 /// `check` on a crease pattern of many vertices: its verdict as a JSON object.
-pub fn check_json(path: &Path, closure_tol: f64) -> Result<(Value, String)> {
-    let model = load_model(path)?;
+pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value, String)> {
+    let (model, projection) = load_projected(path, project)?;
     let settings = CheckSettings {
         closure_tol,
         ..CheckSettings::default()
@@ -436,6 +471,10 @@ pub fn check_json(path: &Path, closure_tol: f64) -> Result<(Value, String)> {
         report.evidence
     );
     let mut value = check_value(&model, path, &report, seconds);
+    if let Some((note, json)) = &projection {
+        line.push_str(&format!("; {note}"));
+        value["projection"] = json.clone();
+    }
     if let Some(unfolding) = &unfolding {
         line.push_str(&format!(
             "; unfolding by energy: {} ({})",
@@ -621,7 +660,7 @@ pub fn unfold_network_one(
     use nanofold::plot::folding::angles_svg;
     use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
     use std::fmt::Write as _;
-    let model = load_model(pattern_path)?;
+    let (model, projection) = load_projected(pattern_path, solver.project)?;
     let settings = NetworkUnfoldSettings {
         energy: solver.energy.into(),
         p: solver.p,
@@ -712,11 +751,15 @@ pub fn unfold_network_one(
         "restarts_used": 0,
         "crossings_refused": report.crossings_refused,
         "radial_steps": report.radial_steps,
-        "adjustments": Vec::<String>::new(),
+        "adjustments": projection.iter().map(|(note, _)| note.clone()).collect::<Vec<_>>(),
+        "projection": projection.as_ref().map_or(Value::Null, |(_, json)| json.clone()),
         "max_closure_residual_rad": report.max_closure_residual,
         "out": dir.display().to_string(),
     });
     let mut text = String::new();
+    if let Some((note, _)) = &projection {
+        writeln!(text, "{}: {note}", model.pattern.name)?;
+    }
     writeln!(
         text,
         "{}: {} ({})",

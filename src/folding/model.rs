@@ -214,6 +214,17 @@ impl FoldingModel {
             .map(|&e| self.pattern.fold_angles[e])
             .collect()
     }
+
+    /// The same pattern carrying `fold_angles` (one per crease) as its state. A folded form's
+    /// fit is dropped: the state no longer comes from its 3D coordinates.
+    pub fn with_fold_angles(&self, fold_angles: &[f64]) -> FoldingModel {
+        let mut model = self.clone();
+        for (&e, &rho) in model.pattern.creases.iter().zip(fold_angles) {
+            model.pattern.fold_angles[e] = rho;
+        }
+        model.pattern.folded_form = None;
+        model
+    }
 }
 
 fn bounds(vertices: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {

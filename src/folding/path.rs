@@ -566,3 +566,47 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         newton_iterations,
     )
 }
+
+/// A nearly rigid state moved onto every vertex closure (`docs/model.md#folded-forms`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Projection {
+    /// The rigid state, rad (one per crease).
+    pub fold_angles: Vec<f64>,
+    /// Largest change of any fold angle, rad.
+    pub max_change: f64,
+    /// Root-mean-square change over the creases, rad.
+    pub rms_change: f64,
+    /// Worst vertex closure residual before, rad.
+    pub residual_before: f64,
+    /// Newton iterations.
+    pub iterations: usize,
+}
+
+/// The rigid state near `fold_angles` (a compliant simulator's export, say): Newton's
+/// least-norm steps onto every vertex closure, within `tol` rad per vertex. Least-norm steps
+/// move the fold angles as little as each linearisation allows, so the result is the nearest
+/// rigid state to first order. Fails by name when Newton does not converge.
+pub fn project_to_rigid(model: &FoldingModel, fold_angles: &[f64], tol: f64) -> Result<Projection> {
+    let residual_before = super::vertex_residuals(model, fold_angles)
+        .into_iter()
+        .fold(0.0, f64::max);
+    let mut rho = fold_angles.to_vec();
+    let mut solver = NormalSolver::new(1e-10);
+    let iterations = restore_closure(model, &mut rho, tol, &mut solver)?.ok_or_else(|| {
+        crate::error::NanofoldError::invalid(
+            "fold_angles",
+            format!("worst vertex closure {residual_before:.3e} rad"),
+            "Newton found no rigid state near it (too far from rigid to project)",
+        )
+    })?;
+    let changes: Vec<f64> = rho.iter().zip(fold_angles).map(|(a, b)| (a - b).abs()).collect();
+    let max_change = changes.iter().copied().fold(0.0, f64::max);
+    let rms_change = (changes.iter().map(|c| c * c).sum::<f64>() / changes.len().max(1) as f64).sqrt();
+    Ok(Projection {
+        fold_angles: rho,
+        max_change,
+        rms_change,
+        residual_before,
+        iterations,
+    })
+}

@@ -27,10 +27,14 @@ struct EnergyStar {
     arcs: Vec<Arc>,
 }
 
-/// Σ_v U_v(ρ) over the vertices, with its gradient in fold-angle coordinates.
+/// Σ_v U_v(ρ) over the vertices, plus Σ (1 − cos ρ_c) over the creases that meet no
+/// interior vertex, with its gradient in fold-angle coordinates.
 pub struct NetworkEnergy {
     energy: Box<dyn Energy>,
     stars: Vec<EnergyStar>,
+    /// Creases with no interior vertex at either end: no spherical linkage holds them, so
+    /// their own opening energy, lowest at flat, drives them.
+    free_columns: Vec<usize>,
 }
 
 impl NetworkEnergy {
@@ -68,9 +72,16 @@ impl NetworkEnergy {
                 }
             })
             .collect();
+        let mut starred = vec![false; model.crease_count()];
+        for star in &model.stars {
+            for &c in &star.columns {
+                starred[c] = true;
+            }
+        }
         NetworkEnergy {
             energy: kind.build(p),
             stars,
+            free_columns: (0..starred.len()).filter(|&c| !starred[c]).collect(),
         }
     }
 
@@ -81,10 +92,17 @@ impl NetworkEnergy {
 
     /// U(ρ); infinite when some vertex's sectors touch.
     pub fn value(&self, fold_angles: &[f64], ws: &mut EnergyWorkspace) -> f64 {
-        self.stars
+        let vertices: f64 = self
+            .stars
             .iter()
             .map(|star| self.energy.value(&Self::nodes(star, fold_angles), &star.arcs, ws))
-            .sum()
+            .sum();
+        vertices
+            + self
+                .free_columns
+                .iter()
+                .map(|&c| 1.0 - fold_angles[c].cos())
+                .sum::<f64>()
     }
 
     /// U(ρ) and ∂U/∂ρ (overwrites `gradient`). Node k of a vertex turns about the axis of
@@ -109,6 +127,10 @@ impl NetworkEnergy {
                 }
                 suffix += nodes[j].cross(&node_gradient[j]);
             }
+        }
+        for &c in &self.free_columns {
+            total += 1.0 - fold_angles[c].cos();
+            gradient[c] += fold_angles[c].sin();
         }
         total
     }
