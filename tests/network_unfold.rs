@@ -435,3 +435,46 @@ fn random_waterbomb_states_folded_by_fold_unfold_flat() {
         }
     }
 }
+
+/// A restart: one crease across a sheet folded to exactly 180° sits where its own energy's
+/// gradient (sin ρ) vanishes, a stationary point that is no minimum. A kick along the rigid
+/// motions (one way puts the panels through each other, the other opens them) starts the
+/// descent again, and it ends flat with the restart counted.
+#[test]
+fn a_stationary_start_is_left_by_a_restart() {
+    use nanofold::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
+    use nanofold::pattern::Assignment;
+    let builder = CreasePatternBuilder {
+        name: "one_crease".into(),
+        vertices: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [0.0, 1.0]],
+        edges: vec![[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]],
+        kinds: vec![
+            EdgeKind::Boundary,
+            EdgeKind::Boundary,
+            EdgeKind::Boundary,
+            EdgeKind::Boundary,
+            EdgeKind::Boundary,
+            EdgeKind::Boundary,
+            EdgeKind::Crease(Assignment::Valley),
+        ],
+        fold_angles: vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, std::f64::consts::PI],
+        angle_field: "edges_foldAngle".into(),
+        ..Default::default()
+    };
+    let model = FoldingModel::new(builder.build().unwrap()).unwrap();
+    let start = model.given_fold_angles();
+    let report = unfold_network(&model, &start, &NetworkUnfoldSettings::default()).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::Flat, "{}", report.evidence);
+    assert_eq!(report.restarts_used, 1);
+    let without = unfold_network(
+        &model,
+        &start,
+        &NetworkUnfoldSettings {
+            restarts: 0,
+            ..NetworkUnfoldSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(without.verdict, NetworkVerdict::LocalMinimum);
+    assert!(without.evidence.contains("0 restarts tried"), "{}", without.evidence);
+}

@@ -748,7 +748,7 @@ pub fn unfold_network_one(
         "max_arc_residual": Value::Null,
         "planarity_residual": planarity,
         "flat_layout_error": flat_layout_error,
-        "restarts_used": 0,
+        "restarts_used": report.restarts_used,
         "crossings_refused": report.crossings_refused,
         "radial_steps": report.radial_steps,
         "adjustments": projection.iter().map(|(note, _)| note.clone()).collect::<Vec<_>>(),

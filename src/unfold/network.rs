@@ -14,6 +14,7 @@ use crate::geometry::kinematics::forward;
 use crate::geometry::sphere::Vec3;
 use crate::unfold::barrier::{BarrierSettings, PanelBarrier};
 use crate::unfold::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
+use crate::unfold::solver::SplitMix64;
 use std::f64::consts::PI;
 
 /// One vertex's spherical linkage for the energy: its rays (creases and the flat rays that
@@ -163,6 +164,8 @@ pub struct NetworkUnfoldSettings {
     pub memory: usize,
     /// The barrier between panels that share no vertex (None: crossings are only refused).
     pub barrier: Option<BarrierSettings>,
+    /// Random kicks tried from a local minimum before it is the verdict.
+    pub restarts: usize,
 }
 
 impl Default for NetworkUnfoldSettings {
@@ -180,6 +183,7 @@ impl Default for NetworkUnfoldSettings {
             },
             memory: 8,
             barrier: Some(BarrierSettings::default()),
+            restarts: 3,
         }
     }
 }
@@ -245,6 +249,8 @@ pub struct NetworkReport {
     /// Steps taken along the ray to flat, ρ → (1 − f)ρ, where the projected gradient's
     /// line search found none.
     pub radial_steps: usize,
+    /// Random kicks taken from local minima.
+    pub restarts_used: usize,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -253,6 +259,46 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
+}
+
+/// The largest fold-angle change of a restart's kick, rad.
+const RESTART_KICK: f64 = 0.05;
+
+/// A restart from a local minimum: a random direction of the null space of J (the rigid
+/// motions), scaled so no crease moves more than [`RESTART_KICK`], tried both ways and up to
+/// four draws; the first kicked state that closes with finite energy and no crossing panels.
+#[allow(clippy::too_many_arguments)]
+fn restart(
+    objective: &Objective,
+    settings: &NetworkUnfoldSettings,
+    factor: &crate::folding::normal::NormalFactor,
+    random: &mut SplitMix64,
+    rho: &[f64],
+    ws: &mut EnergyWorkspace,
+    poses: &mut Vec<Pose>,
+    solver: &mut NormalSolver,
+) -> Result<Option<Accepted>> {
+    let model = objective.model;
+    for _ in 0..4 {
+        let mut direction: Vec<f64> = rho.iter().map(|_| 2.0 * random.next_f64() - 1.0).collect();
+        model.hold_locked(&mut direction);
+        let direction = factor.project(&direction);
+        let size = direction.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        if size <= 1e-14 {
+            continue;
+        }
+        for sign in [1.0, -1.0] {
+            let trial: Vec<f64> = rho
+                .iter()
+                .zip(&direction)
+                .map(|(r, d)| r + sign * RESTART_KICK * d / size)
+                .collect();
+            if let Trial::Accepted(state) = try_state(model, objective, settings, solver, ws, poses, trial, |_| true)? {
+                return Ok(Some(state));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// Below this largest |ρ|, rad, a step along the ray to flat is tried before the line search.
@@ -273,16 +319,16 @@ fn radial_step(
     rho: &[f64],
     u: f64,
     crossings_refused: &mut usize,
-    refused_for_crossing: &mut bool,
+    refused_for_crossing: &mut Option<[usize; 2]>,
 ) -> Result<Option<Accepted>> {
     let mut f = 0.5;
     while f > 1e-4 {
         let trial: Vec<f64> = rho.iter().map(|r| (1.0 - f) * r).collect();
         match try_state(model, objective, settings, solver, ws, poses, trial, |v| v < u)? {
             Trial::Accepted(state) => return Ok(Some(state)),
-            Trial::Crossing => {
+            Trial::Crossing(pair) => {
                 *crossings_refused += 1;
-                *refused_for_crossing = true;
+                *refused_for_crossing = Some(pair);
             }
             Trial::Refused => {}
         }
@@ -352,14 +398,14 @@ type Accepted = (Vec<f64>, f64, Vec<f64>);
 enum Trial {
     /// Closed, energy accepted, no panels crossing.
     Accepted(Accepted),
-    /// Closed and energy accepted, but panels cross.
-    Crossing,
+    /// Closed and energy accepted, but these panels cross.
+    Crossing([usize; 2]),
     /// Newton could not close it, or its energy was not accepted.
     Refused,
 }
 
-/// Restores `trial` onto the closure and judges it: its energy must be finite and pass
-/// `accept`, and no two panels may cross.
+/// Restores `trial` onto the closure and judges it: every fold angle within ±π, its energy
+/// finite and passing `accept`, and no two panels crossing.
 #[allow(clippy::too_many_arguments)]
 fn try_state(
     model: &FoldingModel,
@@ -374,17 +420,17 @@ fn try_state(
     if restore_closure(model, &mut trial, settings.closure_tol, solver)?.is_none() {
         return Ok(Trial::Refused);
     }
+    // Beyond ±π a crease has passed its two panels through each other.
+    if trial.iter().any(|r| r.abs() > PI + 1e-12) {
+        return Ok(Trial::Refused);
+    }
     let mut gradient = vec![0.0; trial.len()];
     let value = objective.evaluate(&trial, ws, poses, &mut gradient);
     if !(value.is_finite() && accept(value)) {
         return Ok(Trial::Refused);
     }
-    if panel_contacts(model, poses, &settings.contact)
-        .crossing()
-        .next()
-        .is_some()
-    {
-        return Ok(Trial::Crossing);
+    if let Some(contact) = panel_contacts(model, poses, &settings.contact).crossing().next() {
+        return Ok(Trial::Crossing(contact.panels));
     }
     Ok(Trial::Accepted((trial, value, gradient)))
 }
@@ -437,6 +483,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             max_closure_residual: residual,
             crossings_refused: 0,
             radial_steps: 0,
+            restarts_used: 0,
         });
     }
     let objective = Objective {
@@ -469,7 +516,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     let mut history: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::new();
     let mut pending: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut quasi_newton_scale = 1.0;
+    let mut kick = SplitMix64(0x5EED_0F);
     let mut scale = 1.0;
+    // Restarts taken, read by `finish` (a Cell, as the loop counts while `finish` is held).
+    let restarts = std::cell::Cell::new(0usize);
     let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused, radial_steps| {
         let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
         Ok(NetworkReport {
@@ -480,6 +530,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             max_closure_residual,
             crossings_refused,
             radial_steps,
+            restarts_used: restarts.get(),
         })
     };
     if jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
@@ -528,9 +579,32 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let steepest: Vec<f64> = factor.project(&downhill);
         let steepest_size = steepest.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         if steepest_size <= 1e-14 {
+            if restarts.get() < settings.restarts {
+                if let Some(state) = restart(
+                    &objective,
+                    settings,
+                    &factor,
+                    &mut kick,
+                    &rho,
+                    &mut ws,
+                    &mut poses,
+                    &mut solver,
+                )? {
+                    restarts.set(restarts.get() + 1);
+                    (rho, u, gradient) = state;
+                    history.clear();
+                    pending = None;
+                    steps.push(NetworkStep {
+                        energy: u,
+                        fold_angles: rho.clone(),
+                        max_residual: worst(&rho),
+                    });
+                    continue;
+                }
+            }
             return finish(
                 NetworkVerdict::LocalMinimum,
-                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad"),
+                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad; {} restarts tried (kicks of {RESTART_KICK} rad along random directions of the null space)", restarts.get()),
                 iteration,
                 steps,
                 crossings_refused,
@@ -607,7 +681,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             }
         }
         let t_before_search = t;
-        let mut refused_for_crossing = false;
+        let mut refused_for_crossing = None;
         let mut halvings = 0;
         // Near flat the ray to flat is tried first: the cheapest step that keeps the branch.
         let radial_first = largest <= NEAR_FLAT;
@@ -645,9 +719,9 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     accepted = Some(state);
                     break;
                 }
-                Trial::Crossing => {
+                Trial::Crossing(pair) => {
                     crossings_refused += 1;
-                    refused_for_crossing = true;
+                    refused_for_crossing = Some(pair);
                 }
                 Trial::Refused => {}
             }
@@ -673,7 +747,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             radial_steps += usize::from(accepted.is_some());
         }
         let Some((next, u_next, g_next)) = accepted else {
-            if largest <= STALL_TOL && !refused_for_crossing {
+            if largest <= STALL_TOL && refused_for_crossing.is_none() {
                 // The energy's changes are below its rounding this close to flat; the flat
                 // state is rigid and the descent was heading there.
                 steps.push(flat_step(&objective, n, &mut ws));
@@ -686,17 +760,45 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     radial_steps,
                 );
             }
-            let (verdict, why) = if refused_for_crossing {
-                (
+            if let Some([a, b]) = refused_for_crossing {
+                return finish(
                     NetworkVerdict::Blocked,
-                    "every shorter step still puts panels through each other",
-                )
-            } else {
-                (NetworkVerdict::LocalMinimum, "the line search found no decrease")
-            };
+                    format!("every shorter step still puts panels through each other: panels {a} and {b} would meet (max |ρ| = {largest:.3e} rad)"),
+                    iteration,
+                    steps,
+                    crossings_refused,
+                    radial_steps,
+                );
+            }
+            if restarts.get() < settings.restarts {
+                if let Some(state) = restart(
+                    &objective,
+                    settings,
+                    &factor,
+                    &mut kick,
+                    &rho,
+                    &mut ws,
+                    &mut poses,
+                    &mut solver,
+                )? {
+                    restarts.set(restarts.get() + 1);
+                    (rho, u, gradient) = state;
+                    history.clear();
+                    pending = None;
+                    steps.push(NetworkStep {
+                        energy: u,
+                        fold_angles: rho.clone(),
+                        max_residual: worst(&rho),
+                    });
+                    continue;
+                }
+            }
             return finish(
-                verdict,
-                format!("{why} (max |ρ| = {largest:.3e} rad)"),
+                NetworkVerdict::LocalMinimum,
+                format!(
+                    "the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e}); {} restarts tried (kicks of {RESTART_KICK} rad along random directions of the null space)",
+                    restarts.get()
+                ),
                 iteration,
                 steps,
                 crossings_refused,
