@@ -516,7 +516,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     let mut history: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::new();
     let mut pending: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut quasi_newton_scale = 1.0;
-    let mut kick = SplitMix64(0x5EED_0F);
+    let mut kick = SplitMix64(0x5EED_F00D);
     let mut scale = 1.0;
     // Restarts taken, read by `finish` (a Cell, as the loop counts while `finish` is held).
     let restarts = std::cell::Cell::new(0usize);
