@@ -793,6 +793,9 @@ fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
             .unwrap_or_else(|_| panic!("{}", String::from_utf8_lossy(&out.stderr)))
     };
     assert_eq!(run(&["check", "--json"])["verdict"], "not_rigid");
+    // Without --project, `unfold` refuses to unfold a state that needs bending.
+    let refused = run(&["unfold", "--json", "--out", dir.join("raw").to_str().unwrap()]);
+    assert_eq!(refused["verdict"], "not_rigid", "{refused}");
     let checked = run(&["check", "--json", "--project"]);
     assert_eq!(checked["verdict"], "rigid", "{checked}");
     assert!(checked["projection"]["max_change_rad"].as_f64().unwrap() > 0.0);
