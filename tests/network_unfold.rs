@@ -478,3 +478,77 @@ fn a_stationary_start_is_left_by_a_restart() {
     assert_eq!(without.verdict, NetworkVerdict::LocalMinimum);
     assert!(without.evidence.contains("0 restarts tried"), "{}", without.evidence);
 }
+
+/// Random trapezoidal Miura-ori (a sector angle per zigzag line, so the panels are
+/// trapezoids, not parallelograms): rigidly foldable quad meshes beyond the Miura-ori. The
+/// generator's closed-form state closes every vertex; `fold` from flat follows the closed
+/// form (one straight fold angle for every horizontal crease, tan(ρ_z,j/2) = tan(ρ_h/2)/cos γ_j
+/// on line j) at every frame; and the folded state unfolds flat.
+#[test]
+fn random_trapezoidal_miura_quad_meshes_fold_by_the_closed_form_and_unfold_flat() {
+    use nanofold::folding::{fold_path, Drive, FoldSettings};
+    let mut seed = 0x7A9E_u64;
+    for case in 0..8 {
+        let rows = 2 + (uniform(&mut seed) * 4.0) as usize;
+        let cols = 2 + (uniform(&mut seed) * 4.0) as usize;
+        let spec = MiuraSpec {
+            rows,
+            cols,
+            sector_angle: 60f64.to_radians(),
+            width: 1.5,
+            slant: 1.0,
+            zigzag_fold_angle: (40.0 + 100.0 * uniform(&mut seed)).to_radians(),
+        };
+        let angles: Vec<f64> = (0..=cols)
+            .map(|_| (45.0 + 30.0 * uniform(&mut seed)).to_radians())
+            .collect();
+        let name = format!(
+            "case {case}: {rows}x{cols}, γ_j {:?}°",
+            angles.iter().map(|g| g.to_degrees().round()).collect::<Vec<_>>()
+        );
+        let model = FoldingModel::new(spec.build_with_column_angles(&angles).unwrap().build().unwrap()).unwrap();
+        // The closed-form state closes every vertex.
+        let state = model.given_fold_angles();
+        let worst = vertex_residuals(&model, &state).into_iter().fold(0.0, f64::max);
+        assert!(worst < 1e-12, "{name}: closed form residual {worst:e}");
+        // Which creases are horizontal, and each zigzag crease's line.
+        let line_of = |c: usize| {
+            let [a, b] = model.pattern.edges[model.pattern.creases[c]];
+            let (pa, pb) = (model.pattern.vertices[a], model.pattern.vertices[b]);
+            ((pa[1] - pb[1]).abs() > 1e-9).then(|| a % (cols + 1))
+        };
+        // Fold from flat (the crease pattern alone) along the assignment.
+        let flat = model.with_fold_angles(&vec![0.0; state.len()]);
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to: 0.6 },
+            ..FoldSettings::default()
+        };
+        let path = fold_path(&flat, &flat.given_fold_angles(), &settings).unwrap();
+        for step in path.steps.iter().filter(|s| s.progress > 0.05) {
+            let rho = &step.fold_angles;
+            let straight: Vec<f64> = (0..rho.len())
+                .filter(|&c| line_of(c).is_none())
+                .map(|c| rho[c].abs())
+                .collect();
+            let rho_h = straight[0];
+            assert!(
+                straight.iter().all(|r| (r - rho_h).abs() < 1e-9),
+                "{name}: straight creases differ"
+            );
+            for c in (0..rho.len()).filter(|&c| line_of(c).is_some()) {
+                let gamma = angles[line_of(c).unwrap()];
+                let expected = 2.0 * ((rho_h / 2.0).tan() / gamma.cos()).atan();
+                assert!(
+                    (rho[c].abs() - expected).abs() < 1e-9,
+                    "{name}: zigzag {c} {} vs {expected}",
+                    rho[c]
+                );
+            }
+        }
+        let start = path.steps.last().unwrap().fold_angles.clone();
+        let report = unfold_network(&flat, &start, &NetworkUnfoldSettings::default()).unwrap();
+        assert_eq!(report.verdict, NetworkVerdict::Flat, "{name}: {}", report.evidence);
+        assert!(report.max_closure_residual <= 1e-10, "{name}");
+        assert_eq!(report.crossings_refused, 0, "{name}");
+    }
+}

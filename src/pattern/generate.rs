@@ -81,23 +81,59 @@ impl MiuraSpec {
     /// mountains for odd j; the straight lines' segments alternate, so that every vertex
     /// has three creases of one kind (Maekawa).
     pub fn build(&self) -> Result<CreasePatternBuilder> {
+        self.build_with_column_angles(&vec![self.sector_angle; self.cols + 1])
+    }
+
+    /// A Miura-ori whose zigzag line j has its own sector angle γ_j (`cols + 1` of them):
+    /// row height h = slant·sin γ as before, line j shifted on odd rows by h / tan γ_j, so the
+    /// panels are trapezoids. Every vertex keeps sectors (γ_j, π − γ_j, π − γ_j, γ_j), and the
+    /// pattern folds rigidly with one straight fold angle ρ_h for every horizontal crease and
+    /// tan(ρ_z,j / 2) = tan(ρ_h / 2) / cos γ_j on line j; the state written is the one whose
+    /// ρ_h is [`Self::straight_fold_angle`].
+    pub fn build_with_column_angles(&self, column_angles: &[f64]) -> Result<CreasePatternBuilder> {
         self.validate()?;
         let (rows, cols) = (self.rows, self.cols);
-        let (height, shift) = (
-            self.slant * self.sector_angle.sin(),
-            self.slant * self.sector_angle.cos(),
-        );
+        if column_angles.len() != cols + 1 {
+            return Err(NanofoldError::invalid(
+                "column_angles",
+                format!("{} angles", column_angles.len()),
+                format!("one per zigzag line ({})", cols + 1),
+            ));
+        }
+        if let Some(j) = column_angles
+            .iter()
+            .position(|g| !(*g >= 1f64.to_radians() && *g <= 89f64.to_radians()))
+        {
+            return Err(NanofoldError::invalid(
+                format!("column_angles[{j}]"),
+                column_angles[j].to_degrees(),
+                "must lie in [1°, 89°]",
+            ));
+        }
+        let height = self.slant * self.sector_angle.sin();
+        let shifts: Vec<f64> = column_angles.iter().map(|g| height / g.tan()).collect();
+        if let Some(j) = (0..cols).find(|&j| self.width + shifts[j + 1] - shifts[j] < 0.2 * self.width) {
+            return Err(NanofoldError::invalid(
+                format!("column_angles[{}]", j + 1),
+                column_angles[j + 1].to_degrees(),
+                "the odd rows' panel between lines j and j + 1 would be narrower than 0.2 width",
+            ));
+        }
         let index = |i: usize, j: usize| i * (cols + 1) + j;
         let vertices: Vec<[f64; 2]> = (0..=rows)
             .flat_map(|i| (0..=cols).map(move |j| (i, j)))
             .map(|(i, j)| {
                 [
-                    j as f64 * self.width + if i % 2 == 1 { shift } else { 0.0 },
+                    j as f64 * self.width + if i % 2 == 1 { shifts[j] } else { 0.0 },
                     i as f64 * height,
                 ]
             })
             .collect();
-        let (rho_z, rho_h) = (self.zigzag_fold_angle, self.straight_fold_angle());
+        let rho_h = self.straight_fold_angle();
+        let rho_z: Vec<f64> = column_angles
+            .iter()
+            .map(|g| 2.0 * ((rho_h / 2.0).tan() / g.cos()).atan())
+            .collect();
         let zigzag_sign = |j: usize| if j.is_multiple_of(2) { 1.0 } else { -1.0 };
         let mut builder = CreasePatternBuilder {
             name: format!("miura_{rows}x{cols}"),
@@ -137,7 +173,7 @@ impl MiuraSpec {
                 if j == 0 || j == cols {
                     push(edge, EdgeKind::Boundary, 0.0);
                 } else {
-                    push(edge, crease(zigzag_sign(j)), zigzag_sign(j) * rho_z);
+                    push(edge, crease(zigzag_sign(j)), zigzag_sign(j) * rho_z[j]);
                 }
             }
         }
