@@ -168,12 +168,12 @@ impl MiuraSpec {
             }
         }
         for i in 0..rows {
-            for j in 0..=cols {
+            for (j, rho) in rho_z.iter().enumerate() {
                 let edge = [index(i, j), index(i + 1, j)];
                 if j == 0 || j == cols {
                     push(edge, EdgeKind::Boundary, 0.0);
                 } else {
-                    push(edge, crease(zigzag_sign(j)), zigzag_sign(j) * rho_z[j]);
+                    push(edge, crease(zigzag_sign(j)), zigzag_sign(j) * rho);
                 }
             }
         }
