@@ -190,6 +190,11 @@ pub struct ConstraintsArgs {
     /// vertices: J is a FOLD edge index).
     #[arg(long = "lock", value_name = "J=DEG", allow_hyphen_values = true)]
     pub locks: Vec<String>,
+    /// Keep only these creases free besides the driver (comma-separated indices, e.g.
+    /// --free 2,3,4); every other crease is held at its folded angle, as if each had a
+    /// --lock. An explicit --lock still sets its own angle.
+    #[arg(long, value_name = "I,J,...", value_delimiter = ',')]
+    pub free: Vec<usize>,
     /// Polynomial degree 1..=20, or `auto` with --tol.
     #[arg(long, default_value = "4", allow_hyphen_values = true)]
     pub degree: String,
@@ -737,11 +742,23 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         Err(e) => return Err(e.into()),
     };
     let driver = crease_index(&pattern, args.drive, "--drive")?;
-    let locks = args
+    let mut locks = args
         .locks
         .iter()
         .map(|text| parse_lock(&pattern, text))
         .collect::<Result<Vec<_>>>()?;
+    if !args.free.is_empty() {
+        let free = args
+            .free
+            .iter()
+            .map(|&i| crease_index(&pattern, i, "--free"))
+            .collect::<Result<Vec<_>>>()?;
+        for (c, crease) in pattern.creases.iter().enumerate() {
+            if c != driver && !free.contains(&c) && !locks.iter().any(|(l, _)| *l == c) {
+                locks.push((c, crease.folded_angle));
+            }
+        }
+    }
     let range = args.range.as_deref().map(parse_range).transpose()?;
     let setup = Setup::new(&pattern, driver, &locks).map_err(constraints_flags)?;
     // A long sweep (up to 100 000 Newton solves) shows that it is working.
@@ -873,11 +890,13 @@ fn print_constraints(
             "  {:<12} fit error {:.3e} rad, slope error {:.3e}, closure residual {:.3e} rad; coefficients (deg):",
             curve.label, curve.max_fit_error_rad, curve.max_slope_error, curve.max_closure_residual
         );
+        // Every coefficient at full precision (shortest round-trip form): at degree 16 the
+        // top term is ~1e-34 · 180^16, so seven digits would move the curve by 1e-3°.
         let terms: Vec<String> = curve
             .coeffs_deg
             .iter()
             .enumerate()
-            .map(|(k, c)| format!("{c:+.6e}·θ^{k}"))
+            .map(|(k, c)| format!("{c:+e}·θ^{k}"))
             .collect();
         println!("      {}", terms.join(" "));
     }

@@ -563,6 +563,24 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
             args.drive, args.drive, model.pattern.name
         )
     })?;
+    // --free I,J,...: every crease but these and the driver held at its folded angle.
+    if !args.free.is_empty() {
+        let mut free = vec![false; model.crease_count()];
+        for &edge in &args.free {
+            let column = model.column_of_edge.get(edge).copied().flatten().with_context(|| {
+                format!(
+                    "invalid --free {edge}: edge {edge} is not a crease of {}",
+                    model.pattern.name
+                )
+            })?;
+            free[column] = true;
+        }
+        for (column, locked) in model.locked_columns.iter_mut().enumerate() {
+            if column != driver && !free[column] {
+                *locked = true;
+            }
+        }
+    }
     if rho.iter().all(|&r| r == 0.0) {
         bail!(
             "{}: constraint curves of many vertices start from a folded state (e.g. folded.fold written by `nanofold fold`); this pattern is flat",
