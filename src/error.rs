@@ -169,6 +169,24 @@ pub enum NumericalError {
         #[source]
         source: diffsol::error::DiffsolError,
     },
+    /// diffsol failed during a step; its own message gives its scaled time.
+    #[error(
+        "ODE integration ({method}, diffsol) failed at t = {reached_s:.6e} s of {end_s:.6e} s \
+         (diffsol's message below counts time in units of 1/ω_slow = {time_unit:.6e} s)"
+    )]
+    OdeStep {
+        /// The integrator.
+        method: String,
+        /// Where the run had got to, s.
+        reached_s: f64,
+        /// Its end, s.
+        end_s: f64,
+        /// Seconds per unit of diffsol's scaled time.
+        time_unit: f64,
+        /// diffsol's own error.
+        #[source]
+        source: diffsol::error::DiffsolError,
+    },
     /// A dynamic run used its step budget before the end of its time span.
     #[error(
         "{method} used its budget of {steps} steps by t = {reached_s:.6e} s of {end_s:.6e} s; at this pace it needs \

@@ -997,3 +997,32 @@ fn free_creases_replace_a_lock_for_every_other_crease() {
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--free 99"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A failed integration says when it failed in seconds of the run, not in diffsol's scaled
+/// time alone.
+#[test]
+fn a_failed_integration_reports_the_runs_own_time() {
+    let dir = temp_dir("ode-failure");
+    let out = nanofold()
+        .args([
+            "simulate",
+            "patterns/bridge_step.scene.json",
+            "--model",
+            "dynamic",
+            "--method",
+            "esdirk34",
+            "--rtol",
+            "1e-15",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        text.contains("failed at t = ") && text.contains(" s of 2.000000e-3 s"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

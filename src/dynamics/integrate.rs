@@ -279,7 +279,19 @@ impl<P: Plant> Driver<'_, P> {
         let lever = plant.contact_lever();
         let (mut step_stride, mut step_samples) = (1usize, 0usize);
         loop {
-            let reason = solver.step()?;
+            let reason = match solver.step() {
+                Ok(reason) => reason,
+                Err(source) => {
+                    return Err(NumericalError::OdeStep {
+                        method: format!("{:?}", self.method),
+                        reached_s: solver.state().t * self.time_unit,
+                        end_s: self.s_end * self.time_unit,
+                        time_unit: self.time_unit,
+                        source,
+                    }
+                    .into())
+                }
+            };
             steps += 1;
             let s_now = solver.state().t;
             if !s_now.is_finite() || (0..2 * n).any(|i| !solver.state().y[i].is_finite()) {
