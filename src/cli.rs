@@ -125,7 +125,18 @@ pub enum ExportKind {
         /// fastest natural period).
         #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
         timestep: f64,
+        /// How a closed loop is closed: `connect` equalities (exact; every crease a hinge) or
+        /// fitted quartic `polycoef` equalities (the cut crease has no joint).
+        #[arg(long, value_enum, default_value_t = ClosureArg::Connect)]
+        closure: ClosureArg,
     },
+}
+
+/// `export mujoco --closure`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ClosureArg {
+    Connect,
+    Poly,
 }
 
 /// Arguments of `nanofold simulate`.
@@ -1151,13 +1162,24 @@ fn simulate_flags(error: nanofold::NanofoldError) -> anyhow::Error {
 }
 
 fn run_export(format: &ExportKind) -> Result<()> {
-    let ExportKind::Mujoco { scene, out, timestep } = format;
+    let ExportKind::Mujoco {
+        scene,
+        out,
+        timestep,
+        closure,
+    } = format;
     let built = load_scene(scene)?;
     let scales = match &built.system {
         System::Strip(chain) => chain.time_scales()?,
         System::Closed(chain) => chain.time_scales()?,
     };
-    let settings = nanofold::io::mujoco::MujocoSettings { timestep: *timestep };
+    let settings = nanofold::io::mujoco::MujocoSettings {
+        timestep: *timestep,
+        closure: match closure {
+            ClosureArg::Connect => nanofold::io::mujoco::LoopClosure::Connect,
+            ClosureArg::Poly => nanofold::io::mujoco::LoopClosure::Polycoef,
+        },
+    };
     settings
         .validate(scales.fastest_period_s)
         .map_err(|e| with_flags(e, &[("timestep", "--timestep")]))?;

@@ -204,5 +204,35 @@ fn mujoco_runs_the_exported_corner_cube_to_nanofolds_first_contact() {
     // MuJoCo's equalities are soft (relaxing over two steps): the loop stays closed to 10 nm,
     // 3e-5 of a 300 µm face (measured 2.3 nm at 10 ns steps).
     assert!(result["max_equality_violation"].as_f64().unwrap() < 1e-2, "{result}");
+    // Closed instead by the fitted quartics (`--closure poly`): the keyframe lies on them, the
+    // equalities hold to 1e-4 rad, and the contact comes within 5e-3 (measured 1.3e-3 early:
+    // the quartics are 1.7e-3 rad off the closure, and the cut crease has no spring).
+    let poly_model = dir.join("corner_cube_step1_poly.xml");
+    let out = nanofold()
+        .args([
+            "export",
+            "mujoco",
+            "patterns/corner_cube_step1.scene.json",
+            "--closure",
+            "poly",
+            "--timestep",
+            "1e-8",
+            "--out",
+        ])
+        .arg(&poly_model)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mjcf = std::fs::read_to_string(&poly_model).unwrap();
+    assert!(mjcf.contains("curve_crease_3") && !mjcf.contains("<connect"));
+    let poly = run_mujoco(&python, &poly_model, 1.2 * t_nanofold);
+    let t_poly = poly["first_contact"]["time_us"]
+        .as_f64()
+        .expect("MuJoCo reached a contact");
+    assert!(
+        (t_poly / t_nanofold - 1.0).abs() < 5e-3,
+        "poly: MuJoCo {t_poly} µs, nanofold {t_nanofold} µs"
+    );
+    assert!(poly["max_equality_violation"].as_f64().unwrap() < 1e-4, "{poly}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -25,17 +25,80 @@ pub const TORQUE_UNIT: f64 = MASS_UNIT * LENGTH_UNIT * LENGTH_UNIT / (TIME_UNIT 
 /// lightest plate's (its inertia likewise).
 pub const CUT_BODY_SHARE: f64 = 1e-6;
 
+/// How a closed loop is closed in MuJoCo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopClosure {
+    /// Geometric `connect` equalities on a light body carrying the cut crease: exact, every
+    /// crease a hinge with its stiffness.
+    Connect,
+    /// Fitted quartic `polycoef` equalities, each dependent crease a polynomial of the
+    /// driver's angle; the cut crease has no joint (and so no stiffness).
+    Polycoef,
+}
+
 /// How to write a scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MujocoSettings {
     /// Integrator time step, s (RK4).
     pub timestep: f64,
+    /// How a closed chain's loop is closed.
+    pub closure: LoopClosure,
 }
 
 impl Default for MujocoSettings {
     fn default() -> Self {
-        MujocoSettings { timestep: 1e-9 }
+        MujocoSettings {
+            timestep: 1e-9,
+            closure: LoopClosure::Connect,
+        }
     }
+}
+
+/// A quartic y = Σ a_k x^k (x the driver's angle, rad) for every dependent crease of a closed
+/// chain, least squares over 64 Chebyshev points of the constraint's domain, and the largest
+/// error at 400 points of it, rad.
+pub struct QuarticCurves {
+    /// (crease, coefficients a_0..a_4) per dependent crease.
+    pub curves: Vec<(usize, [f64; 5])>,
+    /// Largest |fit − constraint| over the domain, rad.
+    pub max_error: f64,
+}
+
+/// The closed chain's dependent creases as quartics of the driver (MuJoCo's `polycoef`).
+pub fn quartic_curves(chain: &ClosedChain) -> Result<QuarticCurves> {
+    let [lo, hi] = chain.source.domain();
+    let mut ws = chain.workspace();
+    let nodes: Vec<f64> = (0..64)
+        .map(|k| {
+            let c = (std::f64::consts::PI * (k as f64 + 0.5) / 64.0).cos();
+            0.5 * (lo + hi) + 0.5 * (hi - lo) * c
+        })
+        .collect();
+    let mut values = Vec::new();
+    for &q in &nodes {
+        chain.update_creases(q, &mut ws)?;
+        values.push(ws.crease_angles.clone());
+    }
+    let design = nalgebra::DMatrix::from_fn(nodes.len(), 5, |i, k| nodes[i].powi(k as i32));
+    let svd = design.svd(true, true);
+    let mut curves = Vec::new();
+    for &c in &chain.dependents {
+        let rhs = nalgebra::DVector::from_iterator(nodes.len(), values.iter().map(|v| v[c]));
+        let solution = svd
+            .solve(&rhs, 1e-14)
+            .map_err(|e| NanofoldError::invalid("constraint", e, "the quartic fit failed"))?;
+        curves.push((c, [solution[0], solution[1], solution[2], solution[3], solution[4]]));
+    }
+    let mut max_error: f64 = 0.0;
+    for k in 0..=400 {
+        let q = lo + (hi - lo) * k as f64 / 400.0;
+        chain.update_creases(q, &mut ws)?;
+        for (c, a) in &curves {
+            let fit = a.iter().rev().fold(0.0, |acc, x| acc * q + x);
+            max_error = max_error.max((fit - ws.crease_angles[*c]).abs());
+        }
+    }
+    Ok(QuarticCurves { curves, max_error })
 }
 
 impl MujocoSettings {
@@ -154,7 +217,7 @@ fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
 /// A closed chain's bodies, the body the cut body must meet, and the two connect anchors.
 type ClosedBodies = (Vec<BodySpec>, Vec<String>, Vec<Point3<f64>>);
 
-fn closed_bodies(chain: &ClosedChain) -> Result<ClosedBodies> {
+fn closed_bodies(chain: &ClosedChain, closure: LoopClosure) -> Result<ClosedBodies> {
     let model = &chain.model;
     let torques = step_torques(&chain.forcing, &chain.crease_stiffness, "the closed chain")?;
     let label = |c: usize| format!("crease_{}", chain.crease_user_indices[c]);
@@ -177,6 +240,9 @@ fn closed_bodies(chain: &ClosedChain) -> Result<ClosedBodies> {
             )
         })
         .collect();
+    if closure == LoopClosure::Polycoef {
+        return Ok((bodies, Vec::new(), Vec::new()));
+    }
     // The cut crease: between sector ray−1 (the clockwise side) and sector ray.
     let cut = chain.cut_crease;
     let rays = chain.sector_angles.len();
@@ -283,7 +349,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                 .to_string(),
         ),
         System::Closed(chain) => {
-            let (bodies, targets, anchors) = closed_bodies(chain)?;
+            let (bodies, targets, anchors) = closed_bodies(chain, settings.closure)?;
             (
                 bodies,
                 targets,
@@ -291,8 +357,12 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                 None,
                 chain.model.drag(),
                 format!(
-                    "a closed vertex: the anchored sector is the world's geom `ground`; the loop is cut at crease_{} and closed by two connect equalities",
-                    chain.crease_user_indices[chain.cut_crease]
+                    "a closed vertex: the anchored sector is the world's geom `ground`; the loop is cut at crease_{} and closed by {}",
+                    chain.crease_user_indices[chain.cut_crease],
+                    match settings.closure {
+                        LoopClosure::Connect => "two connect equalities on a light body that keeps the cut crease a hinge",
+                        LoopClosure::Polycoef => "fitted quartic polycoef equalities (the cut crease has no joint and no stiffness)",
+                    }
                 ),
             )
         }
@@ -458,12 +528,16 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         writeln!(w, "    <exclude body1=\"world\" body2=\"{}\"/>", bodies[0].name).unwrap();
         writeln!(w, "  </contact>").unwrap();
     }
-    if !connect_targets.is_empty() {
-        let cut = bodies.last().expect("the cut crease's body");
+    let quartics = match (&scene.system, settings.closure) {
+        (System::Closed(chain), LoopClosure::Polycoef) => Some(quartic_curves(chain)?),
+        _ => None,
+    };
+    if let System::Closed(chain) = &scene.system {
         writeln!(w, "  <equality>").unwrap();
         // Two points of the cut body: one off its hinge axis, one on it away from the vertex
         // (the vertex itself is shared through the tree), so the three fix it to its target.
         for (k, anchor) in connect_anchors.iter().enumerate() {
+            let cut = bodies.last().expect("the cut crease's body");
             let local = cut.pose.inverse_transform_point(anchor);
             writeln!(
                 w,
@@ -477,7 +551,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
             )
             .unwrap();
         }
-        if let System::Closed(chain) = &scene.system {
+        {
             for &(c, value) in &chain.locked {
                 writeln!(
                     w,
@@ -485,6 +559,26 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                     chain.crease_user_indices[c],
                     chain.crease_user_indices[c],
                     fmt(value),
+                    fmt(2.0 * dt)
+                )
+                .unwrap();
+            }
+        }
+        if let Some(quartics) = &quartics {
+            let driver = chain.crease_user_indices[chain.driver];
+            writeln!(
+                w,
+                "    <!-- Each dependent crease a quartic of crease_{driver} (rad), least squares over the constraint's domain; largest error {:.3e} rad. crease_{} is cut: no joint, no equality. -->",
+                quartics.max_error,
+                chain.crease_user_indices[chain.cut_crease]
+            )
+            .unwrap();
+            for (c, a) in quartics.curves.iter().filter(|(c, _)| *c != chain.cut_crease) {
+                let index = chain.crease_user_indices[*c];
+                writeln!(
+                    w,
+                    "    <joint name=\"curve_crease_{index}\" joint1=\"crease_{index}\" joint2=\"crease_{driver}\" polycoef=\"{}\" solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001\"/>",
+                    a.iter().map(|&x| fmt(x)).collect::<Vec<_>>().join(" "),
                     fmt(2.0 * dt)
                 )
                 .unwrap();
@@ -511,7 +605,15 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let mut start = vec![0.0; joint_order.len()];
     if let System::Closed(chain) = &scene.system {
         let mut ws = chain.workspace();
-        chain.update_creases(keyframe_driver_angle(chain), &mut ws)?;
+        let q = keyframe_driver_angle(chain);
+        chain.update_creases(q, &mut ws)?;
+        // With polycoef equalities the keyframe lies on the fitted curves, so MuJoCo starts
+        // with every equality satisfied.
+        if let Some(quartics) = &quartics {
+            for (c, a) in &quartics.curves {
+                ws.crease_angles[*c] = a.iter().rev().fold(0.0, |acc, x| acc * q + x);
+            }
+        }
         for (slot, name) in start.iter_mut().zip(&joint_order) {
             if let Some(c) =
                 (0..chain.crease_labels.len()).find(|&c| *name == format!("crease_{}", chain.crease_user_indices[c]))
