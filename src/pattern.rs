@@ -118,6 +118,8 @@ pub struct FlatMesh {
     pub center: usize,
     /// Polar angle of ray 0 in the crease pattern's xy-plane.
     pub ray0_direction: f64,
+    /// The file's `frame_unit`, written back on the outputs.
+    pub unit: Option<String>,
 }
 
 /// A validated single vertex.

@@ -1026,3 +1026,58 @@ fn a_failed_integration_reports_the_runs_own_time() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `frame_unit` is kept: a single vertex's `unfold.fold`, and `fold`'s `fold.fold` and
+/// `folded.fold` (and `unfold` of that) carry the input's unit; a unit that is not a short
+/// string is refused by name.
+#[test]
+fn the_frame_unit_is_kept_on_every_output() {
+    let dir = temp_dir("unit");
+    std::fs::create_dir_all(&dir).unwrap();
+    let with_unit = |source: &str, unit: serde_json::Value, name: &str| {
+        let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(source).unwrap()).unwrap();
+        value["frame_unit"] = unit;
+        let path = dir.join(name);
+        std::fs::write(&path, value.to_string()).unwrap();
+        path
+    };
+    let unit_of = |path: std::path::PathBuf| {
+        let value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        value["frame_unit"].clone()
+    };
+    let vertex = with_unit("patterns/corner_cube.fold", "um".into(), "cube.fold");
+    let out = nanofold()
+        .arg("unfold")
+        .arg(&vertex)
+        .arg("--out")
+        .arg(dir.join("cube"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(unit_of(dir.join("cube/unfold.fold")), "um");
+    let miura = with_unit("patterns/many/miura_4x4.fold", "mm".into(), "miura.fold");
+    let out = nanofold()
+        .arg("fold")
+        .arg(&miura)
+        .args(["--to", "50", "--out"])
+        .arg(dir.join("miura"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(unit_of(dir.join("miura/fold.fold")), "mm");
+    assert_eq!(unit_of(dir.join("miura/folded.fold")), "mm");
+    let out = nanofold()
+        .arg("unfold")
+        .arg(dir.join("miura/folded.fold"))
+        .arg("--out")
+        .arg(dir.join("miura_unfolded"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(unit_of(dir.join("miura_unfolded/unfold.fold")), "mm");
+    let bad = with_unit("patterns/many/miura_4x4.fold", 3.into(), "bad.fold");
+    let out = nanofold().arg("check").arg(&bad).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && text.contains("frame_unit"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

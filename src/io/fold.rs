@@ -95,6 +95,21 @@ pub(crate) struct FoldGraph<'v> {
     pub angles_json: Option<&'v [Value]>,
     pub locked: Vec<bool>,
     pub faces_vertices: Option<Vec<Vec<usize>>>,
+    /// `frame_unit`, kept for the outputs.
+    pub unit: Option<String>,
+}
+
+/// The key frame's `frame_unit`: a short string, or absent.
+fn frame_unit(value: &Value) -> Result<Option<String>> {
+    match value.get("frame_unit") {
+        None | Some(Value::Null) => Ok(None),
+        Some(Value::String(unit)) if unit.len() <= 64 => Ok(Some(unit.clone())),
+        Some(other) => Err(NanofoldError::invalid(
+            "frame_unit",
+            other.to_string().chars().take(80).collect::<String>(),
+            "a unit name of at most 64 characters (FOLD: \"unit\", \"mm\", \"um\", …)",
+        )),
+    }
 }
 
 /// Parses a FOLD key frame's vertices, edges, assignments, fold angles, locks and faces.
@@ -258,6 +273,7 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
         angles_json,
         locked,
         faces_vertices,
+        unit: frame_unit(value)?,
     })
 }
 
@@ -273,6 +289,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
         angles_json,
         locked,
         faces_vertices,
+        unit,
     } = parse_graph(value, VERTEX_LIMITS)?;
     if is_3d {
         let i = coords3.iter().position(|p| p[2] != 0.0).expect("is_3d");
@@ -456,6 +473,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             faces_vertices,
             center,
             ray0_direction: spokes[start].direction,
+            unit,
         }),
     })
 }
@@ -528,6 +546,7 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
         angle_field: graph.angle_key.to_string(),
         folded_form: None,
         locked: graph.locked,
+        unit: graph.unit,
     })
 }
 
@@ -595,6 +614,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
         faces: None,
         angle_field: "dihedral angle of the 3D faces".into(),
         locked: graph.locked,
+        unit: graph.unit,
         folded_form: Some(FoldedFormFit {
             development_error: development.development_error,
             face_nonplanarity: development.face_nonplanarity,

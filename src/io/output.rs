@@ -88,6 +88,7 @@ fn export_mesh(pattern: &Pattern) -> ExportMesh {
         faces_vertices,
         center,
         ray0_direction,
+        ..
     }) = &pattern.mesh
     {
         let mut edge_crease = vec![None; edges_vertices.len()];
@@ -236,6 +237,7 @@ pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldRep
         "frame_title": format!("{}: crease pattern and folded state (unfolding verdict {})", pattern.name, report.verdict.as_str()),
         "frame_classes": ["creasePattern"],
         "frame_attributes": ["2D"],
+        "frame_unit": pattern.mesh.as_ref().and_then(|m| m.unit.clone()).unwrap_or_else(|| "unit".into()),
         "vertices_coords": mesh.coords_2d,
         "edges_vertices": mesh.edges_vertices,
         "edges_assignment": mesh.edges_assignment,

@@ -46,6 +46,8 @@ pub struct CreasePatternBuilder {
     pub folded_form: Option<FoldedFormFit>,
     /// Creases held at their fold angle (one per edge, or empty for none).
     pub locked: Vec<bool>,
+    /// The file's `frame_unit` (None: unstated), written back on the outputs.
+    pub unit: Option<String>,
 }
 
 /// What developing a 3D folded form into its crease pattern measured
@@ -110,6 +112,8 @@ pub struct CreasePattern {
     pub folded_form: Option<FoldedFormFit>,
     /// Whether each edge is a crease held at its fold angle.
     pub locked: Vec<bool>,
+    /// The file's `frame_unit` (None: unstated), written back on the outputs.
+    pub unit: Option<String>,
 }
 
 impl CreasePatternBuilder {
@@ -125,6 +129,7 @@ impl CreasePatternBuilder {
             angle_field,
             folded_form,
             locked,
+            unit,
         } = self;
         let (nv, ne) = (vertices.len(), edges.len());
         if edges.len() > MAX_EDGES {
@@ -254,6 +259,7 @@ impl CreasePatternBuilder {
             outline,
             folded_form,
             locked,
+            unit,
         })
     }
 }
@@ -663,6 +669,7 @@ mod tests {
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
             locked: Vec::new(),
+            unit: None,
         };
         let cp = b.build().unwrap();
         assert_eq!(
@@ -739,6 +746,7 @@ mod tests {
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
             locked: Vec::new(),
+            unit: None,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("cross"), "{e}");
@@ -756,6 +764,7 @@ mod tests {
             angle_field: "edges_foldAngle".into(),
             folded_form: None,
             locked: Vec::new(),
+            unit: None,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("inside another edge"), "{e}");
