@@ -116,7 +116,7 @@ pub enum ExportKind {
     /// loop closed by `connect` equalities; units µm, pg, µs. Drag is in custom numerics for
     /// a passive callback (tests/mujoco/nanofold_mujoco.py).
     Mujoco {
-        /// A scene file (.scene.json), strip or closed chain, step actuation.
+        /// A scene file (.scene.json), strip or closed chain, step or ramp actuation.
         scene: PathBuf,
         /// The MJCF file to write (default: output/<scene name>/<scene name>.xml).
         #[arg(long)]

@@ -140,24 +140,36 @@ struct JointSpec {
     axis: Vector3<f64>,
     point: Point3<f64>,
     stiffness: f64,
-    /// Step torque of its stressed layer, N·m (None: passive).
-    step_torque: Option<f64>,
+    /// Its stressed layer's drive (None: passive).
+    drive: Option<StressDrive>,
 }
 
-fn step_torques(forcing: &Forcing, stiffness: &[f64], what: &str) -> Result<Vec<Option<f64>>> {
-    if let Actuation::Ramp { .. } = forcing.actuation {
-        return Err(NanofoldError::invalid(
-            "actuation",
-            "ramp",
-            format!("{what}: the MuJoCo export writes step actuation only (a ramp's torque changes with time; drive the actuator's ctrl with K θ_drive(t) yourself)"),
-        ));
-    }
-    Ok(forcing
+/// What a hinge's stressed layer does, as MuJoCo will apply it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum StressDrive {
+    /// τ = K θ_target from t = 0: an actuator's constant bias.
+    Step { torque: f64 },
+    /// τ = K θ_drive(t), θ_drive growing at `rate` (rad/s) up to `target`: an integrator
+    /// actuator whose activation is θ_drive (ctrl = the rate, activation clamped at the target).
+    Ramp { stiffness: f64, rate: f64, target: f64 },
+}
+
+fn stress_drives(forcing: &Forcing, stiffness: &[f64]) -> Vec<Option<StressDrive>> {
+    forcing
         .hinges
         .iter()
         .zip(stiffness)
-        .map(|(h, k)| h.actuated.then_some(k * h.target))
-        .collect())
+        .map(|(h, &k)| {
+            h.actuated.then_some(match forcing.actuation {
+                Actuation::Step => StressDrive::Step { torque: k * h.target },
+                Actuation::Ramp { etch_rate } => StressDrive::Ramp {
+                    stiffness: k,
+                    rate: (etch_rate / h.radius_of_curvature).copysign(h.target),
+                    target: h.target,
+                },
+            })
+        })
+        .collect()
 }
 
 /// The structural thickness of a lamina from its inertia: I_xx + I_yy − I_zz = m t²/6.
@@ -190,7 +202,7 @@ fn plate_body(model: &Model, j: usize, name: String, joint: JointSpec, collide: 
 fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
     let model = &chain.model;
     let stiffness: Vec<f64> = model.joints().iter().map(|j| j.stiffness).collect();
-    let torques = step_torques(&chain.forcing, &stiffness, "the strip")?;
+    let torques = stress_drives(&chain.forcing, &stiffness);
     Ok((0..model.dof())
         .map(|j| {
             let joint = &model.joints()[j];
@@ -203,7 +215,7 @@ fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
                     axis: joint.axis.into_inner(),
                     point: joint.point,
                     stiffness: joint.stiffness,
-                    step_torque: torques[j],
+                    drive: torques[j],
                 },
                 true,
             )
@@ -219,7 +231,7 @@ type ClosedBodies = (Vec<BodySpec>, Vec<String>, Vec<Point3<f64>>);
 
 fn closed_bodies(chain: &ClosedChain, closure: LoopClosure) -> Result<ClosedBodies> {
     let model = &chain.model;
-    let torques = step_torques(&chain.forcing, &chain.crease_stiffness, "the closed chain")?;
+    let torques = stress_drives(&chain.forcing, &chain.crease_stiffness);
     let label = |c: usize| format!("crease_{}", chain.crease_user_indices[c]);
     let mut bodies: Vec<BodySpec> = (0..model.dof())
         .map(|j| {
@@ -234,7 +246,7 @@ fn closed_bodies(chain: &ClosedChain, closure: LoopClosure) -> Result<ClosedBodi
                     axis: joint.axis.into_inner(),
                     point: joint.point,
                     stiffness: chain.crease_stiffness[c],
-                    step_torque: torques[c],
+                    drive: torques[c],
                 },
                 false,
             )
@@ -274,7 +286,7 @@ fn closed_bodies(chain: &ClosedChain, closure: LoopClosure) -> Result<ClosedBodi
             axis,
             point: Point3::origin(),
             stiffness: chain.crease_stiffness[cut],
-            step_torque: torques[cut],
+            drive: torques[cut],
         }),
         mass: share * lightest,
         inertia: [share * smallest, share * smallest, share * smallest, 0.0, 0.0, 0.0],
@@ -587,16 +599,41 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         writeln!(w, "  </equality>").unwrap();
     }
     writeln!(w, "  <actuator>").unwrap();
+    // The keyframe's ctrl: a ramp actuator's rate, 0 for a step's (its ctrl adds torque).
+    let mut controls = Vec::new();
     for body in &bodies {
-        if let Some(joint) = body.joint.as_ref().filter(|j| j.step_torque.is_some()) {
-            writeln!(
-                w,
-                "    <general name=\"stress_{}\" joint=\"{}\" gainprm=\"1\" biastype=\"affine\" biasprm=\"{} 0 0\"/>",
-                joint.name,
-                joint.name,
-                fmt(joint.step_torque.unwrap_or(0.0) * torque_scale)
-            )
-            .unwrap();
+        let Some(joint) = body.joint.as_ref() else { continue };
+        match joint.drive {
+            Some(StressDrive::Step { torque }) => {
+                writeln!(
+                    w,
+                    "    <general name=\"stress_{}\" joint=\"{}\" gainprm=\"1\" biastype=\"affine\" biasprm=\"{} 0 0\"/>",
+                    joint.name,
+                    joint.name,
+                    fmt(torque * torque_scale)
+                )
+                .unwrap();
+                controls.push(0.0);
+            }
+            Some(StressDrive::Ramp {
+                stiffness,
+                rate,
+                target,
+            }) => {
+                let (lo, hi) = if target >= 0.0 { (0.0, target) } else { (target, 0.0) };
+                writeln!(
+                    w,
+                    "    <general name=\"stress_{}\" joint=\"{}\" dyntype=\"integrator\" gainprm=\"{}\" actlimited=\"true\" actrange=\"{} {}\"/>",
+                    joint.name,
+                    joint.name,
+                    fmt(stiffness * torque_scale),
+                    fmt(lo),
+                    fmt(hi)
+                )
+                .unwrap();
+                controls.push(rate * TIME_UNIT);
+            }
+            None => {}
         }
     }
     writeln!(w, "  </actuator>").unwrap();
@@ -633,10 +670,26 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
     }
     writeln!(w, "  <keyframe>").unwrap();
+    if controls.iter().any(|&c| c != 0.0) {
+        writeln!(
+            w,
+            "  <!-- Ramp actuation: each stressed hinge's activation is its drive angle θ_drive(t), growing at the rate in ctrl (rad/µs, set by this keyframe) until it reaches its target; the actuator's force is K θ_drive. -->"
+        )
+        .unwrap();
+    }
     writeln!(
         w,
-        "    <key name=\"start\" qpos=\"{}\"/>",
-        start.iter().map(|&q| fmt(q)).collect::<Vec<_>>().join(" ")
+        "    <key name=\"start\" qpos=\"{}\"{}/>",
+        start.iter().map(|&q| fmt(q)).collect::<Vec<_>>().join(" "),
+        if controls.iter().any(|&c| c != 0.0) {
+            format!(
+                " ctrl=\"{}\" act=\"{}\"",
+                controls.iter().map(|&c| fmt(c)).collect::<Vec<_>>().join(" "),
+                vec!["0"; controls.len()].join(" ")
+            )
+        } else {
+            String::new()
+        }
     )
     .unwrap();
     writeln!(w, "  </keyframe>").unwrap();
