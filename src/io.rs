@@ -76,7 +76,8 @@ pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions
         ));
     }
     let builder = if is_fold_object(&value) {
-        fold::read_fold(&value, name)?
+        let unflattened = fold::unflatten_folded_form(&value)?;
+        fold::read_fold(unflattened.as_ref().unwrap_or(&value), name)?
     } else {
         native::read_native(&value, name)?
     };
@@ -107,7 +108,8 @@ pub fn parse_crease_pattern(text: &str, name: &str, origin: &str) -> Result<Crea
             "a crease pattern of many vertices is read from a FOLD file (vertices_coords, edges_vertices, edges_assignment)",
         ));
     }
-    fold::read_crease_pattern(&value, name)?.build()
+    let unflattened = fold::unflatten_folded_form(&value)?;
+    fold::read_crease_pattern(unflattened.as_ref().unwrap_or(&value), name)?.build()
 }
 
 /// Does this JSON object look like a scene file (keys only scenes have)?

@@ -954,3 +954,69 @@ fn the_bird_base_folds_with_the_flat_foldable_vertex_closed_form() {
         );
     }
 }
+
+/// Flat-folded forms written by FOLD's own `fold-convert --flat-fold`
+/// (tests/fixtures/fold-convert): read as their crease pattern (`vertices_flatUnfoldCoords`)
+/// with every mountain and valley at ∓180°, each is a rigid state (its vertices flat-foldable).
+/// The bird base, the Miura-ori and the package's diagonal unfold flat from it; the square
+/// twist, not rigidly foldable (Evans et al. 2015), has no rigid motion out of it. A 2D folded
+/// form without its crease pattern is refused by name.
+#[test]
+fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
+    use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
+    use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings, NetworkVerdict};
+    let dir = Path::new("tests/fixtures/fold-convert");
+    for (name, unfolds) in [
+        ("bird_base", true),
+        ("miura_4x4", true),
+        ("square_twist", false),
+        ("diagonal-cp", true),
+    ] {
+        let path = dir.join(format!("{name}-flat.fold"));
+        let value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let model = FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap();
+        // The crease pattern is the unfolded coordinates, not the folded ones.
+        let unfolded = value["vertices_flatUnfoldCoords"].as_array().unwrap();
+        for (v, p) in model.pattern.vertices.iter().enumerate() {
+            assert!(
+                (p[0] - unfolded[v][0].as_f64().unwrap()).abs() < 1e-12,
+                "{name}: vertex {v}"
+            );
+            assert!(
+                (p[1] - unfolded[v][1].as_f64().unwrap()).abs() < 1e-12,
+                "{name}: vertex {v}"
+            );
+        }
+        let rho = model.given_fold_angles();
+        assert!(
+            rho.iter().all(|r| (r.abs() - std::f64::consts::PI).abs() < 1e-12),
+            "{name}"
+        );
+        let report = check_pattern(&model, &CheckSettings::default()).unwrap();
+        assert_eq!(report.verdict, PatternVerdict::Rigid, "{name}: {}", report.evidence);
+        let unfolding = unfold_network(&model, &rho, &NetworkUnfoldSettings::default()).unwrap();
+        if unfolds {
+            assert_eq!(
+                unfolding.verdict,
+                NetworkVerdict::Flat,
+                "{name}: {}",
+                unfolding.evidence
+            );
+            assert_eq!(unfolding.crossings_refused, 0, "{name}");
+        } else {
+            assert_eq!(
+                unfolding.verdict,
+                NetworkVerdict::LocalMinimum,
+                "{name}: {}",
+                unfolding.evidence
+            );
+            assert_eq!(unfolding.iterations, 0, "{name}");
+        }
+    }
+    // Without its crease pattern a 2D folded form cannot be read.
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bird_base-flat.fold")).unwrap()).unwrap();
+    value.as_object_mut().unwrap().remove("vertices_flatUnfoldCoords");
+    let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
+    assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
+}

@@ -112,6 +112,64 @@ fn frame_unit(value: &Value) -> Result<Option<String>> {
     }
 }
 
+/// A flat-folded form as FOLD's own `fold-convert --flat-fold` writes it — `frame_classes`
+/// with `foldedForm`, 2D `vertices_coords` holding the folded positions and
+/// `vertices_flatUnfoldCoords` the crease pattern — turned back into its crease pattern with
+/// every mountain and valley folded by ∓180° (unless the file gives `edges_foldAngle`). A 2D
+/// folded form without the crease pattern is refused by name; anything else is unchanged.
+pub(crate) fn unflatten_folded_form(value: &Value) -> Result<Option<Value>> {
+    let folded = value
+        .get("frame_classes")
+        .and_then(Value::as_array)
+        .is_some_and(|classes| classes.iter().any(|c| c.as_str() == Some("foldedForm")));
+    let planar = value
+        .get("vertices_coords")
+        .and_then(Value::as_array)
+        .is_some_and(|coords| coords.iter().all(|p| p.as_array().is_some_and(|p| p.len() == 2)));
+    if !(folded && planar) {
+        return Ok(None);
+    }
+    let Some(unfolded) = value.get("vertices_flatUnfoldCoords") else {
+        return Err(NanofoldError::invalid(
+            "frame_classes",
+            "foldedForm with 2D vertices_coords",
+            "a flat-folded form needs its crease pattern (vertices_flatUnfoldCoords, as fold-convert --flat-fold writes it); or give the crease pattern itself (creasePattern)",
+        ));
+    };
+    let count = value["vertices_coords"].as_array().map_or(0, Vec::len);
+    if unfolded.as_array().map(Vec::len) != Some(count) {
+        return Err(NanofoldError::invalid(
+            "vertices_flatUnfoldCoords",
+            input_len(unfolded),
+            format!("one 2D point per vertex ({count})"),
+        ));
+    }
+    let mut pattern = value.clone();
+    pattern["vertices_coords"] = unfolded.clone();
+    pattern["frame_classes"] = serde_json::json!(["creasePattern"]);
+    if value.get("edges_foldAngle").is_none() {
+        let letters = value.get("edges_assignment").and_then(Value::as_array);
+        if let Some(letters) = letters {
+            let angles: Vec<Value> = letters
+                .iter()
+                .map(|l| match l.as_str() {
+                    Some("V") | Some("v") => serde_json::json!(180.0),
+                    Some("M") | Some("m") => serde_json::json!(-180.0),
+                    _ => serde_json::json!(0.0),
+                })
+                .collect();
+            pattern["edges_foldAngle"] = Value::Array(angles);
+        }
+    }
+    Ok(Some(pattern))
+}
+
+fn input_len(value: &Value) -> String {
+    value
+        .as_array()
+        .map_or_else(|| "not an array".to_string(), |a| format!("{} entries", a.len()))
+}
+
 /// Parses a FOLD key frame's vertices, edges, assignments, fold angles, locks and faces.
 pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGraph<'_>> {
     // vertices_coords: 2D, or 3D with z = 0 (a crease pattern, not a folded form).

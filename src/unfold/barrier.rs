@@ -69,6 +69,8 @@ pub struct PanelBarrier {
     stiffness: f64,
     /// For each panel, the tree steps (indices into `model.tree`) from the root to it.
     paths: Vec<Vec<usize>>,
+    /// Panel pairs left out: layers already touching at the start (a flat-folded state).
+    excluded: std::collections::HashSet<(usize, usize)>,
     /// Each panel's distinct triangle edges (vertex pairs).
     edges: Vec<Vec<[usize; 2]>>,
 }
@@ -119,7 +121,25 @@ impl PanelBarrier {
             stiffness: settings.stiffness,
             paths,
             edges,
+            excluded: Default::default(),
         })
+    }
+
+    /// Leaves out the panel pairs that touch (within 1e-9 of the pattern's size) at `poses`:
+    /// the layers of a flat-folded start lie on each other, and would make the barrier
+    /// infinite before the first step. Crossings of those pairs are still refused.
+    pub fn exclude_touching(&mut self, model: &FoldingModel, poses: &[Pose]) -> usize {
+        let settings = crate::folding::ContactSettings {
+            search: 0.0,
+            ..crate::folding::ContactSettings::default()
+        };
+        let report = crate::folding::panel_contacts(model, poses, &settings);
+        for contact in &report.contacts {
+            if contact.distance <= 1e-9 * model.size {
+                self.excluded.insert((contact.panels[0], contact.panels[1]));
+            }
+        }
+        self.excluded.len()
     }
 
     /// The activation distance d̂, in the pattern's length unit.
@@ -149,7 +169,7 @@ impl PanelBarrier {
             .collect();
         let mut total = 0.0;
         for (a, b) in candidate_pairs(&boxes) {
-            if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
+            if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) || self.excluded.contains(&(a, b)) {
                 continue;
             }
             let mut close = Vec::new();

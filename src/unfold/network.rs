@@ -261,6 +261,16 @@ fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// What the restarts did, for a local minimum's evidence.
+fn restart_note(taken: usize, failed: bool) -> String {
+    let kicks = format!("kicks of {RESTART_KICK} rad along random directions of the null space");
+    if failed {
+        format!("{taken} restarts taken, then none found: no kicked state closes within ±π without crossing panels ({kicks})")
+    } else {
+        format!("{taken} restarts tried ({kicks})")
+    }
+}
+
 /// The largest fold-angle change of a restart's kick, rad.
 const RESTART_KICK: f64 = 0.05;
 
@@ -279,8 +289,21 @@ fn restart(
     solver: &mut NormalSolver,
 ) -> Result<Option<Accepted>> {
     let model = objective.model;
-    for _ in 0..4 {
-        let mut direction: Vec<f64> = rho.iter().map(|_| 2.0 * random.next_f64() - 1.0).collect();
+    for draw in 0..4 {
+        // The first two draws head towards flat (every crease's |ρ| shrinking by a random
+        // share: a start folded to ±π sits at a stationary point on its bound); the others
+        // are any direction.
+        let mut direction: Vec<f64> = rho
+            .iter()
+            .map(|&r| {
+                let u = random.next_f64();
+                if draw < 2 && r != 0.0 {
+                    -r.signum() * u
+                } else {
+                    2.0 * u - 1.0
+                }
+            })
+            .collect();
         model.hold_locked(&mut direction);
         let direction = factor.project(&direction);
         let size = direction.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
@@ -486,10 +509,16 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             restarts_used: 0,
         });
     }
+    let mut barrier = settings.barrier.map(|b| PanelBarrier::new(model, &b)).transpose()?;
+    if let Some(barrier) = barrier.as_mut() {
+        let mut poses = Vec::new();
+        panel_poses(model, start, &mut poses);
+        barrier.exclude_touching(model, &poses);
+    }
     let objective = Objective {
         model,
         energy: NetworkEnergy::new(model, settings.energy, settings.p),
-        barrier: settings.barrier.map(|b| PanelBarrier::new(model, &b)).transpose()?,
+        barrier,
     };
     let mut solver = NormalSolver::new(1e-10);
     let mut ws = EnergyWorkspace::default();
@@ -520,6 +549,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     let mut scale = 1.0;
     // Restarts taken, read by `finish` (a Cell, as the loop counts while `finish` is held).
     let restarts = std::cell::Cell::new(0usize);
+    let mut restart_failed = false;
     let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused, radial_steps| {
         let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
         Ok(NetworkReport {
@@ -601,10 +631,14 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     });
                     continue;
                 }
+                restart_failed = true;
             }
             return finish(
                 NetworkVerdict::LocalMinimum,
-                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad; {} restarts tried (kicks of {RESTART_KICK} rad along random directions of the null space)", restarts.get()),
+                format!(
+                    "the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad; {}",
+                    restart_note(restarts.get(), restart_failed)
+                ),
                 iteration,
                 steps,
                 crossings_refused,
@@ -792,12 +826,13 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     });
                     continue;
                 }
+                restart_failed = true;
             }
             return finish(
                 NetworkVerdict::LocalMinimum,
                 format!(
-                    "the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e}); {} restarts tried (kicks of {RESTART_KICK} rad along random directions of the null space)",
-                    restarts.get()
+                    "the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e}); {}",
+                    restart_note(restarts.get(), restart_failed)
                 ),
                 iteration,
                 steps,
