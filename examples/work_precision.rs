@@ -6,7 +6,7 @@
 //!
 //! `cargo run --release --example work_precision` prints the tables and writes
 //! `output/work_precision/{report.json, unfold_*.svg, fits.svg, bridge_step.svg,
-//! bridge_ramp.svg, scaling.svg}` (about two minutes on two cores).
+//! bridge_ramp.svg, scaling.svg}` (35 s on the 2-core VM of README, one run).
 
 mod common;
 
