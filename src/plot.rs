@@ -49,6 +49,100 @@ pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .map_err(plot_error)
 }
 
+/// A legend drawn beside a chart (in the right margin of [`LEGEND_MARGIN`] pixels of
+/// `area`), so it covers no data: each entry's line sample, dashed as its series, and label.
+pub(crate) fn draw_side_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    top: i32,
+    entries: &[(String, RGBColor, LineKind)],
+) -> Result<()> {
+    let x = area.dim_in_pixel().0 as i32 - LEGEND_MARGIN as i32 + 16;
+    for (k, (label, colour, kind)) in entries.iter().enumerate() {
+        let y = top + 16 * k as i32;
+        let style = colour.stroke_width(2);
+        let pieces: Vec<(i32, i32)> = match kind {
+            LineKind::Solid => vec![(0, 22)],
+            LineKind::Dashed => vec![(0, 9), (14, 22)],
+            LineKind::Dotted => vec![(0, 3), (7, 10), (14, 17), (21, 24)],
+        };
+        for (a, b) in pieces {
+            area.draw(&PathElement::new(vec![(x + a, y), (x + b, y)], style))
+                .map_err(plot_error)?;
+        }
+        area.draw(&Text::new(label.clone(), (x + 30, y - 6), ("sans-serif", 12)))
+            .map_err(plot_error)?;
+    }
+    Ok(())
+}
+
+/// Room to the right of a plotting area for its legend, pixels.
+pub(crate) const LEGEND_MARGIN: u32 = 190;
+
+/// Series `i`'s line: eight colours, solid for the first eight series, dashed for the next
+/// eight, dotted after, so sixteen creases stay apart.
+pub(crate) fn series_line(i: usize) -> (RGBColor, LineKind) {
+    const COLOURS: [RGBColor; 8] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(23, 190, 207),
+        RGBColor(188, 189, 34),
+    ];
+    let kind = match i / COLOURS.len() {
+        0 => LineKind::Solid,
+        1 => LineKind::Dashed,
+        _ => LineKind::Dotted,
+    };
+    (COLOURS[i % COLOURS.len()], kind)
+}
+
+/// How a series' line is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LineKind {
+    Solid,
+    Dashed,
+    Dotted,
+}
+
+/// Draws `points` as series `i` in its colour and dash (see [`series_line`]); returns its
+/// legend entry.
+pub(crate) fn draw_series_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    points: Vec<(f64, f64)>,
+    i: usize,
+    label: String,
+) -> Result<(String, RGBColor, LineKind)> {
+    let (colour, kind) = series_line(i);
+    let style = colour.stroke_width(2);
+    match kind {
+        LineKind::Solid => chart.draw_series(LineSeries::new(points, style)),
+        LineKind::Dashed => chart.draw_series(DashedLineSeries::new(points, 9, 5, style)),
+        LineKind::Dotted => chart.draw_series(DashedLineSeries::new(points, 3, 4, style)),
+    }
+    .map_err(plot_error)?;
+    Ok((label, colour, kind))
+}
+
+/// For each series, an earlier one it coincides with (largest difference ≤ `tol`), so the
+/// legend can say that one line hides another.
+pub(crate) fn coinciding(series: &[Vec<f64>], tol: f64) -> Vec<Option<usize>> {
+    (0..series.len())
+        .map(|i| {
+            (0..i).find(|&j| {
+                series[i].len() == series[j].len()
+                    && series[i].iter().zip(&series[j]).all(|(a, b)| (a - b).abs() <= tol)
+            })
+        })
+        .collect()
+}
+
 /// Colour of series `i`.
 pub fn series_colour(i: usize) -> RGBColor {
     const PALETTE: [RGBColor; 10] = [
@@ -86,6 +180,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
                 ("sans-serif", 20),
             )
             .margin(12)
+            .margin_right(LEGEND_MARGIN)
             .x_label_area_size(36)
             .y_label_area_size(52)
             .build_cartesian_2d(0.0..last as f64, -180.0..180.0)
@@ -96,18 +191,23 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
             .y_desc("fold angle (deg)")
             .draw()
             .map_err(plot_error)?;
+        let series: Vec<Vec<f64>> = (0..pattern.creases.len())
+            .map(|i| traj.iter().map(|r| r.fold_angles[i]).collect())
+            .collect();
+        let same = coinciding(&series, 1e-9);
+        let mut entries = Vec::new();
         for (i, crease) in pattern.creases.iter().enumerate() {
-            let colour = series_colour(i);
-            chart
-                .draw_series(LineSeries::new(
-                    traj.iter().map(|r| (r.iteration as f64, r.fold_angles[i].to_degrees())),
-                    colour.stroke_width(2),
-                ))
-                .map_err(plot_error)?
-                .label(format!("{} ({})", crease.label, crease.assignment.letter()))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+            let mut label = format!("{} ({})", crease.label, crease.assignment.letter());
+            if let Some(j) = same[i] {
+                label.push_str(&format!(" = {}", pattern.creases[j].label));
+            }
+            let points = traj
+                .iter()
+                .map(|r| (r.iteration as f64, r.fold_angles[i].to_degrees()))
+                .collect();
+            entries.push(draw_series_line(&mut chart, points, i, label)?);
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        draw_side_legend(&top, 44, &entries)?;
 
         // 3D views at four moments.
         let picks = snapshot_indices(report, 11);

@@ -2,7 +2,10 @@
 //! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of a strip, figure 5-7; the
 //! plates in 3D for a closed chain, figures 5-10 to 5-12).
 
-use super::{axis_range, draw_legend, plot_error, series_colour};
+use super::{
+    axis_range, coinciding, draw_legend, draw_series_line, draw_side_legend, plot_error, series_colour, LineKind,
+    LEGEND_MARGIN,
+};
 use crate::dynamics::algorithms::{update_corners, update_poses};
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::model::Data;
@@ -148,6 +151,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 ("sans-serif", 18),
             )
             .margin(12)
+            .margin_right(LEGEND_MARGIN)
             .x_label_area_size(36)
             .y_label_area_size(56)
             .build_cartesian_2d(axis_range(0.0, t_max, 0.0), y_range.clone())
@@ -158,19 +162,24 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .y_desc("fold angle (deg)")
             .draw()
             .map_err(plot_error)?;
+        // Hinges that move alike draw one line over another: the legend says which.
+        let series: Vec<Vec<f64>> = (0..view.labels.len())
+            .map(|i| response.samples.iter().map(|s| s.angles[i]).collect())
+            .collect();
+        let same = coinciding(&series, 1e-9);
+        let mut entries = Vec::new();
         for (i, label) in view.labels.iter().enumerate() {
-            let colour = series_colour(i);
-            chart
-                .draw_series(LineSeries::new(
-                    response
-                        .samples
-                        .iter()
-                        .map(|s| (s.time / scale, s.angles[i].to_degrees())),
-                    colour.stroke_width(2),
-                ))
-                .map_err(plot_error)?
-                .label(label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+            let label = match same[i] {
+                Some(j) => format!("{label} (= {})", view.labels[j]),
+                None => label.clone(),
+            };
+            let points = response
+                .samples
+                .iter()
+                .map(|s| (s.time / scale, s.angles[i].to_degrees()))
+                .collect();
+            let (label, colour, kind) = draw_series_line(&mut chart, points, i, label)?;
+            entries.push((label, colour, kind));
             let Some(target) = view.targets[i].map(f64::to_degrees) else {
                 continue;
             };
@@ -184,17 +193,20 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             chart.draw_series(dashes).map_err(plot_error)?;
         }
         if let Some(c) = &response.collision {
+            // Black, dotted: no hinge's colour.
             let x = c.time / scale;
             chart
-                .draw_series(std::iter::once(PathElement::new(
+                .draw_series(DashedLineSeries::new(
                     vec![(x, y_range.start), (x, y_range.end)],
-                    RED.stroke_width(2),
-                )))
-                .map_err(plot_error)?
-                .label("first contact")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED.stroke_width(2)));
+                    4,
+                    4,
+                    BLACK.stroke_width(2),
+                ))
+                .map_err(plot_error)?;
+            entries.push(("first contact".into(), BLACK, LineKind::Dotted));
         }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
+        entries.push(("target (thin dashes)".into(), RGBColor(150, 150, 150), LineKind::Dashed));
+        draw_side_legend(&top, 44, &entries)?;
 
         // Energies in the unit that suits them.
         let largest = response
@@ -234,6 +246,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 ("sans-serif", 16),
             )
             .margin(12)
+            .margin_right(LEGEND_MARGIN)
             .x_label_area_size(36)
             .y_label_area_size(56)
             .build_cartesian_2d(axis_range(0.0, t_max, 0.0), axis_range(e_lo, e_hi, 0.06))
@@ -244,6 +257,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .y_desc(format!("energy ({e_unit})"))
             .draw()
             .map_err(plot_error)?;
+        let mut entries = Vec::new();
         for (k, (label, f)) in series.iter().enumerate() {
             let colour = if k == 3 { BLACK } else { series_colour(k + 5) };
             energy
@@ -251,11 +265,10 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                     response.samples.iter().map(|s| (s.time / scale, f(s) / e_scale)),
                     colour.stroke_width(2),
                 ))
-                .map_err(plot_error)?
-                .label(*label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2)));
+                .map_err(plot_error)?;
+            entries.push((label.to_string(), colour, LineKind::Solid));
         }
-        draw_legend(&mut energy, SeriesLabelPosition::UpperRight)?;
+        draw_side_legend(&bottom, 40, &entries)?;
         root.present().map_err(plot_error)?;
     }
     Ok(svg)

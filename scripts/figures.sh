@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Regenerates every figure under docs/ from the commands and examples that draw it (about a
+# minute and a half on 2 cores; the work-precision example is the long part). Outputs go to
+# output/figures/ first, then are copied over docs/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release --quiet --examples
+bin=target/release/nanofold
+out=output/figures
+rm -rf "$out"
+mkdir -p "$out"
+$bin unfold patterns/corner_cube.fold --out "$out/corner_cube" > /dev/null
+cp "$out/corner_cube/unfold.svg" docs/unfold_corner_cube.svg
+$bin constraints patterns/corner_cube.fold --drive 0 --lock 1=0 --range 0:180 --out "$out/constraints" > /dev/null
+cp "$out/constraints/constraints.svg" docs/constraints_corner_cube.svg
+$bin fold patterns/many/miura_4x4.fold --to 90 --out "$out/miura_4x4" > /dev/null
+cp "$out/miura_4x4/fold.svg" docs/fold_miura_4x4.svg
+for scene in bridge_step bridge_ramp corner_cube_step1 corner_cube_step1_ramp corner_cube_step2; do
+  $bin simulate "patterns/$scene.scene.json" --out "$out/$scene" > /dev/null
+  cp "$out/$scene/response.svg" "docs/${scene}_response.svg"
+  if [ -f "docs/${scene}_snapshots.svg" ]; then
+    cp "$out/$scene/snapshots.svg" "docs/${scene}_snapshots.svg"
+  fi
+done
+target/release/examples/closed_chain_timing > /dev/null
+cp output/closed_chain_timing/poly_vs_exact.svg docs/corner_cube_poly_vs_exact.svg
+target/release/examples/work_precision > /dev/null
+for figure in output/work_precision/*.svg; do
+  cp "$figure" "docs/work_precision_$(basename "$figure")"
+done
+echo "regenerated every figure in docs/"
