@@ -61,9 +61,9 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
     let (e_lo, e_hi) = (e_lo / 10.0, e_hi * 10.0);
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1100, 600)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        let root = root.titled(title, ("sans-serif", 18)).map_err(plot_error)?;
+        let base = SVGBackend::with_string(&mut svg, (1100, 600)).into_drawing_area();
+        base.fill(&WHITE).map_err(plot_error)?;
+        let root = base.titled(title, ("sans-serif", 18)).map_err(plot_error)?;
         // The legend gets its own column: with a dozen series it would hide points.
         let (plot_area, legend_area) = root.split_horizontally(760);
         let mut chart = ChartBuilder::on(&plot_area)
@@ -80,6 +80,7 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
             .x_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(plot_error)?;
+        let mut pending_labels = Vec::new();
         for (i, line) in series.iter().enumerate() {
             let colour = series_colour(i);
             let points: Vec<(f64, f64)> = line
@@ -97,14 +98,26 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
             }
             .map_err(plot_error)?;
-            chart
-                .draw_series(
-                    line.points
-                        .iter()
-                        .filter(|p| shown(p))
-                        .map(|p| Text::new(p.label.clone(), (p.seconds / unit, p.error), ("sans-serif", 12))),
-                )
-                .map_err(plot_error)?;
+            // Points that land on each other (within 0.05 decade in time and 0.1 in error)
+            // share one label, "1e-2, 1e-4, 1e-6", instead of printing over each other.
+            let mut groups: Vec<(f64, f64, Vec<String>)> = Vec::new();
+            for p in line.points.iter().filter(|p| shown(p)) {
+                let (x, y) = (p.seconds / unit, p.error);
+                let near = groups
+                    .iter_mut()
+                    .find(|(gx, gy, _)| (gx.log10() - x.log10()).abs() < 0.05 && (gy.log10() - y.log10()).abs() < 0.1);
+                match near {
+                    Some((_, _, labels)) => {
+                        if !labels.contains(&p.label) {
+                            labels.push(p.label.clone());
+                        }
+                    }
+                    None => groups.push((x, y, vec![p.label.clone()])),
+                }
+            }
+            for (x, y, labels) in groups {
+                pending_labels.push((chart.backend_coord(&(x, y)), labels.join(", "), colour));
+            }
             let y = 30 + 20 * i as i32;
             legend_area
                 .draw(&PathElement::new(vec![(4, y), (26, y)], colour.stroke_width(2)))
@@ -119,7 +132,31 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 .draw(&Text::new(line.name.clone(), (32, y - 7), ("sans-serif", 13)))
                 .map_err(plot_error)?;
         }
-        root.present().map_err(plot_error)?;
+        // Labels of every series placed last, each moved down past any label already placed
+        // (boxes estimated at 6.5 px a character, 13 px high), so none prints over another.
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        for ((px, py), text, colour) in pending_labels {
+            let width = (6.5 * text.chars().count() as f64) as i32;
+            let (x0, mut y0) = (px + 5, py + 2);
+            for _ in 0..12 {
+                let clash = placed
+                    .iter()
+                    .any(|&(a, b, c, d)| x0 < c && a < x0 + width && y0 < d && b < y0 + 13);
+                if !clash {
+                    break;
+                }
+                y0 += 13;
+            }
+            placed.push((x0, y0, x0 + width, y0 + 13));
+            // backend_coord is in the whole figure's pixels: draw on the untitled area.
+            base.draw(&Text::new(
+                text,
+                (x0, y0),
+                ("sans-serif", 12).into_font().color(&colour.mix(0.9)),
+            ))
+            .map_err(plot_error)?;
+        }
+        base.present().map_err(plot_error)?;
     }
     Ok(svg)
 }
