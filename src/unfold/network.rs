@@ -573,6 +573,44 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             0,
         );
     }
+    // A stop away from flat with no panels in the way: a restart if one is left and found
+    // (the descent goes on from it), else `local_minimum` saying what the restarts did.
+    macro_rules! restart_or_stop {
+        ($factor:expr, $iteration:expr, $why:expr) => {
+            if restarts.get() < settings.restarts {
+                if let Some(state) = restart(
+                    &objective,
+                    settings,
+                    &$factor,
+                    &mut kick,
+                    &rho,
+                    &mut ws,
+                    &mut poses,
+                    &mut solver,
+                )? {
+                    restarts.set(restarts.get() + 1);
+                    (rho, u, gradient) = state;
+                    history.clear();
+                    pending = None;
+                    steps.push(NetworkStep {
+                        energy: u,
+                        fold_angles: rho.clone(),
+                        max_residual: worst(&rho),
+                    });
+                    continue;
+                }
+                restart_failed = true;
+            }
+            return finish(
+                NetworkVerdict::LocalMinimum,
+                format!("{}; {}", $why, restart_note(restarts.get(), restart_failed)),
+                $iteration,
+                steps,
+                crossings_refused,
+                radial_steps,
+            );
+        };
+    }
     for iteration in 0..settings.max_iterations {
         let largest = rho.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
         if largest <= STALL_TOL && largest > settings.flat_tol {
@@ -609,40 +647,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let steepest: Vec<f64> = factor.project(&downhill);
         let steepest_size = steepest.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         if steepest_size <= 1e-14 {
-            if restarts.get() < settings.restarts {
-                if let Some(state) = restart(
-                    &objective,
-                    settings,
-                    &factor,
-                    &mut kick,
-                    &rho,
-                    &mut ws,
-                    &mut poses,
-                    &mut solver,
-                )? {
-                    restarts.set(restarts.get() + 1);
-                    (rho, u, gradient) = state;
-                    history.clear();
-                    pending = None;
-                    steps.push(NetworkStep {
-                        energy: u,
-                        fold_angles: rho.clone(),
-                        max_residual: worst(&rho),
-                    });
-                    continue;
-                }
-                restart_failed = true;
-            }
-            return finish(
-                NetworkVerdict::LocalMinimum,
-                format!(
-                    "the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad; {}",
-                    restart_note(restarts.get(), restart_failed)
-                ),
+            restart_or_stop!(
+                factor,
                 iteration,
-                steps,
-                crossings_refused,
-                radial_steps,
+                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad")
             );
         }
         // The L-BFGS direction on the manifold: curvature pairs of steps and changes of the
@@ -804,40 +812,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     radial_steps,
                 );
             }
-            if restarts.get() < settings.restarts {
-                if let Some(state) = restart(
-                    &objective,
-                    settings,
-                    &factor,
-                    &mut kick,
-                    &rho,
-                    &mut ws,
-                    &mut poses,
-                    &mut solver,
-                )? {
-                    restarts.set(restarts.get() + 1);
-                    (rho, u, gradient) = state;
-                    history.clear();
-                    pending = None;
-                    steps.push(NetworkStep {
-                        energy: u,
-                        fold_angles: rho.clone(),
-                        max_residual: worst(&rho),
-                    });
-                    continue;
-                }
-                restart_failed = true;
-            }
-            return finish(
-                NetworkVerdict::LocalMinimum,
-                format!(
-                    "the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e}); {}",
-                    restart_note(restarts.get(), restart_failed)
-                ),
+            restart_or_stop!(
+                factor,
                 iteration,
-                steps,
-                crossings_refused,
-                radial_steps,
+                format!("the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e})")
             );
         };
         // The line search's memory: twice the largest step if this one needed no halving,
