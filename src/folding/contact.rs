@@ -329,38 +329,43 @@ fn segment_distance(p1: &Point, q1: &Point, p2: &Point, q2: &Point) -> f64 {
     ((p1 + d1 * s) - (p2 + d2 * t)).norm()
 }
 
-/// Distance from a point to a triangle (closest point by Voronoi regions).
+/// Distance from a point to a triangle.
 fn point_triangle_distance(p: &Point, triangle: &[Point; 3]) -> f64 {
+    (p - closest_point_on_triangle(p, triangle)).norm()
+}
+
+/// The point of a triangle nearest to p (Voronoi regions of its vertices, edges and face).
+pub(crate) fn closest_point_on_triangle(p: &Point, triangle: &[Point; 3]) -> Point {
     let [a, b, c] = triangle;
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.norm();
+        return *a;
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return bp.norm();
+        return *b;
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+        return a + ab * (d1 / (d1 - d3));
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
     if d6 >= 0.0 && d5 <= d6 {
-        return cp.norm();
+        return *c;
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+        return a + ac * (d2 / (d2 - d6));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
     }
     let denominator = 1.0 / (va + vb + vc);
-    (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm()
+    a + ab * (vb * denominator) + ac * (vc * denominator)
 }
 
 #[cfg(test)]

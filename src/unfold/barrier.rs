@@ -4,7 +4,7 @@
 //! the activation distance d̂, with its gradient in fold angles through the panels' poses.
 
 use crate::error::{NanofoldError, Result};
-use crate::folding::contact::{candidate_pairs, median_panel_size, share_vertex};
+use crate::folding::contact::{candidate_pairs, closest_point_on_triangle, median_panel_size, share_vertex};
 use crate::folding::{FoldingModel, Pose};
 use nalgebra::Vector3;
 
@@ -178,7 +178,7 @@ impl PanelBarrier {
                     let p = place(first, v);
                     for t in &model.panel_triangles[second] {
                         let triangle = t.map(|w| place(second, w));
-                        let q = closest_on_triangle(&p, &triangle);
+                        let q = closest_point_on_triangle(&p, &triangle);
                         let distance = (p - q).norm();
                         if distance < self.activation {
                             let (on_first, on_second) = if first == a { (p, q) } else { (q, p) };
@@ -247,40 +247,6 @@ impl PanelBarrier {
             gradient[step.column] += force.dot(&velocity);
         }
     }
-}
-
-/// The point of a triangle nearest to p (Voronoi regions of its vertices, edges and face).
-fn closest_on_triangle(p: &Point, triangle: &[Point; 3]) -> Point {
-    let [a, b, c] = triangle;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return *a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return *b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return *c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denominator = 1.0 / (va + vb + vc);
-    a + ab * (vb * denominator) + ac * (vc * denominator)
 }
 
 /// The nearest points of segments p1q1 and p2q2 (parameters clamped to the segments).

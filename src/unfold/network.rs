@@ -725,23 +725,30 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let t_before_search = t;
         let mut refused_for_crossing = None;
         let mut halvings = 0;
+        // A step along the ray to flat, counted when taken.
+        macro_rules! try_radial {
+            () => {{
+                let state = radial_step(
+                    model,
+                    &objective,
+                    settings,
+                    &mut solver,
+                    &mut ws,
+                    &mut poses,
+                    &rho,
+                    u,
+                    &mut crossings_refused,
+                    &mut refused_for_crossing,
+                )?;
+                radial_steps += usize::from(state.is_some());
+                state
+            }};
+        }
         // Near flat the ray to flat is tried first: the cheapest step that keeps the branch.
         let radial_first = largest <= NEAR_FLAT;
         let mut accepted = None;
         if radial_first {
-            accepted = radial_step(
-                model,
-                &objective,
-                settings,
-                &mut solver,
-                &mut ws,
-                &mut poses,
-                &rho,
-                u,
-                &mut crossings_refused,
-                &mut refused_for_crossing,
-            )?;
-            radial_steps += usize::from(accepted.is_some());
+            accepted = try_radial!();
         }
         // Steps shorter than this are lost in the closure tolerance.
         while accepted.is_none() && t * size > 1e-13 {
@@ -774,19 +781,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // its rounding: count it as the line search stalling.
         let mut accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
         if accepted.is_none() && !radial_first {
-            accepted = radial_step(
-                model,
-                &objective,
-                settings,
-                &mut solver,
-                &mut ws,
-                &mut poses,
-                &rho,
-                u,
-                &mut crossings_refused,
-                &mut refused_for_crossing,
-            )?;
-            radial_steps += usize::from(accepted.is_some());
+            accepted = try_radial!();
         }
         let Some((next, u_next, g_next)) = accepted else {
             if largest <= STALL_TOL && refused_for_crossing.is_none() {
