@@ -552,3 +552,50 @@ fn random_trapezoidal_miura_quad_meshes_fold_by_the_closed_form_and_unfold_flat(
         assert_eq!(report.crossings_refused, 0, "{name}");
     }
 }
+
+/// New inputs refused by name: the barrier's settings, a trapezoidal Miura-ori's column
+/// angles, and a flat-folded form whose crease pattern has the wrong number of vertices.
+#[test]
+fn new_inputs_are_refused_by_name() {
+    use nanofold::unfold::barrier::{BarrierSettings, PanelBarrier};
+    let model = miura(3, 100.0);
+    for (settings, field) in [
+        (
+            BarrierSettings {
+                activation: 0.0,
+                stiffness: 1.0,
+            },
+            "barrier.activation",
+        ),
+        (
+            BarrierSettings {
+                activation: f64::NAN,
+                stiffness: 1.0,
+            },
+            "barrier.activation",
+        ),
+        (
+            BarrierSettings {
+                activation: 0.01,
+                stiffness: -1.0,
+            },
+            "barrier.stiffness",
+        ),
+    ] {
+        let error = PanelBarrier::new(&model, &settings).err().expect("refused");
+        assert!(error.to_string().contains(field), "{error}");
+    }
+    let spec = MiuraSpec::default();
+    let error = spec.build_with_column_angles(&[1.0; 3]).unwrap_err();
+    assert!(error.to_string().contains("column_angles"), "{error}");
+    let mut angles = vec![60f64.to_radians(); spec.cols + 1];
+    angles[2] = 95f64.to_radians();
+    let error = spec.build_with_column_angles(&angles).unwrap_err();
+    assert!(error.to_string().contains("column_angles[2]"), "{error}");
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("tests/fixtures/fold-convert/bird_base-flat.fold").unwrap())
+            .unwrap();
+    value["vertices_flatUnfoldCoords"].as_array_mut().unwrap().pop();
+    let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
+    assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
+}
