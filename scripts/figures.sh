@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates every figure under docs/ from the commands and examples that draw it (about a
+# Regenerates every figure under docs/ (and docs/thesis.md's tables) from the commands and examples that draw it (about a
 # minute and a half on 2 cores; the work-precision example is the long part). Outputs go to
 # output/figures/ first, then are copied over docs/.
 set -euo pipefail
@@ -28,4 +28,5 @@ target/release/examples/work_precision > /dev/null
 for figure in output/work_precision/*.svg; do
   cp "$figure" "docs/work_precision_$(basename "$figure")"
 done
-echo "regenerated every figure in docs/"
+target/release/examples/thesis --write > /dev/null
+echo "regenerated every figure in docs/ and the tables of docs/thesis.md"

@@ -6,8 +6,8 @@ mod folding;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{
-    default_domain, fit_to_tolerance, held_pattern, mujoco_snippet, sweep_samples, trajectory_samples, ConstraintPoly,
-    ConstraintReport, Setup,
+    check_curve, default_domain, fit_to_tolerance, held_pattern, mujoco_snippet, sweep_samples, trajectory_samples,
+    ConstraintPoly, ConstraintReport, Setup,
 };
 use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
@@ -206,6 +206,11 @@ pub struct ConstraintsArgs {
     /// --lock. An explicit --lock still sets its own angle.
     #[arg(long, value_name = "I,J,...", value_delimiter = ',')]
     pub free: Vec<usize>,
+    /// Measure a given polynomial of crease J against exact loop closure (repeatable), e.g. a
+    /// published table's: coefficients in degrees of the driving angle in degrees, constant
+    /// first, e.g. --check 3=0.5,0.7,-3e-5 (single vertices).
+    #[arg(long = "check", value_name = "J=C0,C1,...", allow_hyphen_values = true)]
+    pub checks: Vec<String>,
     /// Polynomial degree 1..=20, or `auto` with --tol.
     #[arg(long, default_value = "4", allow_hyphen_values = true)]
     pub degree: String,
@@ -682,6 +687,26 @@ fn takes_many_vertices(error: &nanofold::NanofoldError, path: &Path) -> bool {
     not_a_vertex || (!matches!(error, ClosureViolated { .. }) && nanofold::io::load_crease_pattern(path).is_ok())
 }
 
+/// Parses "J=C0,C1,..." into (crease index, coefficients in degrees).
+fn parse_check(pattern: &Pattern, text: &str) -> Result<(usize, Vec<f64>)> {
+    let (index, coeffs) = text
+        .split_once('=')
+        .with_context(|| format!("invalid --check {text:?}: expected J=C0,C1,..., e.g. --check 3=0.5,0.7,-3e-5"))?;
+    let index: usize = index
+        .trim()
+        .parse()
+        .with_context(|| format!("invalid --check {text:?}: crease index {index:?} is not a number"))?;
+    let coeffs = coeffs
+        .split(',')
+        .map(|c| {
+            c.trim()
+                .parse::<f64>()
+                .with_context(|| format!("invalid --check {text:?}: coefficient {c:?} is not a number"))
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    Ok((crease_index(pattern, index, "--check")?, coeffs))
+}
+
 /// Parses "J=DEG" into (crease index, rad).
 fn parse_lock(pattern: &Pattern, text: &str) -> Result<(usize, f64)> {
     let (index, degrees) = text
@@ -770,8 +795,26 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
             }
         }
     }
+    let checks = args
+        .checks
+        .iter()
+        .map(|text| parse_check(&pattern, text))
+        .collect::<Result<Vec<_>>>()?;
     let range = args.range.as_deref().map(parse_range).transpose()?;
     let setup = Setup::new(&pattern, driver, &locks).map_err(constraints_flags)?;
+    for ((crease, _), text) in checks.iter().zip(&args.checks) {
+        if !setup.dependents.contains(crease) {
+            anyhow::bail!(
+                "invalid --check {text:?}: {} is {}; a checked curve belongs to a crease that follows the driver",
+                pattern.creases[*crease].label,
+                if *crease == driver {
+                    "the driver"
+                } else {
+                    "held by --lock/--free"
+                }
+            );
+        }
+    }
     // A long sweep (up to 100 000 Newton solves) shows that it is working.
     let spinner = if args.json {
         indicatif::ProgressBar::hidden()
@@ -780,7 +823,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     };
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     spinner.set_message(format!("sweeping {} samples", args.samples));
-    let result = constraints_after_setup(args, &pattern, &setup, range, degree, &spinner);
+    let result = constraints_after_setup(args, &pattern, &setup, range, degree, &checks, &spinner);
     spinner.finish_and_clear();
     let (report, dir, files) = result?;
     print_constraints(args, &pattern, &report, &dir, &files)
@@ -796,6 +839,7 @@ fn constraints_after_setup(
     setup: &Setup,
     range: Option<[f64; 2]>,
     degree: Option<usize>,
+    checks: &[(usize, Vec<f64>)],
     spinner: &indicatif::ProgressBar,
 ) -> Result<(ConstraintReport, PathBuf, OutputFiles)> {
     let (pattern, setup, driver) = (pattern.clone(), setup.clone(), setup.driver);
@@ -823,7 +867,7 @@ fn constraints_after_setup(
         }
     };
     spinner.set_message("fitting");
-    let (poly, report) = match degree {
+    let (poly, mut report) = match degree {
         Some(d) => {
             let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
             let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
@@ -854,6 +898,12 @@ fn constraints_after_setup(
         }
         None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default()).map_err(constraints_flags)?,
     };
+    for (crease, coeffs) in checks {
+        report.checked_curves.push(
+            check_curve(&pattern, &samples, *crease, coeffs)
+                .map_err(|e| anyhow::anyhow!("invalid --check for crease {}: {e}", pattern.user_index(*crease)))?,
+        );
+    }
     // Render everything before writing anything.
     let dir = args
         .out
@@ -915,6 +965,17 @@ fn print_constraints(
         "  all curves together: loop-closure residual {:.3e} rad",
         report.max_closure_residual
     );
+    for checked in &report.checked_curves {
+        println!(
+            "  checked {:<12} largest error {:.3e} rad ({:.4}°) at {:.4}°; at the folded end {:.4}°: {:+.4}°",
+            checked.label,
+            checked.max_error_rad,
+            checked.max_error_rad.to_degrees(),
+            checked.max_error_at_deg,
+            checked.folded_end_deg,
+            checked.folded_end_error_rad.to_degrees()
+        );
+    }
     print_written(dir, files);
     Ok(())
 }

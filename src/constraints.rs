@@ -619,6 +619,100 @@ pub struct ConstraintReport {
     pub max_closure_residual: f64,
     /// One curve per dependent crease.
     pub curves: Vec<CurveReport>,
+    /// Curves given by the user (a published table), checked against the exact samples.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub checked_curves: Vec<CheckedCurve>,
+}
+
+/// A given polynomial for one dependent crease (`coeffs_deg`: θ and result in degrees,
+/// ascending powers, as the thesis's Table 2), measured against the exact samples.
+#[derive(Debug, Clone, Serialize)]
+pub struct CheckedCurve {
+    /// The crease's user index.
+    pub crease: usize,
+    /// Its label.
+    pub label: String,
+    /// The coefficients as given.
+    pub coeffs_deg: Vec<f64>,
+    /// Largest |polynomial − exact| over the samples, rad.
+    pub max_error_rad: f64,
+    /// The driving angle where it occurs, degrees.
+    pub max_error_at_deg: f64,
+    /// The domain's end farthest from flat (the folded state), degrees.
+    pub folded_end_deg: f64,
+    /// polynomial − exact there, rad.
+    pub folded_end_error_rad: f64,
+}
+
+/// Most coefficients a checked curve may have (degree 20, as fits).
+pub const MAX_CHECKED_COEFFICIENTS: usize = MAX_DEGREE + 1;
+
+/// Measures the polynomial `coeffs_deg` (degrees → degrees, ascending powers) of crease `c`
+/// (internal index) against the exact samples: a published curve's error, in the same
+/// terms as a fit's.
+pub fn check_curve(pattern: &Pattern, samples: &CurveSamples, c: usize, coeffs_deg: &[f64]) -> Result<CheckedCurve> {
+    let setup = &samples.setup;
+    let label = pattern
+        .creases
+        .get(c)
+        .map(|crease| crease.label.clone())
+        .ok_or_else(|| {
+            NanofoldError::invalid(
+                "crease",
+                c,
+                format!("the pattern has {} creases", pattern.creases.len()),
+            )
+        })?;
+    if !setup.dependents.contains(&c) {
+        let role = if c == setup.driver {
+            "the driver"
+        } else {
+            "held (locked)"
+        };
+        return Err(NanofoldError::invalid(
+            "crease",
+            &label,
+            format!("is {role}: a checked curve belongs to a crease that follows the driver"),
+        ));
+    }
+    if coeffs_deg.is_empty() || coeffs_deg.len() > MAX_CHECKED_COEFFICIENTS {
+        return Err(NanofoldError::invalid(
+            "coeffs_deg",
+            format!("{} coefficients", coeffs_deg.len()),
+            format!("give 1 to {MAX_CHECKED_COEFFICIENTS} (degree 0 to {MAX_DEGREE})"),
+        ));
+    }
+    if let Some(k) = coeffs_deg.iter().position(|x| !x.is_finite()) {
+        return Err(NanofoldError::invalid(
+            format!("coeffs_deg[{k}]"),
+            coeffs_deg[k],
+            "must be a finite number",
+        ));
+    }
+    let (mut max_error, mut at) = (0.0_f64, samples.domain[0]);
+    let (mut end, mut end_error) = (0.0_f64, 0.0);
+    for (&drive, angles) in samples.drive_angles.iter().zip(&samples.fold_angles) {
+        let value_deg = coeffs_deg
+            .iter()
+            .rev()
+            .fold(0.0, |acc, &k| acc * drive.to_degrees() + k);
+        let error = value_deg.to_radians() - angles[c];
+        if error.abs() > max_error {
+            (max_error, at) = (error.abs(), drive);
+        }
+        if drive.abs() >= end.abs() {
+            (end, end_error) = (drive, error);
+        }
+    }
+    Ok(CheckedCurve {
+        crease: pattern.user_index(c),
+        label,
+        coeffs_deg: coeffs_deg.to_vec(),
+        max_error_rad: max_error,
+        max_error_at_deg: at.to_degrees(),
+        folded_end_deg: end.to_degrees(),
+        folded_end_error_rad: end_error,
+    })
 }
 
 impl ConstraintReport {
@@ -695,6 +789,7 @@ impl ConstraintReport {
             samples_max_closure_residual: samples.max_closure_residual,
             max_closure_residual: all_poly_residual,
             curves,
+            checked_curves: Vec::new(),
         })
     }
 

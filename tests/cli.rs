@@ -998,6 +998,58 @@ fn free_creases_replace_a_lock_for_every_other_crease() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--check` measures a given polynomial against exact closure. The Miura vertex's collinear
+/// creases fold equal and opposite (a flat-foldable degree-4 vertex, closed form), so
+/// ρ₂ = −ρ₀ exactly: −θ has no error, +0.5° has 0.5° everywhere, and a 1e-3·θ² term has
+/// 1e-3·θ_end² at the folded end.
+#[test]
+fn a_checked_curve_is_measured_against_exact_closure() {
+    let dir = temp_dir("check");
+    let run = |checks: &[&str]| {
+        let mut command = nanofold();
+        command.args([
+            "constraints",
+            "patterns/miura_vertex.fold",
+            "--drive",
+            "0",
+            "--json",
+            "--out",
+        ]);
+        command.arg(dir.join("out"));
+        for check in checks {
+            command.args(["--check", check]);
+        }
+        command.output().unwrap()
+    };
+    let out = run(&["2=0,-1", "2=0.5,-1", "2=0,-1,1e-3"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let checked = report["checked_curves"].as_array().unwrap();
+    assert_eq!(checked.len(), 3);
+    let end = report["domain_deg"][0].as_f64().unwrap();
+    assert!((checked[0]["max_error_rad"].as_f64().unwrap()) < 1e-9, "{}", checked[0]);
+    let offset = checked[1]["max_error_rad"].as_f64().unwrap();
+    assert!((offset - 0.5_f64.to_radians()).abs() < 1e-9, "{offset}");
+    let quadratic = checked[2]["folded_end_error_rad"].as_f64().unwrap();
+    assert!((checked[2]["folded_end_deg"].as_f64().unwrap() - end).abs() < 1e-9);
+    assert!(
+        (quadratic - (1e-3 * end * end).to_radians()).abs() < 1e-9,
+        "{quadratic} at {end}°"
+    );
+    // The driver, a held crease and a bad coefficient are refused by name.
+    for (check, says) in [
+        ("0=1", "edges[0] is the driver"),
+        ("1=1,x", "coefficient \"x\" is not a number"),
+        ("1=nan", "coeffs_deg[0]"),
+        ("9=1", "--check 9"),
+    ] {
+        let out = run(&[check]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(says), "{check}: {stderr}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A failed integration says when it failed in seconds of the run, not in diffsol's scaled
 /// time alone.
 #[test]

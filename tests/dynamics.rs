@@ -406,6 +406,34 @@ fn bad_scenes_get_errors_that_name_the_field() {
             "time.t_end_s",
         ),
         ("{".to_string(), "malformed JSON"),
+        (
+            bridge_text().replacen(
+                r#""material": "SiN" }"#,
+                r#""material": "SiN", "moment_about_crease_kg_m2": 5.4e6 }"#,
+                1,
+            ),
+            "invalid `plates[0].moment_about_crease_kg_m2`: 5400000 (must lie within a factor 10⁶",
+        ),
+        (
+            bridge_text().replacen(
+                r#""material": "SiN" }"#,
+                r#""material": "SiN", "moment_about_crease_kg_m2": -1e-20 }"#,
+                1,
+            ),
+            "plates[0].moment_about_crease_kg_m2",
+        ),
+        (
+            bridge_text().replacen(r#""actuated": true,"#, r#""actuated": true, "stiffness_scale": 0,"#, 1),
+            "hinges[0].stiffness_scale",
+        ),
+        (
+            bridge_text().replacen(
+                r#""actuated": true,"#,
+                r#""actuated": true, "stiffness_scale": 1e9,"#,
+                1,
+            ),
+            "hinges[0].stiffness_scale",
+        ),
     ];
     for (text, expected) in cases {
         let message = scene_error(&text);
@@ -513,4 +541,36 @@ fn ramp_drive_rates_are_the_derivative_of_the_drive_angles() {
     // a / ρ_c = (1.5 µm/min) / 20 µm.
     ramp.drive_rates(0.0, &mut rates);
     assert!((rates[0] - 1.5e-6 / 60.0 / 20e-6).abs() < 1e-15);
+}
+
+/// The two stated-reading fields of a strip: a `stiffness_scale` s scales every frequency by
+/// √s (K → sK, M unchanged, the same folded target), and a `moment_about_crease_kg_m2`
+/// equal to the box's m (L² + t²)/12 changes nothing.
+#[test]
+fn stated_stiffness_and_moment_act_as_their_closed_forms() {
+    let frequencies = |text: &str| {
+        let scene = scene_text(text).unwrap();
+        let chain = scene.strip().unwrap();
+        modes(&chain.model, chain.target_angles().as_slice())
+            .unwrap()
+            .frequencies_hz
+    };
+    let base = frequencies(&bridge_text());
+    let scaled =
+        frequencies(&bridge_text().replace(r#""actuated": true,"#, r#""actuated": true, "stiffness_scale": 4,"#));
+    for (f, g) in base.iter().zip(&scaled) {
+        assert!((g / f - 2.0).abs() < 1e-9, "{g} against 2 × {f}");
+    }
+    // Plate 0: 100 × 100 × 0.2 µm of SiN at 3.27 g/cm³.
+    let (l, t) = (100e-6_f64, 0.2e-6_f64);
+    let mass = 3270.0 * l * 100e-6 * t;
+    let moment = mass * (l * l + t * t) / 12.0;
+    let stated = bridge_text().replacen(
+        r#""material": "SiN" }"#,
+        &format!(r#""material": "SiN", "moment_about_crease_kg_m2": {moment:e} }}"#),
+        1,
+    );
+    for (f, g) in base.iter().zip(&frequencies(&stated)) {
+        assert!((g / f - 1.0).abs() < 1e-12, "{g} against {f}");
+    }
 }

@@ -536,6 +536,9 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
 pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usize>) -> Result<()> {
     use nanofold::constraints::network::{fit_network, fit_network_to_tolerance, network_mujoco, network_sweep};
+    if !args.checks.is_empty() {
+        bail!("--check is for single vertices; for a crease pattern of many vertices compare with the sweep in constraints.json");
+    }
     if args.source != super::SourceArg::Sweep {
         bail!("--source unfold is for single vertices; a crease pattern of many vertices is swept exactly");
     }

@@ -315,6 +315,7 @@ mod tests {
                 .map(|&[x, y]| Point3::new(x, y, 0.0))
                 .collect(),
             area: 1.0,
+            thickness: 0.01,
         }
     }
 

@@ -30,6 +30,8 @@ pub struct Plate {
     pub outline: Vec<Point3<f64>>,
     /// Area facing the air (drag), m².
     pub area: f64,
+    /// Structural thickness, m (drawn plates, exported meshes).
+    pub thickness: f64,
 }
 
 impl Plate {
@@ -79,6 +81,7 @@ impl Plate {
             reference_pose: Isometry3::translation(cx, cy, 0.0),
             outline: outline.iter().map(|&[x, y]| Point3::new(x - cx, y - cy, 0.0)).collect(),
             area,
+            thickness,
         }
     }
 

@@ -144,11 +144,14 @@ impl StripSpec {
             // The flat plate spans x ∈ [−w/2, w/2], y ∈ [y, y + L]: a box whose moment about the
             // crease-parallel x axis involves its length, not its width (`docs/model.md#plates`).
             let half = 0.5 * width;
-            let plate = Plate::lamina(
+            let mut plate = Plate::lamina(
                 &[[-half, y], [half, y], [half, y + length], [-half, y + length]],
                 thickness,
                 density,
             );
+            if let Some(moment) = spec.moment_about_crease_kg_m2 {
+                plate.inertia[(0, 0)] = moment_about_crease(i, moment, plate.inertia[(0, 0)])?;
+            }
             let mass = plate.mass;
             let usable = |x: f64| x.is_finite() && x > 0.0;
             if !(usable(mass) && (0..3).all(|k| usable(plate.inertia[(k, k)]))) {
@@ -230,6 +233,24 @@ impl StripSpec {
             t_end,
             outputs: self.outputs.clone(),
         })
+    }
+}
+
+/// A plate's stated moment about its crease axis, if it lies within a factor 10⁶ of the
+/// box's `box_moment` either way (a wider gap is a unit slip, not a reading).
+fn moment_about_crease(i: usize, moment: f64, box_moment: f64) -> Result<f64> {
+    let field = format!("plates[{i}].moment_about_crease_kg_m2");
+    let ratio = moment / box_moment;
+    if moment.is_finite() && (1e-6..=1e6).contains(&ratio) {
+        Ok(moment)
+    } else {
+        Err(NanofoldError::invalid(
+            field,
+            moment,
+            format!(
+                "must lie within a factor 10⁶ of the plate's box moment {box_moment:.4e} kg·m² (a wider gap is a unit slip: kg·m², not pg·µm²)"
+            ),
+        ))
     }
 }
 

@@ -38,6 +38,11 @@ pub struct PlateSpec {
     pub thickness_um: f64,
     /// A key of `materials`.
     pub material: String,
+    /// The plate's moment of inertia about its crease-parallel axis through its centre of
+    /// mass, kg·m², in place of the box's m (L² + t²)/12: a stated reading of another model
+    /// (`docs/thesis.md`) or a measured value. The only moment a strip's planar motion uses.
+    #[serde(default)]
+    pub moment_about_crease_kg_m2: Option<f64>,
 }
 
 /// One layer of a hinge: structural (first) or stressed (actuating).
@@ -67,6 +72,10 @@ pub struct HingeSpec {
     /// ρ_c of the released hinge; needed by a ramp.
     #[serde(default)]
     pub radius_of_curvature_um: Option<f64>,
+    /// Multiplies the T5.7 stiffness (default 1): a calibration against measurement, or a
+    /// stated reading of another model (`docs/thesis.md`).
+    #[serde(default)]
+    pub stiffness_scale: Option<f64>,
 }
 
 /// How the hinges are released.
@@ -210,6 +219,7 @@ impl HingeSpec {
             actuated: false,
             target_angle_deg: None,
             radius_of_curvature_um: None,
+            stiffness_scale: None,
         }
     }
 
@@ -227,6 +237,7 @@ impl HingeSpec {
             actuated: true,
             target_angle_deg: Some(target_angle_deg),
             radius_of_curvature_um,
+            stiffness_scale: None,
         }
     }
 }
@@ -288,6 +299,7 @@ impl StripSpec {
             width_um,
             thickness_um,
             material: material.to_string(),
+            moment_about_crease_kg_m2: None,
         });
         self
     }
@@ -346,6 +358,9 @@ pub struct CreaseHingeSpec {
     /// ρ_c of the driver, µm (needed by a ramp).
     #[serde(default)]
     pub radius_of_curvature_um: Option<f64>,
+    /// Multiplies the T5.7 stiffness (default 1).
+    #[serde(default)]
+    pub stiffness_scale: Option<f64>,
 }
 
 impl CreaseHingeSpec {
@@ -357,6 +372,7 @@ impl CreaseHingeSpec {
             actuated: self.actuated,
             target_angle_deg: self.target_angle_deg,
             radius_of_curvature_um: self.radius_of_curvature_um,
+            stiffness_scale: self.stiffness_scale,
         }
     }
 }
@@ -501,6 +517,8 @@ pub mod limits {
     pub const SNAPSHOTS: (usize, usize) = (1, 64);
     /// Plates of a strip (∂M has n³ entries: 8 MB at 100).
     pub const MAX_PLATES: usize = 100;
+    /// A hinge's `stiffness_scale`.
+    pub const STIFFNESS_SCALE: (f64, f64) = (1e-6, 1e6);
     /// Exact sweep samples of a closed chain's constraint.
     pub const CONSTRAINT_SAMPLES: (usize, usize) = (3, 100_000);
 }
@@ -630,8 +648,9 @@ pub(crate) fn time_and_outputs(time: &TimeSpec, outputs: &OutputSpec) -> Result<
     Ok(t_end)
 }
 
-/// K = Σ_layers w t³ E / (3 l (1 − ν²)) (`docs/model.md#hinge-stiffness`), with w the width
-/// of the plate the hinge carries (a crease's length for a sector plate).
+/// K = s Σ_layers w t³ E / (3 l (1 − ν²)) (`docs/model.md#hinge-stiffness`), with w the width
+/// of the plate the hinge carries (a crease's length for a sector plate) and s the hinge's
+/// `stiffness_scale` (1 unless given).
 pub(crate) fn hinge_stiffness(
     materials: &BTreeMap<String, MaterialSpec>,
     i: usize,
@@ -663,5 +682,14 @@ pub(crate) fn hinge_stiffness(
         let modulus = m.youngs_modulus_gpa * 1e9;
         stiffness += width * t.powi(3) * modulus / (3.0 * length * (1.0 - m.poisson_ratio * m.poisson_ratio));
     }
-    Ok(stiffness)
+    let scale = match hinge.stiffness_scale {
+        Some(scale) => within(
+            &format!("hinges[{i}].stiffness_scale"),
+            scale,
+            limits::STIFFNESS_SCALE,
+            "",
+        )?,
+        None => 1.0,
+    };
+    Ok(scale * stiffness)
 }

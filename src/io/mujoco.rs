@@ -172,12 +172,6 @@ fn stress_drives(forcing: &Forcing, stiffness: &[f64]) -> Vec<Option<StressDrive
         .collect()
 }
 
-/// The structural thickness of a lamina from its inertia: I_xx + I_yy − I_zz = m t²/6.
-fn lamina_thickness(plate: &Plate) -> f64 {
-    let i = &plate.inertia;
-    (6.0 * (i[(0, 0)] + i[(1, 1)] - i[(2, 2)]) / plate.mass).max(0.0).sqrt()
-}
-
 fn inertia6(plate: &Plate) -> [f64; 6] {
     let i = &plate.inertia;
     [i[(0, 0)], i[(1, 1)], i[(2, 2)], i[(0, 1)], i[(0, 2)], i[(1, 2)]]
@@ -193,20 +187,22 @@ fn plate_body(model: &Model, j: usize, name: String, joint: JointSpec, collide: 
         mass: plate.mass,
         inertia: inertia6(plate),
         outline: Some(plate.outline.clone()),
-        thickness: lamina_thickness(plate),
+        thickness: plate.thickness,
         drag_area: plate.area,
         collide,
     }
 }
 
-fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
+/// A strip's bodies, and a note for each plate whose off-axis moments had to move.
+fn strip_bodies(chain: &StripChain) -> Result<(Vec<BodySpec>, Vec<String>)> {
     let model = &chain.model;
     let stiffness: Vec<f64> = model.joints().iter().map(|j| j.stiffness).collect();
     let torques = stress_drives(&chain.forcing, &stiffness);
-    Ok((0..model.dof())
+    let mut notes = Vec::new();
+    let bodies = (0..model.dof())
         .map(|j| {
             let joint = &model.joints()[j];
-            plate_body(
+            let mut body = plate_body(
                 model,
                 j,
                 format!("plate_{j}"),
@@ -218,9 +214,36 @@ fn strip_bodies(chain: &StripChain) -> Result<Vec<BodySpec>> {
                     drive: torques[j],
                 },
                 true,
-            )
+            );
+            if let Some(note) = satisfy_triangle_inequality(&mut body.inertia) {
+                notes.push(format!("plate_{j}: {note}"));
+            }
+            body
         })
-        .collect())
+        .collect();
+    Ok((bodies, notes))
+}
+
+/// MuJoCo refuses moments that break the triangle inequality, as a stated
+/// `moment_about_crease_kg_m2` can. Every hinge of a strip turns about x, so only I_xx enters
+/// its motion: I_yy or I_zz is raised to the least value MuJoCo accepts, and the change named.
+fn satisfy_triangle_inequality(inertia: &mut [f64; 6]) -> Option<String> {
+    let [ixx, iyy, izz, ..] = *inertia;
+    if izz > ixx + iyy {
+        inertia[1] = izz - ixx;
+        Some(format!(
+            "I_yy raised from {iyy:.4e} to {:.4e} kg·m² so that I_zz ≤ I_xx + I_yy (it does not enter motion about x)",
+            inertia[1]
+        ))
+    } else if ixx > iyy + izz {
+        inertia[1] = ixx - izz;
+        Some(format!(
+            "I_yy raised from {iyy:.4e} to {:.4e} kg·m² so that I_xx ≤ I_yy + I_zz (it does not enter motion about x)",
+            inertia[1]
+        ))
+    } else {
+        None
+    }
 }
 
 /// A closed chain's bodies: the sector plates on their tree, and a light body that turns
@@ -351,15 +374,22 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
 /// The MJCF text of `scene`.
 pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let (bodies, connect_targets, connect_anchors, substrate_edge, drag, description) = match &scene.system {
-        System::Strip(chain) => (
-            strip_bodies(chain)?,
-            Vec::new(),
-            Vec::new(),
-            Some(chain.substrate_edge_y),
-            chain.model.drag(),
-            "a strip: plate i hangs from plate i − 1 by hinge i; the substrate is the box under z = 0 for y ≤ the edge"
-                .to_string(),
-        ),
+        System::Strip(chain) => {
+            let (bodies, notes) = strip_bodies(chain)?;
+            let mut description = "a strip: plate i hangs from plate i − 1 by hinge i; the substrate is the box under z = 0 for y ≤ the edge"
+                .to_string();
+            for note in notes {
+                description.push_str(&format!(";\n       {note}"));
+            }
+            (
+                bodies,
+                Vec::new(),
+                Vec::new(),
+                Some(chain.substrate_edge_y),
+                chain.model.drag(),
+                description,
+            )
+        }
         System::Closed(chain) => {
             let (bodies, targets, anchors) = closed_bodies(chain, settings.closure)?;
             (

@@ -180,7 +180,9 @@ def main():
                 "first_contact": first,
                 "mujoco_geom_contact": own_contact,
                 "max_equality_violation": equality_violation,
+                "final_time_us": data.time,
                 "final_qpos": [float(q) for q in data.qpos],
+                "final_qvel": [float(v) for v in data.qvel],
                 "joint_names": [model.joint(j).name for j in range(model.njnt)],
                 "seconds": time.perf_counter() - clock,
             }
