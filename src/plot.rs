@@ -1,6 +1,7 @@
 //! SVG figures drawn with plotters: the unfolding (fold angles against iteration and 3D
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
+mod canvas;
 pub mod folding;
 pub mod response;
 pub mod work_precision;
@@ -10,6 +11,7 @@ use crate::error::{NanofoldError, Result};
 use crate::io::output::{snapshot_indices, write_atomic};
 use crate::pattern::Pattern;
 use crate::unfold::UnfoldReport;
+use canvas::{canvas, px, pxi, shown_at};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -35,41 +37,42 @@ pub(crate) fn plot_error(e: impl std::fmt::Display) -> NanofoldError {
     }
 }
 
-/// The series legend every figure uses: a translucent white box at `position`.
-pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> Result<()> {
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(position)
-        .draw()
-        .map_err(plot_error)
-}
-
-/// A legend drawn beside a chart (in the right margin of [`LEGEND_MARGIN`] pixels of
-/// `area`), so it covers no data: each entry's line sample, dashed as its series, and label.
+/// A legend drawn beside a chart (in the right margin of [`LEGEND_MARGIN`] output pixels of
+/// `area`, `top` output pixels down), so it covers no data: each entry's line sample, dashed as its series, and label.
 pub(crate) fn draw_side_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     top: i32,
     entries: &[(String, RGBColor, LineKind)],
 ) -> Result<()> {
-    let x = area.dim_in_pixel().0 as i32 - LEGEND_MARGIN as i32 + 16;
+    draw_legend_in_margin(area, LEGEND_MARGIN, top, entries)
+}
+
+/// [`draw_side_legend`] in a right margin of `margin` output pixels.
+pub(crate) fn draw_legend_in_margin<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    margin: u32,
+    top: i32,
+    entries: &[(String, RGBColor, LineKind)],
+) -> Result<()> {
+    let x = area.dim_in_pixel().0 as i32 - pxi(margin as i32 - 16);
     for (k, (label, colour, kind)) in entries.iter().enumerate() {
-        let y = top + 16 * k as i32;
+        let y = pxi(top + 16 * k as i32);
         let style = colour.stroke_width(2);
         let pieces: Vec<(i32, i32)> = match kind {
             LineKind::Solid => vec![(0, 22)],
             LineKind::Dashed => vec![(0, 9), (14, 22)],
             LineKind::Dotted => vec![(0, 3), (7, 10), (14, 17), (21, 24)],
+            LineKind::Cross => {
+                area.draw(&Cross::new((x + pxi(11), y), px(5), style))
+                    .map_err(plot_error)?;
+                vec![]
+            }
         };
         for (a, b) in pieces {
-            area.draw(&PathElement::new(vec![(x + a, y), (x + b, y)], style))
+            area.draw(&PathElement::new(vec![(x + pxi(a), y), (x + pxi(b), y)], style))
                 .map_err(plot_error)?;
         }
-        area.draw(&Text::new(label.clone(), (x + 30, y - 6), ("sans-serif", 12)))
+        area.draw(&Text::new(label.clone(), (x + pxi(30), y - pxi(6)), ("sans-serif", 12)))
             .map_err(plot_error)?;
     }
     Ok(())
@@ -105,6 +108,8 @@ pub(crate) enum LineKind {
     Solid,
     Dashed,
     Dotted,
+    /// A marker (a contact), no line.
+    Cross,
 }
 
 /// Draws `points` as series `i` in its colour and dash (see [`series_line`]); returns its
@@ -123,8 +128,8 @@ pub(crate) fn draw_series_line<'a, DB: DrawingBackend + 'a>(
     let style = colour.stroke_width(2);
     match kind {
         LineKind::Solid => chart.draw_series(LineSeries::new(points, style)),
-        LineKind::Dashed => chart.draw_series(DashedLineSeries::new(points, 9, 5, style)),
-        LineKind::Dotted => chart.draw_series(DashedLineSeries::new(points, 3, 4, style)),
+        LineKind::Dashed => chart.draw_series(DashedLineSeries::new(points, px(9), px(5), style)),
+        LineKind::Dotted | LineKind::Cross => chart.draw_series(DashedLineSeries::new(points, px(3), px(4), style)),
     }
     .map_err(plot_error)?;
     Ok((label, colour, kind))
@@ -164,9 +169,9 @@ pub fn series_colour(i: usize) -> RGBColor {
 pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();
+        let root = canvas(&mut svg, (1000, 680));
         root.fill(&WHITE).map_err(plot_error)?;
-        let (top, bottom) = root.split_vertically(400);
+        let (top, bottom) = root.split_vertically(px(400));
         let traj = &report.trajectory;
         let last = traj.last().map_or(1, |r| r.iteration.max(1));
         let mut chart = ChartBuilder::on(&top)
@@ -179,14 +184,15 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
                 ),
                 ("sans-serif", 20),
             )
-            .margin(12)
-            .margin_right(LEGEND_MARGIN)
-            .x_label_area_size(36)
-            .y_label_area_size(52)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(52))
             .build_cartesian_2d(0.0..last as f64, -180.0..180.0)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc("iteration")
             .y_desc("fold angle (deg)")
             .draw()
@@ -221,7 +227,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
             let step = &traj[index];
             let mut view = ChartBuilder::on(panel)
                 .caption(format!("iteration {}", step.iteration), ("sans-serif", 16))
-                .margin(6)
+                .margin(px(6))
                 .build_cartesian_3d(-1.1..1.1, -1.1..1.1, -1.1..1.1)
                 .map_err(plot_error)?;
             view.with_projection(|mut p| {
@@ -255,7 +261,7 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
         }
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 /// Writes `unfold.svg`.
@@ -269,9 +275,9 @@ pub fn write_unfold_svg(path: &Path, pattern: &Pattern, report: &UnfoldReport) -
 pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 800)).into_drawing_area();
+        let root = canvas(&mut svg, (1000, 800));
         root.fill(&WHITE).map_err(plot_error)?;
-        let (top, bottom) = root.split_vertically(480);
+        let (top, bottom) = root.split_vertically(px(480));
         let x_deg: Vec<f64> = samples.drive_angles.iter().map(|x| x.to_degrees()).collect();
         let domain_deg = (poly.domain[0].to_degrees(), poly.domain[1].to_degrees());
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -293,18 +299,21 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
                 ),
                 ("sans-serif", 18),
             )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(52)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(52))
             .build_cartesian_2d(axis_range(domain_deg.0, domain_deg.1, 0.0), y_range)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("{} (deg)", driver.label))
             .y_desc("fold angle (deg)")
             .draw()
             .map_err(plot_error)?;
         let fine = 400;
+        let mut entries = Vec::new();
         for (c, crease) in pattern.creases.iter().enumerate() {
             let colour = series_colour(c);
             let role = if c == poly.driver {
@@ -322,9 +331,8 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
                         .map(|(&x, a)| (x, a[c].to_degrees())),
                     colour.mix(0.45).stroke_width(4),
                 ))
-                .map_err(plot_error)?
-                .label(format!("{} ({role})", crease.label))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.mix(0.45).stroke_width(4)));
+                .map_err(plot_error)?;
+            entries.push((format!("{} ({role})", crease.label), colour, LineKind::Solid));
             if let Some(j) = poly.dependents.iter().position(|&d| d == c) {
                 let curve = &poly.curves[j];
                 let points = (0..=fine).map(|i| {
@@ -332,11 +340,16 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
                     (x.to_degrees(), curve.eval(x).to_degrees())
                 });
                 chart
-                    .draw_series(DashedLineSeries::new(points, 8, 5, colour.stroke_width(2)))
+                    .draw_series(DashedLineSeries::new(points, px(8), px(5), colour.stroke_width(2)))
                     .map_err(plot_error)?;
             }
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        entries.push((
+            format!("degree-{} fit", poly.degree()),
+            RGBColor(90, 90, 90),
+            LineKind::Dashed,
+        ));
+        draw_side_legend(&top, 44, &entries)?;
 
         // Fit error per dependent, at the samples.
         let errors: Vec<Vec<f64>> = poly
@@ -356,13 +369,15 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
         let bottom_error = (errors.iter().flatten().copied().fold(f64::INFINITY, f64::min)).max(1e-17) / 3.0;
         let mut error_chart = ChartBuilder::on(&bottom)
             .caption("fit error |f(θ) − exact| (rad)", ("sans-serif", 16))
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(64)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(64))
             .build_cartesian_2d(domain_deg.0..domain_deg.1, (bottom_error..top_error).log_scale())
             .map_err(plot_error)?;
         error_chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("{} (deg)", driver.label))
             .y_desc("rad")
             .y_label_formatter(&|v| format!("{v:.0e}"))
@@ -378,7 +393,7 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
         }
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 #[cfg(test)]

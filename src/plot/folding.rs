@@ -1,6 +1,7 @@
 //! The folding path's figure: fold angles against progress, and 3D views of the panels at
 //! four moments.
 
+use super::canvas::{canvas, px, shown_at};
 use super::{axis_range, plot_error};
 use crate::error::Result;
 use crate::folding::{panel_poses, FoldPath, FoldingModel};
@@ -36,20 +37,21 @@ pub fn angles_svg(
     let pattern = &model.pattern;
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();
+        let root = canvas(&mut svg, (1000, 680));
         root.fill(&WHITE).map_err(plot_error)?;
-        let (top, bottom) = root.split_vertically(400);
+        let (top, bottom) = root.split_vertically(px(400));
         let first = xs.iter().copied().fold(f64::INFINITY, f64::min);
         let last = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let mut chart = ChartBuilder::on(&top)
             .caption(title, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(52)
+            .margin(px(12))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(52))
             .build_cartesian_2d(axis_range(first, last, 0.02), -180.0..180.0)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(x_label)
             .y_desc("fold angle (deg)")
             .draw()
@@ -109,7 +111,7 @@ pub fn angles_svg(
         for ((area, poses), &i) in views.iter().zip(&poses_at).zip(&picks) {
             let mut view = ChartBuilder::on(area)
                 .caption(format!("{x_name} {:.4}", xs[i]), ("sans-serif", 16))
-                .margin(6)
+                .margin(px(6))
                 .build_cartesian_3d(-1.05..1.05, -1.05..1.05, -1.05..1.05)
                 .map_err(plot_error)?;
             view.with_projection(|mut p| {
@@ -146,7 +148,7 @@ pub fn angles_svg(
         }
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 /// Renders `constraints.svg` for a crease pattern of many vertices: every crease's exact
@@ -157,7 +159,7 @@ pub fn network_constraints_svg(
 ) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 560)).into_drawing_area();
+        let root = canvas(&mut svg, (1000, 560));
         root.fill(&WHITE).map_err(plot_error)?;
         let [a, b] = curves.domain_deg;
         let mut chart = ChartBuilder::on(&root)
@@ -168,13 +170,14 @@ pub fn network_constraints_svg(
                 ),
                 ("sans-serif", 18),
             )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(52)
+            .margin(px(12))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(52))
             .build_cartesian_2d(axis_range(a, b, 0.02), -180.0..180.0)
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("driver: crease {} (deg)", curves.driver_edge))
             .y_desc("fold angle (deg)")
             .draw()
@@ -199,7 +202,7 @@ pub fn network_constraints_svg(
                         .iter()
                         .zip(&sweep.states)
                         .step_by(4)
-                        .map(|(t, s)| Circle::new((t.to_degrees(), s[column].to_degrees()), 2, colour.filled())),
+                        .map(|(t, s)| Circle::new((t.to_degrees(), s[column].to_degrees()), px(2), colour.filled())),
                 )
                 .map_err(plot_error)?;
             chart
@@ -225,5 +228,5 @@ pub fn network_constraints_svg(
             .map_err(plot_error)?;
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }

@@ -2,9 +2,9 @@
 //! thesis's figures 5-4 and 5-6) and `snapshots.svg` (side view of a strip, figure 5-7; the
 //! plates in 3D for a closed chain, figures 5-10 to 5-12).
 
+use super::canvas::{canvas, px, shown_at};
 use super::{
-    axis_range, coinciding, draw_legend, draw_series_line, draw_side_legend, plot_error, series_colour, LineKind,
-    LEGEND_MARGIN,
+    axis_range, coinciding, draw_series_line, draw_side_legend, plot_error, series_colour, LineKind, LEGEND_MARGIN,
 };
 use crate::dynamics::algorithms::{update_corners, update_poses};
 use crate::dynamics::closed::ClosedChain;
@@ -124,9 +124,9 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
 pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1000, 760)).into_drawing_area();
+        let root = canvas(&mut svg, (1000, 760));
         root.fill(&WHITE).map_err(plot_error)?;
-        let (top, bottom) = root.split_vertically(470);
+        let (top, bottom) = root.split_vertically(px(470));
         let (scale, unit) = time_unit(response.t_end.max(response.samples.last().map_or(0.0, |s| s.time)));
         let t_max = response.samples.last().map_or(1.0, |s| s.time).max(f64::MIN_POSITIVE) / scale;
         let mut lo: f64 = -10.0;
@@ -150,14 +150,15 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 format!("{}: fold angles ({}; {collision})", view.name, model_label(response)),
                 ("sans-serif", 18),
             )
-            .margin(12)
-            .margin_right(LEGEND_MARGIN)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(56))
             .build_cartesian_2d(axis_range(0.0, t_max, 0.0), y_range.clone())
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("time ({unit})"))
             .y_desc("fold angle (deg)")
             .draw()
@@ -198,8 +199,8 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             chart
                 .draw_series(DashedLineSeries::new(
                     vec![(x, y_range.start), (x, y_range.end)],
-                    4,
-                    4,
+                    px(4),
+                    px(4),
                     BLACK.stroke_width(2),
                 ))
                 .map_err(plot_error)?;
@@ -245,14 +246,15 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 format!("energy (drag {})", if view.drag { "on" } else { "off" }),
                 ("sans-serif", 16),
             )
-            .margin(12)
-            .margin_right(LEGEND_MARGIN)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(56))
             .build_cartesian_2d(axis_range(0.0, t_max, 0.0), axis_range(e_lo, e_hi, 0.06))
             .map_err(plot_error)?;
         energy
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("time ({unit})"))
             .y_desc(format!("energy ({e_unit})"))
             .draw()
@@ -271,7 +273,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         draw_side_legend(&bottom, 40, &entries)?;
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 /// Indices of `count` samples spread evenly in time, the last sample included.
@@ -339,7 +341,7 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
     y_lo = y_lo.min(edge - 50.0);
     let (width, height) = (1000u32, 620u32);
     // Equal scales on both axes: widen whichever range is short.
-    let plot_w = (width - 90) as f64;
+    let plot_w = (width - 90 - LEGEND_MARGIN) as f64;
     let plot_h = (height - 110) as f64;
     let pad = 0.08 * (y_hi - y_lo).max(z_hi - z_lo);
     let (mut y0, mut y1, mut z0, mut z1) = (y_lo - pad, y_hi + pad, z_lo - pad, z_hi + pad);
@@ -351,20 +353,22 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
     z1 = zm + 0.5 * per_px * plot_h;
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        let root = canvas(&mut svg, (width, height));
         root.fill(&WHITE).map_err(plot_error)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(
                 format!("{}: side view along the creases ({})", name, model_label(response)),
                 ("sans-serif", 18),
             )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
+            .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
+            .x_label_area_size(px(36))
+            .y_label_area_size(px(56))
             .build_cartesian_2d(axis_range(y0, y1, 0.0), axis_range(z0, z1, 0.0))
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc("y (µm)")
             .y_desc("z (µm)")
             .draw()
@@ -375,9 +379,8 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
                 vec![(y0, 0.0), (edge, 0.0)],
                 grey.stroke_width(4),
             )))
-            .map_err(plot_error)?
-            .label("substrate")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(4)));
+            .map_err(plot_error)?;
+        let mut entries = vec![("substrate".to_string(), grey, LineKind::Solid)];
         let dashes = (0..60).map(|k| {
             let a = edge + (y1 - edge) * k as f64 / 60.0;
             PathElement::new(
@@ -393,25 +396,23 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
                     points.clone(),
                     colour.stroke_width(3),
                 )))
-                .map_err(plot_error)?
-                .label(format!("t = {:.4} {unit}", time / scale))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(3)));
+                .map_err(plot_error)?;
+            entries.push((format!("t = {:.4} {unit}", time / scale), colour, LineKind::Solid));
             chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .draw_series(points.iter().map(|&p| Circle::new(p, px(3), colour.filled())))
                 .map_err(plot_error)?;
         }
         if let Some(c) = &response.collision {
             let p = (c.point.y * 1e6, c.point.z * 1e6);
             chart
-                .draw_series(std::iter::once(Cross::new(p, 9, RED.stroke_width(3))))
-                .map_err(plot_error)?
-                .label(format!("contact: {} / {}", c.pair[0], c.pair[1]))
-                .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(2)));
+                .draw_series(std::iter::once(Cross::new(p, px(9), RED.stroke_width(3))))
+                .map_err(plot_error)?;
+            entries.push((format!("contact: {} / {}", c.pair[0], c.pair[1]), RED, LineKind::Cross));
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        draw_side_legend(&root, 44, &entries)?;
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 /// A closed chain's `snapshots.svg`: the sector plates in 3D (the anchored one grey) at
@@ -436,9 +437,9 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
     let picks = snapshot_samples(response, count);
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1100, 400)).into_drawing_area();
+        let root = canvas(&mut svg, (1100, 400));
         root.fill(&WHITE).map_err(plot_error)?;
-        let (title, body) = root.split_vertically(34);
+        let (title, body) = root.split_vertically(px(34));
         title
             .titled(
                 &format!(
@@ -462,7 +463,7 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
             update_corners(model, &mut data);
             let mut view = ChartBuilder::on(panel)
                 .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
-                .margin(4)
+                .margin(px(4))
                 .build_cartesian_3d(-reach..reach, -reach..reach, -reach..reach)
                 .map_err(plot_error)?;
             view.with_projection(|mut p| {
@@ -491,5 +492,5 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
         }
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }

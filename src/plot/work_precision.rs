@@ -2,7 +2,8 @@
 //! setting, one line per series (a method, or one kind of error); and cost-against-size
 //! figures for scaling, with the fitted power law.
 
-use super::{draw_legend, plot_error, series_colour};
+use super::canvas::{canvas, px, pxi, shown_at};
+use super::{draw_legend_in_margin, plot_error, series_colour, LineKind};
 use crate::error::Result;
 use plotters::prelude::*;
 
@@ -61,19 +62,20 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
     let (e_lo, e_hi) = (e_lo / 10.0, e_hi * 10.0);
     let mut svg = String::new();
     {
-        let base = SVGBackend::with_string(&mut svg, (1100, 600)).into_drawing_area();
+        let base = canvas(&mut svg, (1100, 600));
         base.fill(&WHITE).map_err(plot_error)?;
         let root = base.titled(title, ("sans-serif", 18)).map_err(plot_error)?;
         // The legend gets its own column: with a dozen series it would hide points.
-        let (plot_area, legend_area) = root.split_horizontally(760);
+        let (plot_area, legend_area) = root.split_horizontally(px(760));
         let mut chart = ChartBuilder::on(&plot_area)
-            .margin(14)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
+            .margin(px(14))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(70))
             .build_cartesian_2d((t_lo..t_hi).log_scale(), (e_lo..e_hi).log_scale())
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(format!("wall time ({unit_name})"))
             .y_desc(error_label)
             .y_label_formatter(&|v| format!("{v:.0e}"))
@@ -93,9 +95,9 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
                 .map_err(plot_error)?;
             if triangles(i) {
-                chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 6, colour.filled())))
+                chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, px(6), colour.filled())))
             } else {
-                chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, px(4), colour.filled())))
             }
             .map_err(plot_error)?;
             // Points that land on each other (within 0.05 decade in time and 0.1 in error)
@@ -118,36 +120,40 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
             for (x, y, labels) in groups {
                 pending_labels.push((chart.backend_coord(&(x, y)), labels.join(", "), colour));
             }
-            let y = 30 + 20 * i as i32;
+            let y = pxi(30 + 20 * i as i32);
             legend_area
-                .draw(&PathElement::new(vec![(4, y), (26, y)], colour.stroke_width(2)))
+                .draw(&PathElement::new(
+                    vec![(pxi(4), y), (pxi(26), y)],
+                    colour.stroke_width(2),
+                ))
                 .map_err(plot_error)?;
             if triangles(i) {
-                legend_area.draw(&TriangleMarker::new((15, y), 6, colour.filled()))
+                legend_area.draw(&TriangleMarker::new((pxi(15), y), px(6), colour.filled()))
             } else {
-                legend_area.draw(&Circle::new((15, y), 4, colour.filled()))
+                legend_area.draw(&Circle::new((pxi(15), y), px(4), colour.filled()))
             }
             .map_err(plot_error)?;
             legend_area
-                .draw(&Text::new(line.name.clone(), (32, y - 7), ("sans-serif", 13)))
+                .draw(&Text::new(line.name.clone(), (pxi(32), y - pxi(7)), ("sans-serif", 13)))
                 .map_err(plot_error)?;
         }
         // Labels of every series placed last, each moved down past any label already placed
         // (boxes estimated at 6.5 px a character, 13 px high), so none prints over another.
         let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-        for ((px, py), text, colour) in pending_labels {
-            let width = (6.5 * text.chars().count() as f64) as i32;
-            let (x0, mut y0) = (px + 5, py + 2);
+        let line_height = pxi(13);
+        for ((x, y), text, colour) in pending_labels {
+            let width = pxi((6.5 * text.chars().count() as f64) as i32);
+            let (x0, mut y0) = (x + pxi(5), y + pxi(2));
             for _ in 0..12 {
                 let clash = placed
                     .iter()
-                    .any(|&(a, b, c, d)| x0 < c && a < x0 + width && y0 < d && b < y0 + 13);
+                    .any(|&(a, b, c, d)| x0 < c && a < x0 + width && y0 < d && b < y0 + line_height);
                 if !clash {
                     break;
                 }
-                y0 += 13;
+                y0 += line_height;
             }
-            placed.push((x0, y0, x0 + width, y0 + 13));
+            placed.push((x0, y0, x0 + width, y0 + line_height));
             // backend_coord is in the whole figure's pixels: draw on the untitled area.
             base.draw(&Text::new(
                 text,
@@ -158,7 +164,7 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
         }
         base.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 /// Series past the palette's ten colours get triangles instead of circles.
@@ -209,6 +215,9 @@ pub struct ScalingSeries {
     pub points: Vec<(f64, f64)>,
 }
 
+/// Room for the scaling figure's legend (its entries carry fitted exponents), output pixels.
+const SCALING_LEGEND: u32 = 330;
+
 /// Log–log SVG of cost (in the unit that shows it best) against size (points sorted by
 /// size), each series with its points joined and, in the legend, the exponent fitted over
 /// its three largest sizes.
@@ -233,13 +242,14 @@ pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> R
     }
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
+        let root = canvas(&mut svg, (900, 600));
         root.fill(&WHITE).map_err(plot_error)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 18))
-            .margin(14)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
+            .margin(px(14))
+            .margin_right(px(SCALING_LEGEND))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(70))
             .build_cartesian_2d(
                 (n_lo / 1.3..n_hi * 1.3).log_scale(),
                 (c_lo / 3.0..c_hi * 3.0).log_scale(),
@@ -247,12 +257,14 @@ pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> R
             .map_err(plot_error)?;
         chart
             .configure_mesh()
+            .set_all_tick_mark_size(px(5))
             .x_desc(size_label)
             .y_desc(format!("time ({unit_name})"))
             .x_label_formatter(&|v| format!("{v:.0}"))
             .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(plot_error)?;
+        let mut entries = Vec::new();
         for (i, line) in series.iter().enumerate() {
             let colour = series_colour(i);
             let points: Vec<(f64, f64)> = line
@@ -267,17 +279,16 @@ pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> R
             };
             chart
                 .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                .map_err(plot_error)?
-                .label(name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+                .map_err(plot_error)?;
+            entries.push((name, colour, LineKind::Solid));
             chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .draw_series(points.iter().map(|&p| Circle::new(p, px(4), colour.filled())))
                 .map_err(plot_error)?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        draw_legend_in_margin(&root, SCALING_LEGEND, 44, &entries)?;
         root.present().map_err(plot_error)?;
     }
-    Ok(svg)
+    Ok(shown_at(svg))
 }
 
 #[cfg(test)]
