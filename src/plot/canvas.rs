@@ -190,14 +190,20 @@ mod tests {
         let mut svg = String::new();
         {
             let root = canvas(&mut svg, (100, 50));
-            root.draw(&PathElement::new(vec![(0, 0), (pxi(33) + 1, pxi(10) + 2)], BLACK.stroke_width(2)))
-                .unwrap();
+            root.draw(&PathElement::new(
+                vec![(0, 0), (pxi(33) + 1, pxi(10) + 2)],
+                BLACK.stroke_width(2),
+            ))
+            .unwrap();
             root.draw(&Text::new("label", (pxi(10), pxi(10)), ("sans-serif", 12)))
                 .unwrap();
             root.present().unwrap();
         }
         let svg = shown_at(svg);
-        assert!(svg.starts_with("<svg width=\"100\" height=\"50\" viewBox=\"0 0 400 200\""), "{svg}");
+        assert!(
+            svg.starts_with("<svg width=\"100\" height=\"50\" viewBox=\"0 0 400 200\""),
+            "{svg}"
+        );
         // 133/4 = 33.25 output pixels: a quarter pixel the integer backend could not place.
         assert!(svg.contains("133,42"), "{svg}");
         assert!(svg.contains("stroke-width=\"8\""), "{svg}");

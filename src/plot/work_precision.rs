@@ -216,7 +216,7 @@ pub struct ScalingSeries {
 }
 
 /// Room for the scaling figure's legend (its entries carry fitted exponents), output pixels.
-const SCALING_LEGEND: u32 = 330;
+const SCALING_LEGEND: u32 = 420;
 
 /// Log–log SVG of cost (in the unit that shows it best) against size (points sorted by
 /// size), each series with its points joined and, in the legend, the exponent fitted over
@@ -242,7 +242,7 @@ pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> R
     }
     let mut svg = String::new();
     {
-        let root = canvas(&mut svg, (900, 600));
+        let root = canvas(&mut svg, (1100, 600));
         root.fill(&WHITE).map_err(plot_error)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 18))

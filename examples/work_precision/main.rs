@@ -6,9 +6,13 @@
 //!
 //! `cargo run --release --example work_precision` prints the tables and writes
 //! `output/work_precision/{report.json, unfold_*.svg, fits.svg, bridge_step.svg,
-//! bridge_ramp.svg, scaling.svg}` (35 s on the 2-core VM of README, one run).
+//! bridge_ramp.svg, scaling.svg}` (35–55 s on the 2-core VM of README, one run); the
+//! figures are drawn from the report (`figures.rs`), and `-- --from REPORT.json` redraws a
+//! saved report's figures without measuring.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod figures;
 
 use common::{library_patterns, machine, many_creases, median, timed};
 use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
@@ -20,9 +24,7 @@ use nanofold::dynamics::strip::StripPlant;
 use nanofold::geometry::sphere::Vec3;
 use nanofold::io::output::write_atomic;
 use nanofold::pattern::LoadOptions;
-use nanofold::plot::work_precision::{
-    largest_sizes, power_law_fit, scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries,
-};
+use nanofold::plot::work_precision::{largest_sizes, power_law_fit};
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::{self, QpMethod};
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
@@ -80,12 +82,9 @@ impl UnfoldConfig {
     }
 }
 
-/// A configuration with its median seconds and its distance from the flat layout.
-type MeasuredConfig = (UnfoldConfig, f64, f64);
-
 /// The unfolding sweep: every pattern that unfolds × direction solver × finish × flat
 /// tolerance, plus the step cap of the line search at the default setting.
-fn unfold_part(out: &Path) -> Value {
+fn unfold_part() -> Value {
     let defaults = UnfoldSettings::default();
     let mut configs = Vec::new();
     for qp in [QpMethod::Direct, QpMethod::Clarabel] {
@@ -128,7 +127,6 @@ fn unfold_part(out: &Path) -> Value {
         "pattern", "direction, finish", "flat tol", "step cap", "verdict", "iters", "ms", "layout err", "arc resid"
     );
     let mut rows = Vec::new();
-    let mut by_pattern: Vec<(String, Vec<MeasuredConfig>)> = Vec::new();
     for pattern in library_patterns() {
         let probe = unfold(&pattern, &defaults).expect("library pattern unfolds without error");
         if probe.verdict != Verdict::Flat {
@@ -140,7 +138,6 @@ fn unfold_part(out: &Path) -> Value {
             rows.push(json!({"pattern": pattern.name, "verdict": probe.verdict.as_str()}));
             continue;
         }
-        let mut points = Vec::new();
         for config in &configs {
             let settings = config.settings();
             let (seconds, report) = timed(RUNS, || unfold(&pattern, &settings).expect("unfold"));
@@ -163,62 +160,14 @@ fn unfold_part(out: &Path) -> Value {
                 "iterations": report.iterations, "seconds": seconds,
                 "flat_layout_error": report.flat_layout_error, "max_arc_residual": report.max_arc_residual,
             }));
-            if config.max_step_rad == defaults.max_step_rad {
-                points.push((*config, seconds, report.flat_layout_error));
-            }
         }
-        by_pattern.push((pattern.name.clone(), points));
     }
 
-    // One figure per family; a line per pattern and (direction, finish), a point per tolerance.
-    let families: [(&str, &str, &[&str]); 4] = [
-        ("unfold_two_creases.svg", "two creases", &["half_paper", "sheet_corner"]),
-        (
-            "unfold_degree4.svg",
-            "degree 4",
-            &["degree4_generic", "degree4_native", "miura_vertex"],
-        ),
-        ("unfold_corner_cube.svg", "corner cube", &["corner_cube"]),
-        (
-            "unfold_degree6_to_16.svg",
-            "degree 6 to 16",
-            &["degree6_asymmetric", "waterbomb", "symmetric16"],
-        ),
-    ];
-    for (file, family, members) in families {
-        let mut series = Vec::new();
-        for (name, points) in by_pattern.iter().filter(|(name, _)| members.contains(&name.as_str())) {
-            let mut lines: Vec<String> = points.iter().map(|(c, _, _)| c.series()).collect();
-            lines.dedup();
-            for line in lines {
-                series.push(WorkSeries {
-                    name: format!("{name}: {line}"),
-                    points: points
-                        .iter()
-                        .filter(|(c, _, _)| c.series() == line)
-                        .map(|(c, seconds, error)| WorkPoint {
-                            label: format!("{:.0e}", c.flat_tol),
-                            seconds: *seconds,
-                            // Exactly on the layout cannot be drawn on a log axis.
-                            error: error.max(1e-17),
-                        })
-                        .collect(),
-                });
-            }
-        }
-        let svg = work_precision_svg(
-            &format!("unfolding, {family}: distance from the exact flat layout (points: --flat-tol)"),
-            "max node distance from the flat layout",
-            &series,
-        )
-        .expect("figure");
-        write(out, file, &svg);
-    }
     json!({"runs_per_point": RUNS, "rows": rows})
 }
 
 /// Degree against error and evaluation time of f and G for the corner cube's step-1 curves.
-fn fits_part(out: &Path) -> Value {
+fn fits_part() -> Value {
     let pattern =
         nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
     let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).expect("setup");
@@ -234,7 +183,7 @@ fn fits_part(out: &Path) -> Value {
     );
     let thetas: Vec<f64> = (0..1000).map(|i| PI * i as f64 / 999.0).collect();
     let mut buffer = vec![0.0; setup.dependents.len()];
-    let (mut rows, mut f_points, mut g_points) = (Vec::new(), Vec::new(), Vec::new());
+    let mut rows = Vec::new();
     for degree in [1, 2, 3, 4, 6, 8, 10, 12, 14, 16, 20] {
         let poly = ConstraintPoly::fit(&pattern, &samples, degree).expect("fit");
         let report = ConstraintReport::new(&pattern, &samples, &poly).expect("report");
@@ -270,33 +219,7 @@ fn fits_part(out: &Path) -> Value {
             "max_closure_residual_rad": report.max_closure_residual,
             "f_seconds_per_eval": f_seconds, "g_seconds_per_eval": g_seconds,
         }));
-        f_points.push(WorkPoint {
-            label: format!("{degree}"),
-            seconds: f_seconds,
-            error: report.max_fit_error(),
-        });
-        g_points.push(WorkPoint {
-            label: format!("{degree}"),
-            seconds: g_seconds,
-            error: slope_error,
-        });
     }
-    let svg = work_precision_svg(
-        "constraint fits, corner cube step 1: error against one evaluation (points: degree)",
-        "max error (rad; slope: rad/rad)",
-        &[
-            WorkSeries {
-                name: "f: fit error vs the exact sweep".into(),
-                points: f_points,
-            },
-            WorkSeries {
-                name: "G = f′: slope error vs the implicit function theorem".into(),
-                points: g_points,
-            },
-        ],
-    )
-    .expect("figure");
-    write(out, "fits.svg", &svg);
     json!({
         "pattern": "corner_cube", "driver": 0, "held": {"1": 0.0}, "domain_rad": [0.0, PI], "samples": 201,
         "sweep_seconds": sweep_seconds, "rows": rows,
@@ -305,7 +228,7 @@ fn fits_part(out: &Path) -> Value {
 
 /// The bridge's step response per integrator and tolerance against a reference, and its
 /// etch ramp quasi-static against dynamic.
-fn dynamics_part(out: &Path) -> Value {
+fn dynamics_part() -> Value {
     let step = load_scene(Path::new("patterns/bridge_step.scene.json"));
     let reference_settings = SimulationSettings {
         rtol: 1e-13,
@@ -325,10 +248,8 @@ fn dynamics_part(out: &Path) -> Value {
         "method", "rtol", "ms", "steps", "rhs", "|Δt contact| s", "max|Δθ| rad"
     );
     let mut rows = Vec::new();
-    let (mut angle_series, mut time_series) = (Vec::new(), Vec::new());
     for method in [Method::Tsit45, Method::Bdf, Method::Esdirk34, Method::TrBdf2] {
         let name = format!("{method:?}").to_lowercase();
-        let (mut angle_points, mut time_points) = (Vec::new(), Vec::new());
         for rtol in [1e-6, 1e-8, 1e-10] {
             // The implicit methods take seconds at 1e-10 on this ringing response.
             if method != Method::Tsit45 && rtol < 1e-8 {
@@ -355,36 +276,8 @@ fn dynamics_part(out: &Path) -> Value {
                 "rhs_evaluations": response.rhs_evaluations, "contact_time_error_s": time_error,
                 "angle_error_at_contact_rad": angle_error,
             }));
-            let label = format!("{rtol:.0e}");
-            angle_points.push(WorkPoint {
-                label: label.clone(),
-                seconds,
-                error: angle_error,
-            });
-            time_points.push(WorkPoint {
-                label,
-                seconds,
-                // Relative to the contact time, so both errors share one axis.
-                error: time_error / reference_contact.time,
-            });
         }
-        angle_series.push(WorkSeries {
-            name: format!("{name}: max |Δθ| at contact (rad)"),
-            points: angle_points,
-        });
-        time_series.push(WorkSeries {
-            name: format!("{name}: |Δt contact| / t contact"),
-            points: time_points,
-        });
     }
-    angle_series.extend(time_series);
-    let svg = work_precision_svg(
-        "bridge step response to first contact: error against Tsit45 at rtol 1e-13 (points: rtol)",
-        "error",
-        &angle_series,
-    )
-    .expect("figure");
-    write(out, "bridge_step.svg", &svg);
 
     let ramp = load_scene(Path::new("patterns/bridge_ramp.scene.json"));
     let quasi_settings = SimulationSettings {
@@ -409,11 +302,6 @@ fn dynamics_part(out: &Path) -> Value {
         "model": "quasi_static", "seconds": quasi_seconds, "error_bound_rad": quasi.quasi_static_error_estimate,
         "measured_error_rad": measured, "contact_time_s": quasi_contact.time,
     })];
-    let mut ramp_points = vec![WorkPoint {
-        label: "quasi-static (measured error)".into(),
-        seconds: quasi_seconds,
-        error: measured,
-    }];
     for rtol in [1e-6, 1e-8, 1e-10] {
         let settings = SimulationSettings {
             model: ModelChoice::Dynamic,
@@ -441,22 +329,7 @@ fn dynamics_part(out: &Path) -> Value {
             "model": "dynamic", "method": "esdirk34", "rtol": rtol, "seconds": seconds, "steps": dynamic.steps,
             "deviation_from_quasi_static_rad": deviation, "contact_time_s": contact.time,
         }));
-        ramp_points.push(WorkPoint {
-            label: format!("ESDIRK34 {rtol:.0e}"),
-            seconds,
-            error: deviation,
-        });
     }
-    let svg = work_precision_svg(
-        "bridge etch ramp: quasi-static (its measured error) and dynamic (its distance from quasi-static)",
-        "error (rad)",
-        &[WorkSeries {
-            name: "ramp models".into(),
-            points: ramp_points,
-        }],
-    )
-    .expect("figure");
-    write(out, "bridge_ramp.svg", &svg);
     json!({
         "step": {"scene": "bridge_step", "reference": {"method": "tsit45", "rtol": 1e-13, "seconds": reference_seconds,
                  "contact_time_s": reference_contact.time}, "runs_per_point": DYNAMIC_RUNS, "rows": rows},
@@ -477,7 +350,7 @@ fn per_call(mut work: impl FnMut()) -> f64 {
 }
 
 /// The cost of one unfold iteration against n, split into its parts.
-fn scaling_part(out: &Path) -> Value {
+fn scaling_part() -> Value {
     println!("\n== one unfold iteration against the number of creases (random vertices, median) ==");
     println!(
         "{:>5} {:>14} {:>14} {:>20} {:>10} {:>13} {:>6} {:>10} {:>10}",
@@ -562,37 +435,28 @@ fn scaling_part(out: &Path) -> Value {
         tail(&energy).unwrap_or(f64::NAN),
         tail(&direction).unwrap_or(f64::NAN)
     );
-    let svg = scaling_svg(
-        "cost of one unfold iteration against the number of creases (random vertices)",
-        "creases n",
-        &[
-            ScalingSeries {
-                name: "one iteration".into(),
-                points: iteration,
-            },
-            ScalingSeries {
-                name: "direction (factorisations, solve)".into(),
-                points: direction,
-            },
-            ScalingSeries {
-                name: "U + ∇U".into(),
-                points: energy,
-            },
-        ],
-    )
-    .expect("figure");
-    write(out, "scaling.svg", &svg);
     json!({"rows": rows, "exponents_over_64_to_256": exponents})
 }
 
 fn main() {
     let out = Path::new("output/work_precision");
     std::fs::create_dir_all(out).expect("output folder");
+    // --from REPORT: redraw the figures of a saved report, measuring nothing.
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(at) = args.iter().position(|a| a == "--from") {
+        let path = args.get(at + 1).expect("--from REPORT.json");
+        let report: Value = serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+        for (name, svg) in figures::figures(&report) {
+            write(out, name, &svg);
+        }
+        println!("redrew the figures of {path} into {}", out.display());
+        return;
+    }
     let started = Instant::now();
-    let unfolding = unfold_part(out);
-    let fits = fits_part(out);
-    let dynamics = dynamics_part(out);
-    let scaling = scaling_part(out);
+    let unfolding = unfold_part();
+    let fits = fits_part();
+    let dynamics = dynamics_part();
+    let scaling = scaling_part();
     let report = json!({
         "machine": machine(),
         "seconds_total": started.elapsed().as_secs_f64(),
@@ -606,6 +470,9 @@ fn main() {
         "report.json",
         &serde_json::to_string_pretty(&report).expect("json"),
     );
+    for (name, svg) in figures::figures(&report) {
+        write(out, name, &svg);
+    }
     println!(
         "\nwrote {}/{{report.json, unfold_*.svg, fits.svg, bridge_step.svg, bridge_ramp.svg, scaling.svg}} in {:.0} s",
         out.display(),
