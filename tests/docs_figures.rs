@@ -1,8 +1,13 @@
 //! The figures under docs/ are current: each deterministic one is drawn again by the command
 //! `scripts/figures.sh` uses and compared with the committed file, text exactly and every
 //! number to within one pixel (so a last-digit difference of another CPU's rounding does not
-//! count). The work-precision figures carry timings and are left out. After a change that
-//! moves a figure, run `bash scripts/figures.sh`.
+//! count). The work-precision figures carry timings: they are drawn again from the kept
+//! measurement, `docs/work_precision_report.json`. After a change that moves a figure, run
+//! `bash scripts/figures.sh --keep-timings`.
+
+#[allow(dead_code)]
+#[path = "../examples/work_precision/figures.rs"]
+mod work_precision_figures;
 
 use std::path::Path;
 use std::process::Command;
@@ -46,7 +51,7 @@ fn same_figure(drawn: &Path, committed: &str) {
     assert_eq!(
         ta.len(),
         tb.len(),
-        "{committed} is not current: run bash scripts/figures.sh"
+        "{committed} is not current: run bash scripts/figures.sh --keep-timings"
     );
     for (x, y) in ta.iter().zip(&tb) {
         let same = match (x, y) {
@@ -56,7 +61,7 @@ fn same_figure(drawn: &Path, committed: &str) {
         };
         assert!(
             same,
-            "{committed} is not current ({x:?} against {y:?}): run bash scripts/figures.sh"
+            "{committed} is not current ({x:?} against {y:?}): run bash scripts/figures.sh --keep-timings"
         );
     }
 }
@@ -111,6 +116,23 @@ fn the_docs_figures_are_current() {
         if Path::new(&snapshots).exists() {
             same_figure(&dir.join(scene).join("snapshots.svg"), &snapshots);
         }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The work-precision figures are the kept report's.
+#[test]
+fn the_work_precision_figures_are_the_kept_reports() {
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("docs/work_precision_report.json").unwrap()).unwrap();
+    let dir = std::env::temp_dir().join(format!("nanofold-wp-figures-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let figures = work_precision_figures::figures(&report);
+    assert_eq!(figures.len(), 8);
+    for (name, svg) in figures {
+        let drawn = dir.join(name);
+        std::fs::write(&drawn, svg).unwrap();
+        same_figure(&drawn, &format!("docs/work_precision_{name}"));
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
