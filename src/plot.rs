@@ -383,14 +383,23 @@ pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &Constra
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(plot_error)?;
-        for (&c, series) in poly.dependents.iter().zip(&errors) {
+        // Errors that coincide (a symmetric pair of creases) draw one line: the legend says so.
+        let same = coinciding(&errors, 1e-9 * top_error);
+        let mut error_entries = Vec::new();
+        for (j, (&c, series)) in poly.dependents.iter().zip(&errors).enumerate() {
             error_chart
                 .draw_series(LineSeries::new(
                     x_deg.iter().copied().zip(series.iter().copied()),
                     series_colour(c).stroke_width(2),
                 ))
                 .map_err(plot_error)?;
+            let mut label = pattern.creases[c].label.clone();
+            if let Some(k) = same[j] {
+                label.push_str(&format!(" = {}", pattern.creases[poly.dependents[k]].label));
+            }
+            error_entries.push((label, series_colour(c), LineKind::Solid));
         }
+        draw_side_legend(&bottom, 40, &error_entries)?;
         root.present().map_err(plot_error)?;
     }
     Ok(shown_at(svg))
