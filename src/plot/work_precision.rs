@@ -66,7 +66,7 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
         base.fill(&WHITE).map_err(plot_error)?;
         let root = base.titled(title, ("sans-serif", 18)).map_err(plot_error)?;
         // The legend gets its own column: with a dozen series it would hide points.
-        let (plot_area, legend_area) = root.split_horizontally(px(760));
+        let (plot_area, legend_area) = root.split_horizontally(px(PLOT_WIDTH));
         let mut chart = ChartBuilder::on(&plot_area)
             .margin(px(14))
             .x_label_area_size(px(40))
@@ -83,6 +83,7 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
             .draw()
             .map_err(plot_error)?;
         let mut pending_labels = Vec::new();
+        let mut markers = Vec::new();
         for (i, line) in series.iter().enumerate() {
             let colour = series_colour(i);
             let points: Vec<(f64, f64)> = line
@@ -100,6 +101,7 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 chart.draw_series(points.iter().map(|&p| Circle::new(p, px(4), colour.filled())))
             }
             .map_err(plot_error)?;
+            markers.extend(points.iter().map(|p| chart.backend_coord(p)));
             // Points that land on each other (within 0.05 decade in time and 0.1 in error)
             // share one label, "1e-2, 1e-4, 1e-6", instead of printing over each other.
             let mut groups: Vec<(f64, f64, Vec<String>)> = Vec::new();
@@ -137,22 +139,43 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
                 .draw(&Text::new(line.name.clone(), (pxi(32), y - pxi(7)), ("sans-serif", 13)))
                 .map_err(plot_error)?;
         }
-        // Labels of every series placed last, each moved down past any label already placed
-        // (boxes estimated at 6.5 px a character, 13 px high), so none prints over another.
-        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        // Labels of every series placed last, each at the free spot nearest its point: right
+        // or left of it, below or above, then a line further out each round; a spot is free
+        // when it covers no label already placed and no marker (boxes estimated at 6.5 px a
+        // character, 13 px high). None prints over another, and each stays by its point.
+        let (figure_w, figure_h) = base.dim_in_pixel();
         let line_height = pxi(13);
+        let mut placed: Vec<(i32, i32, i32, i32)> = markers
+            .iter()
+            .map(|&(x, y)| (x - pxi(5), y - pxi(5), x + pxi(5), y + pxi(5)))
+            .collect();
+        // The legend's column is not a place for labels either.
+        placed.push((pxi(PLOT_WIDTH as i32), 0, figure_w as i32, figure_h as i32));
         for ((x, y), text, colour) in pending_labels {
             let width = pxi((6.5 * text.chars().count() as f64) as i32);
-            let (x0, mut y0) = (x + pxi(5), y + pxi(2));
-            for _ in 0..12 {
-                let clash = placed
-                    .iter()
-                    .any(|&(a, b, c, d)| x0 < c && a < x0 + width && y0 < d && b < y0 + line_height);
-                if !clash {
+            let free = |x0: i32, y0: i32| {
+                x0 >= 0
+                    && y0 >= 0
+                    && x0 + width <= figure_w as i32
+                    && y0 + line_height <= figure_h as i32
+                    && !placed
+                        .iter()
+                        .any(|&(a, b, c, d)| x0 < c && a < x0 + width && y0 < d && b < y0 + line_height)
+            };
+            let candidates = (0..12).flat_map(|k| {
+                let below = y + pxi(2) + k * line_height;
+                let above = y - pxi(2) - (k + 1) * line_height;
+                let (right, left) = (x + pxi(7), x - pxi(7) - width);
+                [(right, below), (right, above), (left, below), (left, above)]
+            });
+            let mut spot = (x + pxi(7), y + pxi(2));
+            for (x0, y0) in candidates {
+                if free(x0, y0) {
+                    spot = (x0, y0);
                     break;
                 }
-                y0 += line_height;
             }
+            let (x0, y0) = spot;
             placed.push((x0, y0, x0 + width, y0 + line_height));
             // backend_coord is in the whole figure's pixels: draw on the untitled area.
             base.draw(&Text::new(
@@ -166,6 +189,9 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
     }
     Ok(shown_at(svg))
 }
+
+/// Width of a work-precision figure's plot, output pixels; its legend takes the rest.
+const PLOT_WIDTH: u32 = 760;
 
 /// Series past the palette's ten colours get triangles instead of circles.
 fn triangles(i: usize) -> bool {
@@ -304,6 +330,57 @@ mod tests {
         let (k, c) = power_law_fit(&points).unwrap();
         assert!((k - 2.5).abs() < 1e-12 && (c / 3e-7 - 1.0).abs() < 1e-10);
         assert!(power_law_fit(&[(8.0, 1.0)]).is_none());
+    }
+
+    /// Point labels of a crowded figure neither cover one another nor any marker. Boxes here
+    /// are 6 px a character and 12 px high, independent of the placement's own estimate.
+    #[test]
+    fn point_labels_cover_no_label_and_no_marker() {
+        let series: Vec<WorkSeries> = (0..4)
+            .map(|s| WorkSeries {
+                name: format!("series {s}"),
+                points: (0..6)
+                    .map(|k| WorkPoint {
+                        label: format!("rtol 1e-{}", 4 + k),
+                        seconds: 1e-3 * (1.0 + 0.08 * k as f64 + 0.02 * s as f64),
+                        error: 10f64.powf(-2.0 - 0.15 * k as f64 - 0.05 * s as f64),
+                    })
+                    .collect(),
+            })
+            .collect();
+        let svg = work_precision_svg("crowded", "error", &series).unwrap();
+        let attribute = |tag: &str, key: &str| -> f64 {
+            let start = tag.find(&format!(" {key}=\"")).unwrap() + key.len() + 3;
+            tag[start..].split('"').next().unwrap().parse().unwrap()
+        };
+        let scale = f64::from(super::super::canvas::SCALE);
+        let mut boxes = Vec::new();
+        for piece in svg.split("<text").skip(1) {
+            let (tag, rest) = piece.split_once('>').unwrap();
+            if !tag.contains("opacity=\"0.9\"") {
+                continue;
+            }
+            let text = rest.split("</text>").next().unwrap().trim();
+            let (x, y) = (attribute(tag, "x"), attribute(tag, "y"));
+            boxes.push((x, y, x + 6.0 * scale * text.chars().count() as f64, y + 12.0 * scale));
+        }
+        assert!(boxes.len() >= 4, "{} labels", boxes.len());
+        for (i, a) in boxes.iter().enumerate() {
+            for b in &boxes[..i] {
+                let overlap = a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+                assert!(!overlap, "labels at {a:?} and {b:?} overlap");
+            }
+        }
+        for piece in svg.split("<circle").skip(1) {
+            let tag = piece.split_once('>').unwrap().0;
+            let (cx, cy) = (attribute(tag, "cx"), attribute(tag, "cy"));
+            for b in &boxes {
+                assert!(
+                    !(b.0 < cx && cx < b.2 && b.1 < cy && cy < b.3),
+                    "a label at {b:?} covers the marker at ({cx}, {cy})"
+                );
+            }
+        }
     }
 
     #[test]
