@@ -1,13 +1,17 @@
 //! The figures under docs/ are current: each deterministic one is drawn again by the command
 //! `scripts/figures.sh` uses and compared with the committed file, text exactly and every
 //! number to within one pixel (so a last-digit difference of another CPU's rounding does not
-//! count). The work-precision figures carry timings: they are drawn again from the kept
-//! measurement, `docs/work_precision_report.json`. After a change that moves a figure, run
+//! count). The timing figures are drawn again from their kept measurements,
+//! `docs/work_precision_report.json` and `docs/closed_chain_timing_report.json`. After a change that moves a figure, run
 //! `bash scripts/figures.sh --keep-timings`.
 
 #[allow(dead_code)]
 #[path = "../examples/work_precision/figures.rs"]
 mod work_precision_figures;
+
+#[allow(dead_code)]
+#[path = "../examples/closed_chain_timing/figures.rs"]
+mod closed_chain_figures;
 
 use std::path::Path;
 use std::process::Command;
@@ -120,7 +124,7 @@ fn the_docs_figures_are_current() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The work-precision figures are the kept report's.
+/// The timing figures are their kept reports'.
 #[test]
 fn the_work_precision_figures_are_the_kept_reports() {
     let report: serde_json::Value =
@@ -134,5 +138,13 @@ fn the_work_precision_figures_are_the_kept_reports() {
         std::fs::write(&drawn, svg).unwrap();
         same_figure(&drawn, &format!("docs/work_precision_{name}"));
     }
+    // The closed chain's poly-against-exact figure, from its kept report.
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("docs/closed_chain_timing_report.json").unwrap()).unwrap();
+    let (name, svg) = closed_chain_figures::figures(&report).remove(0);
+    assert_eq!(name, "poly_vs_exact.svg");
+    let drawn = dir.join(name);
+    std::fs::write(&drawn, svg).unwrap();
+    same_figure(&drawn, "docs/corner_cube_poly_vs_exact.svg");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,9 +2,13 @@
 //! f = poly (degrees 2…8) and f = exact, each against the exact run (contact time, angles at
 //! contact, loop-closure drift); and the etch ramp quasi-static against dynamic.
 //! `cargo run --release --example closed_chain_timing` writes
-//! `output/closed_chain_timing/{report.json, poly_vs_exact.svg, ramp.svg}`.
+//! `output/closed_chain_timing/{report.json, poly_vs_exact.svg, ramp.svg}`, the figures drawn
+//! from the report (`figures.rs`); `-- --from REPORT.json` redraws a saved report's figures
+//! without measuring.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod figures;
 
 use common::machine;
 use nanofold::dynamics::closed::ClosedPlant;
@@ -13,8 +17,7 @@ use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate, ModelChoice, Simulation, SimulationSettings};
 use nanofold::io::output::write_atomic;
-use nanofold::plot::work_precision::{work_precision_svg, WorkPoint, WorkSeries};
-use serde_json::json;
+use serde_json::{json, Value};
 use std::path::Path;
 
 const RUNS: usize = 5;
@@ -36,6 +39,17 @@ fn timed(scene: &Scene, settings: &SimulationSettings) -> (f64, Simulation) {
 fn main() {
     let out = Path::new("output/closed_chain_timing");
     std::fs::create_dir_all(out).unwrap();
+    // --from REPORT: redraw the figures of a saved report, measuring nothing.
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(at) = args.iter().position(|a| a == "--from") {
+        let path = args.get(at + 1).expect("--from REPORT.json");
+        let report: Value = serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+        for (name, svg) in figures::figures(&report) {
+            write_atomic(&out.join(name), svg.as_bytes()).unwrap();
+        }
+        println!("redrew the figures of {path} into {}", out.display());
+        return;
+    }
     let settings = SimulationSettings {
         model: ModelChoice::Dynamic,
         method: Method::Tsit45,
@@ -69,7 +83,6 @@ fn main() {
         "max_closure_residual": closure(&exact), "contact_time_s": exact_contact.time,
         "contact_time_error_s": 0.0, "contact_angle_error_rad": 0.0,
     })];
-    let (mut drift, mut timing, mut angles) = (Vec::new(), Vec::new(), Vec::new());
     for degree in 2..=8 {
         let poly_scene = scene(
             "corner_cube_step1",
@@ -95,50 +108,7 @@ fn main() {
             "slope_error": report.slope_error, "max_closure_residual": report.max_closure_residual,
             "contact_time_s": contact.time, "contact_time_error_s": dt, "contact_angle_error_rad": dtheta,
         }));
-        let label = format!("{degree}");
-        drift.push(WorkPoint {
-            label: label.clone(),
-            seconds,
-            error: report.max_closure_residual,
-        });
-        timing.push(WorkPoint {
-            label: label.clone(),
-            seconds,
-            error: dt.abs() / exact_contact.time,
-        });
-        angles.push(WorkPoint {
-            label,
-            seconds,
-            error: dtheta,
-        });
     }
-    // Exact last: the line runs from the cheapest fit to the reference.
-    drift.push(WorkPoint {
-        label: "exact".into(),
-        seconds: exact_seconds,
-        error: closure(&exact),
-    });
-    let figure = work_precision_svg(
-        "corner cube step 1: f = poly (degree beside each point) against f = exact",
-        "error against the exact run",
-        &[
-            WorkSeries {
-                name: "max loop-closure residual (rad; exact at its own)".into(),
-                points: drift,
-            },
-            WorkSeries {
-                name: "angles at contact − exact (rad)".into(),
-                points: angles,
-            },
-            WorkSeries {
-                name: "|contact time − exact| / contact time".into(),
-                points: timing,
-            },
-        ],
-    )
-    .unwrap();
-    write_atomic(&out.join("poly_vs_exact.svg"), figure.as_bytes()).unwrap();
-
     // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
     let ramp = nanofold::io::load_scene(Path::new("patterns/corner_cube_step1_ramp.scene.json"))
         .and_then(|spec| spec.build())
@@ -161,11 +131,6 @@ fn main() {
         "model": "quasi_static", "seconds": qs_seconds, "error_bound_rad": qs.quasi_static_error_estimate,
         "measured_error_rad": qs_measured,
     })];
-    let mut ramp_points = vec![WorkPoint {
-        label: "quasi-static".into(),
-        seconds: qs_seconds,
-        error: qs.quasi_static_error_estimate,
-    }];
     for rtol in [1e-10, 1e-11] {
         let dynamic = SimulationSettings {
             model: ModelChoice::Dynamic,
@@ -188,22 +153,7 @@ fn main() {
             "model": "dynamic", "method": "esdirk34", "rtol": rtol, "seconds": seconds, "steps": run.steps,
             "deviation_from_quasi_static_rad": deviation,
         }));
-        ramp_points.push(WorkPoint {
-            label: format!("ESDIRK34 {rtol:.0e}"),
-            seconds,
-            error: deviation,
-        });
     }
-    let figure = work_precision_svg(
-        "corner cube step 1 etch ramp: quasi-static (its error bound) against dynamic (its distance from it)",
-        "error (rad)",
-        &[WorkSeries {
-            name: "ramp models".into(),
-            points: ramp_points,
-        }],
-    )
-    .unwrap();
-    write_atomic(&out.join("ramp.svg"), figure.as_bytes()).unwrap();
     let report = json!({
         "machine": machine(),
         "runs_per_point": RUNS,
@@ -215,5 +165,8 @@ fn main() {
         serde_json::to_string_pretty(&report).unwrap().as_bytes(),
     )
     .unwrap();
+    for (name, svg) in figures::figures(&report) {
+        write_atomic(&out.join(name), svg.as_bytes()).unwrap();
+    }
     println!("wrote {}/{{report.json, poly_vs_exact.svg, ramp.svg}}", out.display());
 }
