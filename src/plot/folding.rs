@@ -2,7 +2,7 @@
 //! four moments.
 
 use super::canvas::{canvas, px, shown_at};
-use super::{axis_range, plot_error};
+use super::{axis_range, draw_side_legend, plot_error, LineKind, LEGEND_MARGIN};
 use crate::error::Result;
 use crate::folding::{panel_poses, FoldPath, FoldingModel};
 use crate::io::folding_output::evenly;
@@ -22,6 +22,45 @@ pub fn fold_svg(model: &FoldingModel, path: &FoldPath, title: &str) -> Result<St
         "progress",
         title,
     )
+}
+
+/// Line colours by assignment: valley, mountain, other (flat or unassigned).
+const ASSIGNMENT_COLOURS: [RGBColor; 3] = [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(127, 127, 127)];
+
+/// Index into [`ASSIGNMENT_COLOURS`].
+fn assignment_kind(kind: &EdgeKind) -> usize {
+    match kind {
+        EdgeKind::Crease(Assignment::Valley) => 0,
+        EdgeKind::Crease(Assignment::Mountain) => 1,
+        _ => 2,
+    }
+}
+
+/// The side legend of a figure coloured by assignment: how many lines of each, and how many
+/// of all were drawn.
+fn draw_assignment_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    counts: [usize; 3],
+    drawn: usize,
+    total: usize,
+) -> Result<()> {
+    let names = ["valley", "mountain", "flat or unassigned"];
+    let mut entries: Vec<(String, RGBColor, LineKind)> = (0..3)
+        .filter(|&k| counts[k] > 0)
+        .map(|k| {
+            (
+                format!("{} ({})", names[k], counts[k]),
+                ASSIGNMENT_COLOURS[k],
+                LineKind::Solid,
+            )
+        })
+        .collect();
+    if drawn < total {
+        entries.push((format!("{drawn} of {total} drawn"), WHITE, LineKind::Solid));
+    }
+    // A line with no legend colour of its own: creases that fold alike draw one line.
+    entries.push(("same angles: one line".into(), WHITE, LineKind::Solid));
+    draw_side_legend(area, 44, &entries)
 }
 
 /// Fold angles of every crease against `xs` (one state per x), and 3D views of the panels
@@ -45,6 +84,7 @@ pub fn angles_svg(
         let mut chart = ChartBuilder::on(&top)
             .caption(title, ("sans-serif", 20))
             .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
             .x_label_area_size(px(36))
             .y_label_area_size(px(52))
             .build_cartesian_2d(axis_range(first, last, 0.02), -180.0..180.0)
@@ -58,12 +98,11 @@ pub fn angles_svg(
             .map_err(plot_error)?;
         // Creases that fold alike draw one line over another; colour says the assignment.
         let shown = evenly(pattern.creases.len(), 400);
+        let mut counts = [0usize; 3];
         for &column in &shown {
-            let colour = match pattern.kinds[pattern.creases[column]] {
-                EdgeKind::Crease(Assignment::Valley) => RGBColor(31, 119, 180),
-                EdgeKind::Crease(Assignment::Mountain) => RGBColor(214, 39, 40),
-                _ => RGBColor(127, 127, 127),
-            };
+            let kind = assignment_kind(&pattern.kinds[pattern.creases[column]]);
+            counts[kind] += 1;
+            let colour = ASSIGNMENT_COLOURS[kind];
             chart
                 .draw_series(LineSeries::new(
                     xs.iter().zip(states).map(|(x, s)| (*x, s[column].to_degrees())),
@@ -71,17 +110,7 @@ pub fn angles_svg(
                 ))
                 .map_err(plot_error)?;
         }
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!(
-                    "{} of {} creases drawn; blue valley, red mountain",
-                    shown.len(),
-                    pattern.creases.len()
-                ),
-                (first, 170.0),
-                ("sans-serif", 13),
-            )))
-            .map_err(plot_error)?;
+        draw_assignment_legend(&top, counts, shown.len(), pattern.creases.len())?;
 
         // 3D views at four moments, one scale for all.
         let picks = evenly(states.len(), 4);
@@ -171,6 +200,7 @@ pub fn network_constraints_svg(
                 ("sans-serif", 18),
             )
             .margin(px(12))
+            .margin_right(px(LEGEND_MARGIN))
             .x_label_area_size(px(36))
             .y_label_area_size(px(52))
             .build_cartesian_2d(axis_range(a, b, 0.02), -180.0..180.0)
@@ -187,13 +217,16 @@ pub fn network_constraints_svg(
         let columns: Vec<usize> = (0..sweep.states.first().map_or(0, Vec::len))
             .filter(|&c| c != driver)
             .collect();
+        let mut counts = [0usize; 3];
         for &i in &shown {
             let curve = &curves.curves[i];
-            let colour = if curve.assignment == "V" {
-                RGBColor(31, 119, 180)
-            } else {
-                RGBColor(214, 39, 40)
+            let kind = match curve.assignment.as_str() {
+                "V" => 0,
+                "M" => 1,
+                _ => 2,
             };
+            counts[kind] += 1;
+            let colour = ASSIGNMENT_COLOURS[kind];
             let column = columns[i];
             chart
                 .draw_series(
@@ -215,17 +248,19 @@ pub fn network_constraints_svg(
                 ))
                 .map_err(plot_error)?;
         }
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!(
-                    "{} of {} curves; dots: exact sweep (every 4th point), lines: fits; blue valley, red mountain",
-                    shown.len(),
-                    curves.curves.len()
+        draw_assignment_legend(&root, counts, shown.len(), curves.curves.len())?;
+        draw_side_legend(
+            &root,
+            110,
+            &[
+                (
+                    "dots: exact sweep (every 4th)".into(),
+                    RGBColor(90, 90, 90),
+                    LineKind::Dotted,
                 ),
-                (a, 170.0),
-                ("sans-serif", 13),
-            )))
-            .map_err(plot_error)?;
+                ("lines: fits".into(), RGBColor(90, 90, 90), LineKind::Solid),
+            ],
+        )?;
         root.present().map_err(plot_error)?;
     }
     Ok(shown_at(svg))
