@@ -253,11 +253,7 @@ pub fn network_constraints_svg(
             &root,
             110,
             &[
-                (
-                    "dots: exact sweep (every 4th)".into(),
-                    RGBColor(90, 90, 90),
-                    LineKind::Dotted,
-                ),
+                ("dots: exact (every 4th)".into(), RGBColor(90, 90, 90), LineKind::Dotted),
                 ("lines: fits".into(), RGBColor(90, 90, 90), LineKind::Solid),
             ],
         )?;
