@@ -67,6 +67,7 @@ pub(crate) fn draw_legend_in_margin<DB: DrawingBackend>(
                     .map_err(plot_error)?;
                 vec![]
             }
+            LineKind::Note => vec![],
         };
         for (a, b) in pieces {
             area.draw(&PathElement::new(vec![(x + pxi(a), y), (x + pxi(b), y)], style))
@@ -84,22 +85,14 @@ pub(crate) const LEGEND_MARGIN: u32 = 190;
 /// Series `i`'s line: eight colours, solid for the first eight series, dashed for the next
 /// eight, dotted after, so sixteen creases stay apart.
 pub(crate) fn series_line(i: usize) -> (RGBColor, LineKind) {
-    const COLOURS: [RGBColor; 8] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(23, 190, 207),
-        RGBColor(188, 189, 34),
-    ];
-    let kind = match i / COLOURS.len() {
+    // The palette without its red and grey, which mark contacts and targets.
+    const LINE_COLOURS: [usize; 8] = [0, 1, 2, 4, 5, 6, 9, 8];
+    let kind = match i / LINE_COLOURS.len() {
         0 => LineKind::Solid,
         1 => LineKind::Dashed,
         _ => LineKind::Dotted,
     };
-    (COLOURS[i % COLOURS.len()], kind)
+    (PALETTE[LINE_COLOURS[i % LINE_COLOURS.len()]], kind)
 }
 
 /// How a series' line is drawn.
@@ -110,6 +103,8 @@ pub(crate) enum LineKind {
     Dotted,
     /// A marker (a contact), no line.
     Cross,
+    /// A legend line of text alone.
+    Note,
 }
 
 /// Draws `points` as series `i` in its colour and dash (see [`series_line`]); returns its
@@ -129,7 +124,9 @@ pub(crate) fn draw_series_line<'a, DB: DrawingBackend + 'a>(
     match kind {
         LineKind::Solid => chart.draw_series(LineSeries::new(points, style)),
         LineKind::Dashed => chart.draw_series(DashedLineSeries::new(points, px(9), px(5), style)),
-        LineKind::Dotted | LineKind::Cross => chart.draw_series(DashedLineSeries::new(points, px(3), px(4), style)),
+        LineKind::Dotted | LineKind::Cross | LineKind::Note => {
+            chart.draw_series(DashedLineSeries::new(points, px(3), px(4), style))
+        }
     }
     .map_err(plot_error)?;
     Ok((label, colour, kind))
@@ -148,20 +145,22 @@ pub(crate) fn coinciding(series: &[Vec<f64>], tol: f64) -> Vec<Option<usize>> {
         .collect()
 }
 
+/// The ten colours every figure draws series in.
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
 /// Colour of series `i`.
 pub fn series_colour(i: usize) -> RGBColor {
-    const PALETTE: [RGBColor; 10] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(214, 39, 40),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
-    ];
     PALETTE[i % PALETTE.len()]
 }
 

@@ -228,22 +228,13 @@ fn strip_bodies(chain: &StripChain) -> Result<(Vec<BodySpec>, Vec<String>)> {
 /// `moment_about_crease_kg_m2` can. Every hinge of a strip turns about x, so only I_xx enters
 /// its motion: I_yy or I_zz is raised to the least value MuJoCo accepts, and the change named.
 fn satisfy_triangle_inequality(inertia: &mut [f64; 6]) -> Option<String> {
+    // Both I_zz ≤ I_xx + I_yy and I_xx ≤ I_yy + I_zz hold exactly when I_yy ≥ |I_xx − I_zz|.
     let [ixx, iyy, izz, ..] = *inertia;
-    if izz > ixx + iyy {
-        inertia[1] = izz - ixx;
-        Some(format!(
-            "I_yy raised from {iyy:.4e} to {:.4e} kg·m² so that I_zz ≤ I_xx + I_yy (it does not enter motion about x)",
-            inertia[1]
-        ))
-    } else if ixx > iyy + izz {
-        inertia[1] = ixx - izz;
-        Some(format!(
-            "I_yy raised from {iyy:.4e} to {:.4e} kg·m² so that I_xx ≤ I_yy + I_zz (it does not enter motion about x)",
-            inertia[1]
-        ))
-    } else {
-        None
-    }
+    let least = (ixx - izz).abs();
+    (iyy < least).then(|| {
+        inertia[1] = least;
+        format!("I_yy raised from {iyy:.4e} to {least:.4e} kg·m² to meet the triangle inequality (it does not enter motion about x)")
+    })
 }
 
 /// A closed chain's bodies: the sector plates on their tree, and a light body that turns

@@ -56,10 +56,10 @@ fn draw_assignment_legend<DB: DrawingBackend>(
         })
         .collect();
     if drawn < total {
-        entries.push((format!("{drawn} of {total} drawn"), WHITE, LineKind::Solid));
+        entries.push((format!("{drawn} of {total} drawn"), BLACK, LineKind::Note));
     }
-    // A line with no legend colour of its own: creases that fold alike draw one line.
-    entries.push(("same angles: one line".into(), WHITE, LineKind::Solid));
+    // Creases that fold alike draw one line.
+    entries.push(("same angles: one line".into(), BLACK, LineKind::Note));
     draw_side_legend(area, 44, &entries)
 }
 
