@@ -202,6 +202,10 @@ fn bad_closed_scenes_name_the_problem() {
         .unwrap_err()
         .to_string();
     assert!(no_face.contains("anchored_face") && no_face.contains('9'), "{no_face}");
+    let bad_scale = step1_scene(|v| v["hinges"][2]["stiffness_scale"] = serde_json::json!(-1))
+        .unwrap_err()
+        .to_string();
+    assert!(bad_scale.contains("hinges[2].stiffness_scale"), "{bad_scale}");
 }
 
 fn scene(name: &str, edit: impl Fn(&mut serde_json::Value)) -> Scene {
