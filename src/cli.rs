@@ -488,7 +488,7 @@ fn unfold_one(
         Err(e) if takes_many_vertices(&e, pattern_path) => {
             return folding::unfold_network_one(pattern_path, solver, dir)
         }
-        Err(e) => return Err(e.into()),
+        Err(e) => return Err(reading(pattern_path, e)),
     };
     let report = unfold_observed(&pattern, &settings, progress)?;
     let model = UnfoldModel::new(&pattern);
@@ -620,7 +620,14 @@ fn print_failure(path: &Path, error: &anyhow::Error, as_json: bool) {
             json!({"file": path.display().to_string(), "error": format!("{error:#}")})
         );
     } else {
-        println!("{}: error: {error:#}", path.display());
+        // The line starts with the file: the message need not name it again.
+        let message = format!("{error:#}");
+        let file = path.display().to_string();
+        let message = [format!("reading {file}: "), format!("{file}: ")]
+            .iter()
+            .find_map(|prefix| message.strip_prefix(prefix.as_str()))
+            .unwrap_or(&message);
+        println!("{file}: error: {message}");
     }
 }
 
@@ -775,7 +782,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     let pattern = match nanofold::io::load_pattern(&args.pattern, &options) {
         Ok(pattern) => pattern,
         Err(e) if takes_many_vertices(&e, &args.pattern) => return folding::run_network_constraints(args, degree),
-        Err(e) => return Err(e.into()),
+        Err(e) => return Err(reading(&args.pattern, e)),
     };
     let driver = crease_index(&pattern, args.drive, "--drive")?;
     let mut locks = args
@@ -1072,9 +1079,21 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
     result
 }
 
+/// A loader's error with the file named, once: I/O and JSON errors name it already.
+pub(crate) fn reading(path: &Path, error: nanofold::NanofoldError) -> anyhow::Error {
+    use nanofold::NanofoldError::{Io, Json};
+    let names_file = matches!(error, Io { .. } | Json { .. });
+    let error = anyhow::Error::new(error);
+    if names_file {
+        error
+    } else {
+        error.context(format!("reading {}", path.display()))
+    }
+}
+
 /// Loads a scene file and builds it (the closed chain's sweep and fit run here).
 fn load_scene(path: &Path) -> Result<Scene> {
-    let spec = nanofold::io::load_scene(path)?;
+    let spec = nanofold::io::load_scene(path).map_err(|e| reading(path, e))?;
     spec.build()
         .with_context(|| format!("building the scene of {}", path.display()))
 }

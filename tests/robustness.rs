@@ -612,3 +612,128 @@ fn a_file_of_the_wrong_kind_is_told_what_it_is() {
         "{e}"
     );
 }
+
+/// Runs the binary on files in a scratch folder; returns (exit code, stdout, stderr).
+fn run_in(dir: &Path, args: &[&str]) -> (Option<i32>, String, String) {
+    let out = nanofold().current_dir(dir).args(args).output().unwrap();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.code(), text(&out.stdout), text(&out.stderr))
+}
+
+#[test]
+fn a_sheet_with_no_face_or_an_edge_sticking_out_is_refused_by_name() {
+    // Was: an index panic in the panel tree (no face) and in the panel poses (an edge with
+    // no paper on either side), in `unfold` and `fold`.
+    let dir = scratch("degenerate-sheet");
+    std::fs::write(
+        dir.join("one_edge.fold"),
+        r#"{"vertices_coords":[[0,0],[1,0]],"edges_vertices":[[0,1]],"edges_assignment":["B"]}"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("sticking_out.fold"),
+        r#"{"vertices_coords":[[0,0],[1,0],[1,1],[0,1],[2,0]],"edges_vertices":[[0,1],[1,2],[2,3],[3,0],[1,4]],"edges_assignment":["B","B","B","B","B"]}"#,
+    )
+    .unwrap();
+    for (file, field, words) in [
+        ("one_edge.fold", "`edges_vertices`", "no region"),
+        (
+            "sticking_out.fold",
+            "`edges_vertices[4]`: [1, 4]",
+            "sticks out of the paper",
+        ),
+    ] {
+        for command in ["unfold", "fold"] {
+            let (code, _, stderr) = run_in(&dir, &[command, file, "--out", "out"]);
+            assert_eq!(code, Some(2), "{command} {file}: {stderr}");
+            assert!(
+                stderr.contains(file) && stderr.contains(field) && stderr.contains(words),
+                "{command} {file}: {stderr}"
+            );
+        }
+        let (code, stdout, _) = run_in(&dir, &["check", file]);
+        assert_eq!(code, Some(1), "check {file}: {stdout}");
+        assert!(stdout.contains(field), "check {file}: {stdout}");
+    }
+    assert!(!dir.join("out").exists(), "nothing is written for a refused file");
+}
+
+#[test]
+fn a_flat_sheet_without_creases_is_flat_and_a_non_rigid_start_prints_no_nan() {
+    // Was: `locked` for the flat square in `unfold` (its DOF test came before the flat
+    // test), `not_rigidly_foldable` in `check`, and
+    // "energy NaN -> NaN" for a start that does not close.
+    let dir = scratch("flat-square");
+    std::fs::write(
+        dir.join("square.fold"),
+        r#"{"vertices_coords":[[0,0],[2,0],[2,2],[0,2]],"edges_vertices":[[0,1],[1,2],[2,3],[3,0]],"edges_assignment":["B","B","B","B"]}"#,
+    )
+    .unwrap();
+    let (code, stdout, stderr) = run_in(&dir, &["unfold", "square.fold", "--json", "--out", "out"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(summary["verdict"], "flat", "{stdout}");
+    // `check` was `not_rigidly_foldable` for it: there is no assignment to fail.
+    let (code, stdout, _) = run_in(&dir, &["check", "square.fold"]);
+    assert_eq!(code, Some(0), "{stdout}");
+    assert!(
+        stdout.contains(": rigid (") && stdout.contains("no creases"),
+        "{stdout}"
+    );
+    // A crease that ends inside the paper, folded: no rigid state has it.
+    std::fs::write(
+        dir.join("slit.fold"),
+        r#"{"vertices_coords":[[0,0],[2,0],[2,2],[0,2],[1,1]],"edges_vertices":[[0,1],[1,2],[2,3],[3,0],[0,4]],"edges_assignment":["B","B","B","B","V"],"edges_foldAngle":[0,0,0,0,90]}"#,
+    )
+    .unwrap();
+    let (code, stdout, stderr) = run_in(&dir, &["unfold", "slit.fold", "--out", "out"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stdout.contains("not_rigid") && stdout.contains("energy not evaluated"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("NaN"), "{stdout}");
+}
+
+#[test]
+fn every_loader_error_names_its_file_once() {
+    // Was: "missing key `actuation`" and "invalid `edges_vertices[7]`" with no file named,
+    // and "F: error: reading F: F: malformed JSON" in `check`.
+    let dir = scratch("loader-errors");
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap()).unwrap();
+    scene.as_object_mut().unwrap().remove("actuation");
+    std::fs::write(dir.join("no_actuation.scene.json"), scene.to_string()).unwrap();
+    for command in ["simulate", "modes"] {
+        let (code, _, stderr) = run_in(&dir, &[command, "no_actuation.scene.json"]);
+        assert_eq!(code, Some(2), "{stderr}");
+        assert!(
+            stderr.contains("no_actuation.scene.json") && stderr.contains("missing key `actuation`"),
+            "{command}: {stderr}"
+        );
+    }
+    std::fs::write(
+        dir.join("bad_index.fold"),
+        r#"{"vertices_coords":[[0,0],[1,0],[0,1],[-1,0],[0,-1]],"edges_vertices":[[0,1],[0,2],[0,3],[0,4],[1,2],[2,3],[3,4],[4,9]],"edges_assignment":["M","V","M","V","B","B","B","B"]}"#,
+    )
+    .unwrap();
+    std::fs::write(dir.join("cut_short.fold"), "{").unwrap();
+    for args in [
+        vec!["unfold", "bad_index.fold", "--out", "out"],
+        vec!["fold", "bad_index.fold", "--out", "out"],
+        vec!["constraints", "bad_index.fold", "--drive", "0", "--out", "out"],
+    ] {
+        let (code, _, stderr) = run_in(&dir, &args);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("bad_index.fold") && stderr.contains("`edges_vertices[7]`: 9"),
+            "{args:?}: {stderr}"
+        );
+    }
+    let (_, stdout, _) = run_in(&dir, &["check", "cut_short.fold", "bad_index.fold"]);
+    for file in ["cut_short.fold", "bad_index.fold"] {
+        let line = stdout.lines().find(|l| l.starts_with(file)).unwrap_or_default();
+        assert_eq!(line.matches(file).count(), 1, "{stdout}");
+        assert!(line.contains(": error: "), "{stdout}");
+    }
+}

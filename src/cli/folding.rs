@@ -1,7 +1,7 @@
 //! The commands for crease patterns of many vertices: `fold`, `generate`, and `check` on a
 //! pattern the single-vertex engine does not take.
 
-use super::{default_folder, print_written, write_outputs};
+use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::folding::{
@@ -290,7 +290,7 @@ fn load_projected(path: &Path, project: bool) -> Result<(FoldingModel, Option<(S
 }
 
 fn load_model(path: &Path) -> Result<FoldingModel> {
-    let pattern = nanofold::io::load_crease_pattern(path).with_context(|| format!("reading {}", path.display()))?;
+    let pattern = nanofold::io::load_crease_pattern(path).map_err(|e| reading(path, e))?;
     Ok(FoldingModel::new(pattern)?)
 }
 
@@ -790,13 +790,16 @@ pub fn unfold_network_one(
     )?;
     writeln!(
         text,
-        "  {} creases at {} vertices: {} steps in {:.3} s; energy {:.6e} -> {:.6e}",
+        "  {} creases at {} vertices: {} steps in {:.3} s; energy {}",
         model.crease_count(),
         model.stars.len(),
         report.iterations,
         seconds,
-        report.steps[0].energy,
-        last.energy
+        if report.steps[0].energy.is_finite() {
+            format!("{:.6e} -> {:.6e}", report.steps[0].energy, last.energy)
+        } else {
+            "not evaluated (the start is not a rigid state)".to_string()
+        }
     )?;
     writeln!(
         text,

@@ -214,6 +214,12 @@ pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<C
         let parts: Vec<String> = facets.into_iter().chain(development).chain(warped).collect();
         (!parts.is_empty()).then(|| parts.join("; "))
     });
+    if model.crease_count() == 0 && bent.is_none() {
+        // No assignment to test: the flat sheet is the one state, and it is rigid.
+        report.verdict = PatternVerdict::Rigid;
+        report.evidence = "no creases: the paper is one rigid panel (0 DOF); nothing to fold".to_string();
+        return Ok(report);
+    }
     if has_state || bent.is_some() {
         (report.verdict, report.evidence) = if let Some(bent) = bent {
             (

@@ -476,6 +476,13 @@ fn check_disc(
     kinds: &[EdgeKind],
     vertex_count: usize,
 ) -> Result<()> {
+    if faces.is_empty() {
+        return Err(NanofoldError::invalid(
+            "edges_vertices",
+            format!("{} edges", edges.len()),
+            "the edges enclose no region: the paper needs at least one face (an outline of boundary (B) edges)",
+        ));
+    }
     if outer.len() != 1 {
         return Err(NanofoldError::invalid(
             "edges_vertices",
@@ -503,7 +510,18 @@ fn check_disc(
     let mut on_outline: std::collections::HashSet<[usize; 2]> = std::collections::HashSet::new();
     for k in 0..loop_.len() {
         let (u, v) = (loop_[k], loop_[(k + 1) % loop_.len()]);
-        on_outline.insert([u.min(v), u.max(v)]);
+        if !on_outline.insert([u.min(v), u.max(v)]) {
+            // The outline walks this edge both ways: no paper on either side.
+            let e = edges
+                .iter()
+                .position(|&[a, b]| [a.min(b), a.max(b)] == [u.min(v), u.max(v)])
+                .unwrap_or(0);
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{e}]"),
+                format!("{:?}", edges[e]),
+                "the edge sticks out of the paper (no face on either side): remove it or close the outline",
+            ));
+        }
     }
     for (e, &[a, b]) in edges.iter().enumerate() {
         let outside = on_outline.contains(&[a.min(b), a.max(b)]);

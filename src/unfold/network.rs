@@ -563,7 +563,9 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             restarts_used: restarts.get(),
         })
     };
-    if jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
+    // An already flat start is `flat` (the loop says so at step 0), even with no motion.
+    let already_flat = rho.iter().all(|r| r.abs() <= settings.flat_tol);
+    if !already_flat && jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
         return finish(
             NetworkVerdict::Locked,
             "0 degrees of freedom at the start: no rigid motion".into(),
