@@ -83,6 +83,35 @@ fn main() {
         assert_eq!(contacts.crossing().count(), 0);
     }
     println!();
+    println!("DOF at the flat Miura-ori (many small singular values: the hard case of the sparse count); best of 3 runs, milliseconds");
+    println!(
+        "{:>4} {:>7} {:>9} {:>9} {:>5} {:>5} {:>11} {:>11}",
+        "n", "creases", "QR rank", "sparse", "dofQR", "dofSp", "kept σ", "dropped σ"
+    );
+    for n in [8, 16, 24, 32, 40] {
+        let model = miura(n, 0.0);
+        let rho = model.given_fold_angles();
+        let jac = closure_jacobian(&model, &rho);
+        let dense = (model.crease_count() <= 2000).then(|| best_of(3, || jacobian_rank_dense(&jac)));
+        let (t_sparse, sparse) = best_of(3, || jacobian_rank_sparse(&jac).unwrap());
+        println!(
+            "{:>4} {:>7} {:>9} {:>9.1} {:>5} {:>5} {:>11.2e} {:>11.2e}",
+            n,
+            model.crease_count(),
+            dense
+                .as_ref()
+                .map_or("-".to_string(), |(t, _)| format!("{:.1}", 1e3 * t)),
+            1e3 * t_sparse,
+            dense.as_ref().map_or("-".to_string(), |(_, r)| r.dof.to_string()),
+            sparse.dof,
+            sparse.smallest_kept,
+            sparse.largest_dropped,
+        );
+        if let Some((_, dense)) = &dense {
+            assert_eq!(dense.dof, sparse.dof, "n = {n}: the two counts disagree");
+        }
+    }
+    println!();
     println!("Folding the flat Miura-ori to 95% (max step 0.05 rad); best of 3 runs");
     println!(
         "{:>4} {:>7} {:>9} {:>6} {:>7} {:>12} {:>12}",

@@ -531,6 +531,23 @@ fn the_sparse_dof_count_agrees_with_the_pivoted_qr() {
     }
 }
 
+/// At the flat state each star's axes lie in the plane: its closure linearises to two
+/// independent equations (the in-plane rotation), so the first-order count is creases −
+/// 2 · interior vertices. The sparse count gets it on flat Miura-ori past the dense limit,
+/// where many small singular values sit just above the threshold.
+#[test]
+fn the_sparse_count_at_the_flat_miura_ori_is_creases_minus_two_per_vertex() {
+    use nanofold::folding::jacobian_rank_sparse;
+    for n in [36, 40] {
+        let model = miura(n, n, 60.0, 0.0);
+        let jac = closure_jacobian(&model, &model.given_fold_angles());
+        let count = jacobian_rank_sparse(&jac).unwrap();
+        let expected = model.crease_count() - 2 * model.stars.len();
+        assert_eq!(count.dof, expected, "n = {n}: {count:?}");
+        assert!(count.smallest_kept > 1e6 * count.threshold, "n = {n}: {count:?}");
+    }
+}
+
 /// Constraint curves of a Miura-ori: the exact sweep is the closed form at every point, and
 /// the fit's error, measured at points it did not see, falls with the degree.
 #[test]

@@ -13,6 +13,10 @@ use faer::Mat;
 /// so |R_00| is that norm.)
 pub const RANK_TOL: f64 = 1e-9;
 
+/// How far above the threshold (in eigenvalues of JᵀJ, squared singular values) the first
+/// value counted in the rank must settle before the sparse count stops early.
+const COUNT_GAP: f64 = 1e6;
+
 /// Patterns with more creases than this get the sparse count (the dense QR costs
 /// O(rows·creases²): about 0.13 s at 1100 creases, 1 s at 2000).
 pub const DENSE_RANK_LIMIT: usize = 1200;
@@ -114,7 +118,7 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     let threshold_lambda = RANK_TOL * RANK_TOL * scale;
     let mut block = 8.min(n);
     loop {
-        let ritz = smallest_eigenvalues(jacobian, &factor, block);
+        let ritz = smallest_eigenvalues(jacobian, &factor, block, threshold_lambda);
         let count = ritz.iter().filter(|&&l| l <= threshold_lambda).count();
         if count < block || block == n {
             let sigma = |l: f64| l.max(0.0).sqrt();
@@ -133,7 +137,19 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
 }
 
 /// Ritz values (ascending) of JᵀJ on the block that inverse subspace iteration settles on.
-fn smallest_eigenvalues(jacobian: &ClosureJacobian, factor: &super::normal::NormalFactor, block: usize) -> Vec<f64> {
+///
+/// Ritz values bound the eigenvalues from above (the k-th Ritz value is at least the k-th
+/// eigenvalue), so a block whose every Ritz value is at or below `threshold` holds that many
+/// null directions for certain, and the iteration stops at once. Otherwise it stops when all
+/// Ritz values settle, or earlier when the count at or below `threshold` has held and the
+/// first value above it has settled [`COUNT_GAP`] times above it: an uncaught null direction
+/// grows by that ratio each iteration, so it could not stay hidden.
+fn smallest_eigenvalues(
+    jacobian: &ClosureJacobian,
+    factor: &super::normal::NormalFactor,
+    block: usize,
+    threshold: f64,
+) -> Vec<f64> {
     let n = jacobian.cols;
     // A fixed pseudo-random start (the count must not depend on the run).
     let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
@@ -141,18 +157,24 @@ fn smallest_eigenvalues(jacobian: &ClosureJacobian, factor: &super::normal::Norm
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     });
+    let count_of = |ritz: &[f64]| ritz.iter().filter(|&&l| l <= threshold).count();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(1e-3 * factor.max_diagonal * RANK_TOL * RANK_TOL);
     let mut previous: Vec<f64> = Vec::new();
-    for _ in 0..60 {
+    for iteration in 0..60 {
         factor.solve_many(x.as_mut());
         orthonormalise(&mut x);
         let ritz = rayleigh_ritz(jacobian, &x);
-        let settled = previous.len() == ritz.len()
-            && ritz
-                .iter()
-                .zip(&previous)
-                .all(|(a, b)| (a - b).abs() <= 1e-6 * a.abs().max(1e-3 * factor.max_diagonal * RANK_TOL * RANK_TOL));
+        let count = count_of(&ritz);
+        let all_null = count == ritz.len();
+        let all_settled = previous.len() == ritz.len() && ritz.iter().zip(&previous).all(|(a, b)| close(*a, *b));
+        let count_settled = iteration >= 2
+            && previous.len() == ritz.len()
+            && count < ritz.len()
+            && count_of(&previous) == count
+            && ritz[count] >= COUNT_GAP * threshold
+            && close(ritz[count], previous[count]);
         previous = ritz;
-        if settled {
+        if all_null || all_settled || count_settled {
             break;
         }
     }
