@@ -523,8 +523,15 @@ fn unfold_one(
     )?;
     writeln!(
         text,
-        "  max arc residual {:.2e} rad, planarity residual {:.2e}, flat layout error {:.2e}, restarts {}",
-        report.max_arc_residual, report.planarity_residual, report.flat_layout_error, report.restarts_used
+        "  max arc residual {:.2e} rad, planarity residual {:.2e}, flat layout error {}, restarts {}",
+        report.max_arc_residual,
+        report.planarity_residual,
+        if report.flat_layout_error.is_finite() {
+            format!("{:.2e}", report.flat_layout_error)
+        } else {
+            "none (no flat state)".to_string()
+        },
+        report.restarts_used
     )?;
     for (c, rho) in pattern.creases.iter().zip(&report.final_fold_angles_rad) {
         writeln!(

@@ -99,7 +99,8 @@ pub struct UnfoldReport {
     pub max_arc_residual: f64,
     /// Largest distance of a node from the best-fit great-circle plane at the end.
     pub planarity_residual: f64,
-    /// Largest node distance from the exact flat layout at the end (meaningful when flat).
+    /// Largest node distance from the exact flat layout at the end (meaningful when flat;
+    /// NaN for a pattern with no flat state, a cone, and `null` in the CLI's JSON).
     pub flat_layout_error: f64,
     /// Restarts from perturbed states taken.
     pub restarts_used: usize,

@@ -737,3 +737,15 @@ fn every_loader_error_names_its_file_once() {
         assert!(line.contains(": error: "), "{stdout}");
     }
 }
+
+#[test]
+fn a_cone_prints_no_nan_for_its_missing_flat_layout() {
+    // Was: "flat layout error NaN" for a vertex whose sectors do not sum to 360°.
+    let dir = scratch("cone");
+    let cone = std::fs::canonicalize("patterns/cone.json").unwrap();
+    let (code, stdout, stderr) = run_in(&dir, &["unfold", cone.to_str().unwrap(), "--out", "out"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("not_flat_foldable"), "{stdout}");
+    assert!(stdout.contains("flat layout error none (no flat state)"), "{stdout}");
+    assert!(!stdout.contains("NaN"), "{stdout}");
+}
