@@ -5,8 +5,12 @@
 
 use super::closure::ClosureJacobian;
 use super::normal::NormalSolver;
-use crate::error::Result;
-use faer::Mat;
+use crate::error::{NumericalError, Result};
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::svd::{svd, svd_scratch, ComputeSvdVectors};
+use faer::linalg::{householder, qr};
+use faer::{Mat, Par};
 
 /// A diagonal entry of R (dense) or a singular value (sparse) at or below this fraction
 /// of J's largest column norm counts as zero. (Pivoted QR puts the largest column first,
@@ -117,8 +121,18 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     let scale = factor.max_diagonal;
     let threshold_lambda = RANK_TOL * RANK_TOL * scale;
     let mut block = 8.min(n);
+    // A fixed pseudo-random start (the count must not depend on the run). A doubled block
+    // keeps the null directions already found and adds fresh columns.
+    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut fresh = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    let mut x = Mat::<f64>::zeros(n, 0);
     loop {
-        let ritz = smallest_eigenvalues(jacobian, &factor, block, threshold_lambda);
+        let kept = x.ncols();
+        x = Mat::<f64>::from_fn(n, block, |i, j| if j < kept { x[(i, j)] } else { fresh() });
+        let ritz = smallest_eigenvalues(jacobian, &factor, &mut x, threshold_lambda)?;
         let count = ritz.iter().filter(|&&l| l <= threshold_lambda).count();
         if count < block || block == n {
             let sigma = |l: f64| l.max(0.0).sqrt();
@@ -136,7 +150,8 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     }
 }
 
-/// Ritz values (ascending) of JᵀJ on the block that inverse subspace iteration settles on.
+/// Ritz values (ascending) of JᵀJ on the block that inverse subspace iteration settles on,
+/// starting from X and leaving its last iterate there.
 ///
 /// Ritz values bound the eigenvalues from above (the k-th Ritz value is at least the k-th
 /// eigenvalue), so a block whose every Ritz value is at or below `threshold` holds that many
@@ -147,23 +162,16 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
 fn smallest_eigenvalues(
     jacobian: &ClosureJacobian,
     factor: &super::normal::NormalFactor,
-    block: usize,
+    x: &mut Mat<f64>,
     threshold: f64,
-) -> Vec<f64> {
-    let n = jacobian.cols;
-    // A fixed pseudo-random start (the count must not depend on the run).
-    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut x = Mat::<f64>::from_fn(n, block, |_, _| {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-    });
+) -> Result<Vec<f64>> {
     let count_of = |ritz: &[f64]| ritz.iter().filter(|&&l| l <= threshold).count();
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(1e-3 * factor.max_diagonal * RANK_TOL * RANK_TOL);
     let mut previous: Vec<f64> = Vec::new();
     for iteration in 0..60 {
         factor.solve_many(x.as_mut());
-        orthonormalise(&mut x);
-        let ritz = rayleigh_ritz(jacobian, &x);
+        orthonormalise(x);
+        let ritz = rayleigh_ritz(jacobian, x)?;
         let count = count_of(&ritz);
         let all_null = count == ritz.len();
         let all_settled = previous.len() == ritz.len() && ritz.iter().zip(&previous).all(|(a, b)| close(*a, *b));
@@ -178,39 +186,45 @@ fn smallest_eigenvalues(
             break;
         }
     }
-    previous
+    Ok(previous)
 }
 
-/// Modified Gram–Schmidt on the columns (twice, for orthogonality to rounding).
+/// Orthonormal columns spanning X's (Householder QR, faer's blocked kernels).
 fn orthonormalise(x: &mut Mat<f64>) {
-    let (n, b) = (x.nrows(), x.ncols());
-    for _ in 0..2 {
-        for j in 0..b {
-            for i in 0..j {
-                let dot: f64 = (0..n).map(|k| x[(k, i)] * x[(k, j)]).sum();
-                for k in 0..n {
-                    let v = x[(k, i)];
-                    x[(k, j)] -= dot * v;
-                }
-            }
-            let norm = (0..n)
-                .map(|k| x[(k, j)] * x[(k, j)])
-                .sum::<f64>()
-                .sqrt()
-                .max(f64::MIN_POSITIVE);
-            for k in 0..n {
-                x[(k, j)] /= norm;
-            }
-        }
-    }
+    let (rows, cols) = (x.nrows(), x.ncols());
+    let block = qr::no_pivoting::factor::recommended_block_size::<f64>(rows, cols);
+    let mut householder = Mat::<f64>::zeros(block, cols.min(rows));
+    let req = StackReq::any_of(&[
+        qr::no_pivoting::factor::qr_in_place_scratch::<f64>(rows, cols, block, Par::Seq, Default::default()),
+        householder::apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(rows, block, cols),
+    ]);
+    let mut buffer = MemBuffer::new(req);
+    qr::no_pivoting::factor::qr_in_place(
+        x.as_mut(),
+        householder.as_mut(),
+        Par::Seq,
+        MemStack::new(&mut buffer),
+        Default::default(),
+    );
+    // Q's first columns: Q applied to the identity's.
+    let mut q = Mat::<f64>::from_fn(rows, cols, |i, j| if i == j { 1.0 } else { 0.0 });
+    householder::apply_block_householder_sequence_on_the_left_in_place_with_conj(
+        x.as_ref(),
+        householder.as_ref(),
+        faer::Conj::No,
+        q.as_mut(),
+        Par::Seq,
+        MemStack::new(&mut buffer),
+    );
+    *x = q;
 }
 
 /// Eigenvalues (ascending) of XᵀJᵀJX for orthonormal X, as the squared singular values of
 /// JX: the singular values keep their absolute accuracy (ε‖J‖) where the eigenvalues of the
 /// Gram matrix would lose the small ones below √ε.
-fn rayleigh_ritz(jacobian: &ClosureJacobian, x: &Mat<f64>) -> Vec<f64> {
+fn rayleigh_ritz(jacobian: &ClosureJacobian, x: &Mat<f64>) -> Result<Vec<f64>> {
     let (n, b) = (x.nrows(), x.ncols());
-    let mut jx = nalgebra::DMatrix::<f64>::zeros(jacobian.rows.max(1), b);
+    let mut jx = Mat::<f64>::zeros(jacobian.rows.max(1), b);
     let mut column = vec![0.0; n];
     let mut image = vec![0.0; jacobian.rows];
     for j in 0..b {
@@ -222,9 +236,34 @@ fn rayleigh_ritz(jacobian: &ClosureJacobian, x: &Mat<f64>) -> Vec<f64> {
             jx[(r, j)] = *v;
         }
     }
-    let mut values: Vec<f64> = jx.singular_values().iter().map(|s| s * s).collect();
+    // Sequential: at these sizes faer's threads cost more than they save on 2 cores.
+    let (rows, cols) = (jx.nrows(), jx.ncols());
+    let req = svd_scratch::<f64>(
+        rows,
+        cols,
+        ComputeSvdVectors::No,
+        ComputeSvdVectors::No,
+        Par::Seq,
+        Default::default(),
+    );
+    let mut buffer = MemBuffer::new(req);
+    let mut singular = Diag::<f64>::zeros(rows.min(cols));
+    svd(
+        jx.as_ref(),
+        singular.as_mut(),
+        None,
+        None,
+        Par::Seq,
+        MemStack::new(&mut buffer),
+        Default::default(),
+    )
+    .map_err(|_| NumericalError::NonFinite {
+        what: "singular values of J X (sparse DOF count)",
+        detail: "the SVD did not converge".into(),
+    })?;
+    let mut values: Vec<f64> = singular.column_vector().iter().map(|s| s * s).collect();
     // JX has min(rows, b) singular values; a block wider than J is tall has zeros besides.
     values.resize(b, 0.0);
     values.sort_by(f64::total_cmp);
-    values
+    Ok(values)
 }
