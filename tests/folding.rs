@@ -548,6 +548,46 @@ fn the_sparse_count_at_the_flat_miura_ori_is_creases_minus_two_per_vertex() {
     }
 }
 
+/// Within 1e-5° of flat the Miura-ori's first-order singular values (∝ the fold angle)
+/// pass through the threshold one by one. The sparse count must give the SVD's count there:
+/// it once reported 0 DOF (its null direction was mixed with the cluster of small singular
+/// values the normal equations cannot separate), where the SVD has 1 to 7.
+#[test]
+fn the_sparse_count_near_flat_is_the_svds_count() {
+    use nanofold::folding::{jacobian_rank_sparse, RANK_TOL};
+    for n in [8, 12, 16] {
+        for zigzag_deg in [5e-7, 1e-6, 2e-6, 5e-6] {
+            let model = miura(n, n, 60.0, zigzag_deg);
+            let jac = closure_jacobian(&model, &model.given_fold_angles());
+            let mut dense = nalgebra::DMatrix::<f64>::zeros(jac.rows, jac.cols);
+            for &(r, c, v) in &jac.entries {
+                dense[(r, c)] += v;
+            }
+            let largest_column = (0..jac.cols).map(|c| dense.column(c).norm()).fold(0.0, f64::max);
+            let threshold = RANK_TOL * largest_column;
+            let singular = dense.singular_values();
+            let svd_dof = jac.cols - singular.iter().filter(|&&s| s > threshold).count();
+            let count = jacobian_rank_sparse(&jac).unwrap();
+            assert_eq!(count.dof, svd_dof, "n = {n}, {zigzag_deg}°: {count:?}");
+            // The values either side of the threshold are the SVD's, not upper bounds.
+            let below = singular.iter().copied().filter(|&s| s <= threshold).fold(0.0, f64::max);
+            let above = singular
+                .iter()
+                .copied()
+                .filter(|&s| s > threshold)
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                (count.largest_dropped - below).abs() <= 1e-3 * below + 1e-6 * threshold,
+                "n = {n}, {zigzag_deg}°: {count:?}, SVD {below:e}"
+            );
+            assert!(
+                (count.smallest_kept - above).abs() <= 1e-3 * above,
+                "n = {n}, {zigzag_deg}°: {count:?}, SVD {above:e}"
+            );
+        }
+    }
+}
+
 /// Constraint curves of a Miura-ori: the exact sweep is the closed form at every point, and
 /// the fit's error, measured at points it did not see, falls with the degree.
 #[test]

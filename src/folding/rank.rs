@@ -21,6 +21,12 @@ pub const RANK_TOL: f64 = 1e-9;
 /// value counted in the rank must settle before the sparse count stops early.
 const COUNT_GAP: f64 = 1e6;
 
+/// Eigenvalues of JᵀJ within this multiple of μ form a cluster the shifted inverse cannot
+/// separate (its factorisation's backward error is of order μ too): the block is doubled
+/// until its largest Ritz value clears this level, so that the block holds the whole
+/// cluster and Rayleigh–Ritz, on JX itself, separates the null directions inside it.
+const CLUSTER_LEVEL: f64 = 1e3;
+
 /// Patterns with more creases than this get the sparse count (the dense QR costs
 /// O(rows·creases²): about 0.13 s at 1100 creases, 1 s at 2000).
 pub const DENSE_RANK_LIMIT: usize = 1200;
@@ -120,6 +126,7 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     let factor = solver.factor(jacobian)?;
     let scale = factor.max_diagonal;
     let threshold_lambda = RANK_TOL * RANK_TOL * scale;
+    let cluster_lambda = CLUSTER_LEVEL * COUNT_REGULARISATION * scale;
     let mut block = 8.min(n);
     // A fixed pseudo-random start (the count must not depend on the run). A doubled block
     // keeps the null directions already found and adds fresh columns.
@@ -132,9 +139,10 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     loop {
         let kept = x.ncols();
         x = Mat::<f64>::from_fn(n, block, |i, j| if j < kept { x[(i, j)] } else { fresh() });
-        let ritz = smallest_eigenvalues(jacobian, &factor, &mut x, threshold_lambda)?;
+        let ritz = smallest_eigenvalues(jacobian, &factor, &mut x, threshold_lambda, cluster_lambda)?;
         let count = ritz.iter().filter(|&&l| l <= threshold_lambda).count();
-        if count < block || block == n {
+        let within_cluster = ritz.last().is_some_and(|&l| l <= cluster_lambda);
+        if (count < block && !within_cluster) || block == n {
             let sigma = |l: f64| l.max(0.0).sqrt();
             return Ok(RankReport {
                 rank: n - count,
@@ -155,7 +163,8 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
 ///
 /// Ritz values bound the eigenvalues from above (the k-th Ritz value is at least the k-th
 /// eigenvalue), so a block whose every Ritz value is at or below `threshold` holds that many
-/// null directions for certain, and the iteration stops at once. Otherwise it stops when all
+/// null directions for certain, and the iteration stops at once; so it does when every Ritz
+/// value is within the `cluster` level (the block is to be widened). Otherwise it stops when all
 /// Ritz values settle, or earlier when the count at or below `threshold` has held and the
 /// first value above it has settled [`COUNT_GAP`] times above it: an uncaught null direction
 /// grows by that ratio each iteration, so it could not stay hidden.
@@ -164,6 +173,7 @@ fn smallest_eigenvalues(
     factor: &super::normal::NormalFactor,
     x: &mut Mat<f64>,
     threshold: f64,
+    cluster: f64,
 ) -> Result<Vec<f64>> {
     let count_of = |ritz: &[f64]| ritz.iter().filter(|&&l| l <= threshold).count();
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(1e-3 * factor.max_diagonal * RANK_TOL * RANK_TOL);
@@ -173,7 +183,9 @@ fn smallest_eigenvalues(
         orthonormalise(x);
         let ritz = rayleigh_ritz(jacobian, x)?;
         let count = count_of(&ritz);
-        let all_null = count == ritz.len();
+        // Every Ritz value counted, or all within the unresolved cluster: a wider block
+        // is needed either way (Ritz values only fall with more iterations).
+        let all_null = count == ritz.len() || ritz.last().is_some_and(|&l| l <= cluster);
         let all_settled = previous.len() == ritz.len() && ritz.iter().zip(&previous).all(|(a, b)| close(*a, *b));
         let count_settled = iteration >= 2
             && previous.len() == ritz.len()
