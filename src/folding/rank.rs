@@ -118,8 +118,9 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
 /// multiplied by (JᵀJ + μI)⁻¹ until the singular values of JX (Rayleigh–Ritz values)
 /// settle; those at or below RANK_TOL·(largest column norm) are the null space. Ritz values bound the
 /// eigenvalues from above, so every one counted is a true small singular value; the block
-/// is doubled while all of it is counted, so the count is complete once the next Ritz value
-/// is above the threshold.
+/// is doubled while all of it is counted, or while all of it lies within the cluster the
+/// shifted inverse cannot separate (10³ μ), so the count is complete once the
+/// next Ritz value is above the threshold (`docs/model.md#rigid-folding`).
 pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
     let n = jacobian.cols;
     let mut solver = NormalSolver::new(COUNT_REGULARISATION);
