@@ -1077,3 +1077,127 @@ fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
     let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
     assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
 }
+
+/// Distance from p to segment [a, b].
+fn point_segment(p: &nalgebra::Vector3<f64>, a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+    (p - (a + ab * t)).norm()
+}
+
+/// Distance between two non-crossing triangles, the slow way: the least of every vertex
+/// against the other triangle (its plane when the foot falls inside, else its edges) and
+/// every edge pair, the latter by a fine scan of one edge against the other's distance.
+fn triangle_gap(s: &[nalgebra::Vector3<f64>; 3], t: &[nalgebra::Vector3<f64>; 3]) -> f64 {
+    let point_triangle = |p: &nalgebra::Vector3<f64>, tri: &[nalgebra::Vector3<f64>; 3]| {
+        let normal = (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).normalize();
+        let foot = p - normal * (p - tri[0]).dot(&normal);
+        let inside = (0..3).all(|k| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            (b - a).cross(&(foot - a)).dot(&normal) >= 0.0
+        });
+        let edges = (0..3)
+            .map(|k| point_segment(p, &tri[k], &tri[(k + 1) % 3]))
+            .fold(f64::INFINITY, f64::min);
+        if inside {
+            (p - foot).norm().min(edges)
+        } else {
+            edges
+        }
+    };
+    let mut best = f64::INFINITY;
+    for p in s {
+        best = best.min(point_triangle(p, t));
+    }
+    for p in t {
+        best = best.min(point_triangle(p, s));
+    }
+    // Edge–edge: the distance from a point of one edge to the other is convex along the
+    // edge; golden-section search finds its minimum.
+    for i in 0..3 {
+        for j in 0..3 {
+            let (a, b) = (s[i], s[(i + 1) % 3]);
+            let (c, d) = (t[j], t[(j + 1) % 3]);
+            let f = |u: f64| point_segment(&(a + (b - a) * u), &c, &d);
+            let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+            for _ in 0..200 {
+                let m1 = lo + (hi - lo) * 0.381_966;
+                let m2 = hi - (hi - lo) * 0.381_966;
+                if f(m1) <= f(m2) {
+                    hi = m2;
+                } else {
+                    lo = m1;
+                }
+            }
+            best = best.min(f(0.5 * (lo + hi)));
+        }
+    }
+    best
+}
+
+/// The smallest clearance the contact test reports along a folding path is the least
+/// distance over every pair of panels that share no vertex, found by brute force with a
+/// separate triangle distance (the test prunes pairs that cannot lower it).
+#[test]
+fn the_smallest_panel_clearance_matches_a_brute_force_search() {
+    let mut checked = 0;
+    for (name, model) in [
+        ("miura 6x6", miura(6, 6, 60.0, 0.0)),
+        (
+            "waterbomb 4x3",
+            FoldingModel::new(
+                nanofold::io::load_crease_pattern(Path::new("patterns/many/waterbomb_4x3.fold")).unwrap(),
+            )
+            .unwrap(),
+        ),
+    ] {
+        let settings = nanofold::folding::FoldSettings {
+            drive: nanofold::folding::Drive::Assignment { to: 0.9 },
+            ..Default::default()
+        };
+        let path = nanofold::folding::fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+        let last = path.steps.len() - 1;
+        for step in [last / 3, 2 * last / 3, last] {
+            let rho = &path.steps[step].fold_angles;
+            let mut poses = Vec::new();
+            panel_poses(&model, rho, &mut poses);
+            let report = panel_contacts(&model, &poses, &ContactSettings::default());
+            let placed: Vec<Vec<[nalgebra::Vector3<f64>; 3]>> = model
+                .panel_triangles
+                .iter()
+                .enumerate()
+                .map(|(p, list)| {
+                    list.iter()
+                        .map(|t| t.map(|v| poses[p].place(model.pattern.vertices[v])))
+                        .collect()
+                })
+                .collect();
+            let mut brute = f64::INFINITY;
+            for a in 0..placed.len() {
+                for b in a + 1..placed.len() {
+                    if model.panel_vertices[a]
+                        .iter()
+                        .any(|v| model.panel_vertices[b].contains(v))
+                    {
+                        continue;
+                    }
+                    for s in &placed[a] {
+                        for t in &placed[b] {
+                            brute = brute.min(triangle_gap(s, t));
+                        }
+                    }
+                }
+            }
+            assert!(report.crossing().next().is_none(), "{name} step {step}");
+            if brute < 0.5 * model.size / 6.0 {
+                let found = report.min_clearance.expect("a pair within the search range");
+                assert!(
+                    (found - brute).abs() <= 1e-9 * model.size,
+                    "{name} step {step}: contact test {found:e}, brute force {brute:e}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 3, "{checked} states compared");
+}

@@ -131,13 +131,16 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
         report.pairs_measured += 1;
         let mut distance = f64::INFINITY;
         let mut crossing = false;
+        // Triangles farther apart than this cannot be a contact nor lower the smallest
+        // clearance found so far (nor matter beyond the search range): their box gap stands
+        // in for their distance.
+        let relevant = search.min(report.min_clearance.unwrap_or(f64::INFINITY)).max(clearance);
         for (s, s_box) in triangles[a].iter().zip(&triangle_boxes[a]) {
             for (t, t_box) in triangles[b].iter().zip(&triangle_boxes[b]) {
-                // Boxes farther apart than the search range: the distance cannot matter.
                 let gap = (0..3)
                     .map(|k| (s_box.0[k] - t_box.1[k]).max(t_box.0[k] - s_box.1[k]))
                     .fold(0.0_f64, f64::max);
-                if gap > search.max(clearance) {
+                if gap > relevant {
                     distance = distance.min(gap);
                     continue;
                 }
