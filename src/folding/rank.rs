@@ -186,7 +186,7 @@ fn smallest_eigenvalues(
         let count = count_of(&ritz);
         // Every Ritz value counted, or all within the unresolved cluster: a wider block
         // is needed either way (Ritz values only fall with more iterations).
-        let all_null = count == ritz.len() || ritz.last().is_some_and(|&l| l <= cluster);
+        let needs_wider_block = count == ritz.len() || ritz.last().is_some_and(|&l| l <= cluster);
         let all_settled = previous.len() == ritz.len() && ritz.iter().zip(&previous).all(|(a, b)| close(*a, *b));
         let count_settled = iteration >= 2
             && previous.len() == ritz.len()
@@ -195,7 +195,7 @@ fn smallest_eigenvalues(
             && ritz[count] >= COUNT_GAP * threshold
             && close(ritz[count], previous[count]);
         previous = ritz;
-        if all_null || all_settled || count_settled {
+        if needs_wider_block || all_settled || count_settled {
             break;
         }
     }
