@@ -14,6 +14,7 @@ pub mod forcing;
 pub mod integrate;
 pub mod model;
 pub mod modes;
+pub mod network;
 pub mod plant;
 pub mod quasi_static;
 pub mod scene;
