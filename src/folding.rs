@@ -19,6 +19,7 @@ pub use path::{
 };
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{
-    jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, RankMethod, RankReport, DENSE_RANK_LIMIT, RANK_TOL,
+    jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, null_space, RankMethod, RankReport, DENSE_RANK_LIMIT,
+    RANK_TOL,
 };
 pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, FlatFoldability, PatternVerdict};

@@ -318,6 +318,8 @@ impl ClosedChain {
             kinetic_energy: 0.5 * reduced_mass * q_dot * q_dot,
             elastic_energy: elastic,
             actuator_potential: -self.drive_torque(t) * q,
+            actuation_work: None,
+            drag_dissipation: None,
         })
     }
 
@@ -656,7 +658,7 @@ impl Plant for ClosedPlant<'_> {
         Ok(())
     }
 
-    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut ClosedData) -> Result<Sample> {
+    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], _accumulated: &[f64], ws: &mut ClosedData) -> Result<Sample> {
         self.chain.sample(t, q[0], q_dot[0], ws)
     }
 

@@ -26,6 +26,9 @@ pub struct HingeDrive {
     pub radius_of_curvature: f64,
     /// Whether a stressed layer drives this hinge.
     pub actuated: bool,
+    /// When an etch front reaches the hinge and its ramp starts, s (0: at once, the thesis's
+    /// ramp; a step ignores it).
+    pub release_time: f64,
 }
 
 impl HingeDrive {
@@ -34,6 +37,7 @@ impl HingeDrive {
         target: 0.0,
         radius_of_curvature: f64::INFINITY,
         actuated: false,
+        release_time: 0.0,
     };
 }
 
@@ -54,7 +58,7 @@ impl Forcing {
         match self.actuation {
             Actuation::Step => hinge.target,
             Actuation::Ramp { etch_rate } => {
-                let released = etch_rate * t.max(0.0) / hinge.radius_of_curvature;
+                let released = etch_rate * (t - hinge.release_time).max(0.0) / hinge.radius_of_curvature;
                 hinge.target.signum() * released.min(hinge.target.abs())
             }
         }
@@ -71,9 +75,12 @@ impl Forcing {
     /// it, else 0.
     pub fn drive_rate(&self, i: usize, t: f64) -> f64 {
         let hinge = &self.hinges[i];
+        let since = t - hinge.release_time;
         match self.actuation {
             Actuation::Ramp { etch_rate }
-                if hinge.target != 0.0 && etch_rate * t.max(0.0) / hinge.radius_of_curvature < hinge.target.abs() =>
+                if hinge.target != 0.0
+                    && since >= 0.0
+                    && etch_rate * since / hinge.radius_of_curvature < hinge.target.abs() =>
             {
                 hinge.target.signum() * etch_rate / hinge.radius_of_curvature
             }
@@ -93,16 +100,23 @@ impl Forcing {
         let hinge = &self.hinges[i];
         match self.actuation {
             Actuation::Ramp { etch_rate } if hinge.actuated && hinge.target != 0.0 => {
-                hinge.radius_of_curvature * hinge.target.abs() / etch_rate
+                hinge.release_time + hinge.radius_of_curvature * hinge.target.abs() / etch_rate
             }
             _ => 0.0,
         }
     }
 
-    /// Times where τ(t) has a kink (a ramp reaching its target), sorted, s.
+    /// Times where τ(t) has a kink (a ramp starting after t = 0 or reaching its target),
+    /// sorted, s.
     pub fn breakpoints(&self) -> Vec<f64> {
+        let starts = self
+            .hinges
+            .iter()
+            .filter(|h| h.actuated && h.target != 0.0 && matches!(self.actuation, Actuation::Ramp { .. }))
+            .map(|h| h.release_time);
         let mut times: Vec<f64> = (0..self.hinges.len())
             .map(|i| self.ramp_time(i))
+            .chain(starts)
             .filter(|&t| t > 0.0)
             .collect();
         times.sort_by(f64::total_cmp);
@@ -159,6 +173,7 @@ mod tests {
                     target: -1.0,
                     radius_of_curvature: 4.0,
                     actuated: true,
+                    release_time: 0.0,
                 },
                 HingeDrive::PASSIVE,
             ],

@@ -8,7 +8,9 @@
 use super::contact::{gaps_at, locate, Collision};
 use super::plant::{Plant, Sample, TimeScales};
 use crate::error::{NanofoldError, NumericalError, Result};
-use diffsol::{NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason};
+use diffsol::{
+    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Vector,
+};
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
 
@@ -115,16 +117,19 @@ pub fn integrate<P: Plant>(
         max_steps,
     } = options;
     let n = plant.dof();
+    let accumulators = plant.accumulators();
+    let size = 2 * n + accumulators;
+    let energy_scale = plant.energy_scale();
     let time_unit = 1.0 / plant.slowest_omega()?;
-    let initial = plant.initial_coordinates();
+    let initial = plant.initial_state()?;
     let evaluations = Cell::new(0usize);
     let failure: RefCell<Option<NanofoldError>> = RefCell::new(None);
-    let workspace = RefCell::new((plant.workspace(), vec![0.0; n], vec![0.0; n]));
+    let workspace = RefCell::new((plant.workspace(), vec![0.0; n], vec![0.0; n], vec![0.0; accumulators]));
     let rhs = |y: &[f64], s: f64, dy: &mut [f64]| {
         evaluations.set(evaluations.get() + 1);
         let mut guard = workspace.borrow_mut();
-        let (ws, rates, accel) = &mut *guard;
-        let (angles, scaled_rates) = y.split_at(n);
+        let (ws, rates, accel, powers) = &mut *guard;
+        let (angles, scaled_rates) = (&y[..n], &y[n..2 * n]);
         for (r, v) in rates.iter_mut().zip(scaled_rates) {
             *r = v / time_unit;
         }
@@ -134,12 +139,18 @@ pub fn integrate<P: Plant>(
             return;
         }
         dy[..n].copy_from_slice(scaled_rates);
-        for (d, a) in dy[n..].iter_mut().zip(accel.iter()) {
+        for (d, a) in dy[n..2 * n].iter_mut().zip(accel.iter()) {
             *d = a * time_unit * time_unit;
+        }
+        if accumulators > 0 {
+            plant.accumulator_rates(ws, powers);
+            for (d, p) in dy[2 * n..].iter_mut().zip(powers.iter()) {
+                *d = p * time_unit / energy_scale;
+            }
         }
     };
     // Jacobian-vector products by central differences (diffsol assembles J from them).
-    let shifted = RefCell::new((vec![0.0; 2 * n], vec![0.0; 2 * n], vec![0.0; 2 * n]));
+    let shifted = RefCell::new((vec![0.0; size], vec![0.0; size], vec![0.0; size]));
     let jacobian_times = |y: &[f64], s: f64, v: &[f64], jv: &mut [f64]| {
         let mut guard = shifted.borrow_mut();
         let (y_shift, f_plus, f_minus) = &mut *guard;
@@ -160,19 +171,26 @@ pub fn integrate<P: Plant>(
             *j = (p - m) / (2.0 * h);
         }
     };
+    let t0 = initial.time / time_unit;
     let mut problem = OdeBuilder::<NalgebraMat<f64>>::new()
+        .t0(t0)
         .rtol(rtol)
-        .atol(vec![rtol; 2 * n])
+        .atol(vec![rtol; size])
         .rhs_implicit(
             |y: &[f64], _p: &[f64], s: f64, dy: &mut [f64]| rhs(y, s, dy),
             |y: &[f64], _p: &[f64], s: f64, v: &[f64], jv: &mut [f64]| jacobian_times(y, s, v, jv),
         )
         .init(
             |_p: &[f64], _t: f64, y: &mut [f64]| {
-                y.iter_mut().for_each(|x| *x = 0.0);
-                y[..n].copy_from_slice(&initial);
+                y[..n].copy_from_slice(&initial.coordinates);
+                for (v, r) in y[n..2 * n].iter_mut().zip(&initial.rates) {
+                    *v = r * time_unit;
+                }
+                for (v, e) in y[2 * n..].iter_mut().zip(&initial.accumulated) {
+                    *v = e / energy_scale;
+                }
             },
-            2 * n,
+            size,
         )
         .build()?;
     // diffsol counts Newton failures over the whole run, not per step: a long run with rare,
@@ -184,6 +202,9 @@ pub fn integrate<P: Plant>(
         plant,
         output_times,
         time_unit,
+        energy_scale,
+        rhs: &rhs,
+        start: &initial,
         s_end,
         progress: progress.as_ref(),
         record_steps,
@@ -208,11 +229,20 @@ pub fn integrate<P: Plant>(
     })
 }
 
+/// The right-hand side in scaled time: (y, s, dy/ds).
+type Rhs<'r> = dyn Fn(&[f64], f64, &mut [f64]) + 'r;
+
 /// Steps a diffsol solver to the end or the first contact, sampling the dense output.
 struct Driver<'r, P: Plant> {
     plant: &'r P,
     output_times: &'r [f64],
     time_unit: f64,
+    /// J per unit of an accumulator in the state.
+    energy_scale: f64,
+    /// The right-hand side in scaled time, to refresh dy/ds after a projection.
+    rhs: &'r Rhs<'r>,
+    /// Where the run starts.
+    start: &'r super::plant::InitialState,
     s_end: f64,
     progress: Option<&'r ProgressObserver>,
     /// Record a sample at every accepted step besides the output times.
@@ -230,20 +260,34 @@ impl<P: Plant> Driver<'_, P> {
     {
         let plant = self.plant;
         let n = plant.dof();
+        let accumulators = plant.accumulators();
+        let size = 2 * n + accumulators;
         let mut ws = plant.workspace();
         let mut samples = Vec::with_capacity(self.output_times.len());
         let mut state = solver.state().y.clone();
         let mut angles = vec![0.0; n];
         let mut rates = vec![0.0; n];
-        let split = |y: &NalgebraVec<f64>, angles: &mut [f64], rates: &mut [f64]| {
+        let mut accumulated = vec![0.0; accumulators];
+        let split = |y: &NalgebraVec<f64>, angles: &mut [f64], rates: &mut [f64], accumulated: &mut [f64]| {
             for i in 0..n {
                 angles[i] = y[i];
                 rates[i] = y[n + i] / self.time_unit;
             }
+            for (k, a) in accumulated.iter_mut().enumerate() {
+                *a = y[2 * n + k] * self.energy_scale;
+            }
         };
-        split(&state, &mut angles, &mut rates);
-        samples.push(plant.sample(0.0, &angles, &rates, &mut ws)?);
-        let mut next_output = 1;
+        // At rest at t = 0; a plant that starts later (leaving a singular start) is sampled
+        // there too, from its own record of the way.
+        let t_start = self.start.time;
+        split(&state, &mut angles, &mut rates, &mut accumulated);
+        if t_start > 0.0 {
+            let at_rest = vec![0.0; n];
+            let zero = vec![0.0; accumulators];
+            samples.push(plant.sample(0.0, &plant.initial_coordinates(), &at_rest, &zero, &mut ws)?);
+        }
+        samples.push(plant.sample(t_start, &angles, &rates, &accumulated, &mut ws)?);
+        let mut next_output = self.output_times.partition_point(|&t| t <= t_start).max(1);
         let mut gaps = Vec::new();
         let mut gaps_scratch = Vec::new();
         let contact_count = plant.contact_count();
@@ -266,13 +310,13 @@ impl<P: Plant> Driver<'_, P> {
             .breakpoints()
             .into_iter()
             .map(|t| t / self.time_unit)
-            .filter(|&s| s > 0.0 && s < self.s_end)
+            .filter(|&s| s > t_start / self.time_unit && s < self.s_end)
             .collect();
         stops.push(self.s_end);
         let mut next_stop = 0;
         solver.set_stop_time(stops[0])?;
         let mut steps = 0;
-        let mut s_previous = 0.0;
+        let mut s_previous = t_start / self.time_unit;
         // Σ|dθ/ds| at the previous step's end, for the contact reach bound.
         let speed_sum = |y: &NalgebraVec<f64>| (n..2 * n).map(|i| y[i].abs()).sum::<f64>();
         let mut previous_speed: f64 = 0.0;
@@ -294,7 +338,7 @@ impl<P: Plant> Driver<'_, P> {
             };
             steps += 1;
             let s_now = solver.state().t;
-            if !s_now.is_finite() || (0..2 * n).any(|i| !solver.state().y[i].is_finite()) {
+            if !s_now.is_finite() || (0..size).any(|i| !solver.state().y[i].is_finite()) {
                 return Err(NumericalError::NonFinite {
                     what: "ODE integration",
                     detail: format!(
@@ -356,14 +400,14 @@ impl<P: Plant> Driver<'_, P> {
             while next_output < self.output_times.len() && self.output_times[next_output] / self.time_unit <= s_stop {
                 let s = (self.output_times[next_output] / self.time_unit).min(s_now);
                 solver.interpolate_inplace(s, &mut state)?;
-                split(&state, &mut angles, &mut rates);
-                samples.push(plant.sample(self.output_times[next_output], &angles, &rates, &mut ws)?);
+                split(&state, &mut angles, &mut rates, &mut accumulated);
+                samples.push(plant.sample(self.output_times[next_output], &angles, &rates, &accumulated, &mut ws)?);
                 next_output += 1;
             }
             if let Some(c) = collision {
                 solver.interpolate_inplace(c.time / self.time_unit, &mut state)?;
-                split(&state, &mut angles, &mut rates);
-                samples.push(plant.sample(c.time, &angles, &rates, &mut ws)?);
+                split(&state, &mut angles, &mut rates, &mut accumulated);
+                samples.push(plant.sample(c.time, &angles, &rates, &accumulated, &mut ws)?);
                 return Ok((
                     samples,
                     Some(c),
@@ -378,8 +422,8 @@ impl<P: Plant> Driver<'_, P> {
             if self.record_steps && steps % step_stride == 0 && samples.last().is_none_or(|last| last.time < s_now_time)
             {
                 solver.interpolate_inplace(s_now, &mut state)?;
-                split(&state, &mut angles, &mut rates);
-                samples.push(plant.sample(s_now_time, &angles, &rates, &mut ws)?);
+                split(&state, &mut angles, &mut rates, &mut accumulated);
+                samples.push(plant.sample(s_now_time, &angles, &rates, &accumulated, &mut ws)?);
                 step_samples += 1;
                 if step_samples % STEP_SAMPLE_CHUNK == 0 {
                     step_stride *= 2;
@@ -390,6 +434,24 @@ impl<P: Plant> Driver<'_, P> {
             }
             if s_now >= self.s_end {
                 break;
+            }
+            // Back onto the plant's constraints (a network's closures); the solver continues
+            // from the projected state with its derivative evaluated there.
+            {
+                let y = solver.state().y.clone();
+                split(&y, &mut angles, &mut rates, &mut accumulated);
+                if plant.project(s_now_time, &mut angles, &mut rates, &mut ws)? {
+                    let mut fresh = y.clone();
+                    for i in 0..n {
+                        fresh[i] = angles[i];
+                        fresh[n + i] = rates[i] * self.time_unit;
+                    }
+                    let mut derivative = solver.state().dy.clone();
+                    (self.rhs)(fresh.batch_as_slice(0), s_now, derivative.batch_as_mut_slice(0));
+                    let state_mut = solver.state_mut();
+                    state_mut.y.copy_from(&fresh);
+                    state_mut.dy.copy_from(&derivative);
+                }
             }
             if matches!(reason, OdeSolverStopReason::TstopReached) {
                 next_stop += 1;

@@ -35,6 +35,11 @@ pub struct Sample {
     pub elastic_energy: f64,
     /// −τ(t)·θ, J: with the elastic energy, the potential of a constant (step) torque.
     pub actuator_potential: f64,
+    /// ∫ τ(t)·θ̇ dt since the start, J: the work of the actuation, integrated with the motion
+    /// (plants that track it; None otherwise and on the quasi-static path).
+    pub actuation_work: Option<f64>,
+    /// −∫ Q_drag·θ̇ dt since the start (≥ 0), J: the energy the air took (plants that track it).
+    pub drag_dissipation: Option<f64>,
 }
 
 impl Sample {
@@ -42,6 +47,29 @@ impl Sample {
     pub fn total_energy(&self) -> f64 {
         self.kinetic_energy + self.elastic_energy + self.actuator_potential
     }
+
+    /// Kinetic + elastic − work of the actuation + drag dissipation, J: constant along any
+    /// run (step or ramp, with or without air) of a plant that tracks the work and the
+    /// dissipation; None otherwise.
+    pub fn energy_balance(&self) -> Option<f64> {
+        Some(self.kinetic_energy + self.elastic_energy - self.actuation_work? + self.drag_dissipation?)
+    }
+}
+
+/// Where an integration starts: at rest at t = 0 for most plants; a plant that must leave a
+/// singular start (a flat crease pattern) first may start later, already moving.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    /// s.
+    pub time: f64,
+    /// q.
+    pub coordinates: Vec<f64>,
+    /// q̇, per s.
+    pub rates: Vec<f64>,
+    /// Energies accumulated before `time` (as [`Plant::accumulator_rates`] orders them), J.
+    pub accumulated: Vec<f64>,
+    /// How the start was reached (None: at rest at t = 0).
+    pub note: Option<String>,
 }
 
 /// A mechanical system the simulation drives: generalised coordinates q (the hinge angles
@@ -64,10 +92,39 @@ pub trait Plant {
     fn slowest_omega(&self) -> Result<f64>;
     /// q at t = 0 (at rest).
     fn initial_coordinates(&self) -> Vec<f64>;
+    /// Where an integration starts (default: at rest at t = 0, at the initial coordinates).
+    fn initial_state(&self) -> Result<InitialState> {
+        let coordinates = self.initial_coordinates();
+        Ok(InitialState {
+            time: 0.0,
+            rates: vec![0.0; coordinates.len()],
+            coordinates,
+            accumulated: vec![0.0; self.accumulators()],
+            note: None,
+        })
+    }
+    /// Energies integrated along with the motion (the work of the actuation, the drag's
+    /// dissipation), 0 by default.
+    fn accumulators(&self) -> usize {
+        0
+    }
+    /// An energy that scales the accumulators to O(1) for the integrator's tolerance, J.
+    fn energy_scale(&self) -> f64 {
+        1.0
+    }
+    /// The accumulators' rates (W) at the state of the last [`Plant::accelerations`] call.
+    fn accumulator_rates(&self, _ws: &Self::Workspace, _out: &mut [f64]) {}
+    /// Moves a state back onto the plant's constraints after an integrator step; true when
+    /// it changed anything (default: nothing to do).
+    fn project(&self, _t: f64, _q: &mut [f64], _q_dot: &mut [f64], _ws: &mut Self::Workspace) -> Result<bool> {
+        Ok(false)
+    }
     /// q̈ at (t, q, q̇), written into `out`.
     fn accelerations(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()>;
-    /// An output sample at (t, q, q̇).
-    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace) -> Result<Sample>;
+    /// An output sample at (t, q, q̇) with the accumulators' values (empty when none are
+    /// tracked, as on the quasi-static path).
+    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], accumulated: &[f64], ws: &mut Self::Workspace)
+        -> Result<Sample>;
     /// The coordinates where the hinges balance the drive angles `drive` (inertia dropped),
     /// Newton from `q` (which it overwrites).
     fn balance(&self, drive: &[f64], q: &mut [f64], ws: &mut Self::Workspace) -> Result<()>;

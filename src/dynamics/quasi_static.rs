@@ -35,7 +35,7 @@ pub fn quasi_static_path<P: Plant>(plant: &P, output_times: &[f64]) -> Result<Qu
     let start = plant.initial_coordinates();
     // A contact in the start configuration stops the run at once.
     if let Some(c) = plant.touching(0.0, &start, &mut ws) {
-        let sample = plant.sample(0.0, &start, &vec![0.0; n], &mut ws)?;
+        let sample = plant.sample(0.0, &start, &vec![0.0; n], &[], &mut ws)?;
         return Ok(QuasiStaticPath {
             samples: vec![sample],
             collision: Some(c),
@@ -89,7 +89,7 @@ pub fn quasi_static_path<P: Plant>(plant: &P, output_times: &[f64]) -> Result<Qu
         plant.balance(&drive, &mut q, &mut ws)?;
         forcing.drive_rates(t, &mut rates);
         plant.balance_rates(&q, &drive, &rates, &mut q_rates, &mut ws)?;
-        samples.push(plant.sample(t, &q, &q_rates, &mut ws)?);
+        samples.push(plant.sample(t, &q, &q_rates, &[], &mut ws)?);
         Ok(())
     };
     for &t in output_times.iter().filter(|&&t| t < stop) {
@@ -119,7 +119,7 @@ pub fn quasi_static_deviation<P: Plant>(plant: &P, samples: &[Sample]) -> Result
     for sample in samples {
         forcing.drive_angles(sample.time, &mut drive);
         plant.balance(&drive, &mut q, &mut ws)?;
-        let balanced = plant.sample(sample.time, &q, &zeros, &mut ws)?;
+        let balanced = plant.sample(sample.time, &q, &zeros, &[], &mut ws)?;
         for (a, b) in sample.angles.iter().zip(balanced.angles.iter()) {
             worst = worst.max((a - b).abs());
         }

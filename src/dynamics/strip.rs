@@ -168,7 +168,14 @@ impl Plant for StripPlant<'_> {
         forward_dynamics(&self.chain.model, q, q_dot, &ws.torques, &mut ws.data, out)
     }
 
-    fn sample(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut StripWorkspace) -> Result<Sample> {
+    fn sample(
+        &self,
+        t: f64,
+        q: &[f64],
+        q_dot: &[f64],
+        _accumulated: &[f64],
+        ws: &mut StripWorkspace,
+    ) -> Result<Sample> {
         let model = &self.chain.model;
         update_kinematics(model, q, &mut ws.data);
         update_mass_matrix(model, &mut ws.data);
@@ -186,6 +193,8 @@ impl Plant for StripPlant<'_> {
                     .map(|(j, a)| j.stiffness * a * a)
                     .sum::<f64>(),
             actuator_potential: -ws.torques.iter().zip(q).map(|(t, a)| t * a).sum::<f64>(),
+            actuation_work: None,
+            drag_dissipation: None,
         })
     }
 

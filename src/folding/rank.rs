@@ -122,6 +122,39 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
 /// shifted inverse cannot separate (10³ μ), so the count is complete once the
 /// next Ritz value is above the threshold (`docs/model.md#rigid-folding`).
 pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
+    Ok(settled_block(jacobian)?.report(jacobian))
+}
+
+/// The block of inverse subspace iteration once the null-space count is settled, with its
+/// Ritz values (ascending) and the thresholds they were judged by.
+struct SettledBlock {
+    x: Mat<f64>,
+    ritz: Vec<f64>,
+    threshold_lambda: f64,
+    scale: f64,
+}
+
+impl SettledBlock {
+    fn count(&self) -> usize {
+        self.ritz.iter().filter(|&&l| l <= self.threshold_lambda).count()
+    }
+
+    fn report(&self, jacobian: &ClosureJacobian) -> RankReport {
+        let count = self.count();
+        let sigma = |l: f64| l.max(0.0).sqrt();
+        RankReport {
+            rank: jacobian.cols - count,
+            // A locked column is zero, so it is in the null space without being a motion.
+            dof: count.saturating_sub(jacobian.held),
+            threshold: RANK_TOL * self.scale.sqrt(),
+            smallest_kept: self.ritz.get(count).map_or(f64::INFINITY, |&l| sigma(l)),
+            largest_dropped: if count > 0 { sigma(self.ritz[count - 1]) } else { 0.0 },
+            method: RankMethod::SubspaceIteration,
+        }
+    }
+}
+
+fn settled_block(jacobian: &ClosureJacobian) -> Result<SettledBlock> {
     let n = jacobian.cols;
     let mut solver = NormalSolver::new(COUNT_REGULARISATION);
     let factor = solver.factor(jacobian)?;
@@ -144,19 +177,83 @@ pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
         let count = ritz.iter().filter(|&&l| l <= threshold_lambda).count();
         let within_cluster = ritz.last().is_some_and(|&l| l <= cluster_lambda);
         if (count < block && !within_cluster) || block == n {
-            let sigma = |l: f64| l.max(0.0).sqrt();
-            return Ok(RankReport {
-                rank: n - count,
-                // A locked column is zero, so it is in the null space without being a motion.
-                dof: count.saturating_sub(jacobian.held),
-                threshold: RANK_TOL * scale.sqrt(),
-                smallest_kept: ritz.get(count).map_or(f64::INFINITY, |&l| sigma(l)),
-                largest_dropped: if count > 0 { sigma(ritz[count - 1]) } else { 0.0 },
-                method: RankMethod::SubspaceIteration,
+            return Ok(SettledBlock {
+                x,
+                ritz,
+                threshold_lambda,
+                scale,
             });
         }
         block = (2 * block).min(n);
     }
+}
+
+/// An orthonormal basis of J's null space, one column per direction: the right singular
+/// vectors whose singular values lie at or below [`RANK_TOL`] of the largest (dense SVD up
+/// to [`DENSE_RANK_LIMIT`] columns), or the Ritz vectors of the settled block of the sparse
+/// count counted as null (its singular values at or below RANK_TOL times the largest column
+/// norm). Zero columns of J (locked creases) are in it like any other direction.
+pub fn null_space(jacobian: &ClosureJacobian) -> Result<Mat<f64>> {
+    let (rows, cols) = (jacobian.rows, jacobian.cols);
+    if cols == 0 {
+        return Ok(Mat::zeros(0, 0));
+    }
+    let (x, b) = if cols <= DENSE_RANK_LIMIT {
+        let dense = jacobian.to_sparse().to_dense();
+        let dense = if rows == 0 { Mat::<f64>::zeros(1, cols) } else { dense };
+        let svd = dense.svd().map_err(|_| NumericalError::NonFinite {
+            what: "singular values of J (null space)",
+            detail: "the SVD did not converge".into(),
+        })?;
+        let s = svd.S().column_vector();
+        let largest = (0..s.nrows()).map(|i| s[i]).fold(0.0_f64, f64::max);
+        let threshold = RANK_TOL * largest;
+        let v = svd.V();
+        let null: Vec<usize> = (0..cols).filter(|&j| j >= s.nrows() || s[j] <= threshold).collect();
+        let basis = Mat::<f64>::from_fn(cols, null.len(), |i, k| v[(i, null[k])]);
+        (basis, null.len())
+    } else {
+        let settled = settled_block(jacobian)?;
+        let count = settled.count();
+        // Rotate the block onto the right singular vectors of JX, smallest first.
+        let jx = apply_to_columns(jacobian, &settled.x);
+        let svd = jx.svd().map_err(|_| NumericalError::NonFinite {
+            what: "singular values of J X (null space)",
+            detail: "the SVD did not converge".into(),
+        })?;
+        let v = svd.V();
+        let b = settled.x.ncols();
+        let s = svd.S().column_vector();
+        let mut order: Vec<usize> = (0..b).collect();
+        order.sort_by(|&i, &j| {
+            let si = if i < s.nrows() { s[i] } else { 0.0 };
+            let sj = if j < s.nrows() { s[j] } else { 0.0 };
+            si.total_cmp(&sj)
+        });
+        let rotated = &settled.x * v;
+        let basis = Mat::<f64>::from_fn(cols, count, |i, k| rotated[(i, order[k])]);
+        (basis, count)
+    };
+    debug_assert_eq!(x.ncols(), b);
+    Ok(x)
+}
+
+/// J X, column by column.
+fn apply_to_columns(jacobian: &ClosureJacobian, x: &Mat<f64>) -> Mat<f64> {
+    let (n, b) = (x.nrows(), x.ncols());
+    let mut jx = Mat::<f64>::zeros(jacobian.rows.max(1), b);
+    let mut column = vec![0.0; n];
+    let mut image = vec![0.0; jacobian.rows];
+    for j in 0..b {
+        for (k, c) in column.iter_mut().enumerate() {
+            *c = x[(k, j)];
+        }
+        jacobian.apply(&column, &mut image);
+        for (r, v) in image.iter().enumerate() {
+            jx[(r, j)] = *v;
+        }
+    }
+    jx
 }
 
 /// Ritz values (ascending) of JᵀJ on the block that inverse subspace iteration settles on,
@@ -236,19 +333,8 @@ fn orthonormalise(x: &mut Mat<f64>) {
 /// JX: the singular values keep their absolute accuracy (ε‖J‖) where the eigenvalues of the
 /// Gram matrix would lose the small ones below √ε.
 fn rayleigh_ritz(jacobian: &ClosureJacobian, x: &Mat<f64>) -> Result<Vec<f64>> {
-    let (n, b) = (x.nrows(), x.ncols());
-    let mut jx = Mat::<f64>::zeros(jacobian.rows.max(1), b);
-    let mut column = vec![0.0; n];
-    let mut image = vec![0.0; jacobian.rows];
-    for j in 0..b {
-        for (k, c) in column.iter_mut().enumerate() {
-            *c = x[(k, j)];
-        }
-        jacobian.apply(&column, &mut image);
-        for (r, v) in image.iter().enumerate() {
-            jx[(r, j)] = *v;
-        }
-    }
+    let b = x.ncols();
+    let jx = apply_to_columns(jacobian, x);
     // Sequential: at these sizes faer's threads cost more than they save on 2 cores.
     let (rows, cols) = (jx.nrows(), jx.ncols());
     let req = svd_scratch::<f64>(

@@ -79,6 +79,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
             }
         },
         actuated: true,
+        release_time: 0.0,
     };
     let anchored_face = geometry.outlines[ground_sector]
         .as_ref()

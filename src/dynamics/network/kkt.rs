@@ -23,6 +23,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, Par, Side};
+use nalgebra::Vector3;
 use std::collections::HashMap;
 
 /// ε on the multipliers' diagonal (the matrix is scaled to O(1)).
@@ -32,6 +33,21 @@ const REGULARISATION: f64 = 1e-12;
 const ROW_FLOOR: f64 = 1e-9;
 /// Refinement rounds against the unregularised matrix.
 const REFINEMENTS: usize = 2;
+
+/// The upper-left block of the saddle-point matrix.
+#[derive(Debug, Clone, Copy)]
+pub enum PrimalBlock<'a> {
+    /// The mass matrix (dynamics, velocity projection).
+    Inertia,
+    /// The Hessian of the hinges' energy on the manifold: diag(K) plus the stars' curvature
+    /// weighted by the multipliers of the last solve (statics).
+    Hessian {
+        /// K per crease, N·m/rad.
+        stiffness: &'a [f64],
+        /// λ per closure row (unscaled rows), N·m.
+        multipliers: &'a [f64],
+    },
+}
 
 /// One closure-row entry: its row, column and the star axis it reads.
 #[derive(Debug, Clone, Copy)]
@@ -57,6 +73,8 @@ pub struct KktSystem {
     /// Slot of each mass-pattern entry (None where it touches a locked crease).
     mass_slots: Vec<Option<usize>>,
     diagonal: Vec<usize>,
+    /// Each star axis's place in its star's holonomy product (rays 1, …, n−1, then 0).
+    order: Vec<usize>,
     structure: SymbolicSparseColMat<usize>,
     symbolic: SymbolicCholesky<usize>,
     /// Matrix values (lower triangle, CSC order) of the last assembly.
@@ -82,8 +100,10 @@ impl KktSystem {
         let rows = 3 * model.folding.stars.len();
         let locked: Vec<bool> = (0..columns).map(|c| model.locked(c)).collect();
         let mut entries = Vec::new();
+        let mut order = Vec::new();
         let mut offset = 0;
         for (s, star) in model.folding.stars.iter().enumerate() {
+            order.extend((0..star.columns.len()).map(|k| if k == 0 { star.columns.len() } else { k }));
             for (k, &column) in star.columns.iter().enumerate() {
                 if !locked[column] {
                     for component in 0..3 {
@@ -178,6 +198,7 @@ impl KktSystem {
             products,
             mass_slots,
             diagonal,
+            order,
             values: vec![0.0; keys.len()],
             factor: vec![0.0; symbolic.len_val()],
             symbolic,
@@ -198,27 +219,79 @@ impl KktSystem {
         self.columns + self.rows
     }
 
-    /// Assembles the matrix at the state whose mass matrix and star axes `data` holds, and
-    /// factorises it.
+    /// Assembles the matrix with the mass block M/μ at the state whose mass matrix and star
+    /// axes `data` holds, and factorises it.
     pub fn factor(&mut self, model: &NetworkModel, data: &NetworkData) -> Result<()> {
+        self.assemble(model, data, PrimalBlock::Inertia, 1.0)
+    }
+
+    /// Assembles the matrix with `block` (and γ times JᵀJ added to it) and factorises it.
+    pub fn assemble(
+        &mut self,
+        model: &NetworkModel,
+        data: &NetworkData,
+        block: PrimalBlock<'_>,
+        augment: f64,
+    ) -> Result<()> {
         self.values.iter_mut().for_each(|v| *v = 0.0);
-        let mut scale: f64 = 0.0;
-        for (k, &(a, c)) in model.mass_pattern.iter().enumerate() {
-            if a == c && !self.locked[c] {
-                scale = scale.max(data.mass_values[k]);
+        let scale = match block {
+            PrimalBlock::Inertia => {
+                let mut scale: f64 = 0.0;
+                for (k, &(a, c)) in model.mass_pattern.iter().enumerate() {
+                    if a == c && !self.locked[c] {
+                        scale = scale.max(data.mass_values[k]);
+                    }
+                }
+                scale
             }
-        }
+            PrimalBlock::Hessian { stiffness, .. } => (0..self.columns)
+                .filter(|&c| !self.locked[c])
+                .map(|c| stiffness[c])
+                .fold(0.0, f64::max),
+        };
         if !(scale.is_finite() && scale > 0.0) {
             return Err(NumericalError::NotPositiveDefinite {
-                matrix: "the network's mass matrix",
+                matrix: match block {
+                    PrimalBlock::Inertia => "the network's mass matrix",
+                    PrimalBlock::Hessian { .. } => "the network's hinge stiffness",
+                },
                 at: format!("largest diagonal entry {scale:e}"),
             }
             .into());
         }
         self.mass_scale = scale;
-        for (k, slot) in self.mass_slots.iter().enumerate() {
-            if let Some(slot) = slot {
-                self.values[*slot] += data.mass_values[k] / scale;
+        match block {
+            PrimalBlock::Inertia => {
+                for (k, slot) in self.mass_slots.iter().enumerate() {
+                    if let Some(slot) = slot {
+                        self.values[*slot] += data.mass_values[k] / scale;
+                    }
+                }
+            }
+            PrimalBlock::Hessian { stiffness, multipliers } => {
+                for (&slot, k) in self.diagonal.iter().zip(stiffness) {
+                    self.values[slot] += k / scale;
+                }
+                // Σ_r λ_r ∇²r_r: ½ λ·(x_a × x_b) for crease a before b in the product order.
+                for &(a, b, slot) in &self.products {
+                    let (ea, eb) = (self.entries[a], self.entries[b]);
+                    if ea.column == eb.column || ea.component != 0 || eb.component != 0 {
+                        continue;
+                    }
+                    let star = ea.row / 3;
+                    let lambda = Vector3::new(
+                        multipliers[3 * star],
+                        multipliers[3 * star + 1],
+                        multipliers[3 * star + 2],
+                    );
+                    let (first, second) = if self.order[ea.axis] < self.order[eb.axis] {
+                        (ea, eb)
+                    } else {
+                        (eb, ea)
+                    };
+                    let cross = data.star_axes[first.axis].cross(&data.star_axes[second.axis]);
+                    self.values[slot] += 0.5 * lambda.dot(&cross) / scale;
+                }
             }
         }
         let mut norms = vec![0.0; self.rows];
@@ -235,7 +308,7 @@ impl KktSystem {
             self.values[self.entry_slots[e]] += value;
         }
         for &(a, b, slot) in &self.products {
-            self.values[slot] += self.entry_values[a] * self.entry_values[b];
+            self.values[slot] += augment * self.entry_values[a] * self.entry_values[b];
         }
         for c in 0..self.columns {
             if self.locked[c] {
@@ -310,6 +383,22 @@ impl KktSystem {
         self.solve_refined(&mut rhs);
         rates.copy_from_slice(&rhs[..self.columns]);
         self.work = rhs;
+    }
+
+    /// Solves the assembled system for `rhs` (creases, then rows as assembled: rows scaled
+    /// to unit length) in place, refined against the unregularised matrix.
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        self.solve_refined(rhs);
+    }
+
+    /// Each closure row's scale (1/|row|, or 1 below the floor) in the last assembly.
+    pub fn row_scales(&self) -> &[f64] {
+        &self.row_scale
+    }
+
+    /// The scale of the upper block in the last assembly (μ or the largest K).
+    pub fn scale(&self) -> f64 {
+        self.mass_scale
     }
 
     /// Solves K_ε x = rhs in place, then refines against the unregularised K.
