@@ -1172,6 +1172,20 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
                 closed.slope_error
             );
         }
+        System::Network(model) => {
+            let report = simulation.network.as_ref().expect("network runs report their network");
+            println!(
+                "{}: {} panels on {} creases, face {} anchored, {} actuation",
+                scene.name,
+                report.panels,
+                report.creases,
+                report.anchored_face,
+                model.forcing.kind()
+            );
+            if let Some(branch) = &report.branch {
+                println!("  {branch}");
+            }
+        }
     }
     println!(
         "  time scales: fastest natural period {:.3e} s, slowest {:.3e} s, forcing {:.3e} s (ratio {:.2e})",
@@ -1182,6 +1196,15 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     if let Some(last) = response.samples.last() {
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
+    }
+    if let Some(report) = &simulation.network {
+        println!(
+            "  max vertex closure residual along the run: {:.3e} rad; energy balance (kinetic + hinges − work + dissipation) held to {}",
+            report.max_closure_residual,
+            report
+                .energy_balance_error
+                .map_or("— (quasi-static: no work tracked)".to_string(), |e| format!("{e:.2e} of the largest energy"))
+        );
     }
     if let Some(closed) = &simulation.closed {
         println!(
@@ -1259,6 +1282,10 @@ fn run_export(format: &ExportKind) -> Result<()> {
     let scales = match &built.system {
         System::Strip(chain) => chain.time_scales()?,
         System::Closed(chain) => chain.time_scales()?,
+        System::Network(_) => anyhow::bail!(
+            "export mujoco {}: MuJoCo export of a network scene is not written yet (strips and closed chains only)",
+            scene.display()
+        ),
     };
     let settings = nanofold::io::mujoco::MujocoSettings {
         timestep: *timestep,
@@ -1295,6 +1322,7 @@ fn run_modes(path: &Path, json: bool) -> Result<()> {
     let scene = load_scene(path)?;
     let chain = match &scene.system {
         System::Closed(chain) => return run_modes_closed(&scene.name, chain, json),
+        System::Network(model) => return run_modes_network(&scene.name, model, json),
         System::Strip(chain) => chain,
     };
     let result = modes(&chain.model, chain.target_angles().as_slice())?;
@@ -1337,6 +1365,67 @@ fn run_modes(path: &Path, json: bool) -> Result<()> {
             "stable: K is positive definite, every eigenvalue > 0"
         } else {
             "NOT stable: some hinge stiffness or eigenvalue is not positive"
+        }
+    );
+    Ok(())
+}
+
+fn run_modes_network(name: &str, model: &nanofold::dynamics::network::NetworkModel, json: bool) -> Result<()> {
+    let result = nanofold::dynamics::network::modes::folded_modes(model)?;
+    if json {
+        println!("{}", nanofold::io::output::network_modes_json(name, model, &result));
+        return Ok(());
+    }
+    let modes = &result.modes;
+    let eq = &modes.equilibrium;
+    println!(
+        "{}: modes of the network ({} panels, {} creases, face {} anchored) at its folded equilibrium: {} degree(s) of freedom",
+        name,
+        model.panels(),
+        model.columns(),
+        model.anchored_face,
+        modes.basis.ncols()
+    );
+    if !result.released.is_empty() {
+        let list: Vec<String> = result
+            .released
+            .iter()
+            .map(|&(c, a)| format!("{} at {:.3}°", model.labels[c], a.to_degrees()))
+            .collect();
+        println!("  locks released (springs at rest there): {}", list.join(", "));
+    }
+    println!(
+        "  equilibrium: {} Newton steps at the full drive, residual torque {:.1e} N·m, closure {:.1e} rad",
+        eq.iterations, eq.residual_torque, eq.closure_residual
+    );
+    let shown = model.columns().min(12);
+    println!(
+        "  {:>4} {:>14} {:>12} {:>16}  shape (unit max-norm; the {} creases that move most)",
+        "mode", "λ (rad²/s²)", "f (Hz)", "f, ZᵀKZ only", shown
+    );
+    for k in 0..modes.modes.eigenvalues.len() {
+        let column = modes.crease_shapes.column(k);
+        let mut order: Vec<usize> = (0..model.columns()).collect();
+        order.sort_by(|&a, &b| column[b].abs().total_cmp(&column[a].abs()));
+        let shape: Vec<String> = order[..shown]
+            .iter()
+            .map(|&c| format!("{} {:+.4}", model.labels[c], column[c]))
+            .collect();
+        println!(
+            "  {:>4} {:>14.6e} {:>12.3} {:>16.3}  ({})",
+            k,
+            modes.modes.eigenvalues[k],
+            modes.modes.frequencies_hz[k],
+            modes.frequencies_without_load_hz[k],
+            shape.join(", ")
+        );
+    }
+    println!(
+        "  {}",
+        if modes.modes.stable {
+            "stable: the stiffness on the manifold is positive definite, every eigenvalue > 0"
+        } else {
+            "NOT stable: some eigenvalue of the stiffness on the manifold is not positive"
         }
     );
     Ok(())

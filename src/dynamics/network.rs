@@ -8,10 +8,12 @@
 //! integrator, with the [`contact`] candidates.
 
 pub mod algorithms;
+pub mod assemble;
 pub mod contact;
 pub mod kkt;
 pub mod manifold;
 pub mod model;
+pub mod modes;
 pub mod plant;
 pub mod start;
 

@@ -5,12 +5,14 @@
 use super::closed::{assemble, ClosedChain};
 use super::forcing::{Actuation, Forcing, HingeDrive};
 use super::model::{Joint, Model, Plate};
+use super::network::NetworkModel;
 use super::spec::{
     actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, time_and_outputs, validate_materials,
-    within, ClosedSpec, StripSpec, MICROMETRE,
+    within, ClosedSpec, NetworkSpec, StripSpec, MICROMETRE,
 };
 use super::strip::StripChain;
 use crate::error::{NanofoldError, Result};
+use crate::pattern::crease_pattern::CreasePattern;
 use crate::pattern::Pattern;
 use nalgebra::{Point3, Vector3};
 
@@ -23,6 +25,8 @@ pub enum SceneSpec {
     Strip(StripSpec),
     /// The sectors of a closed single vertex.
     Closed(Box<ClosedSpec<Pattern>>),
+    /// The panels of any crease pattern.
+    Network(Box<NetworkSpec<CreasePattern>>),
 }
 
 impl SceneSpec {
@@ -32,6 +36,7 @@ impl SceneSpec {
         match self {
             SceneSpec::Strip(spec) => spec.build(),
             SceneSpec::Closed(spec) => spec.build(),
+            SceneSpec::Network(spec) => spec.build(),
         }
     }
 
@@ -40,6 +45,7 @@ impl SceneSpec {
         match self {
             SceneSpec::Strip(spec) => spec.name.as_deref(),
             SceneSpec::Closed(spec) => spec.name.as_deref(),
+            SceneSpec::Network(spec) => spec.name.as_deref(),
         }
     }
 }
@@ -51,6 +57,8 @@ pub enum System {
     Strip(StripChain),
     /// A closed single vertex.
     Closed(Box<ClosedChain>),
+    /// The panels of a crease pattern.
+    Network(Box<NetworkModel>),
 }
 
 /// A validated scene: the system, its time span and what to record.
@@ -71,15 +79,23 @@ impl Scene {
     pub fn strip(&self) -> Option<&StripChain> {
         match &self.system {
             System::Strip(chain) => Some(chain),
-            System::Closed(_) => None,
+            _ => None,
         }
     }
 
     /// The closed chain, if this is one.
     pub fn closed(&self) -> Option<&ClosedChain> {
         match &self.system {
-            System::Strip(_) => None,
             System::Closed(chain) => Some(chain),
+            _ => None,
+        }
+    }
+
+    /// The panel network, if this is one.
+    pub fn network(&self) -> Option<&NetworkModel> {
+        match &self.system {
+            System::Network(model) => Some(model),
+            _ => None,
         }
     }
 
@@ -88,6 +104,7 @@ impl Scene {
         match &self.system {
             System::Strip(chain) => &chain.forcing,
             System::Closed(chain) => &chain.forcing,
+            System::Network(model) => &model.forcing,
         }
     }
 
@@ -97,6 +114,7 @@ impl Scene {
         match &self.system {
             System::Strip(chain) => chain.model.joints().iter().map(|j| j.stiffness).collect(),
             System::Closed(chain) => chain.crease_stiffness.clone(),
+            System::Network(model) => model.stiffness(),
         }
     }
 }
@@ -264,6 +282,20 @@ impl ClosedSpec<Pattern> {
         Ok(Scene {
             name: self.name.clone().unwrap_or_else(|| "scene".to_string()),
             system: System::Closed(Box::new(chain)),
+            t_end,
+            outputs: self.outputs.clone(),
+        })
+    }
+}
+
+impl NetworkSpec<CreasePattern> {
+    /// Validates the scene and assembles its network ([`super::network::assemble::network`]).
+    pub fn build(&self) -> Result<Scene> {
+        let t_end = time_and_outputs(&self.time, &self.outputs)?;
+        let model = super::network::assemble::network(self)?;
+        Ok(Scene {
+            name: self.name.clone().unwrap_or_else(|| "scene".to_string()),
+            system: System::Network(Box::new(model)),
             t_end,
             outputs: self.outputs.clone(),
         })

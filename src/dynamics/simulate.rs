@@ -6,6 +6,8 @@
 use super::closed::{ClosedPlant, ClosedReport};
 use super::contact::Collision;
 use super::integrate::{integrate, output_times, IntegrationOptions, Method, ProgressObserver, IMPLICIT_RATIO};
+use super::network::plant::NetworkReport;
+use super::network::NetworkPlant;
 use super::plant::{Plant, Sample, TimeScales};
 use super::quasi_static::{quasi_static_deviation, quasi_static_path};
 use super::scene::{Scene, System};
@@ -179,6 +181,8 @@ pub struct Simulation {
     pub response: Response,
     /// The closed chain's constraint errors, torque magnification and closure residual.
     pub closed: Option<ClosedReport>,
+    /// A network's branch, closure residuals and energy balance.
+    pub network: Option<NetworkReport>,
 }
 
 /// Runs a scene: the dynamics, or the quasi-static path when the model is chosen so (`auto`:
@@ -206,7 +210,11 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
                 settings,
                 &times,
             )?;
-            Ok(Simulation { response, closed: None })
+            Ok(Simulation {
+                response,
+                closed: None,
+                network: None,
+            })
         }
         System::Closed(chain) => {
             let response = run(
@@ -216,7 +224,21 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
                 &times,
             )?;
             let closed = Some(chain.report(&response.samples)?);
-            Ok(Simulation { response, closed })
+            Ok(Simulation {
+                response,
+                closed,
+                network: None,
+            })
+        }
+        System::Network(model) => {
+            let plant = NetworkPlant::new(model, collisions)?;
+            let response = run(&plant, &NetworkPlant::new(model, false)?, settings, &times)?;
+            let network = Some(plant.report(&response)?);
+            Ok(Simulation {
+                response,
+                closed: None,
+                network,
+            })
         }
     }
 }

@@ -89,6 +89,16 @@ pub enum ActuationSpec {
         /// a, µm/min (KOH: 1.5).
         etch_rate_um_per_min: f64,
     },
+    /// A straight etch front crossing the wafer in direction `direction_deg` (in the
+    /// pattern's plane, from its x axis, counter-clockwise) at `etch_rate_um_per_min`: each
+    /// actuated hinge's ramp starts when the front reaches the first point of its crease,
+    /// the first hinge the front meets at t = 0 (pattern scenes only).
+    Front {
+        /// a, µm/min.
+        etch_rate_um_per_min: f64,
+        /// The direction the front moves, degrees.
+        direction_deg: f64,
+    },
 }
 
 fn default_drag_coefficient() -> f64 {
@@ -489,6 +499,123 @@ impl<P> ClosedSpec<P> {
     }
 }
 
+/// The hinge every crease of a network scene gets unless `hinges` lists it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HingeDefaultsSpec {
+    /// l, µm.
+    pub hinge_length_um: f64,
+    /// Structural layer first, then the stressed one if actuated.
+    pub layers: Vec<LayerSpec>,
+    /// Whether a stressed layer drives these hinges (default false).
+    #[serde(default)]
+    pub actuated: bool,
+    /// The folded angle's magnitude, degrees: each crease drives to it with its assignment's
+    /// sign (valley +, mountain −); an unassigned crease needs its own entry in `hinges`.
+    #[serde(default)]
+    pub target_angle_deg: Option<f64>,
+    /// ρ_c, µm (needed by a ramp or a front).
+    #[serde(default)]
+    pub radius_of_curvature_um: Option<f64>,
+    /// Multiplies the T5.7 stiffness (default 1).
+    #[serde(default)]
+    pub stiffness_scale: Option<f64>,
+}
+
+impl HingeDefaultsSpec {
+    /// The same hinge as a strip's hinge spec, for the shared checks.
+    pub(crate) fn hinge(&self) -> HingeSpec {
+        HingeSpec {
+            hinge_length_um: self.hinge_length_um,
+            layers: self.layers.clone(),
+            actuated: self.actuated,
+            target_angle_deg: self.target_angle_deg,
+            radius_of_curvature_um: self.radius_of_curvature_um,
+            stiffness_scale: self.stiffness_scale,
+        }
+    }
+}
+
+/// Where a network scene's substrate is a contact.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkSubstrateSpec {
+    /// Whether a panel reaching z = 0 outside the paper's flat outline (off the etched pit)
+    /// touches the substrate (default false: the panels hang over the pit).
+    #[serde(default)]
+    pub contact: bool,
+}
+
+/// A scene of any crease pattern (`docs/model.md#panel-networks`): its panels are plates,
+/// its creases hinges; the start is the pattern's own state, at rest. `P` is the pattern: a
+/// path in a scene file, a [`crate::pattern::crease_pattern::CreasePattern`] once loaded.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkSpec<P> {
+    /// Names the scene; "scene" when absent (the loader puts the file's name here).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// The pattern: a FOLD crease pattern or folded form (relative to the scene file).
+    pub pattern: P,
+    /// One pattern coordinate unit in µm.
+    pub length_unit_um: f64,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Every panel's structural layer.
+    pub plates: SectorPlateSpec,
+    /// Hinges by crease (FOLD edge index).
+    #[serde(default)]
+    pub hinges: Vec<CreaseHingeSpec>,
+    /// The hinge of every crease `hinges` does not list.
+    #[serde(default)]
+    pub hinge_defaults: Option<HingeDefaultsSpec>,
+    /// The face on the substrate (FOLD face index); default: the panel nearest the pattern's
+    /// centre.
+    #[serde(default)]
+    pub anchored_face: Option<usize>,
+    /// Creases held at their start angle.
+    #[serde(default)]
+    pub locks: Vec<LockSpec>,
+    /// Step, ramp or front.
+    pub actuation: ActuationSpec,
+    /// The air.
+    pub environment: EnvironmentSpec,
+    /// Whether the substrate is a contact.
+    #[serde(default)]
+    pub substrate: NetworkSubstrateSpec,
+    /// The time span.
+    pub time: TimeSpec,
+    /// What to record.
+    #[serde(default)]
+    pub outputs: OutputSpec,
+}
+
+impl<P> NetworkSpec<P> {
+    /// The same scene with its pattern resolved.
+    pub fn with_pattern<Q>(self, resolve: impl FnOnce(P) -> Result<Q>) -> Result<NetworkSpec<Q>> {
+        Ok(NetworkSpec {
+            name: self.name,
+            description: self.description,
+            pattern: resolve(self.pattern)?,
+            length_unit_um: self.length_unit_um,
+            materials: self.materials,
+            plates: self.plates,
+            hinges: self.hinges,
+            hinge_defaults: self.hinge_defaults,
+            anchored_face: self.anchored_face,
+            locks: self.locks,
+            actuation: self.actuation,
+            environment: self.environment,
+            substrate: self.substrate,
+            time: self.time,
+            outputs: self.outputs,
+        })
+    }
+}
+
 /// Accepted ranges of a scene's inputs, (lowest, highest): wide enough for nanometre films
 /// and centimetre models, narrow enough that every derived quantity (masses ~ρ L² t,
 /// stiffnesses ~E t³, their ratio) stays far inside double precision.
@@ -521,6 +648,8 @@ pub mod limits {
     pub const STIFFNESS_SCALE: (f64, f64) = (1e-6, 1e6);
     /// Exact sweep samples of a closed chain's constraint.
     pub const CONSTRAINT_SAMPLES: (usize, usize) = (3, 100_000);
+    /// Creases of a network scene.
+    pub const MAX_NETWORK_CREASES: usize = 20_000;
 }
 
 /// `value` if it lies in `range` (closed); else an error naming `field` and the range.
@@ -628,6 +757,13 @@ pub(crate) fn drag_law(env: &EnvironmentSpec) -> Result<Option<Drag>> {
 pub(crate) fn actuation(spec: &ActuationSpec) -> Result<Actuation> {
     Ok(match spec {
         ActuationSpec::Step => Actuation::Step,
+        ActuationSpec::Front { .. } => {
+            return Err(NanofoldError::invalid(
+                "actuation.kind",
+                "\"front\"",
+                "an etch front crossing the wafer is for pattern scenes of many panels; a strip or a closed chain takes \"ramp\"",
+            ))
+        }
         ActuationSpec::Ramp { etch_rate_um_per_min } => Actuation::Ramp {
             etch_rate: within(
                 "actuation.etch_rate_um_per_min",
@@ -637,6 +773,24 @@ pub(crate) fn actuation(spec: &ActuationSpec) -> Result<Actuation> {
             )? * MICROMETRE
                 / 60.0,
         },
+    })
+}
+
+/// A network scene's actuation and, for an etch front, the unit vector it moves along in
+/// the pattern's plane.
+pub(crate) fn network_actuation(spec: &ActuationSpec) -> Result<(Actuation, Option<[f64; 2]>)> {
+    Ok(match spec {
+        ActuationSpec::Front {
+            etch_rate_um_per_min,
+            direction_deg,
+        } => {
+            let rate = actuation(&ActuationSpec::Ramp {
+                etch_rate_um_per_min: *etch_rate_um_per_min,
+            })?;
+            let angle = finite("actuation.direction_deg", *direction_deg)?.to_radians();
+            (rate, Some([angle.cos(), angle.sin()]))
+        }
+        other => (actuation(other)?, None),
     })
 }
 
@@ -657,15 +811,26 @@ pub(crate) fn hinge_stiffness(
     hinge: &HingeSpec,
     width: f64,
 ) -> Result<f64> {
+    hinge_stiffness_named(materials, &format!("hinges[{i}]"), hinge, width)
+}
+
+/// [`hinge_stiffness`] for a hinge the scene names `prefix` (`hinges[3]`, `hinge_defaults`).
+pub(crate) fn hinge_stiffness_named(
+    materials: &BTreeMap<String, MaterialSpec>,
+    prefix: &str,
+    hinge: &HingeSpec,
+    width: f64,
+) -> Result<f64> {
+    let i = prefix;
     let length = within(
-        &format!("hinges[{i}].hinge_length_um"),
+        &format!("{i}.hinge_length_um"),
         hinge.hinge_length_um,
         limits::LENGTH_UM,
         "µm",
     )? * MICROMETRE;
     if hinge.layers.is_empty() {
         return Err(NanofoldError::invalid(
-            format!("hinges[{i}].layers"),
+            format!("{i}.layers"),
             "[]",
             "a hinge needs its structural layer",
         ));
@@ -673,22 +838,17 @@ pub(crate) fn hinge_stiffness(
     let mut stiffness = 0.0;
     for (k, layer) in hinge.layers.iter().enumerate() {
         let t = within(
-            &format!("hinges[{i}].layers[{k}].thickness_um"),
+            &format!("{i}.layers[{k}].thickness_um"),
             layer.thickness_um,
             limits::THICKNESS_UM,
             "µm",
         )? * MICROMETRE;
-        let m = material(materials, &format!("hinges[{i}].layers[{k}].material"), &layer.material)?;
+        let m = material(materials, &format!("{i}.layers[{k}].material"), &layer.material)?;
         let modulus = m.youngs_modulus_gpa * 1e9;
         stiffness += width * t.powi(3) * modulus / (3.0 * length * (1.0 - m.poisson_ratio * m.poisson_ratio));
     }
     let scale = match hinge.stiffness_scale {
-        Some(scale) => within(
-            &format!("hinges[{i}].stiffness_scale"),
-            scale,
-            limits::STIFFNESS_SCALE,
-            "",
-        )?,
+        Some(scale) => within(&format!("{i}.stiffness_scale"), scale, limits::STIFFNESS_SCALE, "")?,
         None => 1.0,
     };
     Ok(scale * stiffness)

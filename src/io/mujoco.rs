@@ -365,6 +365,13 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
 /// The MJCF text of `scene`.
 pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let (bodies, connect_targets, connect_anchors, substrate_edge, drag, description) = match &scene.system {
+        System::Network(_) => {
+            return Err(NanofoldError::invalid(
+                "scene",
+                &scene.name,
+                "MuJoCo export of a network scene is not written yet: strips and closed chains only",
+            ))
+        }
         System::Strip(chain) => {
             let (bodies, notes) = strip_bodies(chain)?;
             let mut description = "a strip: plate i hangs from plate i − 1 by hinge i; the substrate is the box under z = 0 for y ≤ the edge"

@@ -5,6 +5,8 @@
 use crate::dynamics::closed::modes::ClosedModes;
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::modes::Modes;
+use crate::dynamics::network::modes::NetworkModes;
+use crate::dynamics::network::NetworkModel;
 use crate::dynamics::plant::Sample;
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{Response, Simulation, SimulationSettings};
@@ -334,6 +336,15 @@ pub fn target_angles(scene: &Scene) -> Vec<f64> {
             }
             targets
         }
+        System::Network(model) => (0..model.columns())
+            .map(|c| {
+                if model.locked(c) {
+                    model.start[c]
+                } else {
+                    model.forcing.hinges[c].target
+                }
+            })
+            .collect(),
     }
 }
 
@@ -394,6 +405,21 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         value["max_closure_residual"] = json!(closed.max_closure_residual);
         value["crease_edges"] = json!(chain.crease_user_indices);
     }
+    if let (Some(report), Some(model)) = (&simulation.network, scene.network()) {
+        value["panels"] = json!(report.panels);
+        value["creases"] = json!(report.creases);
+        value["anchored_face"] = json!(report.anchored_face);
+        value["branch"] = json!(report.branch);
+        value["max_closure_residual"] = json!(report.max_closure_residual);
+        value["energy_balance_error"] = json!(report.energy_balance_error);
+        value["crease_edges"] = json!(model.folding.pattern.creases);
+        value["release_times_s"] = json!(model
+            .forcing
+            .hinges
+            .iter()
+            .map(|h| h.release_time)
+            .collect::<Vec<f64>>());
+    }
     value
 }
 
@@ -418,7 +444,40 @@ fn with_samples(mut value: Value, response: &Response) -> Value {
         "actuator_potential": column(&|s| s.actuator_potential),
         "total": column(&|s| s.total_energy()),
     });
+    if samples.iter().all(|s| s.energy_balance().is_some()) && !samples.is_empty() {
+        value["energy_j"]["actuation_work"] = json!(column(&|s| s.actuation_work.unwrap_or(f64::NAN)));
+        value["energy_j"]["drag_dissipation"] = json!(column(&|s| s.drag_dissipation.unwrap_or(f64::NAN)));
+        value["energy_j"]["balance"] = json!(column(&|s| s.energy_balance().unwrap_or(f64::NAN)));
+    }
     value
+}
+
+/// `nanofold modes --json` of a network: the equilibrium, the released locks, the
+/// frequencies (with and without the constraints' load term) and the shapes over every crease.
+pub fn network_modes_json(name: &str, model: &NetworkModel, result: &NetworkModes) -> Value {
+    let modes = &result.modes;
+    let shapes: Vec<Vec<f64>> = (0..modes.crease_shapes.ncols())
+        .map(|k| modes.crease_shapes.column(k).iter().copied().collect())
+        .collect();
+    json!({
+        "scene": name,
+        "panels": model.panels(),
+        "creases": model.columns(),
+        "crease_edges": model.folding.pattern.creases,
+        "anchored_face": model.anchored_face,
+        "degrees_of_freedom": modes.basis.ncols(),
+        "released_locks": result.released.iter().map(|&(c, a)| json!({"edge": model.folding.pattern.creases[c], "angle_rad": a})).collect::<Vec<_>>(),
+        "rest_angles_rad": result.rest_angles,
+        "equilibrium_rad": modes.equilibrium.angles,
+        "equilibrium_newton_steps": modes.equilibrium.iterations,
+        "residual_torque_n_m": modes.equilibrium.residual_torque,
+        "closure_residual_rad": modes.equilibrium.closure_residual,
+        "eigenvalues": modes.modes.eigenvalues,
+        "frequencies_hz": modes.modes.frequencies_hz,
+        "frequencies_without_load_hz": modes.frequencies_without_load_hz,
+        "mode_shapes": shapes,
+        "stable": modes.modes.stable,
+    })
 }
 
 /// `nanofold modes` output of a strip.

@@ -4,7 +4,7 @@
 //! ([`SceneSpec::build`]) validates it and runs the closed chain's sweep and fit.
 
 use crate::dynamics::scene::SceneSpec;
-use crate::dynamics::spec::{ClosedSpec, StripSpec};
+use crate::dynamics::spec::{ClosedSpec, NetworkSpec, StripSpec};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::LoadOptions;
 use std::path::Path;
@@ -46,8 +46,22 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
             "this is a crease pattern, not a scene: unfold it with `unfold`, or name it as a scene's `pattern`",
         ));
     }
-    let closed = value.get("pattern").is_some();
-    let mut spec = if closed {
+    let closed = value.get("pattern").is_some() && value.get("cut_crease").is_some();
+    let network = value.get("pattern").is_some() && !closed;
+    let mut spec = if network {
+        let file: NetworkSpec<String> = crate::io::input::from_value(&value)?;
+        let loaded = file.with_pattern(|path| {
+            let resolved = base.join(&path);
+            crate::io::load_crease_pattern(&resolved).map_err(|e| {
+                NanofoldError::invalid(
+                    "pattern",
+                    format!("\"{path}\" ({})", resolved.display()),
+                    full_message(&e),
+                )
+            })
+        })?;
+        SceneSpec::Network(Box::new(loaded))
+    } else if closed {
         let file: ClosedSpec<String> = crate::io::input::from_value(&value)?;
         let loaded = file.with_pattern(|path| {
             let resolved = base.join(&path);
@@ -69,6 +83,9 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
             s.name.get_or_insert_with(|| fallback_name.to_string());
         }
         SceneSpec::Closed(s) => {
+            s.name.get_or_insert_with(|| fallback_name.to_string());
+        }
+        SceneSpec::Network(s) => {
             s.name.get_or_insert_with(|| fallback_name.to_string());
         }
     }

@@ -9,6 +9,8 @@ use super::{
 use crate::dynamics::algorithms::{update_corners, update_poses};
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::model::Data;
+use crate::dynamics::network::algorithms::update_poses as place_panels;
+use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::plant::Sample;
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{ModelKind, Response};
@@ -54,7 +56,14 @@ pub struct ResponseView {
     pub targets: Vec<Option<f64>>,
     /// Whether drag is modelled (the energy plot says so).
     pub drag: bool,
+    /// The sample's angle each series plots (series i plots angle `columns[i]`).
+    pub columns: Vec<usize>,
+    /// A note on which angles are plotted (None: all of them).
+    pub selection: Option<String>,
 }
+
+/// Networks plot at most this many creases in `response.svg` (those that move most).
+const MAX_SERIES: usize = 16;
 
 impl ResponseView {
     /// A scene's series: a strip's hinges (passive or with their targets), or a closed
@@ -63,6 +72,62 @@ impl ResponseView {
         match &scene.system {
             System::Strip(chain) => Self::of_strip(&scene.name, chain),
             System::Closed(chain) => Self::of_closed(&scene.name, chain),
+            System::Network(model) => Self::of_network(&scene.name, model, None),
+        }
+    }
+
+    /// A network's creases with their assignments and roles; with a response and more than
+    /// [`MAX_SERIES`] creases, the ones whose angle ranges furthest over the run.
+    pub fn of_network(name: &str, model: &NetworkModel, response: Option<&Response>) -> Self {
+        let n = model.columns();
+        let mut columns: Vec<usize> = (0..n).collect();
+        let mut selection = None;
+        if let (Some(response), true) = (response, n > MAX_SERIES) {
+            let range = |c: usize| {
+                let (lo, hi) = response
+                    .samples
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), s| {
+                        (l.min(s.angles[c]), h.max(s.angles[c]))
+                    });
+                hi - lo
+            };
+            columns.sort_by(|&a, &b| range(b).total_cmp(&range(a)).then(a.cmp(&b)));
+            columns.truncate(MAX_SERIES);
+            columns.sort_unstable();
+            selection = Some(format!("{MAX_SERIES} of {n} creases, those that move most"));
+        }
+        let pattern = &model.folding.pattern;
+        ResponseView {
+            name: name.to_string(),
+            labels: columns
+                .iter()
+                .map(|&c| {
+                    let letter = match pattern.kinds[pattern.creases[c]] {
+                        crate::pattern::crease_pattern::EdgeKind::Crease(a) => a.letter(),
+                        _ => "?",
+                    };
+                    let role = if model.locked(c) {
+                        "locked"
+                    } else if model.forcing.hinges[c].actuated {
+                        "actuated"
+                    } else {
+                        "passive"
+                    };
+                    format!("{} {letter} ({role})", model.labels[c])
+                })
+                .collect(),
+            targets: columns
+                .iter()
+                .map(|&c| {
+                    model.forcing.hinges[c]
+                        .actuated
+                        .then_some(model.forcing.hinges[c].target)
+                })
+                .collect(),
+            drag: model.drag.is_some(),
+            columns,
+            selection,
         }
     }
 
@@ -77,6 +142,8 @@ impl ResponseView {
                 .collect(),
             targets: chain.forcing.hinges.iter().map(|h| Some(h.target)).collect(),
             drag: chain.model.drag().is_some(),
+            columns: (0..chain.model.dof()).collect(),
+            selection: None,
         }
     }
 
@@ -102,13 +169,19 @@ impl ResponseView {
                 .map(|c| (c == chain.driver).then_some(chain.target()))
                 .collect(),
             drag: chain.model.drag().is_some(),
+            columns: (0..creases).collect(),
+            selection: None,
         }
     }
 }
 
 /// Renders a scene's `response.svg`.
 pub fn response_svg(scene: &Scene, response: &Response) -> Result<String> {
-    response_view_svg(&ResponseView::of_scene(scene), response)
+    let view = match &scene.system {
+        System::Network(model) => ResponseView::of_network(&scene.name, model, Some(response)),
+        _ => ResponseView::of_scene(scene),
+    };
+    response_view_svg(&view, response)
 }
 
 /// Renders a scene's `snapshots.svg`: a strip seen along its creases, a closed chain's
@@ -117,6 +190,7 @@ pub fn snapshots_svg(scene: &Scene, response: &Response) -> Result<String> {
     match &scene.system {
         System::Strip(chain) => strip_snapshots_svg(&scene.name, chain, scene.outputs.snapshots, response),
         System::Closed(chain) => closed_snapshots_svg(&scene.name, chain, response, 5),
+        System::Network(model) => network_snapshots_svg(&scene.name, model, response, 5),
     }
 }
 
@@ -132,9 +206,9 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         let mut lo: f64 = -10.0;
         let mut hi: f64 = 10.0;
         for s in &response.samples {
-            for a in s.angles.iter() {
-                lo = lo.min(a.to_degrees());
-                hi = hi.max(a.to_degrees());
+            for &c in &view.columns {
+                lo = lo.min(s.angles[c].to_degrees());
+                hi = hi.max(s.angles[c].to_degrees());
             }
         }
         for t in view.targets.iter().flatten() {
@@ -145,9 +219,14 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         let collision = response.collision.as_ref().map_or("no collision".to_string(), |c| {
             format!("{} hits {} at t = {:.4} {unit}", c.pair[0], c.pair[1], c.time / scale)
         });
+        let shown = view.selection.as_ref().map_or(String::new(), |s| format!("; {s}"));
         let mut chart = ChartBuilder::on(&top)
             .caption(
-                format!("{}: fold angles ({}; {collision})", view.name, model_label(response)),
+                format!(
+                    "{}: fold angles ({}; {collision}{shown})",
+                    view.name,
+                    model_label(response)
+                ),
                 ("sans-serif", 18),
             )
             .margin(px(12))
@@ -164,8 +243,10 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .draw()
             .map_err(plot_error)?;
         // Hinges that move alike draw one line over another: the legend says which.
-        let series: Vec<Vec<f64>> = (0..view.labels.len())
-            .map(|i| response.samples.iter().map(|s| s.angles[i]).collect())
+        let series: Vec<Vec<f64>> = view
+            .columns
+            .iter()
+            .map(|&c| response.samples.iter().map(|s| s.angles[c]).collect())
             .collect();
         let same = coinciding(&series, 1e-9);
         let mut entries = Vec::new();
@@ -174,10 +255,11 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 Some(j) => format!("{label} (= {})", view.labels[j]),
                 None => label.clone(),
             };
+            let column = view.columns[i];
             let points = response
                 .samples
                 .iter()
-                .map(|s| (s.time / scale, s.angles[i].to_degrees()))
+                .map(|s| (s.time / scale, s.angles[column].to_degrees()))
                 .collect();
             let (label, colour, kind) = draw_series_line(&mut chart, points, i, label)?;
             entries.push((label, colour, kind));
@@ -218,6 +300,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                     s.kinetic_energy.abs(),
                     s.elastic_energy.abs(),
                     s.actuator_potential.abs(),
+                    s.actuation_work.unwrap_or(0.0).abs(),
                 ]
             })
             .fold(0.0_f64, f64::max);
@@ -228,12 +311,24 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         } else {
             (1e-6, "µJ")
         };
-        let series: [(&str, EnergyTerm); 4] = [
-            ("kinetic ½θ̇ᵀMθ̇", Box::new(|s| s.kinetic_energy)),
-            ("elastic ½θᵀKθ", Box::new(|s| s.elastic_energy)),
-            ("actuator −τ·θ", Box::new(|s| s.actuator_potential)),
-            ("total", Box::new(|s| s.total_energy())),
-        ];
+        let balance = response.samples.iter().all(|s| s.energy_balance().is_some());
+        let series: Vec<(&str, EnergyTerm)> = if balance {
+            vec![
+                ("kinetic ½θ̇ᵀMθ̇", Box::new(|s| s.kinetic_energy)),
+                ("hinges ½θᵀKθ", Box::new(|s| s.elastic_energy)),
+                ("−work of the actuation", Box::new(|s| -s.actuation_work.unwrap_or(0.0))),
+                ("drag dissipation", Box::new(|s| s.drag_dissipation.unwrap_or(0.0))),
+                ("balance (sum)", Box::new(|s| s.energy_balance().unwrap_or(0.0))),
+            ]
+        } else {
+            vec![
+                ("kinetic ½θ̇ᵀMθ̇", Box::new(|s| s.kinetic_energy)),
+                ("elastic ½θᵀKθ", Box::new(|s| s.elastic_energy)),
+                ("actuator −τ·θ", Box::new(|s| s.actuator_potential)),
+                ("total", Box::new(|s| s.total_energy())),
+            ]
+        };
+        let last = series.len() - 1;
         let (mut e_lo, mut e_hi) = (0.0_f64, 0.0_f64);
         for s in &response.samples {
             for (_, f) in &series {
@@ -261,7 +356,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .map_err(plot_error)?;
         let mut entries = Vec::new();
         for (k, (label, f)) in series.iter().enumerate() {
-            let colour = if k == 3 { BLACK } else { series_colour(k + 5) };
+            let colour = if k == last { BLACK } else { series_colour(k + 5) };
             energy
                 .draw_series(LineSeries::new(
                     response.samples.iter().map(|s| (s.time / scale, f(s) / e_scale)),
@@ -488,6 +583,97 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
                 outline.push(outline[0]);
                 view.draw_series(std::iter::once(PathElement::new(outline, BLACK.stroke_width(1))))
                     .map_err(plot_error)?;
+            }
+        }
+        root.present().map_err(plot_error)?;
+    }
+    Ok(shown_at(svg))
+}
+
+/// A network's panels in 3D at `count` moments (anchored panel grey, the others by their
+/// tree crease's colour).
+fn network_snapshots_svg(name: &str, model: &NetworkModel, response: &Response, count: usize) -> Result<String> {
+    let pattern = &model.folding.pattern;
+    let mut data = NetworkData::new(model);
+    let flat = |v: usize| {
+        nalgebra::Vector3::new(
+            pattern.vertices[v][0] * model.unit,
+            pattern.vertices[v][1] * model.unit,
+            0.0,
+        )
+    };
+    let picks = snapshot_samples(response, count);
+    let mut reach: f64 = 1e-12;
+    for &index in &picks {
+        place_panels(model, response.samples[index].angles.as_slice(), &mut data);
+        for (p, triangles) in model.folding.panel_triangles.iter().enumerate() {
+            for &v in triangles.iter().flatten() {
+                reach = reach.max(data.place(p, &flat(v)).amax());
+            }
+        }
+    }
+    let reach = reach * 1e6;
+    let mut svg = String::new();
+    {
+        let root = canvas(&mut svg, (1100, 400));
+        root.fill(&WHITE).map_err(plot_error)?;
+        let (title, body) = root.split_vertically(px(34));
+        title
+            .titled(
+                &format!(
+                    "{}: the panels in 3D (grey: anchored panel; µm){}",
+                    name,
+                    response
+                        .collision
+                        .as_ref()
+                        .map_or(String::new(), |c| format!(", first contact at t = {:.4e} s", c.time))
+                ),
+                ("sans-serif", 18),
+            )
+            .map_err(plot_error)?;
+        let panels = body.split_evenly((1, picks.len().max(1)));
+        let to_plot = |p: nalgebra::Vector3<f64>| (p.x * 1e6, p.z * 1e6, p.y * 1e6);
+        for (area, &index) in panels.iter().zip(&picks) {
+            let sample = &response.samples[index];
+            place_panels(model, sample.angles.as_slice(), &mut data);
+            let mut view = ChartBuilder::on(area)
+                .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
+                .margin(px(4))
+                .build_cartesian_3d(-reach..reach, -reach..reach, -reach..reach)
+                .map_err(plot_error)?;
+            view.with_projection(|mut p| {
+                p.yaw = -0.9;
+                p.pitch = 0.45;
+                p.scale = 1.25;
+                p.into_matrix()
+            });
+            for (p, triangles) in model.folding.panel_triangles.iter().enumerate() {
+                let colour = if p == model.anchored_panel {
+                    RGBColor(150, 150, 150)
+                } else {
+                    series_colour(model.parent_column[p].unwrap_or(0))
+                };
+                for t in triangles {
+                    let corners: Vec<_> = t.iter().map(|&v| to_plot(data.place(p, &flat(v)))).collect();
+                    view.draw_series(std::iter::once(Polygon::new(corners.clone(), colour.mix(0.4).filled())))
+                        .map_err(plot_error)?;
+                }
+                // The panel's outline: its faces' edges that are not facet lines inside it.
+                for (f, face) in pattern
+                    .faces
+                    .iter()
+                    .enumerate()
+                    .filter(|(f, _)| pattern.panel_of_face[*f] == p)
+                {
+                    let _ = f;
+                    let k = face.len();
+                    for i in 0..k {
+                        let (a, b) = (face[i], face[(i + 1) % k]);
+                        let line = vec![to_plot(data.place(p, &flat(a))), to_plot(data.place(p, &flat(b)))];
+                        view.draw_series(std::iter::once(PathElement::new(line, BLACK.stroke_width(1))))
+                            .map_err(plot_error)?;
+                    }
+                }
             }
         }
         root.present().map_err(plot_error)?;

@@ -28,6 +28,8 @@ const STATICS_STEP_CAP: f64 = 0.1;
 const STATICS_ITERATIONS: usize = 200;
 /// The statics stops once its step is below this, rad.
 const STATICS_STEP_TOL: f64 = 1e-12;
+/// The statics takes Newton steps (with the closures' curvature) once its step is below this, rad.
+const NEWTON_SWITCH: f64 = 1e-4;
 /// γ of the statics' augmented Hessian (relative to the largest K).
 const STATICS_AUGMENT: f64 = 10.0;
 
@@ -159,12 +161,16 @@ pub fn equilibrium(model: &NetworkModel, rest: &[f64], start: &[f64], kkt: &mut 
     let mut data = NetworkData::new(model);
     let rows = 3 * model.folding.stars.len();
     let mut multipliers = vec![0.0; rows];
+    let none = vec![0.0; rows];
     let mut rhs = vec![0.0; kkt.size()];
+    // Gauss–Newton (the hinges' K alone) while far off: the multipliers of a state far from
+    // balance, or near a singular one, make a wild curvature term; Newton once steps are small.
+    let mut newton = false;
     for iteration in 0..STATICS_ITERATIONS {
         update_stars(model, &angles, None, &mut data);
         let block = PrimalBlock::Hessian {
             stiffness: &stiffness,
-            multipliers: &multipliers,
+            multipliers: if newton { &multipliers } else { &none },
         };
         kkt.assemble(model, &data, block, STATICS_AUGMENT)?;
         let scale = kkt.scale();
@@ -178,6 +184,7 @@ pub fn equilibrium(model: &NetworkModel, rest: &[f64], start: &[f64], kkt: &mut 
             *m = scale * kkt.row_scales()[r] * rhs[n + r];
         }
         let step = rhs[..n].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        newton = step < NEWTON_SWITCH;
         let cap = if step > STATICS_STEP_CAP {
             STATICS_STEP_CAP / step
         } else {

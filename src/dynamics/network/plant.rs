@@ -22,6 +22,25 @@ use crate::folding::normal::NormalSolver;
 use nalgebra::DVector;
 use std::f64::consts::TAU;
 
+/// What a network run reports beside its response.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct NetworkReport {
+    /// Panels.
+    pub panels: usize,
+    /// Creases.
+    pub creases: usize,
+    /// FOLD face index of the anchored panel.
+    pub anchored_face: usize,
+    /// How a flat start was left (None: the start is not flat).
+    pub branch: Option<String>,
+    /// Largest vertex closure residual over the recorded states, rad.
+    pub max_closure_residual: f64,
+    /// Largest change of kinetic + hinge energy − work of the actuation + drag dissipation
+    /// over the recorded states, relative to the largest of those energies (None on the
+    /// quasi-static path, which tracks no work).
+    pub energy_balance_error: Option<f64>,
+}
+
 /// Scratch of a [`NetworkPlant`].
 pub struct NetworkWorkspace {
     /// The rigid-body buffers.
@@ -63,6 +82,38 @@ impl<'m> NetworkPlant<'m> {
         self.start.as_ref()
     }
 
+    /// The report of a run: its branch, closure residuals and energy balance.
+    pub fn report(&self, response: &crate::dynamics::simulate::Response) -> Result<NetworkReport> {
+        let max_closure_residual = response
+            .samples
+            .iter()
+            .map(|s| worst_residual(self.model, s.angles.as_slice()))
+            .fold(0.0, f64::max);
+        let balances: Option<Vec<f64>> = response.samples.iter().map(|s| s.energy_balance()).collect();
+        let energy_balance_error = balances.and_then(|b| {
+            let first = *b.first()?;
+            let scale = response
+                .samples
+                .iter()
+                .map(|s| {
+                    s.kinetic_energy
+                        .max(s.elastic_energy)
+                        .max(s.actuation_work.unwrap_or(0.0).abs())
+                })
+                .fold(0.0, f64::max);
+            let drift = b.iter().map(|x| (x - first).abs()).fold(0.0, f64::max);
+            Some(if scale > 0.0 { drift / scale } else { 0.0 })
+        });
+        Ok(NetworkReport {
+            panels: self.model.panels(),
+            creases: self.model.columns(),
+            anchored_face: self.model.anchored_face,
+            branch: self.start.as_ref().map(|b| b.note.clone()),
+            max_closure_residual,
+            energy_balance_error,
+        })
+    }
+
     /// A configuration to take the time scales at: the start, or the branch's first state
     /// when the start is flat (its tangent space there is the branch's, not the flat
     /// state's larger first-order one).
@@ -76,7 +127,8 @@ impl<'m> NetworkPlant<'m> {
         let mut rest = vec![0.0; self.model.columns()];
         forcing.drive_angles(forcing.duration().max(1.0), &mut rest);
         self.rest_angles(&mut rest);
-        Ok(equilibrium(self.model, &rest, self.regular_start(), &mut ws.kkt)?.angles)
+        let _ = ws;
+        Ok(super::modes::follow_drive(self.model, &rest, self.regular_start())?.angles)
     }
 
     /// Locked creases rest at their lock.

@@ -18,13 +18,18 @@ use super::kkt::KktSystem;
 use super::manifold::{mass_times, projection_solver, restore};
 use super::model::NetworkModel;
 use crate::error::{NanofoldError, Result};
+use crate::folding::closure_jacobian;
 use crate::folding::normal::NormalSolver;
+use crate::pattern::crease_pattern::EdgeKind;
+use crate::pattern::Assignment;
 
 /// Size of the branch segment modelled in closed form, rad (the largest crease's angle at
 /// its end).
 pub const KICK: f64 = 1e-3;
 /// A star counts as flat when every free crease of it lies within this of 0, rad.
 const FLAT: f64 = 1e-12;
+/// Alternations of Newton and the shift along the push to land on a branch point.
+const BRANCH_ITERATIONS: usize = 500;
 /// RK4 steps over the segment.
 const SEGMENT_STEPS: usize = 2000;
 
@@ -85,23 +90,65 @@ pub fn leave_flat(model: &NetworkModel) -> Result<Option<BranchStart>> {
         return Ok(None);
     }
     let mut solver = projection_solver();
-    let mut kicked: Vec<f64> = start.iter().zip(&push).map(|(s, a)| s + KICK * a / size).collect();
-    restore(model, &mut kicked, &mut solver).map_err(|_| {
-        NanofoldError::invalid(
-            "pattern",
-            "a flat start",
-            format!("Newton found no rigid state {KICK:e} rad from flat along the push of the actuation: no branch leaves flat that way"),
+    // Candidate branches: kicks along the push and along the crease assignment's signs (each
+    // projected onto the first-order motions), Newton onto the closures; the branch taken is
+    // the one the push favours most in the kinetic metric (Gauss's least constraint from
+    // rest: the largest (τ·d)² / dᵀMd with τ·d > 0).
+    let mut candidates: Vec<(Vec<f64>, &str)> = vec![(push.clone(), "the push of the actuation")];
+    let signs: Vec<f64> = (0..n)
+        .map(
+            |c| match model.folding.pattern.kinds[model.folding.pattern.creases[c]] {
+                EdgeKind::Crease(Assignment::Valley) if !model.locked(c) => 1.0,
+                EdgeKind::Crease(Assignment::Mountain) if !model.locked(c) => -1.0,
+                _ => 0.0,
+            },
         )
-    })?;
-    let chord: Vec<f64> = kicked.iter().zip(start).map(|(k, s)| k - s).collect();
-    let norm = chord.iter().map(|v| v * v).sum::<f64>().sqrt();
-    if norm < 0.5 * KICK {
+        .collect();
+    if signs.iter().any(|&s| s != 0.0) {
+        let jacobian = closure_jacobian(&model.folding, start);
+        let projected = NormalSolver::new(1e-10).factor(&jacobian)?.project(&signs);
+        candidates.push((projected, "the crease assignment"));
+    }
+    update_kinematics(model, start, &mut data);
+    update_mass_matrix(model, &mut data);
+    let mut best: Option<(f64, Vec<f64>, &str)> = None;
+    for (direction, source) in candidates {
+        let largest = direction.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if !(largest > 0.0 && largest.is_finite()) {
+            continue;
+        }
+        let mut x: Vec<f64> = start
+            .iter()
+            .zip(&direction)
+            .map(|(s, d)| s + KICK * d / largest)
+            .collect();
+        if restore(model, &mut x, &mut solver).is_err() {
+            continue;
+        }
+        let chord: Vec<f64> = x.iter().zip(start).map(|(a, b)| a - b).collect();
+        if chord.iter().fold(0.0_f64, |m, v| m.max(v.abs())) < 0.5 * KICK {
+            continue;
+        }
+        let mut mass = vec![0.0; n];
+        mass_times(model, &data, &chord, &mut mass);
+        let inertia: f64 = chord.iter().zip(&mass).map(|(a, b)| a * b).sum();
+        let drive: f64 = chord.iter().zip(&torque).map(|(a, b)| a * b).sum();
+        if drive > 0.0 && inertia > 0.0 {
+            let score = drive * drive / inertia;
+            if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
+                best = Some((score, x, source));
+            }
+        }
+    }
+    let Some((_, kicked, source)) = best else {
         return Err(NanofoldError::invalid(
             "pattern",
             "a flat start",
-            "Newton from the push fell back to flat: the actuation pushes along no branch",
+            format!("Newton found no rigid state {KICK:e} rad from flat along the push of the actuation or the assignment that the actuation drives forward: no branch leaves flat that way"),
         ));
-    }
+    };
+    let chord: Vec<f64> = kicked.iter().zip(start).map(|(k, s)| k - s).collect();
+    let norm = chord.iter().map(|v| v * v).sum::<f64>().sqrt();
     let direction: Vec<f64> = chord.iter().map(|v| v / norm).collect();
     let sigma_end = direction.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let sigma_end = KICK / sigma_end;
@@ -194,7 +241,7 @@ pub fn leave_flat(model: &NetworkModel) -> Result<Option<BranchStart>> {
         .map(|(c, v)| (c, *v))
         .unwrap_or((0, 0.0));
     let note = format!(
-        "left flat along the branch the actuation pushes towards (first-order push strongest at {} {}): Newton from a {KICK:e} rad kick, then the branch's one-coordinate equation to {KICK:e} rad in {:.3e} s",
+        "left flat along the branch reached from a {KICK:e} rad kick along {source} (of the candidates the push drives hardest: first-order push strongest at {} {}), then the branch's one-coordinate equation to {KICK:e} rad in {:.3e} s",
         model.labels[largest.0],
         if largest.1 > 0.0 { "valley" } else { "mountain" },
         t
@@ -248,18 +295,21 @@ fn branch_point(
     };
     let scale = sigma / along(guess).max(f64::MIN_POSITIVE);
     let mut rho: Vec<f64> = guess.iter().zip(start).map(|(g, s)| s + (g - s) * scale).collect();
-    for _ in 0..50 {
+    for _ in 0..BRANCH_ITERATIONS {
         restore(model, &mut rho, solver)?;
         let error = sigma - along(&rho);
-        if error.abs() <= 1e-15 * sigma {
+        if error.abs() <= 1e-14 * sigma {
             return Ok(rho);
         }
         for (r, d) in rho.iter_mut().zip(direction) {
             *r += error * d;
         }
     }
-    restore(model, &mut rho, solver)?;
-    Ok(rho)
+    Err(NanofoldError::invalid(
+        "pattern",
+        "a flat start",
+        "no branch point found along the push (the closures and the push's plane do not meet near flat)",
+    ))
 }
 
 /// The branch modelled as ρ(σ) = ρ₀ + σ d₀ + ½ σ² d₁.

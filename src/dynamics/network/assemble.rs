@@ -1,0 +1,295 @@
+//! A network scene's pipeline (`docs/model.md#panel-networks`): a validated
+//! [`NetworkSpec`] → every crease's hinge (its own entry or the defaults), the drives and
+//! the etch front's release times, the start (the pattern's rigid state, projected onto the
+//! closures when it is within the tolerance), the locks and the anchored panel →
+//! [`NetworkModel`]. Loaders never call this; building a scene does.
+
+use super::manifold::{projection_solver, restore, worst_residual};
+use super::model::{NetworkModel, NetworkParts};
+use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
+use crate::dynamics::spec::{
+    count_within, drag_law, finite, hinge_stiffness_named, limits, material, network_actuation, validate_materials,
+    within, HingeSpec, NetworkSpec, MICROMETRE,
+};
+use crate::error::{NanofoldError, Result};
+use crate::folding::FoldingModel;
+use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
+use crate::pattern::Assignment;
+
+/// A start whose closure residual exceeds this is not a rigid state, rad.
+pub const START_TOLERANCE: f64 = 1e-6;
+
+/// Assembles the network a scene describes.
+pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
+    validate_materials(&spec.materials)?;
+    let unit = within("length_unit_um", spec.length_unit_um, limits::LENGTH_UNIT_UM, "µm")? * MICROMETRE;
+    let mut pattern = spec.pattern.clone();
+    let columns = pattern.creases.len();
+    count_within("pattern (creases)", columns, (1, limits::MAX_NETWORK_CREASES)).map_err(|_| {
+        NanofoldError::invalid(
+            "pattern",
+            format!("{columns} creases"),
+            format!(
+                "a network scene needs between 1 and {} creases",
+                limits::MAX_NETWORK_CREASES
+            ),
+        )
+    })?;
+    // Locks: a crease held where the pattern starts.
+    let mut column_of_edge = vec![None; pattern.edges.len()];
+    for (c, &e) in pattern.creases.iter().enumerate() {
+        column_of_edge[e] = Some(c);
+    }
+    let kinds = pattern.kinds.clone();
+    let crease = |field: &str, e: usize| -> Result<usize> {
+        column_of_edge.get(e).copied().flatten().ok_or_else(|| {
+            let what = match kinds.get(e) {
+                Some(EdgeKind::Boundary) => "a boundary edge, not a crease".to_string(),
+                Some(EdgeKind::Facet) => "a flat facet edge (F) inside a panel, not a crease".to_string(),
+                _ => format!("not an edge of the pattern ({} edges)", kinds.len()),
+            };
+            NanofoldError::invalid(field, e, what)
+        })
+    };
+    for (i, lock) in spec.locks.iter().enumerate() {
+        let field = format!("locks[{i}].crease");
+        let c = crease(&field, lock.crease)?;
+        let e = pattern.creases[c];
+        let angle = finite(&format!("locks[{i}].angle_deg"), lock.angle_deg)?.to_radians();
+        if (angle - pattern.fold_angles[e]).abs() > 1e-9 {
+            return Err(NanofoldError::invalid(
+                format!("locks[{i}].angle_deg"),
+                lock.angle_deg,
+                format!(
+                    "the pattern starts crease {} at {:.9}°: a lock holds a crease where it starts",
+                    lock.crease,
+                    pattern.fold_angles[e].to_degrees()
+                ),
+            ));
+        }
+        pattern.locked[e] = true;
+    }
+    let folding = FoldingModel::new(pattern)?;
+    let pattern = &folding.pattern;
+    // Hinges: each crease's own entry, or the defaults.
+    let mut entry: Vec<Option<usize>> = vec![None; columns];
+    for (i, hinge) in spec.hinges.iter().enumerate() {
+        let field = format!("hinges[{i}].crease");
+        let c = crease(&field, hinge.crease)?;
+        if entry[c].replace(i).is_some() {
+            return Err(NanofoldError::invalid(
+                field,
+                hinge.crease,
+                "this crease already has a hinge",
+            ));
+        }
+    }
+    let defaults = spec.hinge_defaults.as_ref().map(|d| d.hinge());
+    let (actuation, front) = network_actuation(&spec.actuation)?;
+    let mut stiffness = vec![0.0; columns];
+    let mut drives = vec![HingeDrive::PASSIVE; columns];
+    for c in 0..columns {
+        let e = pattern.creases[c];
+        let (prefix, hinge): (String, HingeSpec) = match (entry[c], &defaults) {
+            (Some(i), _) => (format!("hinges[{i}]"), spec.hinges[i].hinge()),
+            (None, Some(d)) => ("hinge_defaults".to_string(), d.clone()),
+            (None, None) => {
+                return Err(NanofoldError::missing_with(
+                    format!("hinges: an entry with crease {e}"),
+                    "or `hinge_defaults` for every crease not listed",
+                ))
+            }
+        };
+        let [a, b] = pattern.edges[e];
+        let length = unit
+            * (pattern.vertices[b][0] - pattern.vertices[a][0]).hypot(pattern.vertices[b][1] - pattern.vertices[a][1]);
+        within(
+            &format!("length_unit_um × the length of crease {e}"),
+            length / MICROMETRE,
+            limits::LENGTH_UM,
+            "µm",
+        )?;
+        stiffness[c] = hinge_stiffness_named(&spec.materials, &prefix, &hinge, length)?;
+        if !(stiffness[c].is_finite() && stiffness[c] > 0.0) {
+            return Err(NanofoldError::invalid(
+                prefix,
+                format!("stiffness {:e} N·m/rad", stiffness[c]),
+                "the bending stiffness overflows or vanishes in double precision: check the units",
+            ));
+        }
+        drives[c] = drive(&prefix, &hinge, entry[c].is_some(), pattern.kinds[e], e, actuation)?;
+    }
+    if !drives.iter().any(|d| d.actuated) {
+        return Err(NanofoldError::invalid(
+            "hinges[*].actuated",
+            "all false",
+            "nothing drives the network (set `actuated` on a hinge or on `hinge_defaults`)",
+        ));
+    }
+    if let (Some(u), Actuation::Ramp { etch_rate }) = (front, actuation) {
+        // The front reaches a crease at its first point along u; the first actuated crease it
+        // meets starts at t = 0.
+        let reach: Vec<f64> = (0..columns)
+            .map(|c| {
+                let [a, b] = pattern.edges[pattern.creases[c]];
+                let along = |v: usize| unit * (u[0] * pattern.vertices[v][0] + u[1] * pattern.vertices[v][1]);
+                along(a).min(along(b))
+            })
+            .collect();
+        let first = (0..columns)
+            .filter(|&c| drives[c].actuated)
+            .map(|c| reach[c])
+            .fold(f64::INFINITY, f64::min);
+        for (drive, reach) in drives.iter_mut().zip(&reach) {
+            if drive.actuated {
+                drive.release_time = (reach - first) / etch_rate;
+            }
+        }
+    }
+    let thickness = within(
+        "plates.thickness_um",
+        spec.plates.thickness_um,
+        limits::THICKNESS_UM,
+        "µm",
+    )? * MICROMETRE;
+    let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
+    let anchored_panel = match spec.anchored_face {
+        None => folding.root_panel,
+        Some(face) => {
+            if face >= pattern.faces.len() {
+                return Err(NanofoldError::invalid(
+                    "anchored_face",
+                    face,
+                    format!("the pattern has {} faces", pattern.faces.len()),
+                ));
+            }
+            pattern.panel_of_face[face]
+        }
+    };
+    // The start: the pattern's own state, rigid within the tolerance.
+    let mut start = folding.given_fold_angles();
+    let residual = worst_residual_of(&folding, &start);
+    if residual > START_TOLERANCE {
+        return Err(NanofoldError::invalid(
+            "pattern",
+            format!("closure residual {residual:.3e} rad"),
+            format!("the start is not a rigid state (above {START_TOLERANCE:e} rad at some vertex): fold it with `nanofold fold` or project it with `check --project`"),
+        ));
+    }
+    let drag = drag_law(&spec.environment)?;
+    crate::dynamics::spec::time_and_outputs(&spec.time, &spec.outputs)?;
+    let mut model = NetworkModel::new(NetworkParts {
+        folding,
+        unit,
+        anchored_panel,
+        thickness,
+        density,
+        stiffness,
+        forcing: Forcing {
+            actuation,
+            hinges: drives,
+        },
+        drag,
+        start: start.clone(),
+        substrate_contact: spec.substrate.contact,
+    })?;
+    if worst_residual(&model, &start) > super::manifold::CLOSURE_TOL {
+        restore(&model, &mut start, &mut projection_solver())?;
+        model.start = start;
+    }
+    let usable = |x: f64| x.is_finite() && x > 0.0;
+    if let Some(p) = model.bodies.iter().position(|b| !usable(b.mass)) {
+        return Err(NanofoldError::invalid(
+            "plates",
+            format!("panel {p}: mass {:e} kg", model.bodies[p].mass),
+            "the panel's mass overflows or vanishes in double precision: check length_unit_um, plates.thickness_um and the density",
+        ));
+    }
+    Ok(model)
+}
+
+fn worst_residual_of(folding: &FoldingModel, angles: &[f64]) -> f64 {
+    crate::folding::vertex_residuals(folding, angles)
+        .into_iter()
+        .fold(0.0, f64::max)
+}
+
+/// One crease's drive: its target (its own, signed; or the defaults' magnitude with the
+/// assignment's sign) and its ramp's radius of curvature.
+fn drive(
+    prefix: &str,
+    hinge: &HingeSpec,
+    own: bool,
+    kind: EdgeKind,
+    edge: usize,
+    actuation: Actuation,
+) -> Result<HingeDrive> {
+    let target_field = format!("{prefix}.target_angle_deg");
+    let sign = match kind {
+        EdgeKind::Crease(Assignment::Valley) => 1.0,
+        EdgeKind::Crease(Assignment::Mountain) => -1.0,
+        _ => 0.0,
+    };
+    let target = match (hinge.actuated, hinge.target_angle_deg) {
+        (false, Some(deg)) if own => {
+            return Err(NanofoldError::invalid(
+                target_field,
+                deg,
+                "a passive hinge (actuated: false) has no target",
+            ))
+        }
+        (false, _) => return Ok(HingeDrive::PASSIVE),
+        (true, None) => return Err(NanofoldError::missing(target_field)),
+        (true, Some(deg)) => {
+            finite(&target_field, deg)?;
+            if deg.abs() > 180.0 {
+                return Err(NanofoldError::invalid(target_field, deg, "must lie in [−180, 180]"));
+            }
+            if own {
+                if sign * deg < 0.0 {
+                    return Err(NanofoldError::invalid(
+                        target_field,
+                        deg,
+                        format!(
+                            "crease {edge} is a {}: its target's sign contradicts the assignment (mountain ≤ 0 ≤ valley)",
+                            if sign > 0.0 { "valley" } else { "mountain" }
+                        ),
+                    ));
+                }
+                deg.to_radians()
+            } else {
+                if sign == 0.0 {
+                    return Err(NanofoldError::invalid(
+                        target_field,
+                        deg,
+                        format!("crease {edge} is unassigned: the defaults' target takes the assignment's sign, so it needs its own entry in `hinges`"),
+                    ));
+                }
+                if deg < 0.0 {
+                    return Err(NanofoldError::invalid(
+                        target_field,
+                        deg,
+                        "the defaults' target is a magnitude (each crease takes its assignment's sign)",
+                    ));
+                }
+                sign * deg.to_radians()
+            }
+        }
+    };
+    let radius = match actuation {
+        Actuation::Step => f64::INFINITY,
+        Actuation::Ramp { .. } => {
+            let field = format!("{prefix}.radius_of_curvature_um");
+            let value = hinge
+                .radius_of_curvature_um
+                .ok_or_else(|| NanofoldError::missing(field.clone()))?;
+            within(&field, value, limits::LENGTH_UM, "µm")? * MICROMETRE
+        }
+    };
+    Ok(HingeDrive {
+        target,
+        radius_of_curvature: radius,
+        actuated: true,
+        release_time: 0.0,
+    })
+}
