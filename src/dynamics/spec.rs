@@ -91,8 +91,8 @@ pub enum ActuationSpec {
     },
     /// A straight etch front crossing the wafer in direction `direction_deg` (in the
     /// pattern's plane, from its x axis, counter-clockwise) at `etch_rate_um_per_min`: each
-    /// actuated hinge's ramp starts when the front reaches the first point of its crease,
-    /// the first hinge the front meets at t = 0 (pattern scenes only).
+    /// actuated hinge's ramp starts when the front has passed the whole of its crease line,
+    /// the first hinge so freed at t = 0 (pattern scenes only).
     Front {
         /// a, µm/min.
         etch_rate_um_per_min: f64,

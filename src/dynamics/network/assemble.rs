@@ -127,13 +127,14 @@ pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
         ));
     }
     if let (Some(u), Actuation::Ramp { etch_rate }) = (front, actuation) {
-        // The front reaches a crease at its first point along u; the first actuated crease it
-        // meets starts at t = 0.
+        // The film under a crease holds its panel flat until the front has passed the whole
+        // crease line (its last point along u); the first actuated crease so freed starts at
+        // t = 0.
         let reach: Vec<f64> = (0..columns)
             .map(|c| {
                 let [a, b] = pattern.edges[pattern.creases[c]];
                 let along = |v: usize| unit * (u[0] * pattern.vertices[v][0] + u[1] * pattern.vertices[v][1]);
-                along(a).min(along(b))
+                along(a).max(along(b))
             })
             .collect();
         let first = (0..columns)
