@@ -10,11 +10,13 @@
 pub mod algorithms;
 pub mod assemble;
 pub mod contact;
+pub mod hessian;
 pub mod kkt;
 pub mod manifold;
 pub mod model;
 pub mod modes;
 pub mod plant;
+pub mod rows;
 pub mod start;
 
 pub use algorithms::{NetworkData, Spatial, SpatialInertia};

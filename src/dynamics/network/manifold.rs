@@ -10,7 +10,7 @@
 //! Zᵀ(K + Σ λ ∇²Φ)Z φ = ω² ZᵀMZ φ with Z a basis of the tangent space.
 
 use super::algorithms::{update_kinematics, update_mass_matrix, update_stars, NetworkData};
-use super::kkt::{KktSystem, PrimalBlock};
+use super::hessian::HessianSystem;
 use super::model::NetworkModel;
 use crate::dynamics::modes::{generalized_modes, Modes};
 use crate::error::{NanofoldError, NumericalError, Result};
@@ -30,8 +30,6 @@ const STATICS_ITERATIONS: usize = 200;
 const STATICS_STEP_TOL: f64 = 1e-12;
 /// The statics takes Newton steps (with the closures' curvature) once its step is below this, rad.
 const NEWTON_SWITCH: f64 = 1e-4;
-/// γ of the statics' augmented Hessian (relative to the largest K).
-const STATICS_AUGMENT: f64 = 10.0;
 
 /// Moves `angles` onto every vertex closure (least-norm Newton, locked creases held), within
 /// [`CLOSURE_TOL`]; an error naming the residual when Newton does not get there.
@@ -152,7 +150,7 @@ pub struct Equilibrium {
 
 /// The minimum of V(ρ) = Σ ½ K (ρ − rest)² on the manifold nearest `start` (a closed state),
 /// by Newton on the Lagrangian (`docs/model.md#panel-networks`). Locked creases stay.
-pub fn equilibrium(model: &NetworkModel, rest: &[f64], start: &[f64], kkt: &mut KktSystem) -> Result<Equilibrium> {
+pub fn equilibrium(model: &NetworkModel, rest: &[f64], start: &[f64], kkt: &mut HessianSystem) -> Result<Equilibrium> {
     let n = model.columns();
     let stiffness = model.stiffness();
     let mut angles = start.to_vec();
@@ -161,36 +159,41 @@ pub fn equilibrium(model: &NetworkModel, rest: &[f64], start: &[f64], kkt: &mut 
     let mut data = NetworkData::new(model);
     let rows = 3 * model.folding.stars.len();
     let mut multipliers = vec![0.0; rows];
-    let none = vec![0.0; rows];
-    let mut rhs = vec![0.0; kkt.size()];
-    // Gauss–Newton (the hinges' K alone) while far off: the multipliers of a state far from
-    // balance, or near a singular one, make a wild curvature term; Newton once steps are small.
+    let (mut f, b, mut step_vector) = (vec![0.0; n], vec![0.0; rows], vec![0.0; n]);
+    // Gauss–Newton (the hinges' K alone) while far off, Newton (with the closures' curvature
+    // weighted by the last multipliers) once the steps are small.
     let mut newton = false;
     for iteration in 0..STATICS_ITERATIONS {
         update_stars(model, &angles, None, &mut data);
-        let block = PrimalBlock::Hessian {
-            stiffness: &stiffness,
-            multipliers: if newton { &multipliers } else { &none },
-        };
-        kkt.assemble(model, &data, block, STATICS_AUGMENT)?;
+        // The curvature can leave the Hessian indefinite far from a minimum: K alone then.
+        if !(newton && kkt.assemble(&data, &stiffness, Some(&multipliers)).is_ok()) {
+            kkt.assemble(&data, &stiffness, None)?;
+        }
         let scale = kkt.scale();
-        rhs.iter_mut().for_each(|v| *v = 0.0);
-        for c in (0..n).filter(|&c| !model.locked(c)) {
-            rhs[c] = -stiffness[c] * (angles[c] - rest[c]) / scale;
+        for c in 0..n {
+            f[c] = if model.locked(c) {
+                0.0
+            } else {
+                -stiffness[c] * (angles[c] - rest[c]) / scale
+            };
         }
-        kkt.solve_in_place(&mut rhs);
-        // Scaled rows: Jᵀλ_phys / κ = (S J)ᵀ λ_s, so λ_phys = κ S λ_s.
-        for (r, m) in multipliers.iter_mut().enumerate() {
-            *m = scale * kkt.row_scales()[r] * rhs[n + r];
+        kkt.solve(&f, &b, &mut step_vector);
+        kkt.multipliers(&mut multipliers);
+        if !step_vector.iter().chain(&multipliers).all(|v| v.is_finite()) {
+            return Err(NumericalError::NonFinite {
+                what: "the hinges' balance on the closure",
+                detail: "a Newton step was not finite".into(),
+            }
+            .into());
         }
-        let step = rhs[..n].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let step = step_vector.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         newton = step < NEWTON_SWITCH;
         let cap = if step > STATICS_STEP_CAP {
             STATICS_STEP_CAP / step
         } else {
             1.0
         };
-        for (a, d) in angles.iter_mut().zip(&rhs[..n]) {
+        for (a, d) in angles.iter_mut().zip(&step_vector) {
             *a += cap * d;
         }
         restore(model, &mut angles, &mut solver)?;

@@ -4,7 +4,7 @@
 //! (from the branch a flat start leaves along) as the drive grows from 0 to its full value,
 //! so it lies on the start's branch; the modes are the manifold's about it.
 
-use super::kkt::KktSystem;
+use super::hessian::HessianSystem;
 use super::manifold::{equilibrium, modes, Equilibrium, ManifoldModes};
 use super::model::NetworkModel;
 use super::start::leave_flat;
@@ -63,7 +63,7 @@ pub fn folded_modes(model: &NetworkModel) -> Result<NetworkModes> {
 /// The balance at the full drive `rest`, reached from `from` by growing the actuated hinges'
 /// rest angles from where they start.
 pub fn follow_drive(model: &NetworkModel, rest: &[f64], from: &[f64]) -> Result<Equilibrium> {
-    let mut kkt = KktSystem::new(model)?;
+    let mut kkt = HessianSystem::new(model)?;
     let actuated: Vec<bool> = (0..model.columns()).map(|c| model.forcing.hinges[c].actuated).collect();
     let rest_at = |u: f64| -> Vec<f64> {
         rest.iter()

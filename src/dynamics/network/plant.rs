@@ -10,7 +10,8 @@ use super::algorithms::{
     NetworkData,
 };
 use super::contact::{NetworkContacts, NetworkProbe};
-use super::kkt::{KktSystem, PrimalBlock};
+use super::hessian::HessianSystem;
+use super::kkt::KktSystem;
 use super::manifold::{equilibrium, projection_solver, restore, spring_frequencies, worst_residual, CLOSURE_TOL};
 use super::model::NetworkModel;
 use super::start::{leave_flat, BranchStart};
@@ -46,6 +47,7 @@ pub struct NetworkWorkspace {
     /// The rigid-body buffers.
     pub data: NetworkData,
     kkt: KktSystem,
+    statics: HessianSystem,
     solver: NormalSolver,
     forces: Vec<f64>,
     drive: Vec<f64>,
@@ -206,6 +208,7 @@ impl Plant for NetworkPlant<'_> {
         NetworkWorkspace {
             data: NetworkData::new(self.model),
             kkt: KktSystem::new(self.model).expect("the structure was analysed when the plant was made"),
+            statics: HessianSystem::new(self.model).expect("the structure was analysed when the plant was made"),
             solver: projection_solver(),
             forces: vec![0.0; n],
             drive: vec![0.0; n],
@@ -273,7 +276,7 @@ impl Plant for NetworkPlant<'_> {
                     .fold(0.0, f64::max);
                 let mut rest = vec![0.0; self.model.columns()];
                 self.rest_angles(&mut rest);
-                let settled = equilibrium(self.model, &rest, &start, &mut ws.kkt)?;
+                let settled = equilibrium(self.model, &rest, &start, &mut ws.statics)?;
                 let jump = settled
                     .angles
                     .iter()
@@ -411,7 +414,7 @@ impl Plant for NetworkPlant<'_> {
             }
         }
         self.rest_angles(&mut rest);
-        let found = equilibrium(self.model, &rest, q, &mut ws.kkt)?;
+        let found = equilibrium(self.model, &rest, q, &mut ws.statics)?;
         q.copy_from_slice(&found.angles);
         Ok(())
     }
@@ -434,27 +437,22 @@ impl Plant for NetworkPlant<'_> {
             }
         }
         self.rest_angles(&mut rest);
-        let found = equilibrium(model, &rest, q, &mut ws.kkt)?;
+        let found = equilibrium(model, &rest, q, &mut ws.statics)?;
         let stiffness = model.stiffness();
         update_stars(model, &found.angles, None, &mut ws.data);
-        ws.kkt.assemble(
-            model,
-            &ws.data,
-            PrimalBlock::Hessian {
-                stiffness: &stiffness,
-                multipliers: &found.multipliers,
-            },
-            10.0,
-        )?;
-        let scale = ws.kkt.scale();
-        let mut rhs = vec![0.0; ws.kkt.size()];
-        for c in 0..model.columns() {
-            if model.forcing.hinges[c].actuated && !model.locked(c) {
-                rhs[c] = stiffness[c] * drive_rates[c] / scale;
-            }
-        }
-        ws.kkt.solve_in_place(&mut rhs);
-        out.copy_from_slice(&rhs[..model.columns()]);
+        ws.statics.assemble(&ws.data, &stiffness, Some(&found.multipliers))?;
+        let scale = ws.statics.scale();
+        let f: Vec<f64> = (0..model.columns())
+            .map(|c| {
+                if model.forcing.hinges[c].actuated && !model.locked(c) {
+                    stiffness[c] * drive_rates[c] / scale
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let b = vec![0.0; ws.statics.rows()];
+        ws.statics.solve(&f, &b, out);
         Ok(())
     }
 
