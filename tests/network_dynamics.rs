@@ -1,0 +1,397 @@
+//! Dynamics of panel networks (`docs/model.md#panel-networks`) against independent answers:
+//! the dense open-chain algorithms on a tree, the Miura-ori's closed-form folding motion as
+//! a one-coordinate model (kinetic energy from finite differences of panel poses), energy
+//! balance and closure drift, the etch front's arithmetic and the cube's contact geometry.
+
+mod common;
+
+use common::{full_message, scene_file};
+use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
+use nanofold::dynamics::algorithms::forward_dynamics;
+use nanofold::dynamics::model::{Joint, Model, Plate};
+use nanofold::dynamics::network::modes::folded_modes;
+use nanofold::dynamics::network::{NetworkModel, NetworkPlant};
+use nanofold::dynamics::plant::Plant;
+use nanofold::folding::{panel_poses, Pose};
+use nanofold::pattern::crease_pattern::EdgeKind;
+use nanofold::pattern::Assignment;
+use nanofold::prelude::*;
+use std::path::Path;
+
+fn network(scene: &Scene) -> &NetworkModel {
+    scene.network().expect("a network scene")
+}
+
+/// The cube net is a tree: every crease carries a panel and no star closes a loop, so its
+/// accelerations must be the open-chain model's (dense M, Christoffel-checked Coriolis, the
+/// same drag law), built here from the network's own plates and hinges.
+#[test]
+fn a_tree_network_moves_as_the_dense_tree_model() {
+    let scene = scene_file("patterns/devices/cube_closes.scene.json");
+    let model = network(&scene);
+    assert!(model.folding.stars.is_empty(), "the cube net has no interior vertex");
+    let index: Vec<usize> = {
+        let mut at = vec![usize::MAX; model.panels()];
+        for (k, &p) in model.order[1..].iter().enumerate() {
+            at[p] = k;
+        }
+        at
+    };
+    let (mut joints, mut plates, mut parents) = (Vec::new(), Vec::new(), Vec::new());
+    for &p in &model.order[1..] {
+        let c = model.parent_column[p].unwrap();
+        let body = &model.bodies[p];
+        joints.push(Joint {
+            axis: Unit::new_normalize(model.joint_axis[c]),
+            point: Point3::from(model.hinges[c].point),
+            stiffness: model.hinges[c].stiffness,
+        });
+        plates.push(Plate {
+            mass: body.mass,
+            inertia: body.inertia,
+            reference_pose: Isometry3::translation(body.centre.x, body.centre.y, 0.0),
+            outline: vec![Point3::origin()],
+            area: body.area,
+            thickness: model.thickness,
+        });
+        parents.push(model.parent[p].and_then(|q| (q != model.anchored_panel).then(|| index[q])));
+    }
+    let dense = Model::tree(joints, plates, parents, model.drag).unwrap();
+    let plant = NetworkPlant::new(model, false).unwrap();
+    let mut ws = plant.workspace();
+    let mut data = nanofold::dynamics::Data::new(&dense);
+    let n = model.columns();
+    for (angles, rates) in [
+        (vec![0.3, -0.5, 1.1, 0.7, 2.0], vec![1e4, -3e4, 2e4, 5e3, -1e4]),
+        (vec![1.5, 1.4, 1.6, 1.3, 0.2], vec![-2e3, 4e4, 1e3, -3e4, 2e4]),
+    ] {
+        let mut accel = vec![0.0; n];
+        // Long after every hinge is released and ramped: the drives sit at their targets.
+        plant.accelerations(1e6, &angles, &rates, &mut ws, &mut accel).unwrap();
+        // The dense model's joints in placement order.
+        let column = |k: usize| model.parent_column[model.order[k + 1]].unwrap();
+        let q: Vec<f64> = (0..n).map(|k| angles[column(k)]).collect();
+        let q_dot: Vec<f64> = (0..n).map(|k| rates[column(k)]).collect();
+        let torques: Vec<f64> = (0..n)
+            .map(|k| {
+                let c = column(k);
+                model.hinges[c].stiffness * model.forcing.hinges[c].target
+            })
+            .collect();
+        let mut expected = vec![0.0; n];
+        forward_dynamics(&dense, &q, &q_dot, &torques, &mut data, &mut expected).unwrap();
+        let scale = expected.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for k in 0..n {
+            let got = accel[column(k)];
+            assert!(
+                (got - expected[k]).abs() < 1e-10 * scale,
+                "crease {}: {got:e} vs {:e}",
+                column(k),
+                expected[k]
+            );
+        }
+    }
+}
+
+/// The Miura-ori's one folding motion in closed form: zigzag creases at ±q, straight ones at
+/// ±2 atan(cos γ tan(q/2)), signs by assignment.
+fn miura_state(model: &NetworkModel, q: f64) -> Vec<f64> {
+    let pattern = &model.folding.pattern;
+    let gamma = 60f64.to_radians();
+    pattern
+        .creases
+        .iter()
+        .map(|&e| {
+            let [a, b] = pattern.edges[e];
+            let straight = (pattern.vertices[a][1] - pattern.vertices[b][1]).abs() < 1e-12;
+            let sign = match pattern.kinds[e] {
+                EdgeKind::Crease(Assignment::Mountain) => -1.0,
+                _ => 1.0,
+            };
+            let magnitude = if straight {
+                2.0 * (gamma.cos() * (q / 2.0).tan()).atan()
+            } else {
+                q
+            };
+            sign * magnitude
+        })
+        .collect()
+}
+
+/// Panel p's pose relative to the anchored panel, from the folding layer's own poses (their
+/// root is another panel; kinetic energy is measured against the anchored one).
+fn relative_poses(model: &NetworkModel, angles: &[f64]) -> Vec<(Matrix3<f64>, Vector3<f64>)> {
+    let mut poses: Vec<Pose> = Vec::new();
+    panel_poses(&model.folding, angles, &mut poses);
+    let anchor = poses[model.anchored_panel];
+    let inverse = anchor.rotation.transpose();
+    poses
+        .iter()
+        .map(|p| {
+            (
+                inverse * p.rotation,
+                inverse * (p.translation - anchor.translation) * model.unit,
+            )
+        })
+        .collect()
+}
+
+/// m(q) = 2 T at unit q̇, from central differences of the panels' poses along the closed-form
+/// motion: ½ m |v_c|² + ½ ωᵀ I ω per panel.
+fn miura_mass(model: &NetworkModel, q: f64) -> f64 {
+    let h = 1e-6;
+    let (plus, minus, here) = (
+        relative_poses(model, &miura_state(model, q + h)),
+        relative_poses(model, &miura_state(model, q - h)),
+        relative_poses(model, &miura_state(model, q)),
+    );
+    (0..model.panels())
+        .map(|p| {
+            let body = &model.bodies[p];
+            let centre = |(r, t): &(Matrix3<f64>, Vector3<f64>)| r * body.centre + t;
+            let v = (centre(&plus[p]) - centre(&minus[p])) / (2.0 * h);
+            let w = (plus[p].0 - minus[p].0) / (2.0 * h) * here[p].0.transpose();
+            let omega = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
+            let inertia = here[p].0 * body.inertia * here[p].0.transpose();
+            body.mass * v.norm_squared() + omega.dot(&(inertia * omega))
+        })
+        .sum()
+}
+
+fn miura_energy(model: &NetworkModel, q: f64) -> f64 {
+    miura_state(model, q)
+        .iter()
+        .enumerate()
+        .map(|(c, rho)| {
+            let k = model.hinges[c].stiffness;
+            0.5 * k * (rho - model.forcing.hinges[c].target).powi(2)
+        })
+        .sum()
+}
+
+/// The Miura sheet's folded equilibrium and its one mode against the closed-form motion as a
+/// one-coordinate model: V(q) minimised, ω² = V″(q*) / m(q*), with m from finite differences of
+/// the folding layer's panel poses (neither the network's mass matrix nor its statics).
+#[test]
+fn the_miura_sheets_mode_is_the_closed_form_motions() {
+    let scene = scene_file("patterns/devices/miura_sheet.scene.json");
+    let model = network(&scene);
+    let modes = folded_modes(model).unwrap();
+    assert_eq!(modes.modes.basis.ncols(), 1, "one degree of freedom folded");
+    // Newton on V′(q) = 0 by differences.
+    let h = 1e-5;
+    let slope = |q: f64| (miura_energy(model, q + h) - miura_energy(model, q - h)) / (2.0 * h);
+    let curvature =
+        |q: f64| (miura_energy(model, q + h) - 2.0 * miura_energy(model, q) + miura_energy(model, q - h)) / (h * h);
+    let mut q = 1.5;
+    for _ in 0..30 {
+        q -= slope(q) / curvature(q);
+    }
+    let expected_state = miura_state(model, q);
+    let found = &modes.modes.equilibrium.angles;
+    let worst = expected_state
+        .iter()
+        .zip(found)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-8, "equilibrium off by {worst:e} rad (q* = {q})");
+    let omega = (curvature(q) / miura_mass(model, q)).sqrt();
+    let expected_hz = omega / std::f64::consts::TAU;
+    let got = modes.modes.modes.frequencies_hz[0];
+    assert!(
+        (got - expected_hz).abs() < 1e-6 * expected_hz,
+        "{got} Hz vs {expected_hz} Hz from the closed form"
+    );
+    assert!(modes.modes.modes.stable);
+}
+
+fn run(scene: &Scene, rtol: f64, t_end: f64) -> Simulation {
+    simulate(
+        scene,
+        &SimulationSettings {
+            rtol,
+            t_end: Some(t_end),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
+
+/// From flat, without drag: kinetic + hinge energy − the actuation's work is constant to
+/// 1e-8 of the largest energy; with drag the dissipation makes up the difference as well.
+/// Every recorded state closes to 1e-10 rad. The contact time converges under rtol.
+#[test]
+fn a_miura_sheet_keeps_its_energy_balance_and_its_closures() {
+    let mut spec = nanofold::io::load_scene(Path::new("patterns/devices/miura_sheet.scene.json")).unwrap();
+    if let SceneSpec::Network(network) = &mut spec {
+        network.environment.drag = false;
+    }
+    let still_air = spec.build().unwrap();
+    let mut times = Vec::new();
+    for rtol in [1e-10, 1e-12] {
+        let run = run(&still_air, rtol, 2e-5);
+        let report = run.network.unwrap();
+        assert!(report.branch.is_some(), "it starts flat");
+        assert!(report.energy_balance_error.unwrap() < 1e-8, "{report:?}");
+        assert!(report.max_closure_residual <= 1e-10, "{report:?}");
+        // No drag: it overshoots and folds flat before it rings down.
+        times.push(run.response.collision.expect("panels meet").time);
+    }
+    assert!((times[0] - times[1]).abs() < 1e-9 * times[1], "{times:?}");
+    let air = scene_file("patterns/devices/miura_sheet.scene.json");
+    let run = run(&air, 1e-10, 1e-4);
+    let report = run.network.unwrap();
+    assert!(report.energy_balance_error.unwrap() < 1e-8, "{report:?}");
+    let last = run.response.samples.last().unwrap();
+    assert!(last.drag_dissipation.unwrap() > 0.1 * last.elastic_energy);
+    assert!(report.max_closure_residual <= 1e-10);
+}
+
+/// The etch front's arithmetic: along +y the south wall's crease is passed first (t = 0), the
+/// east, west and north ones after 100 µm (4000 s at 1.5 µm/min), the lid's after 200 µm;
+/// each ramps to 95° in ρ_c θ / a = 1326.5 s. Walls released together meet at their corners;
+/// released after the lid, the south wall hits the lid's edge at the angle plane geometry
+/// gives: the lid, 95° on a north wall at 95°, has its far edge at
+/// (y, z) = (1 + cos 95° + cos 190°, sin 95° + sin 190°) side lengths, which the south wall's
+/// plane reaches at atan(z / −y) = 85.0°.
+#[test]
+fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
+    let ramp = 20.0 * 95f64.to_radians() / 1.5 * 60.0;
+    let closes = scene_file("patterns/devices/cube_closes.scene.json");
+    let release: Vec<f64> = network(&closes).forcing.hinges.iter().map(|h| h.release_time).collect();
+    let expected = [0.0, 4000.0, 4000.0, 4000.0, 8000.0];
+    for (got, want) in release.iter().zip(expected) {
+        assert!((got - want).abs() < 1e-9 * 8000.0, "{release:?}");
+    }
+    let run = simulate(&closes, &SimulationSettings::default()).unwrap();
+    let contact = run.response.collision.unwrap();
+    let angles = &run.response.samples.last().unwrap().angles;
+    // The east and west walls meet the south wall (at 95°) at its corners, within the 1°
+    // margin of a shared vertex, before any reaches 90°.
+    assert!(
+        contact.pair[0].starts_with("face 1") && contact.pair[1].contains("at vertex"),
+        "{contact:?}"
+    );
+    assert!((angles[0] - 95f64.to_radians()).abs() < 1e-9);
+    let wall = angles[1];
+    assert!((wall.to_degrees() - 89.0).abs() < 0.1, "{}", wall.to_degrees());
+    assert!((contact.time - (4000.0 + ramp * wall / 95f64.to_radians())).abs() < 1e-6 * contact.time);
+
+    let jams = scene_file("patterns/devices/cube_jams.scene.json");
+    let run = simulate(&jams, &SimulationSettings::default()).unwrap();
+    let contact = run.response.collision.unwrap();
+    assert_eq!(
+        contact.pair,
+        ["face 1".to_string(), "face 5".to_string()],
+        "{contact:?}"
+    );
+    let (y, z) = (
+        1.0 + 95f64.to_radians().cos() + 190f64.to_radians().cos(),
+        95f64.to_radians().sin() + 190f64.to_radians().sin(),
+    );
+    let blocked = z.atan2(-y);
+    let south = run.response.samples.last().unwrap().angles[0];
+    assert!(
+        (south - blocked).abs() < 1e-6,
+        "{} vs {}",
+        south.to_degrees(),
+        blocked.to_degrees()
+    );
+    assert!((contact.time - (8000.0 + ramp * south / 95f64.to_radians())).abs() < 1e-6 * contact.time);
+}
+
+fn network_error(edit: impl Fn(&mut serde_json::Value)) -> String {
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/devices/cube_closes.scene.json").unwrap()).unwrap();
+    edit(&mut value);
+    let text = value.to_string();
+    match nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build()) {
+        Ok(_) => panic!("accepted a bad scene: {text}"),
+        Err(e) => full_message(&e),
+    }
+}
+
+#[test]
+fn bad_network_scenes_get_errors_that_name_the_field() {
+    use serde_json::json;
+    let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+        (
+            Box::new(
+                |v| v["hinges"] = json!([{"crease": 5, "hinge_length_um": 20, "layers": [{"material": "SiN", "thickness_um": 0.2}], "actuated": false}]),
+            ),
+            "hinges[0].crease`: 5 (a boundary edge, not a crease)",
+        ),
+        (Box::new(|v| v["anchored_face"] = json!(9)), "anchored_face`: 9"),
+        (
+            Box::new(|v| v["hinge_defaults"]["target_angle_deg"] = json!(-95)),
+            "hinge_defaults.target_angle_deg`: -95",
+        ),
+        (
+            Box::new(
+                |v| v["hinges"] = json!([{"crease": 0, "hinge_length_um": 20, "layers": [{"material": "SiN", "thickness_um": 0.2}], "actuated": true, "target_angle_deg": -90, "radius_of_curvature_um": 20}]),
+            ),
+            "hinges[0].target_angle_deg`: -90 (crease 0 is a valley",
+        ),
+        (
+            Box::new(|v| {
+                v.as_object_mut().unwrap().remove("hinge_defaults");
+            }),
+            "missing key `hinges: an entry with crease 0`",
+        ),
+        (
+            Box::new(|v| v["hinge_defaults"]["actuated"] = json!(false)),
+            "hinges[*].actuated`: all false",
+        ),
+        (
+            Box::new(|v| v["actuation"]["direction_deg"] = json!(f64::NAN)),
+            "direction_deg",
+        ),
+        (
+            Box::new(|v| {
+                v["hinge_defaults"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("radius_of_curvature_um")
+                    .map(|_| ())
+                    .unwrap()
+            }),
+            "missing key `hinge_defaults.radius_of_curvature_um`",
+        ),
+        (
+            Box::new(|v| v["locks"] = json!([{"crease": 1, "angle_deg": 10}])),
+            "locks[0].angle_deg`: 10",
+        ),
+        (
+            Box::new(|v| v["substrate"] = json!({"contact": true, "edge_y_um": 0})),
+            "edge_y_um",
+        ),
+        (
+            Box::new(|v| v["pattern"] = json!("nothing.fold")),
+            "pattern`: \"nothing.fold\"",
+        ),
+        (
+            Box::new(|v| v["plates"]["thickness_um"] = json!(0)),
+            "plates.thickness_um",
+        ),
+    ];
+    for (edit, expected) in cases {
+        let message = network_error(edit);
+        assert!(message.contains(expected), "expected {expected:?} in: {message}");
+    }
+}
+
+/// A start that is not a rigid state is refused by name, and nothing runs.
+#[test]
+fn a_network_scene_must_start_rigid() {
+    let text = std::fs::read_to_string("patterns/devices/miura_sheet.scene.json").unwrap();
+    let text = text.replace("../many/miura_4x4.fold", "../many/miura_4x4_bent.fold");
+    let message =
+        match nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build()) {
+            Ok(_) => panic!("a bent start was accepted"),
+            Err(e) => full_message(&e),
+        };
+    assert!(
+        message.contains("invalid `pattern`") && message.contains("not a rigid state"),
+        "{message}"
+    );
+}
