@@ -1198,6 +1198,14 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
     }
     if let Some(report) = &simulation.network {
+        if report.meeting_at_contact.len() > 1 {
+            let pairs: Vec<String> = report
+                .meeting_at_contact
+                .iter()
+                .map(|[a, b]| format!("{a} | {b}"))
+                .collect();
+            println!("  meeting at that moment (to 1e-6): {}", pairs.join("; "));
+        }
         println!(
             "  max vertex closure residual along the run: {:.3e} rad; energy balance (kinetic + hinges − work + dissipation) held to {}",
             report.max_closure_residual,

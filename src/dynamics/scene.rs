@@ -279,9 +279,14 @@ impl ClosedSpec<Pattern> {
         // The cheap checks first: the chain's assembly runs a sweep.
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
         let chain = assemble::closed_chain(self)?;
+        let system = if self.constraint.source == super::spec::SourceKind::Network {
+            System::Network(Box::new(super::network::assemble::from_closed(self, &chain)?))
+        } else {
+            System::Closed(Box::new(chain))
+        };
         Ok(Scene {
             name: self.name.clone().unwrap_or_else(|| "scene".to_string()),
-            system: System::Closed(Box::new(chain)),
+            system,
             t_end,
             outputs: self.outputs.clone(),
         })

@@ -405,6 +405,9 @@ pub enum SourceKind {
     Poly,
     /// Newton loop closure at every evaluation.
     Exact,
+    /// No reduced coordinate: the panel network's path (every crease a coordinate, the loop
+    /// closed exactly by the vertex's closure rows; `docs/model.md#panel-networks`).
+    Network,
 }
 
 fn default_constraint_samples() -> usize {

@@ -412,6 +412,8 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         value["branch"] = json!(report.branch);
         value["max_closure_residual"] = json!(report.max_closure_residual);
         value["energy_balance_error"] = json!(report.energy_balance_error);
+        value["meeting_at_contact"] = json!(report.meeting_at_contact);
+        value["touching_at_start"] = json!(report.touching_at_start);
         value["crease_edges"] = json!(model.folding.pattern.creases);
         value["release_times_s"] = json!(model
             .forcing

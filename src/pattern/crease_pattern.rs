@@ -95,6 +95,9 @@ pub struct CreasePattern {
     pub fold_angles: Vec<f64>,
     /// The faces of the planar graph, counter-clockwise vertex loops.
     pub faces: Vec<Vec<usize>>,
+    /// The file's index (`faces_vertices` order) of each face; the faces' own order when
+    /// the file lists none.
+    pub file_face: Vec<usize>,
     /// The faces on each side of each edge: `[left, right]` seen from `edges[e][0]` to
     /// `edges[e][1]` (None: outside the paper).
     pub edge_faces: Vec<[Option<usize>; 2]>,
@@ -114,6 +117,13 @@ pub struct CreasePattern {
     pub locked: Vec<bool>,
     /// The file's `frame_unit` (None: unstated), written back on the outputs.
     pub unit: Option<String>,
+}
+
+impl CreasePattern {
+    /// The face (graph index) the file lists as `faces_vertices[index]`, if any.
+    pub fn face_from_file(&self, index: usize) -> Option<usize> {
+        self.file_face.iter().position(|&f| f == index)
+    }
 }
 
 impl CreasePatternBuilder {
@@ -206,9 +216,10 @@ impl CreasePatternBuilder {
         let (faces, outer) = graph.faces(&vertices, &edges);
         check_disc(&faces, &outer, &edges, &kinds, nv)?;
         let outline = outer.into_iter().next().expect("check_disc found one outer loop");
-        if let Some(given) = &given_faces {
-            check_given_faces(given, &faces)?;
-        }
+        let file_face = match &given_faces {
+            Some(given) => check_given_faces(given, &faces)?,
+            None => (0..faces.len()).collect(),
+        };
         let edge_faces = graph.edge_faces(&faces, &edges);
         let (panel_of_face, panel_count) = panels(&faces, &edge_faces, &kinds);
         let creases: Vec<usize> = (0..ne).filter(|&e| matches!(kinds[e], EdgeKind::Crease(_))).collect();
@@ -251,6 +262,7 @@ impl CreasePatternBuilder {
             kinds,
             fold_angles,
             faces,
+            file_face,
             edge_faces,
             panel_of_face,
             panel_count,
@@ -546,21 +558,26 @@ fn check_disc(
     Ok(())
 }
 
-/// Given faces must be the graph's faces (each a rotation of one, either orientation).
-fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<()> {
+/// Given faces must be the graph's faces (each a rotation of one, either orientation); the
+/// file's index of each graph face.
+fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<Vec<usize>> {
     let key = |face: &[usize]| {
         let mut sorted = face.to_vec();
         sorted.sort_unstable();
         sorted
     };
-    let known: std::collections::HashSet<Vec<usize>> = faces.iter().map(|f| key(f)).collect();
+    let known: HashMap<Vec<usize>, usize> = faces.iter().enumerate().map(|(g, f)| (key(f), g)).collect();
+    let mut file_face = vec![usize::MAX; faces.len()];
     for (i, face) in given.iter().enumerate() {
-        if !known.contains(&key(face)) {
-            return Err(NanofoldError::invalid(
-                format!("faces_vertices[{i}]"),
-                format!("{face:?}"),
-                "not a face of the crease pattern's edges (faces must be the regions the edges enclose)",
-            ));
+        match known.get(&key(face)) {
+            Some(&g) => file_face[g] = i,
+            None => {
+                return Err(NanofoldError::invalid(
+                    format!("faces_vertices[{i}]"),
+                    format!("{face:?}"),
+                    "not a face of the crease pattern's edges (faces must be the regions the edges enclose)",
+                ))
+            }
         }
     }
     if given.len() != faces.len() {
@@ -570,7 +587,14 @@ fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<()> {
             format!("the edges enclose {} faces", faces.len()),
         ));
     }
-    Ok(())
+    if let Some(i) = (0..given.len()).find(|&i| !file_face.contains(&i)) {
+        return Err(NanofoldError::invalid(
+            format!("faces_vertices[{i}]"),
+            format!("{:?}", given[i]),
+            "lists a face twice",
+        ));
+    }
+    Ok(file_face)
 }
 
 /// Panels: faces joined across facet edges (union–find).

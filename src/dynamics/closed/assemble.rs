@@ -267,7 +267,16 @@ fn constraint_source(spec: &ClosedSpec<Pattern>, step: &Step) -> Result<Constrai
         (SourceKind::Poly, Some(degree)) => {
             ConstraintSource::Poly(ConstraintPoly::fit(pattern, &sweep()?, degree).map_err(scene_fields)?)
         }
-        (SourceKind::Exact, None) => ConstraintSource::Exact(ExactConstraint::new(pattern, &sweep()?)),
+        (SourceKind::Exact | SourceKind::Network, None) => {
+            ConstraintSource::Exact(ExactConstraint::new(pattern, &sweep()?))
+        }
+        (SourceKind::Network, Some(degree)) => {
+            return Err(NanofoldError::invalid(
+                "constraint.degree",
+                degree,
+                "only the \"poly\" source has a degree",
+            ))
+        }
     })
 }
 

@@ -6,15 +6,16 @@
 
 use super::manifold::{projection_solver, restore, worst_residual};
 use super::model::{NetworkModel, NetworkParts};
+use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::spec::{
     count_within, drag_law, finite, hinge_stiffness_named, limits, material, network_actuation, validate_materials,
-    within, HingeSpec, NetworkSpec, MICROMETRE,
+    within, ClosedSpec, HingeSpec, NetworkSpec, MICROMETRE,
 };
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
-use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
-use crate::pattern::Assignment;
+use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
+use crate::pattern::{Assignment, Pattern};
 
 /// A start whose closure residual exceeds this is not a rigid state, rad.
 pub const START_TOLERANCE: f64 = 1e-6;
@@ -156,16 +157,16 @@ pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
     let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
     let anchored_panel = match spec.anchored_face {
         None => folding.root_panel,
-        Some(face) => {
-            if face >= pattern.faces.len() {
+        Some(face) => match pattern.face_from_file(face) {
+            Some(f) => pattern.panel_of_face[f],
+            None => {
                 return Err(NanofoldError::invalid(
                     "anchored_face",
                     face,
                     format!("the pattern has {} faces", pattern.faces.len()),
-                ));
+                ))
             }
-            pattern.panel_of_face[face]
-        }
+        },
     };
     // The start: the pattern's own state, rigid within the tolerance.
     let mut start = folding.given_fold_angles();
@@ -292,5 +293,112 @@ fn drive(
         radius_of_curvature: radius,
         actuated: true,
         release_time: 0.0,
+    })
+}
+
+/// A closed-chain scene (a single vertex, `constraint.source` "network") as a panel network:
+/// its faces the panels, its hinges, drives, locks and anchored face as the chain has them,
+/// and its start (the driver's start angle with the others closed on the chain's branch)
+/// the network's rigid start (`docs/model.md#panel-networks`).
+pub fn from_closed(spec: &ClosedSpec<Pattern>, chain: &ClosedChain) -> Result<NetworkModel> {
+    let pattern = &spec.pattern;
+    let mesh = pattern.mesh.as_ref().ok_or_else(|| {
+        NanofoldError::invalid(
+            "pattern",
+            &pattern.name,
+            "must be a FOLD file (its faces are the plates)",
+        )
+    })?;
+    let mut ws = chain.workspace();
+    chain.update_creases(chain.start, &mut ws)?;
+    let edges = mesh.edges_vertices.len();
+    let mut fold_angles = vec![0.0; edges];
+    let mut locked = vec![false; edges];
+    for c in 0..pattern.creases.len() {
+        let e = pattern.user_index(c);
+        // A flat start carries the sweep's rounding (±1e-13): it must not contradict the assignment.
+        let angle = ws.crease_angles[c];
+        fold_angles[e] = if angle.abs() < 1e-10 { 0.0 } else { angle };
+        locked[e] = chain.locked.iter().any(|&(l, _)| l == c);
+    }
+    let kinds = mesh
+        .edges_assignment
+        .iter()
+        .map(|letter| match letter.as_str() {
+            "B" => EdgeKind::Boundary,
+            "F" => EdgeKind::Facet,
+            "M" => EdgeKind::Crease(Assignment::Mountain),
+            "V" => EdgeKind::Crease(Assignment::Valley),
+            _ => EdgeKind::Crease(Assignment::Unassigned),
+        })
+        .collect();
+    let crease_pattern = CreasePatternBuilder {
+        name: pattern.name.clone(),
+        vertices: mesh.vertices_coords.clone(),
+        edges: mesh.edges_vertices.clone(),
+        kinds,
+        fold_angles,
+        faces: mesh.faces_vertices.clone(),
+        angle_field: "edges_foldAngle".to_string(),
+        folded_form: None,
+        locked,
+        unit: mesh.unit.clone(),
+    }
+    .build()?;
+    let folding = FoldingModel::new(crease_pattern)?;
+    let of_column: Vec<usize> = folding
+        .pattern
+        .creases
+        .iter()
+        .map(|&e| {
+            pattern.crease_from_user_index(e).ok_or_else(|| {
+                NanofoldError::invalid(
+                    "pattern",
+                    e,
+                    "an edge the crease pattern reads as a crease is no crease of the vertex",
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
+    let stiffness = of_column.iter().map(|&c| chain.crease_stiffness[c]).collect();
+    let forcing = Forcing {
+        actuation: chain.forcing.actuation,
+        hinges: of_column.iter().map(|&c| chain.forcing.hinges[c]).collect(),
+    };
+    let start = of_column
+        .iter()
+        .map(|&c| {
+            let angle = ws.crease_angles[c];
+            if angle.abs() < 1e-10 {
+                0.0
+            } else {
+                angle
+            }
+        })
+        .collect();
+    let anchored_panel = folding
+        .pattern
+        .face_from_file(chain.anchored_face)
+        .map(|f| folding.pattern.panel_of_face[f])
+        .ok_or_else(|| NanofoldError::invalid("anchored_face", chain.anchored_face, "not a face of the pattern"))?;
+    let thickness = within(
+        "plates.thickness_um",
+        spec.plates.thickness_um,
+        limits::THICKNESS_UM,
+        "µm",
+    )? * MICROMETRE;
+    let density = material(&spec.materials, "plates.material", &spec.plates.material)?.density_g_cm3 * 1e3;
+    let unit = within("length_unit_um", spec.length_unit_um, limits::LENGTH_UNIT_UM, "µm")? * MICROMETRE;
+    NetworkModel::new(NetworkParts {
+        folding,
+        unit,
+        anchored_panel,
+        thickness,
+        density,
+        stiffness,
+        forcing,
+        drag: chain.model.drag(),
+        start,
+        substrate_contact: false,
     })
 }

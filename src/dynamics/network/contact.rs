@@ -3,11 +3,17 @@
 //! - a crease folding flat: π − |ρ| reaches 0;
 //! - panels that share a vertex but no crease: the angle between their corners at that
 //!   vertex (great-circle arcs on the unit sphere about it) closes to within
-//!   [`ANGLE_MARGIN`] (for convex panels any meeting shows there first);
+//!   [`ANGLE_MARGIN`] (for convex panels any meeting shows there first). SPEC §11 reads 1°;
+//!   a margin that wide reports a flap folding flat, whose edge then meets its neighbour's,
+//!   1.4° before the crease reaches 180° (the corner cube's step 1), so the margin here is
+//!   the crease's own, 1e-9 rad: it still catches edges that only meet as a ramp ends;
 //! - panels that share no vertex: the smallest distance between them, from the folding
 //!   layer's broad phase and exact triangle tests, reaches the clearance (negative once two
 //!   cross);
 //! - with the substrate on, a vertex reaching z = 0 outside the paper's flat outline.
+//!
+//! A pair that already touches at the start (the layers of a flat-folded flap) is left out,
+//! as the unfolding's barrier leaves out stacked layers: it did not close, it was closed.
 
 use super::algorithms::{update_poses, NetworkData};
 use super::model::NetworkModel;
@@ -17,8 +23,8 @@ use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
-/// Panels that share a vertex touch when their corners there close to within this, rad (1°).
-pub const ANGLE_MARGIN: f64 = PI / 180.0;
+/// Panels that share a vertex touch when their corners there close to within this, rad.
+pub const ANGLE_MARGIN: f64 = 1e-9;
 /// A crease touches when |ρ| reaches π to within this, rad.
 const FOLD_TOUCH: f64 = 1e-9;
 
@@ -54,6 +60,8 @@ enum Candidate {
 #[derive(Debug, Clone)]
 pub struct NetworkContacts {
     candidates: Vec<Candidate>,
+    /// Pairs left out because they touch at the start.
+    dropped: Vec<[String; 2]>,
     /// The paper's flat outline, m (substrate gate).
     outline: Vec<[f64; 2]>,
     settings: ContactSettings,
@@ -134,14 +142,41 @@ impl NetworkContacts {
                 }
             }
         }
-        NetworkContacts {
+        let mut contacts = NetworkContacts {
             candidates,
             outline,
             settings: ContactSettings {
                 search: 0.5,
                 ..ContactSettings::default()
             },
+            dropped: Vec::new(),
+        };
+        contacts.drop_touching_at_start(model);
+        contacts
+    }
+
+    /// Leaves out the panel pairs at a shared vertex that touch at the start.
+    fn drop_touching_at_start(&mut self, model: &NetworkModel) {
+        let mut data = NetworkData::new(model);
+        update_poses(model, &model.start, &mut data);
+        let start = &model.start;
+        let mut kept = Vec::with_capacity(self.candidates.len());
+        for k in 0..self.candidates.len() {
+            let touching =
+                matches!(self.candidates[k], Candidate::Vertex { .. }) && self.gap(model, k, start, &data, None) <= 0.0;
+            if touching {
+                self.dropped
+                    .push(self.collision(model, k, 0.0, start, &data, None).pair);
+            } else {
+                kept.push(self.candidates[k].clone());
+            }
         }
+        self.candidates = kept;
+    }
+
+    /// Pairs left out because they touch at the start.
+    pub fn touching_at_start(&self) -> &[[String; 2]] {
+        &self.dropped
     }
 
     /// Number of candidates.
@@ -161,17 +196,61 @@ impl NetworkContacts {
             .map(|k| self.collision(model, k, t, q, data, report.as_ref()))
     }
 
-    fn panel_report(&self, model: &NetworkModel, data: &NetworkData) -> Option<ContactReport> {
-        if !self.candidates.iter().any(|c| matches!(c, Candidate::Panels)) {
-            return None;
+    /// Every pair that meets at `q` to within `tolerance` (rad for angles, a fraction of the
+    /// pattern's size for distances): at a first contact, the pairs that touch together (a
+    /// cube's walls closing at once).
+    pub fn meeting(&self, model: &NetworkModel, q: &[f64], data: &mut NetworkData, tolerance: f64) -> Vec<[String; 2]> {
+        update_poses(model, q, data);
+        let mut pairs = Vec::new();
+        for k in 0..self.count() {
+            match &self.candidates[k] {
+                Candidate::Panels => {
+                    let wide = ContactSettings {
+                        clearance: tolerance,
+                        ..self.settings
+                    };
+                    let report = panel_contacts(&model.folding, &self.poses(model, data), &wide);
+                    for contact in &report.contacts {
+                        pairs.push([
+                            Self::face_name(model, contact.panels[0]),
+                            Self::face_name(model, contact.panels[1]),
+                        ]);
+                    }
+                }
+                Candidate::Substrate { .. } => {
+                    let gap = self.gap(model, k, q, data, None);
+                    if gap <= tolerance * model.size() && self.gate(model, k, data) {
+                        pairs.push(self.collision(model, k, 0.0, q, data, None).pair);
+                    }
+                }
+                _ => {
+                    let margin = match &self.candidates[k] {
+                        Candidate::Fold { .. } => FOLD_TOUCH,
+                        _ => ANGLE_MARGIN,
+                    };
+                    if self.gap(model, k, q, data, None) + margin <= tolerance {
+                        pairs.push(self.collision(model, k, 0.0, q, data, None).pair);
+                    }
+                }
+            }
         }
-        let poses: Vec<Pose> = (0..model.panels())
+        pairs
+    }
+
+    fn poses(&self, model: &NetworkModel, data: &NetworkData) -> Vec<Pose> {
+        (0..model.panels())
             .map(|p| Pose {
                 rotation: data.rotation[p],
                 translation: data.translation[p] / model.unit,
             })
-            .collect();
-        Some(panel_contacts(&model.folding, &poses, &self.settings))
+            .collect()
+    }
+
+    fn panel_report(&self, model: &NetworkModel, data: &NetworkData) -> Option<ContactReport> {
+        if !self.candidates.iter().any(|c| matches!(c, Candidate::Panels)) {
+            return None;
+        }
+        Some(panel_contacts(&model.folding, &self.poses(model, data), &self.settings))
     }
 
     fn gap(
@@ -227,10 +306,12 @@ impl NetworkContacts {
 
     fn face_name(model: &NetworkModel, panel: usize) -> String {
         let pattern = &model.folding.pattern;
-        let faces: Vec<String> = (0..pattern.faces.len())
+        let mut faces: Vec<usize> = (0..pattern.faces.len())
             .filter(|&f| pattern.panel_of_face[f] == panel)
-            .map(|f| f.to_string())
+            .map(|f| pattern.file_face[f])
             .collect();
+        faces.sort_unstable();
+        let faces: Vec<String> = faces.iter().map(|f| f.to_string()).collect();
         if faces.len() == 1 {
             format!("face {}", faces[0])
         } else {

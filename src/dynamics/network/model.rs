@@ -87,7 +87,7 @@ pub struct NetworkModel {
     pub unit: f64,
     /// The panel on the substrate (the tree's root, fixed).
     pub anchored_panel: usize,
-    /// Its FOLD face index (the first face of the panel).
+    /// Its FOLD face index (the panel's first face in the file's `faces_vertices`).
     pub anchored_face: usize,
     /// Panels in placement order, the anchored one first.
     pub order: Vec<usize>,
@@ -245,7 +245,9 @@ impl NetworkModel {
             })
             .collect();
         let anchored_face = (0..pattern.faces.len())
-            .find(|&f| pattern.panel_of_face[f] == anchored_panel)
+            .filter(|&f| pattern.panel_of_face[f] == anchored_panel)
+            .map(|f| pattern.file_face[f])
+            .min()
             .expect("every panel has a face");
         let labels = pattern.creases.iter().map(|e| format!("edges[{e}]")).collect();
         let mut model = NetworkModel {

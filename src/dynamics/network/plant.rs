@@ -40,6 +40,10 @@ pub struct NetworkReport {
     /// over the recorded states, relative to the largest of those energies (None on the
     /// quasi-static path, which tracks no work).
     pub energy_balance_error: Option<f64>,
+    /// Every pair meeting (to 1e-6) at the first contact, the reported one included.
+    pub meeting_at_contact: Vec<[String; 2]>,
+    /// Panel pairs at a shared vertex that touch at the start, left out of the contacts.
+    pub touching_at_start: Vec<[String; 2]>,
 }
 
 /// Scratch of a [`NetworkPlant`].
@@ -106,7 +110,17 @@ impl<'m> NetworkPlant<'m> {
             let drift = b.iter().map(|x| (x - first).abs()).fold(0.0, f64::max);
             Some(if scale > 0.0 { drift / scale } else { 0.0 })
         });
+        let meeting_at_contact = match (&response.collision, response.samples.last()) {
+            (Some(_), Some(last)) => {
+                let mut data = NetworkData::new(self.model);
+                self.contacts
+                    .meeting(self.model, last.angles.as_slice(), &mut data, 1e-6)
+            }
+            _ => Vec::new(),
+        };
         Ok(NetworkReport {
+            meeting_at_contact,
+            touching_at_start: self.contacts.touching_at_start().to_vec(),
             panels: self.model.panels(),
             creases: self.model.columns(),
             anchored_face: self.model.anchored_face,
