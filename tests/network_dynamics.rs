@@ -366,7 +366,8 @@ fn network_error(edit: impl Fn(&mut serde_json::Value)) -> String {
 #[test]
 fn bad_network_scenes_get_errors_that_name_the_field() {
     use serde_json::json;
-    let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(Edit, &str)> = vec![
         (
             Box::new(
                 |v| v["hinges"] = json!([{"crease": 5, "hinge_length_um": 20, "layers": [{"material": "SiN", "thickness_um": 0.2}], "actuated": false}]),
