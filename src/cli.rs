@@ -98,13 +98,17 @@ pub enum Command {
         #[command(subcommand)]
         format: ExportKind,
     },
-    /// Natural frequencies, mode shapes and stability at the folded equilibrium of a scene.
+    /// Natural frequencies, mode shapes and stability at the folded equilibrium of a scene; a
+    /// network scene also writes modes.fold (each mode as a pair of frames).
     Modes {
         /// A scene file (.scene.json).
         scene: PathBuf,
         /// Print one JSON object on stdout instead of a table.
         #[arg(long)]
         json: bool,
+        /// Where a network scene's modes.fold goes (default: output/<scene name>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -1134,7 +1138,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         let file_name = nanofold::io::scene::scene_name(&args.scene);
         PathBuf::from("output").join(folder_name(&scene.name, &file_name))
     });
-    let files = [
+    let mut files = vec![
         (
             "response.json",
             serde_json::to_string(&response_json(&scene, &settings, &simulation))?,
@@ -1142,6 +1146,12 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         ("response.svg", response_svg(&scene, response)?),
         ("snapshots.svg", snapshots_svg(&scene, response)?),
     ];
+    if let System::Network(model) = &scene.system {
+        files.push((
+            "motion.fold",
+            serde_json::to_string(&nanofold::io::folding_output::network_motion_fold(model, response))?,
+        ));
+    }
     write_outputs(&dir, &files)?;
     if args.json {
         println!("{}", response_summary(&scene, &settings, &simulation));
@@ -1326,11 +1336,17 @@ fn run_export(format: &ExportKind) -> Result<()> {
     Ok(())
 }
 
-fn run_modes(path: &Path, json: bool) -> Result<()> {
+fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     let scene = load_scene(path)?;
     let chain = match &scene.system {
         System::Closed(chain) => return run_modes_closed(&scene.name, chain, json),
-        System::Network(model) => return run_modes_network(&scene.name, model, json),
+        System::Network(model) => {
+            let dir = out.map(Path::to_path_buf).unwrap_or_else(|| {
+                let file_name = nanofold::io::scene::scene_name(path);
+                PathBuf::from("output").join(folder_name(&scene.name, &file_name))
+            });
+            return run_modes_network(&scene.name, model, json, &dir);
+        }
         System::Strip(chain) => chain,
     };
     let result = modes(&chain.model, chain.target_angles().as_slice())?;
@@ -1378,10 +1394,20 @@ fn run_modes(path: &Path, json: bool) -> Result<()> {
     Ok(())
 }
 
-fn run_modes_network(name: &str, model: &nanofold::dynamics::network::NetworkModel, json: bool) -> Result<()> {
+fn run_modes_network(
+    name: &str,
+    model: &nanofold::dynamics::network::NetworkModel,
+    json: bool,
+    dir: &Path,
+) -> Result<()> {
     let result = nanofold::dynamics::network::modes::folded_modes(model)?;
+    let fold = nanofold::io::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
+    let files = [("modes.fold", serde_json::to_string(&fold)?)];
+    write_outputs(dir, &files)?;
     if json {
-        println!("{}", nanofold::io::output::network_modes_json(name, model, &result));
+        let mut value = nanofold::io::output::network_modes_json(name, model, &result);
+        value["out"] = serde_json::json!(dir.display().to_string());
+        println!("{value}");
         return Ok(());
     }
     let modes = &result.modes;
@@ -1436,8 +1462,12 @@ fn run_modes_network(name: &str, model: &nanofold::dynamics::network::NetworkMod
             "NOT stable: some eigenvalue of the stiffness on the manifold is not positive"
         }
     );
+    print_written(dir, &files);
     Ok(())
 }
+
+/// Each mode's frames in modes.fold move its largest crease this far either way, rad.
+const MODE_AMPLITUDE: f64 = 0.1;
 
 fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain, json: bool) -> Result<()> {
     let result = chain.folded_modes()?;
@@ -1532,7 +1562,7 @@ pub fn run(cli: Cli) -> Result<bool> {
         Command::Fold(args) => folding::run_fold(&args).map(|_| true),
         Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
-        Command::Modes { scene, json } => run_modes(&scene, json).map(|_| true),
+        Command::Modes { scene, json, out } => run_modes(&scene, json, out.as_deref()).map(|_| true),
         Command::Export { format } => run_export(&format).map(|_| true),
     }
 }

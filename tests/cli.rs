@@ -151,7 +151,7 @@ fn check_of_a_directory_runs_every_pattern_in_parallel_one_line_each() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let lines = json_lines(&out);
     // Every pattern file of the library, scene files skipped, each once.
-    let mut expected: Vec<String> = ["patterns", "patterns/many"]
+    let mut expected: Vec<String> = ["patterns", "patterns/devices", "patterns/many"]
         .iter()
         .flat_map(|dir| std::fs::read_dir(dir).unwrap())
         .map(|e| e.unwrap().path().display().to_string())

@@ -448,3 +448,102 @@ fn a_network_scene_must_start_rigid() {
         "{message}"
     );
 }
+
+/// `motion.fold` and `modes.fold` are FOLD animations whose every frame is the rigid sheet:
+/// each edge keeps its flat length and each face stays flat; the motion's frames are evenly
+/// spaced in time; the modes' frames close every vertex and come in pairs about the
+/// equilibrium; nanofold reads both back (the key frame carries a state).
+#[test]
+fn network_fold_animations_hold_rigid_sheets() {
+    let scene = scene_file("patterns/devices/cube_jams.scene.json");
+    let model = network(&scene);
+    let run = simulate(&scene, &SimulationSettings::default()).unwrap();
+    let motion = nanofold::io::folding_output::network_motion_fold(model, &run.response);
+    let check_frames = |model: &NetworkModel, fold: &serde_json::Value| {
+        let (flat, edges) = (&model.folding.pattern.vertices, &model.folding.pattern.edges);
+        let frames = fold["file_frames"].as_array().unwrap();
+        for frame in frames {
+            let coords: Vec<[f64; 3]> = serde_json::from_value(frame["vertices_coords"].clone()).unwrap();
+            for &[a, b] in edges.iter() {
+                let flat_length = (flat[a][0] - flat[b][0]).hypot(flat[a][1] - flat[b][1]);
+                let d = [0, 1, 2].map(|k| coords[a][k] - coords[b][k]);
+                let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                assert!(
+                    (length - flat_length).abs() < 1e-12 * flat_length,
+                    "{length} vs {flat_length}: edge {a}-{b} in {}",
+                    frame["frame_title"]
+                );
+            }
+        }
+        frames.len()
+    };
+    let count = check_frames(model, &motion);
+    assert_eq!(count, nanofold::io::folding_output::MOTION_FRAMES);
+    let times: Vec<f64> = motion["file_frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            f["frame_title"].as_str().unwrap()[4..]
+                .trim_end_matches(" s")
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    let end = run.response.samples.last().unwrap().time;
+    let step = end / (count - 1) as f64;
+    // Each frame is the sample nearest its even time: within half the output grid's spacing
+    // (401 samples over t_end; the contact ends the run before t_end).
+    let spacing = scene.t_end / 400.0;
+    for (k, t) in times.iter().enumerate() {
+        assert!(
+            (t - k as f64 * step).abs() <= 0.5 * spacing,
+            "frame {k}: {t} vs {}",
+            k as f64 * step
+        );
+    }
+    let text = motion.to_string();
+    let reread = nanofold::io::parse_crease_pattern(&text, "motion", "motion.fold").unwrap();
+    assert!(
+        reread.fold_angles.iter().all(|&a| a == 0.0),
+        "the key frame is the flat start"
+    );
+
+    let miura = scene_file("patterns/devices/miura_sheet.scene.json");
+    let model = network(&miura);
+    let modes = folded_modes(model).unwrap();
+    let fold = nanofold::io::folding_output::network_modes_fold(model, &modes, 0.1).unwrap();
+    assert_eq!(check_frames(model, &fold), 1 + 2 * modes.modes.basis.ncols());
+    let frames = fold["file_frames"].as_array().unwrap();
+    let angles = |f: &serde_json::Value| -> Vec<f64> {
+        let by_edge: Vec<f64> = serde_json::from_value(f["edges_foldAngle"].clone()).unwrap();
+        model
+            .folding
+            .pattern
+            .creases
+            .iter()
+            .map(|&e| by_edge[e].to_radians())
+            .collect()
+    };
+    let equilibrium = angles(&frames[0]);
+    for pair in frames[1..].chunks(2) {
+        let (plus, minus) = (angles(&pair[0]), angles(&pair[1]));
+        for state in [&plus, &minus] {
+            let residual = nanofold::folding::vertex_residuals(&model.folding, state)
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!(residual < 1e-10, "{residual:e}");
+        }
+        let largest = plus
+            .iter()
+            .zip(&equilibrium)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!((largest - 0.1).abs() < 0.02, "{largest}");
+        assert!(plus
+            .iter()
+            .zip(&minus)
+            .zip(&equilibrium)
+            .all(|((p, m), e)| (p - e) * (m - e) <= 1e-12));
+    }
+}

@@ -2,6 +2,12 @@
 //! the crease pattern (with or without a state), the folding path as FOLD frames over the
 //! crease pattern, and its trajectory.
 
+use crate::dynamics::network::algorithms::update_poses;
+use crate::dynamics::network::manifold::{projection_solver, restore};
+use crate::dynamics::network::modes::NetworkModes;
+use crate::dynamics::network::{NetworkData, NetworkModel};
+use crate::dynamics::simulate::Response;
+use crate::error::Result;
 use crate::folding::{panel_poses, vertex_positions, FoldPath, FoldingModel};
 use crate::io::output::number;
 use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
@@ -167,4 +173,121 @@ pub fn evenly(total: usize, count: usize) -> Vec<usize> {
         .collect();
     out.dedup();
     out
+}
+
+/// A network's states as a FOLD animation: the crease pattern is the key frame (2D, with
+/// the first state's fold angles, so the file reads back as the start), then one 3D
+/// `foldedForm` frame per (title, fold angles), posed as the dynamics poses them (the
+/// anchored panel fixed; lengths in the pattern's units).
+pub fn network_states_fold(model: &NetworkModel, frames: &[(String, &[f64])], description: &str) -> Value {
+    let pattern = &model.folding.pattern;
+    let key = frames.first().map(|(_, angles)| *angles);
+    let mut root = crease_pattern_fold(pattern, key, description);
+    root["edges_assignment"] = json!(pattern.kinds.iter().map(|&kind| letter(kind, 0.0)).collect::<Vec<_>>());
+    root["file_classes"] = json!(["animation"]);
+    root["frame_title"] = json!(format!("{}: crease pattern", pattern.name));
+    let mut data = NetworkData::new(model);
+    let frames: Vec<Value> = frames
+        .iter()
+        .map(|(title, fold_angles)| {
+            update_poses(model, fold_angles, &mut data);
+            let coords: Vec<[f64; 3]> = pattern
+                .vertices
+                .iter()
+                .zip(&model.folding.panel_of_vertex)
+                .map(|(&[x, y], &panel)| {
+                    let p =
+                        data.place(panel, &nalgebra::Vector3::new(x * model.unit, y * model.unit, 0.0)) / model.unit;
+                    [p.x, p.y, p.z]
+                })
+                .collect();
+            let (angles, letters) = edge_arrays(pattern, fold_angles);
+            json!({
+                "frame_title": title,
+                "frame_classes": ["foldedForm"],
+                "frame_attributes": ["3D"],
+                "frame_parent": 0,
+                "frame_inherit": true,
+                "vertices_coords": coords,
+                "edges_assignment": letters,
+                "edges_foldAngle": angles,
+            })
+        })
+        .collect();
+    root["file_frames"] = json!(frames);
+    root
+}
+
+/// Most frames of a network's motion animation.
+pub const MOTION_FRAMES: usize = 101;
+
+/// `motion.fold`: the response at up to [`MOTION_FRAMES`] evenly spaced times (the sample
+/// nearest each), so FOLD viewers play it at an even pace.
+pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
+    let samples = &response.samples;
+    let end = samples.last().map_or(0.0, |s| s.time);
+    let count = MOTION_FRAMES.min(samples.len()).max(1);
+    let mut chosen: Vec<usize> = (0..count)
+        .map(|k| {
+            let t = if count > 1 {
+                end * k as f64 / (count - 1) as f64
+            } else {
+                end
+            };
+            (0..samples.len())
+                .min_by(|&a, &b| (samples[a].time - t).abs().total_cmp(&(samples[b].time - t).abs()))
+                .unwrap_or(0)
+        })
+        .collect();
+    chosen.dedup();
+    let frames: Vec<(String, &[f64])> = chosen
+        .iter()
+        .map(|&i| (format!("t = {:.6e} s", samples[i].time), samples[i].angles.as_slice()))
+        .collect();
+    network_states_fold(
+        model,
+        &frames,
+        "a network's motion written by nanofold simulate (frames at even times)",
+    )
+}
+
+/// `modes.fold`: the folded equilibrium as the key frame's state, then each mode as a pair
+/// of frames, the equilibrium moved by ± its shape scaled to `amplitude` rad at its largest
+/// crease and put back onto the closures.
+pub fn network_modes_fold(model: &NetworkModel, modes: &NetworkModes, amplitude: f64) -> Result<Value> {
+    let equilibrium = &modes.modes.equilibrium.angles;
+    let shapes = &modes.modes.crease_shapes;
+    let mut states: Vec<(String, Vec<f64>)> = vec![("folded equilibrium".to_string(), equilibrium.clone())];
+    let mut released = model.clone();
+    released.folding.locked_columns.iter_mut().for_each(|l| *l = false);
+    let mut solver = projection_solver();
+    for k in 0..shapes.ncols() {
+        let largest = shapes
+            .column(k)
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        for sign in [1.0, -1.0] {
+            let mut state: Vec<f64> = equilibrium
+                .iter()
+                .zip(shapes.column(k).iter())
+                .map(|(e, s)| e + sign * amplitude * s / largest)
+                .collect();
+            restore(&released, &mut state, &mut solver)?;
+            states.push((
+                format!(
+                    "mode {k} ({:.3} Hz), {} {amplitude} rad",
+                    modes.modes.modes.frequencies_hz[k],
+                    if sign > 0.0 { "+" } else { "−" }
+                ),
+                state,
+            ));
+        }
+    }
+    let frames: Vec<(String, &[f64])> = states.iter().map(|(t, s)| (t.clone(), s.as_slice())).collect();
+    Ok(network_states_fold(
+        model,
+        &frames,
+        "a network's modes written by nanofold modes: the folded equilibrium, then each mode's shape either way",
+    ))
 }

@@ -88,18 +88,17 @@ impl<'m> NetworkPlant<'m> {
         self.start.as_ref()
     }
 
-    /// The report of a run: its branch, closure residuals and energy balance.
-    pub fn report(&self, response: &crate::dynamics::simulate::Response) -> Result<NetworkReport> {
-        let max_closure_residual = response
-            .samples
+    /// The report of a run (its samples, and whether it stopped at a contact): the branch,
+    /// closure residuals, energy balance and the pairs meeting at the contact.
+    pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkReport> {
+        let max_closure_residual = samples
             .iter()
             .map(|s| worst_residual(self.model, s.angles.as_slice()))
             .fold(0.0, f64::max);
-        let balances: Option<Vec<f64>> = response.samples.iter().map(|s| s.energy_balance()).collect();
+        let balances: Option<Vec<f64>> = samples.iter().map(|s| s.energy_balance()).collect();
         let energy_balance_error = balances.and_then(|b| {
             let first = *b.first()?;
-            let scale = response
-                .samples
+            let scale = samples
                 .iter()
                 .map(|s| {
                     s.kinetic_energy
@@ -110,8 +109,8 @@ impl<'m> NetworkPlant<'m> {
             let drift = b.iter().map(|x| (x - first).abs()).fold(0.0, f64::max);
             Some(if scale > 0.0 { drift / scale } else { 0.0 })
         });
-        let meeting_at_contact = match (&response.collision, response.samples.last()) {
-            (Some(_), Some(last)) => {
+        let meeting_at_contact = match (contact, samples.last()) {
+            (true, Some(last)) => {
                 let mut data = NetworkData::new(self.model);
                 self.contacts
                     .meeting(self.model, last.angles.as_slice(), &mut data, 1e-6)
