@@ -22,6 +22,12 @@ for scene in bridge_step bridge_ramp corner_cube_step1 corner_cube_step1_ramp co
     cp "$out/$scene/snapshots.svg" "docs/${scene}_snapshots.svg"
   fi
 done
+for scene in cube_closes cube_jams miura_sheet; do
+  $bin simulate "patterns/devices/$scene.scene.json" --out "$out/$scene" > /dev/null
+done
+cp "$out/cube_closes/snapshots.svg" docs/cube_closes_snapshots.svg
+cp "$out/cube_jams/snapshots.svg" docs/cube_jams_snapshots.svg
+cp "$out/miura_sheet/response.svg" docs/miura_sheet_response.svg
 # The closed chain's timing figure, likewise from a kept report (README's poly-against-exact
 # table quotes it).
 if [ "${1:-}" != "--keep-timings" ]; then

@@ -121,6 +121,18 @@ fn the_docs_figures_are_current() {
             same_figure(&dir.join(scene).join("snapshots.svg"), &snapshots);
         }
     }
+    // Devices of many panels.
+    for (scene, figure) in [
+        ("cube_closes", "snapshots"),
+        ("cube_jams", "snapshots"),
+        ("miura_sheet", "response"),
+    ] {
+        run(&["simulate", &format!("patterns/devices/{scene}.scene.json")], scene);
+        same_figure(
+            &dir.join(scene).join(format!("{figure}.svg")),
+            &format!("docs/{scene}_{figure}.svg"),
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

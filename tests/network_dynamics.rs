@@ -199,7 +199,7 @@ fn the_miura_sheets_mode_is_the_closed_form_motions() {
     let expected_hz = omega / std::f64::consts::TAU;
     let got = modes.modes.modes.frequencies_hz[0];
     assert!(
-        (got - expected_hz).abs() < 1e-6 * expected_hz,
+        (got - expected_hz).abs() < 1e-7 * expected_hz,
         "{got} Hz vs {expected_hz} Hz from the closed form"
     );
     assert!(modes.modes.modes.stable);

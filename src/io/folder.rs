@@ -24,6 +24,8 @@ pub const OUTPUT_FILES: &[&str] = &[
     "response.json",
     "response.svg",
     "snapshots.svg",
+    "motion.fold",
+    "modes.fold",
 ];
 
 /// Marks temporary and retired folders beside the target: `.{name}.nanofold-{kind}-{pid}-{n}`.

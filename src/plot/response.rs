@@ -107,14 +107,15 @@ impl ResponseView {
                         crate::pattern::crease_pattern::EdgeKind::Crease(a) => a.letter(),
                         _ => "?",
                     };
+                    // Actuated is the rule; the others say what they are.
                     let role = if model.locked(c) {
-                        "locked"
+                        " locked"
                     } else if model.forcing.hinges[c].actuated {
-                        "actuated"
+                        ""
                     } else {
-                        "passive"
+                        " passive"
                     };
-                    format!("{} {letter} ({role})", model.labels[c])
+                    format!("{} {letter}{role}", model.labels[c])
                 })
                 .collect(),
             targets: columns
@@ -252,7 +253,11 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         let mut entries = Vec::new();
         for (i, label) in view.labels.iter().enumerate() {
             let label = match same[i] {
-                Some(j) => format!("{label} (= {})", view.labels[j]),
+                // The name alone of the one it repeats ("edges[12]"), so the legend fits.
+                Some(j) => format!(
+                    "{label} (= {})",
+                    view.labels[j].split(' ').next().unwrap_or(&view.labels[j])
+                ),
                 None => label.clone(),
             };
             let column = view.columns[i];
@@ -603,16 +608,22 @@ fn network_snapshots_svg(name: &str, model: &NetworkModel, response: &Response, 
         )
     };
     let picks = snapshot_samples(response, count);
-    let mut reach: f64 = 1e-12;
+    // One cube around every view's panels, so the views share a scale and fill their frames.
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for &index in &picks {
         place_panels(model, response.samples[index].angles.as_slice(), &mut data);
         for (p, triangles) in model.folding.panel_triangles.iter().enumerate() {
             for &v in triangles.iter().flatten() {
-                reach = reach.max(data.place(p, &flat(v)).amax());
+                let x = data.place(p, &flat(v)) * 1e6;
+                for k in 0..3 {
+                    lo[k] = lo[k].min(x[k]);
+                    hi[k] = hi[k].max(x[k]);
+                }
             }
         }
     }
-    let reach = reach * 1e6;
+    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    let reach = (0..3).map(|k| 0.55 * (hi[k] - lo[k])).fold(1e-6, f64::max);
     let mut svg = String::new();
     {
         let root = canvas(&mut svg, (1100, 400));
@@ -636,10 +647,15 @@ fn network_snapshots_svg(name: &str, model: &NetworkModel, response: &Response, 
         for (area, &index) in panels.iter().zip(&picks) {
             let sample = &response.samples[index];
             place_panels(model, sample.angles.as_slice(), &mut data);
+            // plotters' 3D y axis is vertical: (x, z, y) so the pattern's z is up.
             let mut view = ChartBuilder::on(area)
                 .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
                 .margin(px(4))
-                .build_cartesian_3d(-reach..reach, -reach..reach, -reach..reach)
+                .build_cartesian_3d(
+                    centre[0] - reach..centre[0] + reach,
+                    centre[2] - reach..centre[2] + reach,
+                    centre[1] - reach..centre[1] + reach,
+                )
                 .map_err(plot_error)?;
             view.with_projection(|mut p| {
                 p.yaw = -0.9;
