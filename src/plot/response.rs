@@ -52,6 +52,8 @@ pub struct ResponseView {
     pub name: String,
     /// Legend label of each angle series.
     pub labels: Vec<String>,
+    /// How a series that repeats another names it in the legend ("hinge 1 (= hinge 0)").
+    pub names: Vec<String>,
     /// A dashed target line per series, if any (rad).
     pub targets: Vec<Option<f64>>,
     /// Whether drag is modelled (the energy plot says so).
@@ -100,6 +102,8 @@ impl ResponseView {
         let pattern = &model.folding.pattern;
         ResponseView {
             name: name.to_string(),
+            // A crease's name alone ("edges[12]", not its letter and role), so the legend fits.
+            names: columns.iter().map(|&c| model.labels[c].clone()).collect(),
             labels: columns
                 .iter()
                 .map(|&c| {
@@ -133,14 +137,16 @@ impl ResponseView {
     }
 
     fn of_strip(name: &str, chain: &StripChain) -> Self {
+        let labels: Vec<String> = (0..chain.model.dof())
+            .map(|i| {
+                let passive = !chain.forcing.hinges[i].actuated;
+                format!("hinge {i}{}", if passive { " (passive)" } else { "" })
+            })
+            .collect();
         ResponseView {
             name: name.to_string(),
-            labels: (0..chain.model.dof())
-                .map(|i| {
-                    let passive = !chain.forcing.hinges[i].actuated;
-                    format!("hinge {i}{}", if passive { " (passive)" } else { "" })
-                })
-                .collect(),
+            names: labels.clone(),
+            labels,
             targets: chain.forcing.hinges.iter().map(|h| Some(h.target)).collect(),
             drag: chain.model.drag().is_some(),
             columns: (0..chain.model.dof()).collect(),
@@ -150,22 +156,24 @@ impl ResponseView {
 
     fn of_closed(name: &str, chain: &ClosedChain) -> Self {
         let creases = chain.crease_stiffness.len();
+        let labels: Vec<String> = (0..creases)
+            .map(|c| {
+                let role = if c == chain.driver {
+                    "driven"
+                } else if chain.locked.iter().any(|&(l, _)| l == c) {
+                    "locked"
+                } else if c == chain.cut_crease {
+                    "cut, follows"
+                } else {
+                    "follows"
+                };
+                format!("{} ({role})", chain.crease_labels[c])
+            })
+            .collect();
         ResponseView {
             name: name.to_string(),
-            labels: (0..creases)
-                .map(|c| {
-                    let role = if c == chain.driver {
-                        "driven"
-                    } else if chain.locked.iter().any(|&(l, _)| l == c) {
-                        "locked"
-                    } else if c == chain.cut_crease {
-                        "cut, follows"
-                    } else {
-                        "follows"
-                    };
-                    format!("{} ({role})", chain.crease_labels[c])
-                })
-                .collect(),
+            names: labels.clone(),
+            labels,
             targets: (0..creases)
                 .map(|c| (c == chain.driver).then_some(chain.target()))
                 .collect(),
@@ -253,11 +261,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
         let mut entries = Vec::new();
         for (i, label) in view.labels.iter().enumerate() {
             let label = match same[i] {
-                // The name alone of the one it repeats ("edges[12]"), so the legend fits.
-                Some(j) => format!(
-                    "{label} (= {})",
-                    view.labels[j].split(' ').next().unwrap_or(&view.labels[j])
-                ),
+                Some(j) => format!("{label} (= {})", view.names[j]),
                 None => label.clone(),
             };
             let column = view.columns[i];
