@@ -1300,10 +1300,10 @@ fn run_export(format: &ExportKind) -> Result<()> {
     let scales = match &built.system {
         System::Strip(chain) => chain.time_scales()?,
         System::Closed(chain) => chain.time_scales()?,
-        System::Network(_) => anyhow::bail!(
-            "export mujoco {}: MuJoCo export of a network scene is not written yet (strips and closed chains only)",
-            scene.display()
-        ),
+        System::Network(model) => {
+            use nanofold::dynamics::plant::Plant;
+            nanofold::dynamics::network::NetworkPlant::new(model, false)?.time_scales()?
+        }
     };
     let settings = nanofold::io::mujoco::MujocoSettings {
         timestep: *timestep,

@@ -6,6 +6,8 @@
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::forcing::{Actuation, Forcing};
 use crate::dynamics::model::{Model, Plate};
+use crate::dynamics::network::start::leave_flat;
+use crate::dynamics::network::NetworkModel;
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::strip::StripChain;
 use crate::error::{NanofoldError, Result};
@@ -147,11 +149,17 @@ struct JointSpec {
 /// What a hinge's stressed layer does, as MuJoCo will apply it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum StressDrive {
-    /// τ = K θ_target from t = 0: an actuator's constant bias.
-    Step { torque: f64 },
-    /// τ = K θ_drive(t), θ_drive growing at `rate` (rad/s) up to `target`: an integrator
-    /// actuator whose activation is θ_drive (ctrl = the rate, activation clamped at the target).
-    Ramp { stiffness: f64, rate: f64, target: f64 },
+    /// τ = K θ_target from the release time on: an actuator's constant bias.
+    Step { torque: f64, release_time: f64 },
+    /// τ = K θ_drive(t), θ_drive growing at `rate` (rad/s) up to `target` from the release
+    /// time on: an integrator actuator whose activation is θ_drive (ctrl = the rate,
+    /// activation clamped at the target).
+    Ramp {
+        stiffness: f64,
+        rate: f64,
+        target: f64,
+        release_time: f64,
+    },
 }
 
 fn stress_drives(forcing: &Forcing, stiffness: &[f64]) -> Vec<Option<StressDrive>> {
@@ -161,11 +169,15 @@ fn stress_drives(forcing: &Forcing, stiffness: &[f64]) -> Vec<Option<StressDrive
         .zip(stiffness)
         .map(|(h, &k)| {
             h.actuated.then_some(match forcing.actuation {
-                Actuation::Step => StressDrive::Step { torque: k * h.target },
+                Actuation::Step => StressDrive::Step {
+                    torque: k * h.target,
+                    release_time: h.release_time,
+                },
                 Actuation::Ramp { etch_rate } => StressDrive::Ramp {
                     stiffness: k,
                     rate: (etch_rate / h.radius_of_curvature).copysign(h.target),
                     target: h.target,
+                    release_time: h.release_time,
                 },
             })
         })
@@ -325,6 +337,140 @@ fn closed_bodies(chain: &ClosedChain, closure: LoopClosure) -> Result<ClosedBodi
     Ok((bodies, vec![target_name], anchors))
 }
 
+/// A network's bodies, its anchored panel's outline and the loops' connect equalities.
+type NetworkBodies = (Vec<BodySpec>, Vec<Point3<f64>>, Vec<ConnectSpec>);
+
+/// One `connect` equality: a point of `body1` (given in the world's flat frame) held on
+/// `body2` (a body name, or "world").
+struct ConnectSpec {
+    body1: usize,
+    body2: String,
+    anchor: Point3<f64>,
+    name: String,
+}
+
+/// A network's bodies (every panel but the anchored one, on the spanning tree; a light body
+/// per crease off the tree, turning about it from one side), its anchored panel's outline
+/// (world, flat) and the `connect` equalities that close each loop: three points of each light
+/// body (its crease's ends and the far side's centroid) held on the panel it stands for.
+fn network_bodies(model: &NetworkModel) -> Result<NetworkBodies> {
+    let pattern = &model.folding.pattern;
+    let unit = model.unit;
+    let flat = |v: usize| Point3::new(pattern.vertices[v][0] * unit, pattern.vertices[v][1] * unit, 0.0);
+    let stiffness = model.stiffness();
+    let torques = stress_drives(&model.forcing, &stiffness);
+    let crease_name = |c: usize| format!("crease_{}", pattern.creases[c]);
+    let face_of = |p: usize| {
+        (0..pattern.faces.len())
+            .filter(|&f| pattern.panel_of_face[f] == p)
+            .map(|f| pattern.file_face[f])
+            .min()
+            .expect("every panel has a face")
+    };
+    // Each off-tree crease's light body moves with the panel it stands for once its loop is
+    // closed, so it carries an equal share of that panel's mass and inertia (the panel keeps
+    // the rest): the totals are the panel's own, and no body is so light that MuJoCo's soft
+    // equalities must hold back a large acceleration.
+    let off_tree: Vec<(usize, usize, usize)> = (0..model.columns())
+        .filter(|&c| model.carried[c].is_none())
+        .filter_map(|c| {
+            let [Some(left), Some(right)] = pattern.edge_faces[pattern.creases[c]] else {
+                return None;
+            };
+            let (pl, pr) = (pattern.panel_of_face[left], pattern.panel_of_face[right]);
+            Some(if pl == model.anchored_panel {
+                (c, pr, pl)
+            } else {
+                (c, pl, pr)
+            })
+        })
+        .collect();
+    let mut pieces = vec![1.0; model.panels()];
+    for &(_, _, target) in &off_tree {
+        pieces[target] += 1.0;
+    }
+    let inertia_entries = |p: usize| {
+        let i = model.bodies[p].inertia / pieces[p];
+        [i[(0, 0)], i[(1, 1)], i[(2, 2)], i[(0, 1)], i[(0, 2)], i[(1, 2)]]
+    };
+    let mut body_of = vec![None; model.panels()];
+    let mut bodies = Vec::new();
+    for &p in &model.order[1..] {
+        let c = model.parent_column[p].expect("placed panels hang from a crease");
+        let parent = model.parent[p].expect("and from a parent");
+        let body = &model.bodies[p];
+        let centre = body.centre;
+        let outline = model.folding.panel_vertices[p]
+            .iter()
+            .map(|&v| Point3::from(flat(v).coords - centre))
+            .collect();
+        body_of[p] = Some(bodies.len());
+        bodies.push(BodySpec {
+            name: format!("face_{}", face_of(p)),
+            pose: Isometry3::translation(centre.x, centre.y, centre.z),
+            parent: body_of[parent],
+            joint: Some(JointSpec {
+                name: crease_name(c),
+                axis: model.joint_axis[c],
+                point: Point3::from(model.hinges[c].point),
+                stiffness: stiffness[c],
+                drive: torques[c],
+            }),
+            mass: body.mass / pieces[p],
+            inertia: inertia_entries(p),
+            outline: Some(outline),
+            thickness: model.thickness,
+            drag_area: body.area,
+            collide: false,
+        });
+    }
+    let mut connects = Vec::new();
+    for &(c, carrier, target) in &off_tree {
+        let e = pattern.creases[c];
+        let [Some(left), _] = pattern.edge_faces[e] else {
+            unreachable!("off-tree creases have two sides");
+        };
+        let pl = pattern.panel_of_face[left];
+        let target_on_left = target == pl;
+        let direction = model.hinges[c].direction * if target_on_left { 1.0 } else { -1.0 };
+        let target_centre = model.bodies[target].centre;
+        let index = bodies.len();
+        bodies.push(BodySpec {
+            name: format!("loop_{}", crease_name(c)),
+            pose: Isometry3::translation(target_centre.x, target_centre.y, target_centre.z),
+            parent: body_of[carrier],
+            joint: Some(JointSpec {
+                name: crease_name(c),
+                axis: direction,
+                point: Point3::from(model.hinges[c].point),
+                stiffness: stiffness[c],
+                drive: torques[c],
+            }),
+            mass: model.bodies[target].mass / pieces[target],
+            inertia: inertia_entries(target),
+            outline: None,
+            thickness: 0.0,
+            drag_area: 0.0,
+            collide: false,
+        });
+        let target_name = body_of[target].map_or("world".to_string(), |b| bodies[b].name.clone());
+        let [a, b] = pattern.edges[e];
+        for (k, anchor) in [flat(a), flat(b), Point3::from(target_centre)].into_iter().enumerate() {
+            connects.push(ConnectSpec {
+                body1: index,
+                body2: target_name.clone(),
+                anchor,
+                name: format!("close_{}_{}", crease_name(c), ["a", "b", "c"][k]),
+            });
+        }
+    }
+    let ground = model.folding.panel_vertices[model.anchored_panel]
+        .iter()
+        .map(|&v| flat(v))
+        .collect();
+    Ok((bodies, ground, connects))
+}
+
 /// How far along its branch a closed chain that starts flat is started, degrees of the driver.
 pub const BRANCH_START_DEG: f64 = 1.0;
 
@@ -364,13 +510,25 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
 
 /// The MJCF text of `scene`.
 pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
+    let mut network_parts = None;
     let (bodies, connect_targets, connect_anchors, substrate_edge, drag, description) = match &scene.system {
-        System::Network(_) => {
-            return Err(NanofoldError::invalid(
-                "scene",
-                &scene.name,
-                "MuJoCo export of a network scene is not written yet: strips and closed chains only",
-            ))
+        System::Network(model) => {
+            if settings.closure == LoopClosure::Polycoef {
+                return Err(NanofoldError::invalid(
+                    "closure",
+                    "poly",
+                    "a network's loops are closed by connect equalities (fitted curves are for a single closed vertex)",
+                ));
+            }
+            let (bodies, ground, connects) = network_bodies(model)?;
+            let description = format!(
+                "a network of {} panels: the anchored panel (face {}) is the world's geom `ground`, the others a tree of bodies; each of its {} creases off the tree is a hinge on a light body closed onto its panel by three connect equalities",
+                model.panels(),
+                model.anchored_face,
+                model.columns() - (model.panels() - 1)
+            );
+            network_parts = Some((ground, connects));
+            (bodies, Vec::new(), Vec::new(), None, model.drag, description)
         }
         System::Strip(chain) => {
             let (bodies, notes) = strip_bodies(chain)?;
@@ -459,32 +617,33 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     .unwrap();
     // Meshes: each plate a thin prism of its structural thickness.
     writeln!(w, "  <asset>").unwrap();
-    for body in &bodies {
-        if let Some(outline) = &body.outline {
-            let half = 0.5 * body.thickness.max(1e-3 * LENGTH_UNIT);
-            let mut vertex = Vec::new();
-            for dz in [-half, half] {
-                for p in outline {
-                    vertex.push(vec3(&Vector3::new(p.x, p.y, p.z + dz), l));
-                }
-            }
-            writeln!(w, "    <mesh name=\"{}\" vertex=\"{}\"/>", body.name, vertex.join("  ")).unwrap();
-        }
-    }
-    if let System::Closed(chain) = &scene.system {
-        let half = 0.5
-            * bodies
-                .iter()
-                .map(|b| b.thickness)
-                .fold(0.0, f64::max)
-                .max(1e-3 * LENGTH_UNIT);
+    // A prism of half-thickness `half` over an outline, µm.
+    let prism = |w: &mut String, name: &str, outline: &[Point3<f64>], half: f64| {
         let mut vertex = Vec::new();
         for dz in [-half, half] {
-            for p in &chain.ground {
+            for p in outline {
                 vertex.push(vec3(&Vector3::new(p.x, p.y, p.z + dz), l));
             }
         }
-        writeln!(w, "    <mesh name=\"ground\" vertex=\"{}\"/>", vertex.join("  ")).unwrap();
+        writeln!(w, "    <mesh name=\"{name}\" vertex=\"{}\"/>", vertex.join("  ")).unwrap();
+    };
+    for body in &bodies {
+        if let Some(outline) = &body.outline {
+            prism(w, &body.name, outline, 0.5 * body.thickness.max(1e-3 * LENGTH_UNIT));
+        }
+    }
+    // The anchored sector or panel: as thick as the thickest plate.
+    let ground_half = 0.5
+        * bodies
+            .iter()
+            .map(|b| b.thickness)
+            .fold(0.0, f64::max)
+            .max(1e-3 * LENGTH_UNIT);
+    if let System::Closed(chain) = &scene.system {
+        prism(w, "ground", &chain.ground, ground_half);
+    }
+    if let Some((ground, _)) = &network_parts {
+        prism(w, "ground", ground, ground_half);
     }
     writeln!(w, "  </asset>").unwrap();
     writeln!(w, "  <custom>").unwrap();
@@ -524,6 +683,27 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         )
         .unwrap();
     }
+    if let System::Network(model) = &scene.system {
+        for (c, hinge) in model.forcing.hinges.iter().enumerate() {
+            if hinge.actuated && hinge.release_time > 0.0 {
+                let e = model.folding.pattern.creases[c];
+                writeln!(
+                    w,
+                    "    <numeric name=\"nanofold:release_time:crease_{e}\" data=\"{}\"/>",
+                    fmt(hinge.release_time / TIME_UNIT)
+                )
+                .unwrap();
+                if let Actuation::Ramp { etch_rate } = model.forcing.actuation {
+                    writeln!(
+                        w,
+                        "    <numeric name=\"nanofold:release_rate:crease_{e}\" data=\"{}\"/>",
+                        fmt((etch_rate / hinge.radius_of_curvature).copysign(hinge.target) * TIME_UNIT)
+                    )
+                    .unwrap();
+                }
+            }
+        }
+    }
     writeln!(w, "  </custom>").unwrap();
     writeln!(w, "  <worldbody>").unwrap();
     // The substrate (strip) or the anchored sector (closed).
@@ -545,7 +725,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         )
         .unwrap();
     }
-    if matches!(scene.system, System::Closed(_)) {
+    if matches!(scene.system, System::Closed(_) | System::Network(_)) {
         writeln!(w, "    <geom name=\"ground\" type=\"mesh\" mesh=\"ground\" contype=\"0\" conaffinity=\"0\" rgba=\"0.55 0.55 0.6 1\"/>").unwrap();
     }
     let mut joint_order = Vec::new();
@@ -626,13 +806,57 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
         writeln!(w, "  </equality>").unwrap();
     }
+    if let (Some((_, connects)), System::Network(model)) = (&network_parts, &scene.system) {
+        let any_lock = (0..model.columns()).any(|c| model.locked(c));
+        if !connects.is_empty() || any_lock {
+            writeln!(w, "  <equality>").unwrap();
+        }
+        for connect in connects {
+            let body = &bodies[connect.body1];
+            let local = body.pose.inverse_transform_point(&connect.anchor);
+            writeln!(
+                w,
+                "    <connect name=\"{}\" body1=\"{}\" body2=\"{}\" anchor=\"{}\" solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001\"/>",
+                connect.name,
+                body.name,
+                connect.body2,
+                vec3(&local.coords, l),
+                fmt(2.0 * dt)
+            )
+            .unwrap();
+        }
+        for c in (0..model.columns()).filter(|&c| model.locked(c)) {
+            let e = model.folding.pattern.creases[c];
+            writeln!(
+                w,
+                "    <joint name=\"lock_crease_{e}\" joint1=\"crease_{e}\" polycoef=\"{} 0 0 0 0\" solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001\"/>",
+                fmt(model.start[c]),
+                fmt(2.0 * dt)
+            )
+            .unwrap();
+        }
+        if !connects.is_empty() || any_lock {
+            writeln!(w, "  </equality>").unwrap();
+        }
+    }
+    // A network that starts flat starts in MuJoCo where nanofold leaves the branch point: its
+    // angles, rates and time (MuJoCo's constraint forces would hold the panels still there).
+    let branch = match &scene.system {
+        System::Network(model) => leave_flat(model)?,
+        _ => None,
+    };
+    let key_time = branch.as_ref().map_or(0.0, |b| b.time);
     writeln!(w, "  <actuator>").unwrap();
-    // The keyframe's ctrl: a ramp actuator's rate, 0 for a step's (its ctrl adds torque).
+    // The keyframe's ctrl: a ramp actuator's rate, 0 for a step's (its ctrl adds torque); an
+    // actuator not yet released by an etch front is held off (ctrl 0 for a ramp, minus its
+    // bias for a step). The keyframe's act: each ramp's drive angle at the key's time.
     let mut controls = Vec::new();
+    let mut activations = Vec::new();
+    let mut held_back = 0;
     for body in &bodies {
         let Some(joint) = body.joint.as_ref() else { continue };
         match joint.drive {
-            Some(StressDrive::Step { torque }) => {
+            Some(StressDrive::Step { torque, release_time }) => {
                 writeln!(
                     w,
                     "    <general name=\"stress_{}\" joint=\"{}\" gainprm=\"1\" biastype=\"affine\" biasprm=\"{} 0 0\"/>",
@@ -641,12 +865,16 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                     fmt(torque * torque_scale)
                 )
                 .unwrap();
-                controls.push(0.0);
+                let held = release_time > key_time;
+                held_back += usize::from(held);
+                controls.push(if held { -torque * torque_scale } else { 0.0 });
+                activations.push(None);
             }
             Some(StressDrive::Ramp {
                 stiffness,
                 rate,
                 target,
+                release_time,
             }) => {
                 let (lo, hi) = if target >= 0.0 { (0.0, target) } else { (target, 0.0) };
                 writeln!(
@@ -659,7 +887,11 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                     fmt(hi)
                 )
                 .unwrap();
-                controls.push(rate * TIME_UNIT);
+                let held = release_time > key_time;
+                held_back += usize::from(held);
+                controls.push(if held { 0.0 } else { rate * TIME_UNIT });
+                let drive = (rate * (key_time - release_time).max(0.0)).clamp(lo, hi);
+                activations.push(Some(drive));
             }
             None => {}
         }
@@ -668,6 +900,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     // The state at t = 0: flat for a strip; for a closed chain the driver's start with the
     // locks and the dependents (the cut crease included) on the closure.
     let mut start = vec![0.0; joint_order.len()];
+    let qpos = &mut start;
     if let System::Closed(chain) = &scene.system {
         let mut ws = chain.workspace();
         let q = keyframe_driver_angle(chain);
@@ -679,13 +912,46 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                 ws.crease_angles[*c] = a.iter().rev().fold(0.0, |acc, x| acc * q + x);
             }
         }
-        for (slot, name) in start.iter_mut().zip(&joint_order) {
+        for (slot, name) in qpos.iter_mut().zip(&joint_order) {
             if let Some(c) =
                 (0..chain.crease_labels.len()).find(|&c| *name == format!("crease_{}", chain.crease_user_indices[c]))
             {
                 *slot = ws.crease_angles[c];
             }
         }
+    }
+    let mut velocities = vec![0.0; joint_order.len()];
+    let mut network_note = None;
+    if let System::Network(model) = &scene.system {
+        let (angles, rates) = match &branch {
+            Some(branch) => {
+                network_note = Some(format!(
+                    "The scene starts flat, a branch point where MuJoCo's constraint forces would hold the panels still: the keyframe is nanofold's state where it leaves the branch point, {:e} rad along, {:e} µs after the release.",
+                    crate::dynamics::network::start::KICK,
+                    branch.time / TIME_UNIT
+                ));
+                (branch.angles.clone(), branch.rates.clone())
+            }
+            None => (model.start.clone(), vec![0.0; model.columns()]),
+        };
+        for ((slot, rate), name) in qpos.iter_mut().zip(velocities.iter_mut()).zip(&joint_order) {
+            if let Some(c) =
+                (0..model.columns()).find(|&c| *name == format!("crease_{}", model.folding.pattern.creases[c]))
+            {
+                *slot = angles[c];
+                *rate = rates[c] * TIME_UNIT;
+            }
+        }
+        if held_back > 0 {
+            writeln!(
+                w,
+                "  <!-- An etch front: {held_back} actuator(s) are held off by the keyframe's ctrl until their hinge's release time (custom numeric nanofold:release_time:JOINT, µs), when a client sets ctrl to 0 for a step, or for a ramp to its rate (nanofold:release_rate:JOINT, rad/µs). -->"
+            )
+            .unwrap();
+        }
+    }
+    if let Some(note) = &network_note {
+        writeln!(w, "  <!-- {} -->", xml_escape(note)).unwrap();
     }
     if let System::Closed(chain) = &scene.system {
         if keyframe_driver_angle(chain) != chain.start {
@@ -705,15 +971,30 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         )
         .unwrap();
     }
+    let timing = if key_time > 0.0 {
+        format!(
+            " time=\"{}\" qvel=\"{}\"",
+            fmt(key_time / TIME_UNIT),
+            velocities.iter().map(|&v| fmt(v)).collect::<Vec<_>>().join(" ")
+        )
+    } else {
+        String::new()
+    };
+    // MuJoCo's act holds only the integrator actuators' states.
+    let act: Vec<String> = activations.iter().flatten().map(|&a| fmt(a)).collect();
     writeln!(
         w,
-        "    <key name=\"start\" qpos=\"{}\"{}/>",
+        "    <key name=\"start\"{timing} qpos=\"{}\"{}/>",
         start.iter().map(|&q| fmt(q)).collect::<Vec<_>>().join(" "),
         if controls.iter().any(|&c| c != 0.0) {
             format!(
-                " ctrl=\"{}\" act=\"{}\"",
+                " ctrl=\"{}\"{}",
                 controls.iter().map(|&c| fmt(c)).collect::<Vec<_>>().join(" "),
-                vec!["0"; controls.len()].join(" ")
+                if act.is_empty() {
+                    String::new()
+                } else {
+                    format!(" act=\"{}\"", act.join(" "))
+                }
             )
         } else {
             String::new()
