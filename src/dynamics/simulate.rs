@@ -232,7 +232,7 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
         }
         System::Network(model) => {
             let plant = NetworkPlant::new(model, collisions)?;
-            let response = run(&plant, &NetworkPlant::new(model, false)?, settings, &times)?;
+            let response = run(&plant, &plant.without_contacts(), settings, &times)?;
             let network = Some(plant.report(&response.samples, response.collision.is_some())?);
             Ok(Simulation {
                 response,

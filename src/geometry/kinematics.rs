@@ -10,12 +10,47 @@ use crate::error::{NumericalError, Result};
 use crate::geometry::sphere::Vec3;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
-fn rot_x(angle: f64) -> Matrix3<f64> {
-    *Rotation3::from_axis_angle(&Vector3::x_axis(), angle).matrix()
-}
-
 fn rot_z(angle: f64) -> Matrix3<f64> {
     *Rotation3::from_axis_angle(&Vector3::z_axis(), angle).matrix()
+}
+
+/// `frame ← frame · R_x(ρ) · R_z(α)`, column by column (a third of a full product's work).
+fn turn(frame: &mut Matrix3<f64>, fold_angle: f64, sector_angle: f64) {
+    let (s, c) = fold_angle.sin_cos();
+    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
+    frame.set_column(1, &(c * c1 + s * c2));
+    frame.set_column(2, &(c * c2 - s * c1));
+    let (s, c) = sector_angle.sin_cos();
+    let (c0, c1) = (frame.column(0).into_owned(), frame.column(1).into_owned());
+    frame.set_column(0, &(c * c0 + s * c1));
+    frame.set_column(1, &(c * c1 - s * c0));
+}
+
+/// The frames' chain once round the vertex: returns the holonomy and, when asked, puts
+/// node k (ray k's world axis, k ≥ 1) in `nodes[k]`.
+fn chain(sector_angles: &[f64], fold_angles: &[f64], mut nodes: Option<&mut [Vec3]>) -> Matrix3<f64> {
+    let n = fold_angles.len();
+    let mut frame = rot_z(sector_angles[0]);
+    if let Some(nodes) = nodes.as_deref_mut() {
+        nodes[0] = Vec3::x();
+        if n > 1 {
+            nodes[1] = frame.column(0).into_owned();
+        }
+    }
+    for k in 1..n {
+        turn(&mut frame, fold_angles[k], sector_angles[k]);
+        if let Some(nodes) = nodes.as_deref_mut() {
+            if k + 1 < n {
+                nodes[k + 1] = frame.column(0).into_owned();
+            }
+        }
+    }
+    // The last fold, R_x(ρ_0), on the right.
+    let (s, c) = fold_angles[0].sin_cos();
+    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
+    frame.set_column(1, &(c * c1 + s * c2));
+    frame.set_column(2, &(c * c2 - s * c1));
+    frame
 }
 
 /// Node positions of the rays for the given sector and fold angles, sector 0 fixed in the
@@ -27,11 +62,11 @@ pub fn forward(sector_angles: &[f64], fold_angles: &[f64]) -> Vec<Vec3> {
     let mut frame = Matrix3::identity();
     nodes.push(Vec3::x());
     for k in 1..n {
-        frame = if k == 1 {
-            rot_z(sector_angles[0])
+        if k == 1 {
+            frame = rot_z(sector_angles[0]);
         } else {
-            frame * rot_x(fold_angles[k - 1]) * rot_z(sector_angles[k - 1])
-        };
+            turn(&mut frame, fold_angles[k - 1], sector_angles[k - 1]);
+        }
         nodes.push(frame.column(0).into_owned());
     }
     nodes
@@ -39,12 +74,7 @@ pub fn forward(sector_angles: &[f64], fold_angles: &[f64]) -> Vec<Vec3> {
 
 /// The closed chain's holonomy: identity exactly when the loop closes.
 pub fn closure_rotation(sector_angles: &[f64], fold_angles: &[f64]) -> Matrix3<f64> {
-    let n = fold_angles.len();
-    let mut frame = rot_z(sector_angles[0]);
-    for k in 1..n {
-        frame = frame * rot_x(fold_angles[k]) * rot_z(sector_angles[k]);
-    }
-    frame * rot_x(fold_angles[0])
+    chain(sector_angles, fold_angles, None)
 }
 
 /// Rotation vector (axis × angle) of a rotation matrix, accurate near the identity where
@@ -167,9 +197,10 @@ pub fn refine_closure(sector_angles: &[f64], fold_angles: &mut [f64], free: &[us
 /// The closure residual vector r (rotation vector of the holonomy) and its Jacobian
 /// ∂r/∂ρ_k for the rays in `columns`: the implicit-function-theorem data of `docs/model.md#constraint-curves`.
 pub fn closure_jacobian(sector_angles: &[f64], fold_angles: &[f64], columns: &[usize]) -> (Vector3<f64>, DMatrix<f64>) {
-    let holonomy = closure_rotation(sector_angles, fold_angles);
+    let mut nodes = vec![Vec3::zeros(); fold_angles.len()];
+    let holonomy = chain(sector_angles, fold_angles, Some(&mut nodes));
     let r = rotation_vector(&holonomy);
-    let jac = rotation_vector_jacobian(sector_angles, fold_angles, &holonomy, &r, columns);
+    let jac = jacobian_from_nodes(&nodes, &holonomy, &r, columns);
     (r, jac)
 }
 
@@ -180,8 +211,12 @@ fn rotation_vector_jacobian(
     r: &Vector3<f64>,
     columns: &[usize],
 ) -> DMatrix<f64> {
-    let n = fold_angles.len();
-    let nodes = forward(sector_angles, fold_angles);
+    jacobian_from_nodes(&forward(sector_angles, fold_angles), holonomy, r, columns)
+}
+
+/// J_l(r)⁻¹ times each listed ray's world axis.
+fn jacobian_from_nodes(nodes: &[Vec3], holonomy: &Matrix3<f64>, r: &Vector3<f64>, columns: &[usize]) -> DMatrix<f64> {
+    let n = nodes.len();
     let jl_inv = left_jacobian_inverse(r);
     let mut jac = DMatrix::zeros(3, columns.len());
     for (col, &k) in columns.iter().enumerate() {

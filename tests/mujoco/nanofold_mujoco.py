@@ -3,8 +3,8 @@
 MuJoCo integrates the model as written (RK4 at the file's time step, from the `start`
 keyframe). Two things nanofold models that MJCF cannot say are added here:
 - drag, F = -1/2 C_D rho A |v|^2 sgn(v.n) n at each plate's centre of mass (n the plate's
-  body z), from the file's custom numerics, through MuJoCo's passive-force callback, so every
-  RK4 stage sees it;
+  body z), from the file's custom numerics, set as xfrc_applied by MuJoCo's passive-force
+  callback, so every RK4 stage sees it;
 - nanofold's contact events, measured on MuJoCo's state: a plate corner (a site) reaching the
   substrate's quarter-space {y <= edge, z <= 0} or the plane of a plate two or more links away
   while inside its outline, and a hinge folding flat (|angle| reaching pi). The time is
@@ -38,24 +38,28 @@ def install_drag(model):
         mujoco.set_mjcb_passive(None)
         return 0
     cd, rho = float(cd[0]), float(rho[0])
-    areas = []
+    bodies, areas = [], []
     for body in range(model.nbody):
         area = numeric(model, "nanofold:drag_area:" + model.body(body).name)
         if area is not None:
-            areas.append((body, float(area[0])))
-    velocity = np.zeros(6)
-    zero = np.zeros(3)
+            bodies.append(body)
+            areas.append(float(area[0]))
+    bodies = np.array(bodies, dtype=int)
+    scale = -0.5 * cd * rho * np.array(areas)
+    roots = model.body_rootid[bodies]
 
+    # All plates at once. Each body's frame is its centre of mass, where the force acts; its
+    # velocity there from MuJoCo's com-based velocity (about the subtree centre of its root,
+    # computed before the passive forces). The force goes in as xfrc_applied, which the
+    # same stage's accelerations include.
     def passive(m, d):
-        for body, area in areas:
-            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, body, velocity, 0)
-            v = velocity[3:]
-            n = d.xmat[body].reshape(3, 3)[:, 2]
-            normal_speed = float(v @ n)
-            if normal_speed == 0.0:
-                continue
-            force = -0.5 * cd * rho * area * float(v @ v) * math.copysign(1.0, normal_speed) * n
-            mujoco.mj_applyFT(m, d, force, zero, d.xpos[body], body, d.qfrc_passive)
+        cvel = d.cvel[bodies]
+        v = cvel[:, 3:] + np.cross(cvel[:, :3], d.xipos[bodies] - d.subtree_com[roots])
+        n = d.xmat[bodies][:, [2, 5, 8]]
+        normal_speed = np.einsum("ij,ij->i", v, n)
+        magnitude = scale * np.einsum("ij,ij->i", v, v) * np.sign(normal_speed)
+        d.xfrc_applied[bodies, :3] = magnitude[:, None] * n
+        d.xfrc_applied[bodies, 3:] = 0.0
 
     mujoco.set_mjcb_passive(passive)
     return len(areas)

@@ -34,17 +34,15 @@ const NEWTON_SWITCH: f64 = 1e-4;
 /// Moves `angles` onto every vertex closure (least-norm Newton, locked creases held), within
 /// [`CLOSURE_TOL`]; an error naming the residual when Newton does not get there.
 pub fn restore(model: &NetworkModel, angles: &mut [f64], solver: &mut NormalSolver) -> Result<usize> {
-    let before = worst_residual(model, angles);
-    if before <= CLOSURE_TOL {
-        return Ok(0);
-    }
-    restore_closure(&model.folding, angles, CLOSURE_TOL, solver)?.ok_or_else(|| {
-        NumericalError::ClosureNotConverged {
-            residual: before,
+    match restore_closure(&model.folding, angles, CLOSURE_TOL, solver)? {
+        Some(iterations) => Ok(iterations),
+        // The residual where Newton gave up.
+        None => Err(NumericalError::ClosureNotConverged {
+            residual: worst_residual(model, angles),
             iterations: 30,
         }
-        .into()
-    })
+        .into()),
+    }
 }
 
 /// A Newton solver for [`restore`].

@@ -22,6 +22,7 @@ use crate::error::{NumericalError, Result};
 use crate::folding::normal::NormalSolver;
 use nalgebra::DVector;
 use std::f64::consts::TAU;
+use std::sync::OnceLock;
 
 /// What a network run reports beside its response.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -67,6 +68,9 @@ pub struct NetworkPlant<'m> {
     contacts: NetworkContacts,
     /// Leaving a flat (singular) start along the branch the actuation picks, when it is one.
     start: Option<BranchStart>,
+    /// The final balance, once found (the time scales and the quasi-static estimate both
+    /// need it).
+    balance: OnceLock<Vec<f64>>,
 }
 
 impl<'m> NetworkPlant<'m> {
@@ -75,7 +79,22 @@ impl<'m> NetworkPlant<'m> {
     pub fn new(model: &'m NetworkModel, collisions: bool) -> Result<Self> {
         let contacts = NetworkContacts::new(model, collisions);
         let start = leave_flat(model)?;
-        Ok(NetworkPlant { model, contacts, start })
+        Ok(NetworkPlant {
+            model,
+            contacts,
+            start,
+            balance: OnceLock::new(),
+        })
+    }
+
+    /// The same plant without contact candidates (its branch and balance already found).
+    pub fn without_contacts(&self) -> Self {
+        NetworkPlant {
+            model: self.model,
+            contacts: NetworkContacts::new(self.model, false),
+            start: self.start.clone(),
+            balance: self.balance.clone(),
+        }
     }
 
     /// The model.
@@ -137,13 +156,16 @@ impl<'m> NetworkPlant<'m> {
     }
 
     /// The hinges' balance with every drive at its final angle, from the start.
-    fn final_balance(&self, ws: &mut NetworkWorkspace) -> Result<Vec<f64>> {
+    fn final_balance(&self) -> Result<Vec<f64>> {
+        if let Some(balance) = self.balance.get() {
+            return Ok(balance.clone());
+        }
         let forcing = &self.model.forcing;
         let mut rest = vec![0.0; self.model.columns()];
         forcing.drive_angles(forcing.duration().max(1.0), &mut rest);
         self.rest_angles(&mut rest);
-        let _ = ws;
-        Ok(super::modes::follow_drive(self.model, &rest, self.regular_start())?.angles)
+        let balance = super::modes::follow_drive(self.model, &rest, self.regular_start())?.angles;
+        Ok(self.balance.get_or_init(|| balance).clone())
     }
 
     /// Locked creases rest at their lock.
@@ -204,9 +226,8 @@ impl<'m> NetworkPlant<'m> {
 
     /// Natural angular frequencies at the start and at the final balance, rad/s.
     fn omegas(&self) -> Result<Vec<f64>> {
-        let mut ws = self.workspace();
         let mut all = spring_frequencies(self.model, self.regular_start())?;
-        if let Ok(balance) = self.final_balance(&mut ws) {
+        if let Ok(balance) = self.final_balance() {
             all.extend(spring_frequencies(self.model, &balance)?);
         }
         Ok(all.into_iter().filter(|w| *w > 0.0).collect())
@@ -266,7 +287,7 @@ impl Plant for NetworkPlant<'_> {
         Ok(match self.model.forcing.actuation {
             // A step's jump: from the start to the final balance.
             Actuation::Step => {
-                let balance = self.final_balance(&mut ws)?;
+                let balance = self.final_balance()?;
                 balance
                     .iter()
                     .zip(&start)

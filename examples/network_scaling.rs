@@ -1,0 +1,283 @@
+//! How a panel network's dynamics scales with its size, with its error beside its time: the
+//! folded Miura-ori sheet of `patterns/devices/miura_sheet.scene.json` at n × n panels
+//! (n = 4, 8, 16, 32 by default), released at 100° zigzag folds with its step torques and
+//! drag, run for 20 µs (about 1.4 periods of its one folding motion) at several tolerances
+//! against a reference at rtol 1e-12. For each run: wall time (median of 3, one run from
+//! 16 × 16 up) split into set-up, integration and output samples, steps, right-hand sides,
+//! the largest crease-angle error at the end, the closure residual and the energy balance.
+//! Power laws fit each part's cost against the number of panels. With NANOFOLD_PYTHON set (scripts/test.sh's venv) the
+//! exported MJCF also runs in MuJoCo (RK4, 40, 20 and 10 ns steps) against the same reference.
+//!
+//! `cargo build --release && cargo run --release --example network_scaling [-- 4,8,16]` prints the tables and writes
+//! `output/network_scaling/report.json` (and the generated sheets and scenes beside it).
+
+#[path = "common/mod.rs"]
+mod common;
+
+use common::{machine, timed};
+use nanofold::dynamics::network::NetworkPlant;
+use nanofold::dynamics::plant::Plant;
+use nanofold::dynamics::scene::Scene;
+use nanofold::dynamics::simulate::{simulate, Simulation, SimulationSettings};
+use nanofold::folding::FoldingModel;
+use nanofold::io::folding_output::crease_pattern_fold;
+use nanofold::io::load_scene;
+use nanofold::io::output::write_atomic;
+use nanofold::pattern::generate::MiuraSpec;
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The run's length, s.
+const T_END: f64 = 2e-5;
+/// Tolerances of the timed runs.
+const TOLERANCES: [f64; 4] = [1e-4, 1e-6, 1e-8, 1e-10];
+/// The reference's tolerance.
+const REFERENCE_RTOL: f64 = 1e-12;
+/// MuJoCo's RK4 steps, s.
+const MUJOCO_STEPS: [f64; 3] = [4e-8, 2e-8, 1e-8];
+
+/// Writes the folded n × n sheet and its scene (the bundled Miura sheet's materials, hinges,
+/// step and drag) into `out`; returns the scene's path.
+fn sheet(out: &Path, n: usize) -> PathBuf {
+    let builder = MiuraSpec {
+        rows: n,
+        cols: n,
+        zigzag_fold_angle: 100f64.to_radians(),
+        ..MiuraSpec::default()
+    }
+    .build()
+    .expect("a Miura sheet");
+    let model = FoldingModel::new(builder.build().expect("a pattern")).expect("a folding model");
+    let state = model.given_fold_angles();
+    let note = format!("Miura-ori {n} x {n}, 60 deg, zigzag creases at 100 deg (closed form)");
+    let fold = crease_pattern_fold(&model.pattern, Some(&state), &note);
+    let fold_path = out.join(format!("miura_{n}x{n}_folded.fold"));
+    write_atomic(&fold_path, serde_json::to_string(&fold).unwrap().as_bytes()).unwrap();
+    let mut scene: Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/devices/miura_sheet.scene.json").unwrap()).unwrap();
+    scene["name"] = format!("miura_{n}x{n}_folded").into();
+    scene["pattern"] = fold_path.file_name().unwrap().to_str().unwrap().into();
+    scene["time"]["t_end_s"] = T_END.into();
+    let scene_path = out.join(format!("miura_{n}x{n}_folded.scene.json"));
+    write_atomic(&scene_path, scene.to_string().as_bytes()).unwrap();
+    scene_path
+}
+
+fn run(scene: &Scene, rtol: f64) -> Simulation {
+    let settings = SimulationSettings {
+        rtol,
+        progress: None,
+        ..Default::default()
+    };
+    simulate(scene, &settings).expect("the sheet runs")
+}
+
+fn final_angles(run: &Simulation) -> Vec<f64> {
+    run.response
+        .samples
+        .last()
+        .expect("samples")
+        .angles
+        .iter()
+        .copied()
+        .collect()
+}
+
+fn largest_gap(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+/// MuJoCo's run of the exported sheet at `step` s: (seconds, its final angles by crease column,
+/// the loops' largest opening, µm); None without the client.
+fn mujoco(python: &Path, scene_path: &Path, scene: &Scene, step: f64) -> Option<(f64, Vec<f64>, f64)> {
+    let model_path = scene_path.with_extension("xml");
+    // The CLI beside this example's own directory (target/release/examples/..).
+    let cli = std::env::current_exe().ok()?.parent()?.parent()?.join("nanofold");
+    let export = Command::new(cli)
+        .args(["export", "mujoco"])
+        .arg(scene_path)
+        .args(["--timestep", &step.to_string(), "--out"])
+        .arg(&model_path)
+        .output()
+        .ok()?;
+    if !export.status.success() {
+        eprintln!("export: {}", String::from_utf8_lossy(&export.stderr));
+        return None;
+    }
+    let out = Command::new(python)
+        .arg("tests/mujoco/nanofold_mujoco.py")
+        .arg(&model_path)
+        // Half a step short, so its last step ends at T_END and not one step after.
+        .arg(((T_END - 0.5 * step) * 1e6).to_string())
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        eprintln!("MuJoCo: {}", String::from_utf8_lossy(&out.stderr));
+        return None;
+    }
+    let result: Value = serde_json::from_slice(&out.stdout).ok()?;
+    let network = scene.network()?;
+    let mut angles = vec![f64::NAN; network.columns()];
+    for (name, angle) in result["joint_names"]
+        .as_array()?
+        .iter()
+        .zip(result["final_qpos"].as_array()?)
+    {
+        let edge: usize = name.as_str()?.strip_prefix("crease_")?.parse().ok()?;
+        let column = network.folding.pattern.creases.iter().position(|&e| e == edge)?;
+        angles[column] = angle.as_f64()?;
+    }
+    Some((
+        result["seconds"].as_f64()?,
+        angles,
+        result["max_equality_violation"].as_f64()?,
+    ))
+}
+
+/// Seconds to set a run up: the plant (a flat start's branch), the time scales (natural
+/// periods at the start and at the final balance) and the quasi-static estimate.
+fn setup_seconds(scene: &Scene) -> f64 {
+    let network = scene.network().expect("a network scene");
+    timed(1, || {
+        let plant = NetworkPlant::new(network, true).expect("the plant");
+        (
+            plant.time_scales().expect("time scales"),
+            plant.quasi_static_error_estimate().expect("estimate"),
+        )
+    })
+    .0
+}
+
+fn main() {
+    let sizes: Vec<usize> = std::env::args()
+        .nth(1)
+        .map(|list| list.split(',').map(|n| n.parse().expect("sizes like 4,8,16")).collect())
+        .unwrap_or_else(|| vec![4, 8, 16, 32]);
+    let out = PathBuf::from("output/network_scaling");
+    std::fs::create_dir_all(&out).unwrap();
+    let python = std::env::var_os("NANOFOLD_PYTHON").map(PathBuf::from);
+    println!(
+        "Folded Miura sheet, n x n panels, step to 90 deg with drag, {} us; error against rtol {REFERENCE_RTOL:e}",
+        T_END * 1e6
+    );
+    println!(
+        "ms: the whole run with the scene's {} output samples; 'integrate': with 2 samples, less the set-up; 'samples': the rest",
+        nanofold::dynamics::spec::OutputSpec::default().samples
+    );
+    println!(
+        "{:>3} {:>6} {:>7} {:>7} {:>9} {:>9} {:>9} {:>9} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9}",
+        "n",
+        "panels",
+        "creases",
+        "rtol",
+        "ms",
+        "set-up",
+        "integrate",
+        "samples",
+        "steps",
+        "rhs",
+        "ms/step",
+        "max|dθ|",
+        "closure",
+        "energy"
+    );
+    let mut rows = Vec::new();
+    let mut fits: [Vec<(f64, f64)>; 3] = Default::default();
+    for &n in &sizes {
+        let scene_path = sheet(&out, n);
+        let scene = load_scene(&scene_path).expect("the scene").build().expect("it builds");
+        let mut bare = load_scene(&scene_path).expect("the scene").build().expect("it builds");
+        bare.outputs.samples = 2;
+        let network = scene.network().expect("a network scene");
+        let (panels, creases) = (network.panels(), network.columns());
+        let runs = if n >= 16 { 1 } else { 3 };
+        let (reference_seconds, reference) = timed(1, || run(&scene, REFERENCE_RTOL));
+        let reference_angles = final_angles(&reference);
+        let setup = timed(runs, || setup_seconds(&scene)).0;
+        let mut size_rows = Vec::new();
+        for rtol in TOLERANCES {
+            let (seconds, simulation) = timed(runs, || run(&scene, rtol));
+            let (bare_seconds, bare_run) = timed(runs, || run(&bare, rtol));
+            let response = &simulation.response;
+            let report = simulation.network.as_ref().expect("a network report");
+            let error = largest_gap(&final_angles(&bare_run), &reference_angles);
+            let integrate = (bare_seconds - setup).max(0.0);
+            let sampling = (seconds - bare_seconds).max(0.0);
+            let per_step = integrate / bare_run.response.steps.max(1) as f64;
+            println!(
+                "{n:>3} {panels:>6} {creases:>7} {rtol:>7.0e} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>6} {:>6} {:>9.2} {error:>9.2e} {:>9.1e} {:>9.1e}",
+                seconds * 1e3,
+                setup * 1e3,
+                integrate * 1e3,
+                sampling * 1e3,
+                bare_run.response.steps,
+                bare_run.response.rhs_evaluations,
+                per_step * 1e3,
+                report.max_closure_residual,
+                report.energy_balance_error.unwrap_or(f64::NAN)
+            );
+            if rtol == 1e-8 {
+                fits[0].push((panels as f64, setup));
+                fits[1].push((panels as f64, per_step));
+                fits[2].push((panels as f64, sampling / response.samples.len() as f64));
+            }
+            size_rows.push(json!({
+                "rtol": rtol, "seconds": seconds, "runs": runs, "setup_seconds": setup,
+                "integrate_seconds": integrate, "sampling_seconds": sampling,
+                "samples": response.samples.len(),
+                "steps": bare_run.response.steps, "rhs_evaluations": bare_run.response.rhs_evaluations,
+                "max_angle_error_rad": error,
+                "max_closure_residual": report.max_closure_residual,
+                "energy_balance_error": report.energy_balance_error,
+            }));
+        }
+        let mut mujoco_rows = Vec::new();
+        if let Some(python) = &python {
+            for step in MUJOCO_STEPS {
+                if let Some((seconds, angles, opening)) = mujoco(python, &scene_path, &scene, step) {
+                    let error = largest_gap(&angles, &reference_angles);
+                    println!(
+                        "{n:>3} {panels:>6} {creases:>7} MuJoCo RK4 {:>3.0} ns: {:>9.1} ms, max|dθ| {error:.2e} rad, loops open by {opening:.1e} um",
+                        step * 1e9,
+                        seconds * 1e3
+                    );
+                    mujoco_rows.push(json!({
+                        "timestep_s": step, "seconds": seconds, "max_angle_error_rad": error,
+                        "max_equality_violation_um": opening,
+                    }));
+                }
+            }
+        }
+        rows.push(json!({
+            "n": n, "panels": panels, "creases": creases,
+            "reference": { "rtol": REFERENCE_RTOL, "seconds": reference_seconds,
+                "steps": reference.response.steps, "rhs_evaluations": reference.response.rhs_evaluations },
+            "runs": size_rows, "mujoco": mujoco_rows,
+        }));
+    }
+    let exponents: Vec<Option<f64>> = fits
+        .iter()
+        .map(|points| nanofold::plot::work_precision::power_law_fit(points).map(|f| f.0))
+        .collect();
+    for (what, exponent) in ["set-up", "one integrator step", "one output sample"]
+        .iter()
+        .zip(&exponents)
+    {
+        if let Some(k) = exponent {
+            println!("{what} ~ panels^{k:.2} (rtol 1e-8)");
+        }
+    }
+    let report = json!({
+        "machine": machine(),
+        "t_end_s": T_END,
+        "sizes": rows,
+        "exponents": { "setup": exponents[0], "step": exponents[1], "sample": exponents[2] },
+    });
+    write_atomic(
+        &out.join("report.json"),
+        serde_json::to_string_pretty(&report).unwrap().as_bytes(),
+    )
+    .unwrap();
+    println!("wrote {}", out.join("report.json").display());
+}
