@@ -9,6 +9,7 @@ pub mod normal;
 pub mod path;
 pub mod poses;
 pub mod rank;
+pub mod simd_state;
 pub mod verdict;
 
 pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};

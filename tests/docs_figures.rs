@@ -144,7 +144,7 @@ fn the_work_precision_figures_are_the_kept_reports() {
     let dir = std::env::temp_dir().join(format!("nanofold-wp-figures-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let figures = work_precision_figures::figures(&report);
-    assert_eq!(figures.len(), 8);
+    assert_eq!(figures.len(), 10);
     for (name, svg) in figures {
         let drawn = dir.join(name);
         std::fs::write(&drawn, svg).unwrap();

@@ -215,5 +215,108 @@ pub fn figures(report: &Value) -> Vec<(&'static str, String)> {
     )
     .expect("figure");
     out.push(("scaling.svg", svg));
+    if let Some(networks) = report.get("networks") {
+        out.extend(network_figures(networks));
+    }
+    out
+}
+
+/// The Miura sheets: time against error per size (nanofold by rtol, MuJoCo by step), and
+/// the cost of each part against the number of panels.
+fn network_figures(networks: &Value) -> Vec<(&'static str, String)> {
+    let sizes = rows(networks, "network");
+    let mut series = Vec::new();
+    for size in sizes {
+        let n = size["n"].as_u64().unwrap_or(0);
+        series.push(WorkSeries {
+            name: format!("nanofold {n}×{n} (points: rtol)"),
+            points: size["runs"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|row| WorkPoint {
+                    label: format!("{:.0e}", number(row, "rtol")),
+                    seconds: number(row, "seconds"),
+                    error: number(row, "max_angle_error_rad"),
+                })
+                .collect(),
+        });
+        let mujoco: Vec<WorkPoint> = size["mujoco"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|row| WorkPoint {
+                label: format!("{:.0} ns", number(row, "timestep_s") * 1e9),
+                seconds: number(row, "seconds"),
+                error: number(row, "max_angle_error_rad"),
+            })
+            .collect();
+        if !mujoco.is_empty() {
+            series.push(WorkSeries {
+                name: format!("MuJoCo {n}×{n} (points: RK4 step)"),
+                points: mujoco,
+            });
+        }
+    }
+    let mut out = Vec::new();
+    let svg = work_precision_svg(
+        "folded Miura sheet, 20 µs of its step response: largest crease error against wall time",
+        "max |Δθ| at 20 µs against rtol 1e-12 (rad)",
+        &series,
+    )
+    .expect("figure");
+    out.push(("networks_work_precision.svg", svg));
+    // Each part at rtol 1e-8 against panels; MuJoCo's whole run at its coarsest step.
+    let at = |size: &Value, key: &str| -> Option<f64> {
+        size["runs"]
+            .as_array()?
+            .iter()
+            .find(|row| row["rtol"].as_f64() == Some(1e-8))
+            .and_then(|row| row[key].as_f64())
+    };
+    let part = |key: &str| -> Vec<(f64, f64)> {
+        sizes
+            .iter()
+            .filter_map(|size| Some((number(size, "panels"), at(size, key)?)))
+            .collect()
+    };
+    let mut scaling = vec![
+        ScalingSeries {
+            name: "nanofold, whole run (rtol 1e-8)".into(),
+            points: part("seconds"),
+        },
+        ScalingSeries {
+            name: "set-up (branch, periods, final balance)".into(),
+            points: part("setup_seconds"),
+        },
+        ScalingSeries {
+            name: "integration".into(),
+            points: part("integrate_seconds"),
+        },
+        ScalingSeries {
+            name: "output samples (401, projected)".into(),
+            points: part("sampling_seconds"),
+        },
+    ];
+    let coarsest: Vec<(f64, f64)> = sizes
+        .iter()
+        .filter_map(|size| {
+            let first = size["mujoco"].as_array()?.first()?;
+            Some((number(size, "panels"), number(first, "seconds")))
+        })
+        .collect();
+    if !coarsest.is_empty() {
+        scaling.push(ScalingSeries {
+            name: "MuJoCo, whole run (RK4 40 ns)".into(),
+            points: coarsest,
+        });
+    }
+    let svg = scaling_svg(
+        "folded Miura sheet, 20 µs of its step response: wall time against panels",
+        "panels",
+        &scaling,
+    )
+    .expect("figure");
+    out.push(("networks_scaling.svg", svg));
     out
 }

@@ -1,18 +1,22 @@
 //! Speed against error, in one report (issue 6): unfolding every library pattern over a
 //! sweep of solver settings, the constraint fits by degree, the bridge's step response per
 //! integrator and tolerance against a much tighter reference, the bridge's etch ramp
-//! quasi-static against dynamic, and the cost of one unfold iteration against the number of
-//! creases. Each time is the median of several runs.
+//! quasi-static against dynamic, the cost of one unfold iteration against the number of
+//! creases, and panel networks (the folded Miura sheet from 4 × 4 to 32 × 32, time against
+//! error and against panels, beside MuJoCo when NANOFOLD_PYTHON names its venv's python).
+//! Each time is the median of several runs.
 //!
 //! `cargo run --release --example work_precision` prints the tables and writes
 //! `output/work_precision/{report.json, unfold_*.svg, fits.svg, bridge_step.svg,
-//! bridge_ramp.svg, scaling.svg}` (35–55 s on the 2-core VM of README, one run); the
-//! figures are drawn from the report (`figures.rs`), and `-- --from REPORT.json` redraws a
-//! saved report's figures without measuring.
+//! bridge_ramp.svg, scaling.svg, networks_*.svg}`; the figures are drawn from the report
+//! (`figures.rs`). `-- --from REPORT.json` redraws a saved report's figures without
+//! measuring; `-- --networks-into REPORT.json` measures the network part alone into a saved
+//! report; `-- --network-sizes 4,8` chooses the sheets.
 
 #[path = "../common/mod.rs"]
 mod common;
 mod figures;
+mod networks;
 
 use common::{library_patterns, machine, many_creases, median, timed};
 use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
@@ -452,11 +456,51 @@ fn main() {
         println!("redrew the figures of {path} into {}", out.display());
         return;
     }
+    // --network-sizes 4,8: the Miura sheets measured (default 4, 8, 16, 32).
+    let sizes: Vec<usize> = args
+        .iter()
+        .position(|a| a == "--network-sizes")
+        .map(|at| {
+            args.get(at + 1)
+                .expect("--network-sizes N,N,...")
+                .split(',')
+                .map(|n| n.parse().expect("sizes like 4,8,16"))
+                .collect()
+        })
+        .unwrap_or_else(|| vec![4, 8, 16, 32]);
+    let python = std::env::var_os("NANOFOLD_PYTHON").map(std::path::PathBuf::from);
+    if python.is_none() {
+        println!("(MuJoCo not measured: set NANOFOLD_PYTHON to scripts/test.sh's target/clients-venv/bin/python)");
+    }
+    // --networks-into REPORT: measure the network part only, put it (with its own machine
+    // and commit) into that saved report, and redraw the report's figures.
+    if let Some(at) = args.iter().position(|a| a == "--networks-into") {
+        let path = args.get(at + 1).expect("--networks-into REPORT.json");
+        let mut report: Value =
+            serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+        let mut networks = networks::networks_part(&sizes, python.as_deref());
+        networks["machine"] = machine();
+        report["networks"] = networks;
+        write_atomic(
+            Path::new(path),
+            serde_json::to_string_pretty(&report).expect("json").as_bytes(),
+        )
+        .expect("writing the report");
+        for (name, svg) in figures::figures(&report) {
+            write(out, name, &svg);
+        }
+        println!(
+            "measured the network part into {path}; its figures are in {}",
+            out.display()
+        );
+        return;
+    }
     let started = Instant::now();
     let unfolding = unfold_part();
     let fits = fits_part();
     let dynamics = dynamics_part();
     let scaling = scaling_part();
+    let networks = networks::networks_part(&sizes, python.as_deref());
     let report = json!({
         "machine": machine(),
         "seconds_total": started.elapsed().as_secs_f64(),
@@ -464,6 +508,7 @@ fn main() {
         "constraint_fits": fits,
         "dynamics": dynamics,
         "scaling": scaling,
+        "networks": networks,
     });
     write(
         out,
@@ -474,7 +519,7 @@ fn main() {
         write(out, name, &svg);
     }
     println!(
-        "\nwrote {}/{{report.json, unfold_*.svg, fits.svg, bridge_step.svg, bridge_ramp.svg, scaling.svg}} in {:.0} s",
+        "\nwrote {}/{{report.json, unfold_*.svg, fits.svg, bridge_step.svg, bridge_ramp.svg, scaling.svg, networks_*.svg}} in {:.0} s",
         out.display(),
         started.elapsed().as_secs_f64()
     );

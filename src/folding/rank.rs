@@ -5,6 +5,7 @@
 
 use super::closure::ClosureJacobian;
 use super::normal::NormalSolver;
+use super::simd_state::clear_upper_vector_state;
 use crate::error::{NumericalError, Result};
 use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -104,6 +105,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
     let diagonal: Vec<f64> = (0..rows.min(cols)).map(|i| r[(i, i)].abs()).collect();
     let threshold = RANK_TOL * diagonal[0];
     let rank = diagonal.iter().take_while(|&&d| d > threshold && d > 0.0).count();
+    clear_upper_vector_state();
     RankReport {
         rank,
         dof: cols - jacobian.held - rank,
@@ -122,7 +124,9 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
 /// shifted inverse cannot separate (10³ μ), so the count is complete once the
 /// next Ritz value is above the threshold (`docs/model.md#rigid-folding`).
 pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
-    Ok(settled_block(jacobian)?.report(jacobian))
+    let report = settled_block(jacobian)?.report(jacobian);
+    clear_upper_vector_state();
+    Ok(report)
 }
 
 /// The block of inverse subspace iteration once the null-space count is settled, with its
@@ -235,6 +239,7 @@ pub fn null_space(jacobian: &ClosureJacobian) -> Result<Mat<f64>> {
         (basis, count)
     };
     debug_assert_eq!(x.ncols(), b);
+    clear_upper_vector_state();
     Ok(x)
 }
 

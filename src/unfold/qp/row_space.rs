@@ -433,6 +433,7 @@ impl ChainFactors {
         let kept = self.schur_values.len();
         let v = MatMut::from_column_major_slice_mut(&mut self.schur_vectors, k, kept);
         solve_upper_triangular_in_place(l.transpose(), v, Par::Seq);
+        crate::folding::simd_state::clear_upper_vector_state();
         true
     }
 

@@ -1,20 +1,15 @@
-//! How a panel network's dynamics scales with its size, with its error beside its time: the
-//! folded Miura-ori sheet of `patterns/devices/miura_sheet.scene.json` at n × n panels
-//! (n = 4, 8, 16, 32 by default), released at 100° zigzag folds with its step torques and
-//! drag, run for 20 µs (about 1.4 periods of its one folding motion) at several tolerances
-//! against a reference at rtol 1e-12. For each run: wall time (median of 3, one run from
-//! 16 × 16 up) split into set-up, integration and output samples, steps, right-hand sides,
-//! the largest crease-angle error at the end, the closure residual and the energy balance.
-//! Power laws fit each part's cost against the number of panels. With NANOFOLD_PYTHON set (scripts/test.sh's venv) the
-//! exported MJCF also runs in MuJoCo (RK4, 40, 20 and 10 ns steps) against the same reference.
-//!
-//! `cargo build --release && cargo run --release --example network_scaling [-- 4,8,16]` prints the tables and writes
-//! `output/network_scaling/report.json` (and the generated sheets and scenes beside it).
+//! The network part of the work-precision report: how a panel network's dynamics scales
+//! with its size, with its error beside its time. The folded Miura-ori sheet of
+//! `patterns/devices/miura_sheet.scene.json` at n × n panels, released at 100° zigzag folds
+//! with its step torques and drag, runs for 20 µs (about 1.4 periods of its one folding
+//! motion) at four tolerances against a reference at rtol 1e-12. For each run: wall time
+//! (median of 3, one run from 16 × 16 up) split into set-up, integration and output samples,
+//! steps, right-hand sides, the largest crease-angle error at the end, the closure residual
+//! and the energy balance; power laws fit each part's cost against the number of panels.
+//! With MuJoCo's venv (NANOFOLD_PYTHON) the same sheet, exported, runs in MuJoCo (RK4 at 40,
+//! 20 and 10 ns) against the same reference.
 
-#[path = "common/mod.rs"]
-mod common;
-
-use common::{machine, timed};
+use crate::common::timed;
 use nanofold::dynamics::network::NetworkPlant;
 use nanofold::dynamics::plant::Plant;
 use nanofold::dynamics::scene::Scene;
@@ -22,6 +17,7 @@ use nanofold::dynamics::simulate::{simulate, Simulation, SimulationSettings};
 use nanofold::folding::FoldingModel;
 use nanofold::io::folding_output::crease_pattern_fold;
 use nanofold::io::load_scene;
+use nanofold::io::mujoco::{scene_mjcf, LoopClosure, MujocoSettings};
 use nanofold::io::output::write_atomic;
 use nanofold::pattern::generate::MiuraSpec;
 use serde_json::{json, Value};
@@ -34,8 +30,10 @@ const T_END: f64 = 2e-5;
 const TOLERANCES: [f64; 4] = [1e-4, 1e-6, 1e-8, 1e-10];
 /// The reference's tolerance.
 const REFERENCE_RTOL: f64 = 1e-12;
-/// MuJoCo's RK4 steps, s.
+/// MuJoCo's RK4 steps, s (the finest only up to 16 × 16: at 32 × 32 it takes minutes).
 const MUJOCO_STEPS: [f64; 3] = [4e-8, 2e-8, 1e-8];
+/// Sheets above this many panels skip MuJoCo's finest step.
+const MUJOCO_FINEST_PANELS: usize = 256;
 
 /// Writes the folded n × n sheet and its scene (the bundled Miura sheet's materials, hinges,
 /// step and drag) into `out`; returns the scene's path.
@@ -88,35 +86,28 @@ fn largest_gap(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
-/// MuJoCo's run of the exported sheet at `step` s: (seconds, its final angles by crease column,
-/// the loops' largest opening, µm); None without the client.
-fn mujoco(python: &Path, scene_path: &Path, scene: &Scene, step: f64) -> Option<(f64, Vec<f64>, f64)> {
-    let model_path = scene_path.with_extension("xml");
-    // The CLI beside this example's own directory (target/release/examples/..).
-    let cli = std::env::current_exe().ok()?.parent()?.parent()?.join("nanofold");
-    let export = Command::new(cli)
-        .args(["export", "mujoco"])
-        .arg(scene_path)
-        .args(["--timestep", &step.to_string(), "--out"])
-        .arg(&model_path)
-        .output()
-        .ok()?;
-    if !export.status.success() {
-        eprintln!("export: {}", String::from_utf8_lossy(&export.stderr));
-        return None;
-    }
-    let out = Command::new(python)
+/// MuJoCo's run of the sheet exported at `step` s: (seconds, its final angles by crease
+/// column, the loops' largest opening, µm); None when the client fails (said on stderr).
+fn mujoco(python: &Path, out: &Path, scene: &Scene, step: f64) -> Option<(f64, Vec<f64>, f64)> {
+    let settings = MujocoSettings {
+        timestep: step,
+        closure: LoopClosure::Connect,
+    };
+    let model_path = out.join(format!("{}.xml", scene.name));
+    let mjcf = scene_mjcf(scene, &settings).expect("the sheet exports");
+    write_atomic(&model_path, mjcf.as_bytes()).unwrap();
+    let result = Command::new(python)
         .arg("tests/mujoco/nanofold_mujoco.py")
         .arg(&model_path)
         // Half a step short, so its last step ends at T_END and not one step after.
         .arg(((T_END - 0.5 * step) * 1e6).to_string())
         .output()
         .ok()?;
-    if !out.status.success() {
-        eprintln!("MuJoCo: {}", String::from_utf8_lossy(&out.stderr));
+    if !result.status.success() {
+        eprintln!("MuJoCo: {}", String::from_utf8_lossy(&result.stderr));
         return None;
     }
-    let result: Value = serde_json::from_slice(&out.stdout).ok()?;
+    let result: Value = serde_json::from_slice(&result.stdout).ok()?;
     let network = scene.network()?;
     let mut angles = vec![f64::NAN; network.columns()];
     for (name, angle) in result["joint_names"]
@@ -149,16 +140,13 @@ fn setup_seconds(scene: &Scene) -> f64 {
     .0
 }
 
-fn main() {
-    let sizes: Vec<usize> = std::env::args()
-        .nth(1)
-        .map(|list| list.split(',').map(|n| n.parse().expect("sizes like 4,8,16")).collect())
-        .unwrap_or_else(|| vec![4, 8, 16, 32]);
-    let out = PathBuf::from("output/network_scaling");
-    std::fs::create_dir_all(&out).unwrap();
-    let python = std::env::var_os("NANOFOLD_PYTHON").map(PathBuf::from);
+/// The network part of the report: the folded Miura sheet at n × n panels for each n in
+/// `sizes`, nanofold at four tolerances and, with `python` (MuJoCo's venv), MuJoCo.
+pub fn networks_part(sizes: &[usize], python: Option<&Path>) -> Value {
+    let out = Path::new("output/work_precision/networks");
+    std::fs::create_dir_all(out).unwrap();
     println!(
-        "Folded Miura sheet, n x n panels, step to 90 deg with drag, {} us; error against rtol {REFERENCE_RTOL:e}",
+        "\n== panel networks: the folded Miura sheet, n x n panels, step to 90 deg with drag, {} us; error against rtol {REFERENCE_RTOL:e} ==",
         T_END * 1e6
     );
     println!(
@@ -184,8 +172,8 @@ fn main() {
     );
     let mut rows = Vec::new();
     let mut fits: [Vec<(f64, f64)>; 3] = Default::default();
-    for &n in &sizes {
-        let scene_path = sheet(&out, n);
+    for &n in sizes {
+        let scene_path = sheet(out, n);
         let scene = load_scene(&scene_path).expect("the scene").build().expect("it builds");
         let mut bare = load_scene(&scene_path).expect("the scene").build().expect("it builds");
         bare.outputs.samples = 2;
@@ -233,9 +221,12 @@ fn main() {
             }));
         }
         let mut mujoco_rows = Vec::new();
-        if let Some(python) = &python {
+        if let Some(python) = python {
             for step in MUJOCO_STEPS {
-                if let Some((seconds, angles, opening)) = mujoco(python, &scene_path, &scene, step) {
+                if step == MUJOCO_STEPS[2] && panels > MUJOCO_FINEST_PANELS {
+                    continue;
+                }
+                if let Some((seconds, angles, opening)) = mujoco(python, out, &scene, step) {
                     let error = largest_gap(&angles, &reference_angles);
                     println!(
                         "{n:>3} {panels:>6} {creases:>7} MuJoCo RK4 {:>3.0} ns: {:>9.1} ms, max|dθ| {error:.2e} rad, loops open by {opening:.1e} um",
@@ -268,16 +259,10 @@ fn main() {
             println!("{what} ~ panels^{k:.2} (rtol 1e-8)");
         }
     }
-    let report = json!({
-        "machine": machine(),
+    json!({
         "t_end_s": T_END,
-        "sizes": rows,
+        "reference_rtol": REFERENCE_RTOL,
+        "rows": rows,
         "exponents": { "setup": exponents[0], "step": exponents[1], "sample": exponents[2] },
-    });
-    write_atomic(
-        &out.join("report.json"),
-        serde_json::to_string_pretty(&report).unwrap().as_bytes(),
-    )
-    .unwrap();
-    println!("wrote {}", out.join("report.json").display());
+    })
 }
