@@ -547,3 +547,103 @@ fn network_fold_animations_hold_rigid_sheets() {
             .all(|((p, m), e)| (p - e) * (m - e) <= 1e-12));
     }
 }
+
+/// A strip scene with `equations` set, parsed beside the bundled scenes.
+fn strip_scene(path: &str, equations: &str, edit: impl Fn(&mut serde_json::Value)) -> nanofold::Result<Scene> {
+    let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    value["equations"] = equations.into();
+    edit(&mut value);
+    nanofold::io::parse_scene(&value.to_string(), "test", "test", Path::new("patterns"))?.build()
+}
+
+/// The strip is a chain of panels: the bridge run through the panel network (the substrate
+/// the anchored panel, every plate a panel with the strip's own body) lands plate 3 on the
+/// substrate when the chain's own equations do, to 1e-8 relative at rtol 1e-12 (measured
+/// 3e-10), at the same point, with the same angles; likewise the thesis's reading, whose
+/// plates carry stated moments (so the network takes the strip's bodies, not its own lamina).
+/// Its energy balance holds with drag, and it stays a tree (no closure rows).
+#[test]
+fn the_bridge_runs_the_same_through_the_network() {
+    for path in [
+        "patterns/bridge_step.scene.json",
+        "patterns/thesis/bridge_thesis_reading.scene.json",
+    ] {
+        let chain = strip_scene(path, "chain", |_| {}).unwrap();
+        let network = strip_scene(path, "network", |_| {}).unwrap();
+        assert!(chain.strip().is_some() && network.network().is_some());
+        let model = network.network().unwrap();
+        assert!(model.folding.stars.is_empty(), "a strip has no interior vertex");
+        let a = run(&chain, 1e-12, 2e-3);
+        let b = run(&network, 1e-12, 2e-3);
+        let (ca, cb) = (a.response.collision.unwrap(), b.response.collision.unwrap());
+        assert!(
+            (ca.time - cb.time).abs() < 1e-8 * ca.time,
+            "{path}: {} vs {}",
+            ca.time,
+            cb.time
+        );
+        let mut pair = cb.pair.to_vec();
+        pair.sort();
+        let mut expected = ca.pair.to_vec();
+        expected.sort();
+        // The thesis's reading lands the crease between plates 2 and 3: the chain names one
+        // plate, the network the panels that meet there.
+        if path.contains("thesis") {
+            assert!(pair.iter().any(|p| p.starts_with("plate")), "{path}: {pair:?}");
+        } else {
+            assert_eq!(pair, expected, "{path}");
+            // Both corners of the free edge land together: each names one (x = ±w/2).
+            let same = (ca.point.x.abs() - cb.point.x.abs()).abs()
+                + (ca.point.y - cb.point.y).abs()
+                + (ca.point.z - cb.point.z).abs();
+            assert!(same < 1e-9, "{path}: {:?} vs {:?}", ca.point, cb.point);
+        }
+        let (sa, sb) = (a.response.samples.last().unwrap(), b.response.samples.last().unwrap());
+        assert!(
+            (&sa.angles - &sb.angles).amax() < 1e-6,
+            "{path}: {} vs {}",
+            sa.angles,
+            sb.angles
+        );
+        let report = b.network.unwrap();
+        assert!(report.energy_balance_error.unwrap() < 1e-8, "{path}: {report:?}");
+        eprintln!(
+            "{path}: chain {:e} s, network {:e} s, relative {:.1e}",
+            ca.time,
+            cb.time,
+            (ca.time - cb.time).abs() / ca.time
+        );
+    }
+}
+
+/// `equations` "auto" (the default) keeps short strips on the chain's equations and runs
+/// long ones (25 plates and more) as networks, unless their plates differ in width, which
+/// `network` refuses by name.
+#[test]
+fn strips_choose_their_equations_by_length() {
+    let long = |plates: usize, width: f64| {
+        move |value: &mut serde_json::Value| {
+            let plate = serde_json::json!({"length_um": 20, "width_um": 100, "thickness_um": 0.2, "material": "SiN"});
+            let hinge = value["hinges"][0].clone();
+            value["plates"] = serde_json::Value::Array(vec![plate; plates]);
+            value["plates"][plates - 1]["width_um"] = width.into();
+            value["hinges"] = serde_json::Value::Array(vec![hinge; plates]);
+        }
+    };
+    let bridge = "patterns/bridge_step.scene.json";
+    assert!(strip_scene(bridge, "auto", |_| {}).unwrap().strip().is_some());
+    assert!(strip_scene(bridge, "auto", long(24, 100.0)).unwrap().strip().is_some());
+    assert!(strip_scene(bridge, "auto", long(25, 100.0))
+        .unwrap()
+        .network()
+        .is_some());
+    assert!(strip_scene(bridge, "auto", long(25, 80.0)).unwrap().strip().is_some());
+    let error = strip_scene(bridge, "network", long(25, 80.0)).unwrap_err();
+    let message = full_message(&error);
+    assert!(
+        message.contains("plates[24].width_um") && message.contains("80"),
+        "{message}"
+    );
+    let error = strip_scene(bridge, "ring", |_| {}).unwrap_err();
+    assert!(full_message(&error).contains("equations"), "{}", full_message(&error));
+}

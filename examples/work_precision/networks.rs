@@ -264,5 +264,70 @@ pub fn networks_part(sizes: &[usize], python: Option<&Path>) -> Value {
         "reference_rtol": REFERENCE_RTOL,
         "rows": rows,
         "exponents": { "setup": exponents[0], "step": exponents[1], "sample": exponents[2] },
+        "strips": strips_part(),
     })
+}
+
+/// Plates of the strips timed both ways.
+const STRIP_PLATES: [usize; 5] = [4, 10, 25, 50, 100];
+/// Their run, s (through contacts: the timing is the equations', not the contact search's).
+const STRIP_T_END: f64 = 1e-5;
+
+/// A strip of `plates` bridge hinges and 20 µm plates (the bundled bridge for 4), on the
+/// given equations.
+fn strip(plates: usize, equations: &str) -> Scene {
+    let mut value: Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/bridge_step.scene.json").unwrap()).unwrap();
+    if plates != 4 {
+        let plate = json!({"length_um": 20, "width_um": 100, "thickness_um": 0.2, "material": "SiN"});
+        let hinge = value["hinges"][0].clone();
+        value["plates"] = Value::Array(vec![plate; plates]);
+        value["hinges"] = Value::Array(vec![hinge; plates]);
+    }
+    value["equations"] = equations.into();
+    nanofold::io::parse_scene(&value.to_string(), "strip", "strip", Path::new("patterns"))
+        .and_then(|spec| spec.build())
+        .expect("the strip builds")
+}
+
+/// The strip's two equations of motion (the chain's dense joint-space ones, and the panel
+/// network's), timed on strips of 4 to 100 plates at rtol 1e-8 through contacts, with the
+/// largest difference of their final angles.
+fn strips_part() -> Value {
+    println!(
+        "\n== strips on the chain's equations and on the network's: {} us of a step response through contacts, rtol 1e-8 ==",
+        STRIP_T_END * 1e6
+    );
+    println!(
+        "{:>6} {:>10} {:>7} {:>10} {:>7} {:>10}",
+        "plates", "chain ms", "steps", "network ms", "steps", "max|dθ|"
+    );
+    let settings = SimulationSettings {
+        t_end: Some(STRIP_T_END),
+        ignore_collisions: true,
+        progress: None,
+        ..Default::default()
+    };
+    let mut rows = Vec::new();
+    for plates in STRIP_PLATES {
+        let runs = if plates >= 50 { 1 } else { 3 };
+        let (chain, network) = (strip(plates, "chain"), strip(plates, "network"));
+        let (chain_seconds, chain_run) = timed(runs, || simulate(&chain, &settings).expect("chain"));
+        let (network_seconds, network_run) = timed(runs, || simulate(&network, &settings).expect("network"));
+        let gap = largest_gap(&final_angles(&chain_run), &final_angles(&network_run));
+        println!(
+            "{plates:>6} {:>10.1} {:>7} {:>10.1} {:>7} {gap:>10.2e}",
+            chain_seconds * 1e3,
+            chain_run.response.steps,
+            network_seconds * 1e3,
+            network_run.response.steps
+        );
+        rows.push(json!({
+            "plates": plates, "runs": runs,
+            "chain_seconds": chain_seconds, "chain_steps": chain_run.response.steps,
+            "network_seconds": network_seconds, "network_steps": network_run.response.steps,
+            "max_angle_difference_rad": gap,
+        }));
+    }
+    json!({ "t_end_s": STRIP_T_END, "rtol": 1e-8, "rows": rows })
 }

@@ -8,7 +8,7 @@ use super::model::{Joint, Model, Plate};
 use super::network::NetworkModel;
 use super::spec::{
     actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, time_and_outputs, validate_materials,
-    within, ClosedSpec, NetworkSpec, StripSpec, MICROMETRE,
+    within, ClosedSpec, NetworkSpec, StripEquations, StripSpec, MICROMETRE, NETWORK_FROM_PLATES,
 };
 use super::strip::StripChain;
 use crate::error::{NanofoldError, Result};
@@ -238,16 +238,30 @@ impl StripSpec {
         }
         let drag = drag_law(&self.environment)?;
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
+        let name = self.name.clone().unwrap_or_else(|| "scene".to_string());
+        let chain = StripChain {
+            model: Model::chain(joints, plates, drag)?,
+            forcing: Forcing {
+                actuation,
+                hinges: drives,
+            },
+            substrate_edge_y: edge_y,
+        };
+        let network = match self.equations {
+            StripEquations::Auto => {
+                n >= NETWORK_FROM_PLATES && super::network::assemble::narrower_plate(&chain).is_none()
+            }
+            StripEquations::Chain => false,
+            StripEquations::Network => true,
+        };
+        let system = if network {
+            System::Network(Box::new(super::network::assemble::from_strip(&name, &chain)?))
+        } else {
+            System::Strip(chain)
+        };
         Ok(Scene {
-            name: self.name.clone().unwrap_or_else(|| "scene".to_string()),
-            system: System::Strip(StripChain {
-                model: Model::chain(joints, plates, drag)?,
-                forcing: Forcing {
-                    actuation,
-                    hinges: drives,
-                },
-                substrate_edge_y: edge_y,
-            }),
+            name,
+            system,
             t_end,
             outputs: self.outputs.clone(),
         })

@@ -197,6 +197,28 @@ pub struct StripSpec {
     /// What to record.
     #[serde(default)]
     pub outputs: OutputSpec,
+    /// Which equations of motion run the strip (default: the chain's own).
+    #[serde(default)]
+    pub equations: StripEquations,
+}
+
+/// From this many plates `equations` "auto" runs a strip as a panel network (where the two
+/// cost the same on a bridge-like strip; README, "Devices of many panels").
+pub const NETWORK_FROM_PLATES: usize = 25;
+
+/// The equations of motion a strip runs on.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StripEquations {
+    /// The faster for its length: the chain's below [`NETWORK_FROM_PLATES`] plates, the
+    /// network's from there.
+    #[default]
+    Auto,
+    /// The chain's joint-space equations (a dense mass matrix; `docs/model.md#strip`).
+    Chain,
+    /// The panel network's (the substrate and the plates as panels; recursive, sparse;
+    /// `docs/model.md#panel-networks`).
+    Network,
 }
 
 impl MaterialSpec {
@@ -292,6 +314,7 @@ impl StripSpec {
             substrate: SubstrateSpec::default(),
             time: TimeSpec { t_end_s: 1e-3 },
             outputs: OutputSpec::default(),
+            equations: StripEquations::Auto,
         }
     }
 

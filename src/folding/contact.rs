@@ -300,6 +300,45 @@ fn segment_crosses(p: &Point, q: &Point, triangle: &[Point; 3], tolerance: f64) 
 
 /// Closest distance between segments p1q1 and p2q2 (clamped parameters).
 fn segment_distance(p1: &Point, q1: &Point, p2: &Point, q2: &Point) -> f64 {
+    let (x, y) = segment_closest(p1, q1, p2, q2);
+    (x - y).norm()
+}
+
+/// The nearest points of panels `a` and `b` posed by `poses` (on a, on b): over their
+/// triangles, each vertex against the other triangle and each pair of edges. Where the
+/// panels first touch, these are the contact.
+pub fn nearest_points(model: &FoldingModel, poses: &[Pose], a: usize, b: usize) -> (Point, Point) {
+    let place = |p: usize| -> Vec<[Point; 3]> {
+        model.panel_triangles[p]
+            .iter()
+            .map(|t| t.map(|v| poses[p].place(model.pattern.vertices[v])))
+            .collect()
+    };
+    let (ta, tb) = (place(a), place(b));
+    let mut best = (f64::INFINITY, Point::zeros(), Point::zeros());
+    let mut consider = |x: Point, y: Point| {
+        let d = (x - y).norm();
+        if d < best.0 {
+            best = (d, x, y);
+        }
+    };
+    for s in &ta {
+        for t in &tb {
+            for i in 0..3 {
+                consider(s[i], closest_point_on_triangle(&s[i], t));
+                consider(closest_point_on_triangle(&t[i], s), t[i]);
+                for j in 0..3 {
+                    let (x, y) = segment_closest(&s[i], &s[(i + 1) % 3], &t[j], &t[(j + 1) % 3]);
+                    consider(x, y);
+                }
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
+/// The closest points of segments p1q1 and p2q2 (clamped parameters).
+fn segment_closest(p1: &Point, q1: &Point, p2: &Point, q2: &Point) -> (Point, Point) {
     let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
     let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
     let (s, t) = if a <= f64::MIN_POSITIVE && e <= f64::MIN_POSITIVE {
@@ -329,7 +368,7 @@ fn segment_distance(p1: &Point, q1: &Point, p2: &Point, q2: &Point) -> f64 {
             (s, t)
         }
     };
-    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+    (p1 + d1 * s, p2 + d2 * t)
 }
 
 /// Distance from a point to a triangle.

@@ -5,13 +5,14 @@
 //! [`NetworkModel`]. Loaders never call this; building a scene does.
 
 use super::manifold::{projection_solver, restore, worst_residual};
-use super::model::{NetworkModel, NetworkParts};
+use super::model::{NetworkModel, NetworkParts, PanelBody};
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::spec::{
     count_within, drag_law, finite, hinge_stiffness_named, limits, material, network_actuation, validate_materials,
     within, ClosedSpec, HingeSpec, NetworkSpec, MICROMETRE,
 };
+use crate::dynamics::strip::StripChain;
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
@@ -401,4 +402,161 @@ pub fn from_closed(spec: &ClosedSpec<Pattern>, chain: &ClosedChain) -> Result<Ne
         start,
         substrate_contact: false,
     })
+}
+
+/// A plate's extent along its crease, m.
+fn plate_width(plate: &crate::dynamics::model::Plate) -> f64 {
+    let xs = plate.outline.iter().map(|q| q.x);
+    xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min)
+}
+
+/// The first plate of another width than plate 0's (a strip the network cannot carry).
+pub fn narrower_plate(chain: &StripChain) -> Option<usize> {
+    let plates = chain.model.plates();
+    let w = plate_width(&plates[0]);
+    (1..plates.len()).find(|&i| (plate_width(&plates[i]) / w - 1.0).abs() > 1e-12)
+}
+
+/// A strip scene (`equations` "network") as a panel network: the substrate is the anchored
+/// panel (as wide as the plates, reaching back from the edge as far as the strip reaches
+/// forward), plate i the panel beyond crease i, each with the strip's own plate body (its
+/// mass, centre and inertia, a stated moment included), hinge, drive and drag.
+pub fn from_strip(name: &str, chain: &StripChain) -> Result<NetworkModel> {
+    let model = &chain.model;
+    let plates = model.plates();
+    let n = plates.len();
+    // The strip's plates span x ∈ [−w/2, w/2]; a network's panels must share whole creases.
+    let w = plate_width(&plates[0]);
+    if let Some(i) = narrower_plate(chain) {
+        return Err(NanofoldError::invalid(
+            format!("plates[{i}].width_um"),
+            plate_width(&plates[i]) / MICROMETRE,
+            format!(
+                "equations \"network\" needs every plate as wide as plate 0 ({} µm): a crease joins whole plate edges",
+                w / MICROMETRE
+            ),
+        ));
+    }
+    // Crease lines in µm (the pattern's unit), from the joints' points.
+    let unit = MICROMETRE;
+    let lines: Vec<f64> = model.joints().iter().map(|j| j.point.y / unit).collect();
+    let end = plates
+        .last()
+        .map(|p| {
+            (p.reference_pose.translation.y + p.outline.iter().map(|q| q.y).fold(f64::NEG_INFINITY, f64::max)) / unit
+        })
+        .unwrap_or(lines[0]);
+    let (left, right) = (-0.5 * w / unit, 0.5 * w / unit);
+    let mut rows = vec![lines[0] - (end - lines[0])];
+    rows.extend(&lines);
+    rows.push(end);
+    // Vertices row by row (left, right); faces between consecutive rows.
+    let vertices: Vec<[f64; 2]> = rows.iter().flat_map(|&y| [[left, y], [right, y]]).collect();
+    let (mut edges, mut kinds, mut fold_angles) = (Vec::new(), Vec::new(), Vec::new());
+    for (r, _) in rows.iter().enumerate() {
+        let (l, rr) = (2 * r, 2 * r + 1);
+        let kind = if r == 0 || r == rows.len() - 1 {
+            EdgeKind::Boundary
+        } else {
+            let target = chain.forcing.hinges[r - 1].target;
+            EdgeKind::Crease(if target > 0.0 {
+                Assignment::Valley
+            } else if target < 0.0 {
+                Assignment::Mountain
+            } else {
+                Assignment::Unassigned
+            })
+        };
+        edges.push([l, rr]);
+        kinds.push(kind);
+        fold_angles.push(0.0);
+        if r + 1 < rows.len() {
+            for side in [l, rr] {
+                edges.push([side, side + 2]);
+                kinds.push(EdgeKind::Boundary);
+                fold_angles.push(0.0);
+            }
+        }
+    }
+    let faces: Vec<Vec<usize>> = (0..rows.len() - 1)
+        .map(|r| vec![2 * r, 2 * r + 1, 2 * r + 3, 2 * r + 2])
+        .collect();
+    let locked = vec![false; edges.len()];
+    let pattern = CreasePatternBuilder {
+        name: name.to_string(),
+        vertices,
+        edges,
+        kinds,
+        fold_angles,
+        faces: Some(faces),
+        angle_field: "edges_foldAngle".to_string(),
+        folded_form: None,
+        locked,
+        unit: Some("um".to_string()),
+    }
+    .build()?;
+    let folding = FoldingModel::new(pattern)?;
+    // Column c is crease i when its edge lies on row i + 1.
+    let hinge_of_column: Vec<usize> = folding
+        .pattern
+        .creases
+        .iter()
+        .map(|&e| {
+            let y = folding.pattern.vertices[folding.pattern.edges[e][0]][1];
+            (0..lines.len())
+                .min_by(|&a, &b| (lines[a] - y).abs().total_cmp(&(lines[b] - y).abs()))
+                .expect("a strip has hinges")
+        })
+        .collect();
+    let anchored_panel = folding
+        .pattern
+        .face_from_file(0)
+        .map(|f| folding.pattern.panel_of_face[f])
+        .expect("face 0 is the substrate");
+    let thickness = plates.iter().map(|p| p.thickness).fold(0.0, f64::max);
+    let density = plates[0].mass / (plates[0].area * plates[0].thickness);
+    let mut network = NetworkModel::new(NetworkParts {
+        folding,
+        unit,
+        anchored_panel,
+        thickness,
+        density,
+        stiffness: hinge_of_column.iter().map(|&i| model.joints()[i].stiffness).collect(),
+        forcing: Forcing {
+            actuation: chain.forcing.actuation,
+            hinges: hinge_of_column.iter().map(|&i| chain.forcing.hinges[i]).collect(),
+        },
+        drag: model.drag(),
+        start: vec![0.0; hinge_of_column.len()],
+        substrate_contact: false,
+    })?;
+    // Each plate's own body (the strip's box, or its stated moment), on the panel of face i + 1.
+    for (i, plate) in plates.iter().enumerate() {
+        let face = network
+            .folding
+            .pattern
+            .face_from_file(i + 1)
+            .expect("one face per plate");
+        let panel = network.folding.pattern.panel_of_face[face];
+        network.bodies[panel] = PanelBody {
+            mass: plate.mass,
+            centre: plate.reference_pose.translation.vector,
+            inertia: plate.inertia,
+            area: plate.area,
+        };
+    }
+    for (c, &i) in hinge_of_column.iter().enumerate() {
+        network.labels[c] = format!("hinge {i}");
+    }
+    // The strip's own names: the substrate, plate i.
+    network.panel_names[anchored_panel] = "substrate".to_string();
+    for i in 0..n {
+        let face = network
+            .folding
+            .pattern
+            .face_from_file(i + 1)
+            .expect("one face per plate");
+        network.panel_names[network.folding.pattern.panel_of_face[face]] = format!("plate {i}");
+    }
+    Ok(network)
 }

@@ -18,6 +18,7 @@
 use super::algorithms::{update_poses, NetworkData};
 use super::model::NetworkModel;
 use crate::dynamics::contact::{Collision, ContactProbe};
+use crate::folding::contact::nearest_points;
 use crate::folding::{panel_contacts, ContactReport, ContactSettings, Pose};
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -305,18 +306,7 @@ impl NetworkContacts {
     }
 
     fn face_name(model: &NetworkModel, panel: usize) -> String {
-        let pattern = &model.folding.pattern;
-        let mut faces: Vec<usize> = (0..pattern.faces.len())
-            .filter(|&f| pattern.panel_of_face[f] == panel)
-            .map(|f| pattern.file_face[f])
-            .collect();
-        faces.sort_unstable();
-        let faces: Vec<String> = faces.iter().map(|f| f.to_string()).collect();
-        if faces.len() == 1 {
-            format!("face {}", faces[0])
-        } else {
-            format!("panel of faces {}", faces.join("+"))
-        }
+        model.panel_names[panel].clone()
     }
 
     fn collision(
@@ -375,11 +365,12 @@ impl NetworkContacts {
                             .map(|c| c.panels)
                     })
                     .unwrap_or([0, 0]);
-                let centre = |p: usize| data.place(p, &model.bodies[p].centre);
+                // Midway between the two panels' nearest points (pattern units → m).
+                let (x, y) = nearest_points(&model.folding, &self.poses(model, data), pair[0], pair[1]);
                 Collision {
                     time: t,
                     pair: [Self::face_name(model, pair[0]), Self::face_name(model, pair[1])],
-                    point: (centre(pair[0]) + centre(pair[1])) * 0.5,
+                    point: (x + y) * (0.5 * model.unit),
                 }
             }
             Candidate::Substrate { vertex, panel } => Collision {

@@ -23,8 +23,15 @@ use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Conj, Par, Side};
+
+/// When faer factorises with dense (supernodal) kernels, relative to its own default: a
+/// deep tree (a long strip) has a dense mass matrix, where dense kernels win; a sheet's
+/// saddle-point matrix stays sparse and simplicial (the Miura sheets up to 32 × 32 choose
+/// the same at this threshold as at faer's default).
+const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold(0.5);
 
 /// ε on the multipliers' diagonal (the matrix is scaled to O(1)). Exactly redundant rows make
 /// pivots of size ε, and the factorisation's error grows like 1/ε; the refinement's rate is
@@ -100,7 +107,10 @@ impl KktSystem {
             structure.as_ref(),
             Side::Lower,
             SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SUPERNODAL_THRESHOLD,
+                ..Default::default()
+            },
         )
         .map_err(|e| singular(format!("symbolic: {e:?}")))?;
         let req = symbolic

@@ -114,6 +114,9 @@ pub struct NetworkModel {
     pub start: Vec<f64>,
     /// Every column's name in reports: `edges[E]`.
     pub labels: Vec<String>,
+    /// Every panel's name in reports: `face F` by its file face (`panel of faces F+G` when
+    /// facets join several).
+    pub panel_names: Vec<String>,
     /// Whether the substrate (z = 0 outside the etched pit) is a contact.
     pub substrate_contact: bool,
     /// The mass matrix's entries (row, column), column by column of the tree creases in
@@ -250,6 +253,21 @@ impl NetworkModel {
             .min()
             .expect("every panel has a face");
         let labels = pattern.creases.iter().map(|e| format!("edges[{e}]")).collect();
+        let panel_names = (0..np)
+            .map(|panel| {
+                let mut faces: Vec<usize> = (0..pattern.faces.len())
+                    .filter(|&f| pattern.panel_of_face[f] == panel)
+                    .map(|f| pattern.file_face[f])
+                    .collect();
+                faces.sort_unstable();
+                let faces: Vec<String> = faces.iter().map(|f| f.to_string()).collect();
+                if faces.len() == 1 {
+                    format!("face {}", faces[0])
+                } else {
+                    format!("panel of faces {}", faces.join("+"))
+                }
+            })
+            .collect();
         let mut model = NetworkModel {
             folding,
             unit,
@@ -267,6 +285,7 @@ impl NetworkModel {
             drag,
             start,
             labels,
+            panel_names,
             substrate_contact,
             mass_pattern: Vec::new(),
         };
