@@ -1223,6 +1223,19 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
                 .energy_balance_error
                 .map_or("— (quasi-static: no work tracked)".to_string(), |e| format!("{e:.2e} of the largest energy"))
         );
+        if let Some(reduced) = &report.reduced {
+            println!(
+                "  on fitted curves of edge {} over [{:.3}°, {:.3}°], degree {}: fit error {:.2e} rad, the curves close their loops to {:.2e} rad; reduced balance {:.4}°, {:.6e} Hz",
+                reduced.driver_edge,
+                reduced.domain_deg[0],
+                reduced.domain_deg[1],
+                reduced.degree,
+                reduced.max_fit_error_rad,
+                reduced.curves_closure_residual_rad,
+                reduced.balance_driver_rad.to_degrees(),
+                reduced.balance_frequency_hz
+            );
+        }
     }
     if let Some(closed) = &simulation.closed {
         println!(
@@ -1462,6 +1475,18 @@ fn run_modes_network(
             "NOT stable: some eigenvalue of the stiffness on the manifold is not positive"
         }
     );
+    if let Some(reduction) = &model.reduction {
+        let r = &reduction.report;
+        println!(
+            "  the scene's fitted curves (edge {} driving, degree {}, fit error {:.2e} rad) give {:.6e} Hz at {:.6}°: {:.1e} of the exact mode",
+            r.driver_edge,
+            r.degree,
+            r.max_fit_error_rad,
+            r.balance_frequency_hz,
+            r.balance_driver_rad.to_degrees(),
+            modes.modes.frequencies_hz.first().map_or(f64::NAN, |f| (r.balance_frequency_hz - f).abs() / f)
+        );
+    }
     print_written(dir, &files);
     Ok(())
 }

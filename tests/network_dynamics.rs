@@ -647,3 +647,137 @@ fn strips_choose_their_equations_by_length() {
     let error = strip_scene(bridge, "ring", |_| {}).unwrap_err();
     assert!(full_message(&error).contains("equations"), "{}", full_message(&error));
 }
+
+/// The Miura sheet (`file`, drag on or off) with `constraint` added.
+fn miura_scene(file: &str, drag: bool, constraint: Option<&str>) -> nanofold::Result<Scene> {
+    let mut text = std::fs::read_to_string("patterns/devices/miura_sheet.scene.json")
+        .unwrap()
+        .replace("miura_4x4.fold", file)
+        .replace(r#""drag": true"#, &format!(r#""drag": {drag}"#));
+    if let Some(constraint) = constraint {
+        text = text.replacen(r#""time""#, &format!(r#""constraint": {constraint}, "time""#), 1);
+    }
+    nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build())
+}
+
+/// Largest |Δρ| between two runs at the output times both recorded.
+fn gap_between(a: &Simulation, b: &Simulation) -> (f64, usize) {
+    let mut common = 0;
+    let mut worst: f64 = 0.0;
+    for x in &a.response.samples {
+        if let Some(y) = b.response.samples.iter().find(|y| y.time == x.time) {
+            common += 1;
+            worst = worst.max((&x.angles - &y.angles).amax());
+        }
+    }
+    (worst, common)
+}
+
+/// The thesis's method for a one-DOF network: one crease the coordinate, every other on its
+/// fitted curve. Against the exact network (every closure kept by Newton) the motion agrees
+/// to the fit's error amplified by at most 100, folded without drag and from flat in air;
+/// the reduced equation's frequency at its balance agrees with the exact network's mode to
+/// 100 × the fit error; the energy balance holds (the reduced model is a Lagrangian system
+/// of its own), and the loops close to the curves' stated residual.
+#[test]
+fn a_one_dof_network_moves_on_its_fitted_curves_as_on_its_closures() {
+    let poly = Some(r#"{"source": "poly"}"#);
+    for (file, drag, t_end) in [("miura_4x4_folded.fold", false, 6e-5), ("miura_4x4.fold", true, 1e-4)] {
+        let exact = miura_scene(file, drag, None).unwrap();
+        // From flat in air: the bundled scene.
+        let reduced = if drag {
+            scene_file("patterns/devices/miura_sheet_fitted.scene.json")
+        } else {
+            miura_scene(file, drag, poly).unwrap()
+        };
+        let reduction = network(&reduced)
+            .reduction
+            .as_ref()
+            .expect("the scene chose fitted curves");
+        let fit = reduction.report.max_fit_error_rad;
+        assert!(fit <= 1e-8, "the automatic degree fits to 1e-8: {:?}", reduction.report);
+        let a = run(&exact, 1e-10, t_end);
+        let b = run(&reduced, 1e-10, t_end);
+        let (gap, common) = gap_between(&a, &b);
+        assert!(common > 100, "{common} shared output times");
+        assert!(gap <= 100.0 * fit + 1e-9, "{file}: {gap:e} rad apart, fit {fit:e}");
+        let report = b.network.unwrap();
+        let stated = report.reduced.as_ref().unwrap();
+        assert!(report.energy_balance_error.unwrap() < 1e-8, "{report:?}");
+        assert!(report.max_closure_residual <= stated.curves_closure_residual_rad * (1.0 + 1e-9));
+        assert!(report.max_closure_residual > 0.0, "fitted curves do not close exactly");
+        assert_eq!(report.branch.is_some(), drag, "the flat sheet leaves flat");
+        let modes = folded_modes(network(&exact)).unwrap();
+        let exact_hz = modes.modes.modes.frequencies_hz[0];
+        let relative = (stated.balance_frequency_hz - exact_hz).abs() / exact_hz;
+        assert!(
+            relative <= 100.0 * fit,
+            "{} Hz vs {exact_hz} Hz",
+            stated.balance_frequency_hz
+        );
+        let driver = reduction.driver;
+        assert!((stated.balance_driver_rad - modes.modes.equilibrium.angles[driver]).abs() <= 100.0 * fit);
+    }
+}
+
+/// What the fitted curves cannot do is refused by name.
+#[test]
+fn fitted_curves_are_refused_where_they_cannot_hold() {
+    let message = |constraint: &str| match miura_scene("miura_4x4_folded.fold", false, Some(constraint)) {
+        Ok(_) => panic!("accepted {constraint}"),
+        Err(e) => full_message(&e),
+    };
+    for (constraint, expected) in [
+        (
+            r#"{"source": "poly", "driver_edge": 0}"#,
+            "constraint.driver_edge`: 0 (not a crease",
+        ),
+        (r#"{"source": "poly", "degree": 0}"#, "constraint.degree`: 0"),
+        (
+            r#"{"source": "poly", "degree": 12, "samples": 5}"#,
+            "constraint.samples`: 5",
+        ),
+        (
+            r#"{"source": "poly", "range_deg": [-85, -65]}"#,
+            "must contain the driver's start",
+        ),
+        (
+            r#"{"source": "poly", "range_deg": [-69, -60]}"#,
+            "must contain the driver's folded balance",
+        ),
+        (
+            r#"{"source": "network", "range_deg": [-90, -60]}"#,
+            "constraint.range_deg",
+        ),
+        (r#"{"source": "poly", "tolerance": 1}"#, "tolerance"),
+    ] {
+        let got = message(constraint);
+        assert!(got.contains(expected), "expected {expected:?} in: {got}");
+    }
+    // A tree has as many degrees of freedom as creases.
+    let cube = network_error(|v| v["constraint"] = serde_json::json!({"source": "poly"}));
+    assert!(
+        cube.contains("constraint.source") && cube.contains("degree of freedom"),
+        "{cube}"
+    );
+    // A run that leaves a range it was given stops with the field to widen.
+    let narrow = miura_scene(
+        "miura_4x4_folded.fold",
+        false,
+        Some(r#"{"source": "poly", "range_deg": [-72, -60.5]}"#),
+    )
+    .unwrap();
+    let left = simulate(
+        &narrow,
+        &SimulationSettings {
+            t_end: Some(6e-5),
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        full_message(&left).contains("constraint.range_deg"),
+        "{}",
+        full_message(&left)
+    );
+}

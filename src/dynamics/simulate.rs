@@ -7,7 +7,7 @@ use super::closed::{ClosedPlant, ClosedReport};
 use super::contact::Collision;
 use super::integrate::{integrate, output_times, IntegrationOptions, Method, ProgressObserver, IMPLICIT_RATIO};
 use super::network::plant::NetworkReport;
-use super::network::NetworkPlant;
+use super::network::{NetworkPlant, ReducedPlant};
 use super::plant::{Plant, Sample, TimeScales};
 use super::quasi_static::{quasi_static_deviation, quasi_static_path};
 use super::scene::{Scene, System};
@@ -231,13 +231,24 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
             })
         }
         System::Network(model) => {
-            let plant = NetworkPlant::new(model, collisions)?;
-            let response = run(&plant, &plant.without_contacts(), settings, &times)?;
-            let network = Some(plant.report(&response.samples, response.collision.is_some())?);
+            let (response, network) = match &model.reduction {
+                Some(reduction) => {
+                    let plant = ReducedPlant::new(model, reduction, collisions)?;
+                    let response = run(&plant, &plant.without_contacts(), settings, &times)?;
+                    let report = plant.report(&response.samples, response.collision.is_some())?;
+                    (response, report)
+                }
+                None => {
+                    let plant = NetworkPlant::new(model, collisions)?;
+                    let response = run(&plant, &plant.without_contacts(), settings, &times)?;
+                    let report = plant.report(&response.samples, response.collision.is_some())?;
+                    (response, report)
+                }
+            };
             Ok(Simulation {
                 response,
                 closed: None,
-                network,
+                network: Some(network),
             })
         }
     }

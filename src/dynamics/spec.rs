@@ -612,11 +612,53 @@ pub struct NetworkSpec<P> {
     /// Whether the substrate is a contact.
     #[serde(default)]
     pub substrate: NetworkSubstrateSpec,
+    /// How the closures are kept (default: exactly, every crease a coordinate).
+    #[serde(default)]
+    pub constraint: Option<NetworkConstraintSpec>,
     /// The time span.
     pub time: TimeSpec,
     /// What to record.
     #[serde(default)]
     pub outputs: OutputSpec,
+}
+
+/// Where a network's constraint comes from.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NetworkSource {
+    /// Every crease a coordinate, every closure kept exactly (`docs/model.md#panel-networks`).
+    #[default]
+    Network,
+    /// One driving crease the coordinate, every other crease its fitted curve of the driver
+    /// (the thesis's method; one degree of freedom only; `docs/model.md#fitted-curves-of-a-network`).
+    Poly,
+}
+
+fn default_network_fit_samples() -> usize {
+    64
+}
+
+/// How a network's closures are kept: exactly, or by the fitted curves of one driver.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkConstraintSpec {
+    /// "network" or "poly".
+    pub source: NetworkSource,
+    /// The driving crease (FOLD edge index); default: the crease that moves most along the
+    /// motion at the final balance.
+    #[serde(default)]
+    pub driver_edge: Option<usize>,
+    /// Chebyshev degree of the curves; default: the lowest (up to 20) that fits every crease
+    /// to 1e-8 rad, else the best.
+    #[serde(default)]
+    pub degree: Option<usize>,
+    /// Sweep points fitted (as many − 1 more check the fit; default 64).
+    #[serde(default = "default_network_fit_samples")]
+    pub samples: usize,
+    /// The driver's range [a, b] in degrees; default: from its start to where a step's
+    /// undamped swing past the final balance turns back (energy), a tenth wider.
+    #[serde(default)]
+    pub range_deg: Option<[f64; 2]>,
 }
 
 impl<P> NetworkSpec<P> {
@@ -636,6 +678,7 @@ impl<P> NetworkSpec<P> {
             actuation: self.actuation,
             environment: self.environment,
             substrate: self.substrate,
+            constraint: self.constraint,
             time: self.time,
             outputs: self.outputs,
         })

@@ -414,6 +414,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         value["energy_balance_error"] = json!(report.energy_balance_error);
         value["meeting_at_contact"] = json!(report.meeting_at_contact);
         value["touching_at_start"] = json!(report.touching_at_start);
+        value["reduced"] = json!(report.reduced);
         value["crease_edges"] = json!(model.folding.pattern.creases);
         value["release_times_s"] = json!(model
             .forcing
@@ -479,6 +480,7 @@ pub fn network_modes_json(name: &str, model: &NetworkModel, result: &NetworkMode
         "frequencies_without_load_hz": modes.frequencies_without_load_hz,
         "mode_shapes": shapes,
         "stable": modes.modes.stable,
+        "reduced": model.reduction.as_ref().map(|r| &r.report),
     })
 }
 

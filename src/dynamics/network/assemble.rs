@@ -6,11 +6,12 @@
 
 use super::manifold::{projection_solver, restore, worst_residual};
 use super::model::{NetworkModel, NetworkParts, PanelBody};
+use super::reduced::reduce;
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::spec::{
     count_within, drag_law, finite, hinge_stiffness_named, limits, material, network_actuation, validate_materials,
-    within, ClosedSpec, HingeSpec, NetworkSpec, MICROMETRE,
+    within, ClosedSpec, HingeSpec, NetworkSource, NetworkSpec, MICROMETRE,
 };
 use crate::dynamics::strip::StripChain;
 use crate::error::{NanofoldError, Result};
@@ -207,6 +208,27 @@ pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
             format!("panel {p}: mass {:e} kg", model.bodies[p].mass),
             "the panel's mass overflows or vanishes in double precision: check length_unit_um, plates.thickness_um and the density",
         ));
+    }
+    if let Some(constraint) = &spec.constraint {
+        match constraint.source {
+            NetworkSource::Poly => model.reduction = Some(reduce(&model, constraint)?),
+            NetworkSource::Network => {
+                if let Some(edge) = constraint.driver_edge {
+                    return Err(NanofoldError::invalid(
+                        "constraint.driver_edge",
+                        edge,
+                        "a driver is for the fitted curves (source \"poly\"); the exact network has none",
+                    ));
+                }
+                if let Some([a, b]) = constraint.range_deg {
+                    return Err(NanofoldError::invalid(
+                        "constraint.range_deg",
+                        format!("[{a}, {b}]"),
+                        "a range is for the fitted curves (source \"poly\"); the exact network has none",
+                    ));
+                }
+            }
+        }
     }
     Ok(model)
 }

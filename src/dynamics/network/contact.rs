@@ -489,25 +489,28 @@ fn nearest_edges(a: &[Corner], b: &[Corner], data: &NetworkData) -> (usize, usiz
     best.1
 }
 
+/// A path of fold angles: writes the angles at a path parameter.
+pub type AnglePath<'a> = Box<dyn FnMut(f64, &mut [f64]) + 'a>;
+
 /// The candidates along an integrator's or a drive's path.
 pub struct NetworkProbe<'a> {
     model: &'a NetworkModel,
     contacts: &'a NetworkContacts,
     data: &'a mut NetworkData,
     q: &'a mut [f64],
-    path: &'a mut dyn FnMut(f64, &mut [f64]),
+    path: AnglePath<'a>,
     report: Option<ContactReport>,
     failed: bool,
 }
 
 impl<'a> NetworkProbe<'a> {
-    /// A probe over `path` (which writes the fold angles at a path parameter).
+    /// A probe over `path` (which writes the fold angles at a path parameter into `q`).
     pub fn new(
         model: &'a NetworkModel,
         contacts: &'a NetworkContacts,
         data: &'a mut NetworkData,
         q: &'a mut [f64],
-        path: &'a mut dyn FnMut(f64, &mut [f64]),
+        path: AnglePath<'a>,
     ) -> Self {
         NetworkProbe {
             model,

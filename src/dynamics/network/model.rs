@@ -122,6 +122,9 @@ pub struct NetworkModel {
     /// The mass matrix's entries (row, column), column by column of the tree creases in
     /// placement order: (c, c), then each tree crease above c towards the root.
     pub mass_pattern: Vec<(usize, usize)>,
+    /// The fitted curves a one-DOF network moves on instead of its exact closures, when the
+    /// scene chooses them (`constraint.source` "poly").
+    pub reduction: Option<super::fitted::Reduction>,
 }
 
 /// The inputs of [`NetworkModel::new`], in SI units.
@@ -288,6 +291,7 @@ impl NetworkModel {
             panel_names,
             substrate_contact,
             mass_pattern: Vec::new(),
+            reduction: None,
         };
         let mut mass_pattern = Vec::new();
         for &p in &model.order[1..] {

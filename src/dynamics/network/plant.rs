@@ -45,6 +45,8 @@ pub struct NetworkReport {
     pub meeting_at_contact: Vec<[String; 2]>,
     /// Panel pairs at a shared vertex that touch at the start, left out of the contacts.
     pub touching_at_start: Vec<[String; 2]>,
+    /// The fitted curves a reduced run (`constraint.source` "poly") moved on (None: exact).
+    pub reduced: Option<super::fitted::ReducedReport>,
 }
 
 /// Scratch of a [`NetworkPlant`].
@@ -97,6 +99,11 @@ impl<'m> NetworkPlant<'m> {
         }
     }
 
+    /// The contact candidates.
+    pub fn contacts(&self) -> &NetworkContacts {
+        &self.contacts
+    }
+
     /// The model.
     pub fn model(&self) -> &NetworkModel {
         self.model
@@ -110,42 +117,19 @@ impl<'m> NetworkPlant<'m> {
     /// The report of a run (its samples, and whether it stopped at a contact): the branch,
     /// closure residuals, energy balance and the pairs meeting at the contact.
     pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkReport> {
-        let max_closure_residual = samples
-            .iter()
-            .map(|s| worst_residual(self.model, s.angles.as_slice()))
-            .fold(0.0, f64::max);
-        let balances: Option<Vec<f64>> = samples.iter().map(|s| s.energy_balance()).collect();
-        let energy_balance_error = balances.and_then(|b| {
-            let first = *b.first()?;
-            let scale = samples
-                .iter()
-                .map(|s| {
-                    s.kinetic_energy
-                        .max(s.elastic_energy)
-                        .max(s.actuation_work.unwrap_or(0.0).abs())
-                })
-                .fold(0.0, f64::max);
-            let drift = b.iter().map(|x| (x - first).abs()).fold(0.0, f64::max);
-            Some(if scale > 0.0 { drift / scale } else { 0.0 })
-        });
-        let meeting_at_contact = match (contact, samples.last()) {
-            (true, Some(last)) => {
-                let mut data = NetworkData::new(self.model);
-                self.contacts
-                    .meeting(self.model, last.angles.as_slice(), &mut data, 1e-6)
-            }
-            _ => Vec::new(),
-        };
-        Ok(NetworkReport {
-            meeting_at_contact,
-            touching_at_start: self.contacts.touching_at_start().to_vec(),
-            panels: self.model.panels(),
-            creases: self.model.columns(),
-            anchored_face: self.model.anchored_face,
-            branch: self.start.as_ref().map(|b| b.note.clone()),
-            max_closure_residual,
-            energy_balance_error,
-        })
+        Ok(network_report(
+            self.model,
+            &self.contacts,
+            self.start.as_ref().map(|b| b.note.clone()),
+            samples,
+            contact,
+        ))
+    }
+
+    /// The hinges' balance with every drive at its final angle, reached from the start (along
+    /// the branch a flat start leaves by).
+    pub fn final_balance_angles(&self) -> Result<Vec<f64>> {
+        self.final_balance()
     }
 
     /// A configuration to take the time scales at: the start, or the branch's first state
@@ -262,62 +246,27 @@ impl Plant for NetworkPlant<'_> {
     }
 
     fn time_scales(&self) -> Result<TimeScales> {
-        let omegas = self.omegas()?;
-        let fastest = omegas.iter().copied().fold(0.0, f64::max);
-        let slowest = omegas.iter().copied().fold(f64::INFINITY, f64::min);
-        if !(fastest > 0.0 && slowest.is_finite()) {
-            return Err(NumericalError::NonFinite {
-                what: "natural periods",
-                detail: "the network has no degree of freedom at its start".into(),
-            }
-            .into());
-        }
-        let forcing = self.model.forcing.duration();
-        Ok(TimeScales {
-            fastest_period_s: TAU / fastest,
-            slowest_period_s: TAU / slowest,
-            forcing_time_s: forcing,
-            ratio: forcing * fastest / TAU,
-        })
+        time_scales_of(
+            &self.omegas()?,
+            &self.model.forcing,
+            "the network has no degree of freedom at its start",
+        )
     }
 
     fn quasi_static_error_estimate(&self) -> Result<f64> {
         let mut ws = self.workspace();
         let start = self.regular_start().to_vec();
+        let jump = |to: &[f64]| to.iter().zip(&start).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         Ok(match self.model.forcing.actuation {
             // A step's jump: from the start to the final balance.
-            Actuation::Step => {
-                let balance = self.final_balance()?;
-                balance
-                    .iter()
-                    .zip(&start)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max)
-            }
+            Actuation::Step => jump(&self.final_balance()?),
             Actuation::Ramp { .. } => {
                 let omegas = self.omegas()?;
                 let slowest = omegas.iter().copied().fold(f64::INFINITY, f64::min);
-                let forcing = &self.model.forcing;
-                let rate = (0..self.model.columns())
-                    .map(|c| {
-                        let hinge = &forcing.hinges[c];
-                        if hinge.actuated && hinge.target != 0.0 {
-                            forcing.drive_rate(c, hinge.release_time).abs()
-                        } else {
-                            0.0
-                        }
-                    })
-                    .fold(0.0, f64::max);
                 let mut rest = vec![0.0; self.model.columns()];
                 self.rest_angles(&mut rest);
                 let settled = equilibrium(self.model, &rest, &start, &mut ws.statics)?;
-                let jump = settled
-                    .angles
-                    .iter()
-                    .zip(&start)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max);
-                2.0 * rate / slowest + jump
+                2.0 * fastest_drive_rate(&self.model.forcing) / slowest + jump(&settled.angles)
             }
         })
     }
@@ -361,18 +310,7 @@ impl Plant for NetworkPlant<'_> {
     }
 
     fn energy_scale(&self) -> f64 {
-        let scale: f64 = self
-            .model
-            .hinges
-            .iter()
-            .zip(&self.model.forcing.hinges)
-            .map(|(h, d)| 0.5 * h.stiffness * d.target * d.target)
-            .sum();
-        if scale > 0.0 {
-            scale
-        } else {
-            0.5 * self.model.hinges.iter().map(|h| h.stiffness).sum::<f64>()
-        }
+        energy_scale(self.model)
     }
 
     fn accumulator_rates(&self, ws: &NetworkWorkspace, out: &mut [f64]) {
@@ -413,28 +351,7 @@ impl Plant for NetworkPlant<'_> {
         if worst_residual(self.model, &angles) > CLOSURE_TOL || rates.iter().any(|r| *r != 0.0) {
             self.project_state(&mut angles, &mut rates, ws)?;
         }
-        let model = self.model;
-        update_kinematics(model, &angles, &mut ws.data);
-        update_velocities(model, &rates, &mut ws.data);
-        model.forcing.drive_angles(t, &mut ws.drive);
-        let (mut elastic, mut potential) = (0.0, 0.0);
-        for (c, &angle) in angles.iter().enumerate() {
-            let k = model.hinges[c].stiffness;
-            elastic += 0.5 * k * angle * angle;
-            if model.forcing.hinges[c].actuated {
-                potential -= k * ws.drive[c] * angle;
-            }
-        }
-        let sample = Sample {
-            time: t,
-            angles: DVector::from_column_slice(&angles),
-            rates: DVector::from_column_slice(&rates),
-            kinetic_energy: kinetic_energy(model, &ws.data),
-            elastic_energy: elastic,
-            actuator_potential: potential,
-            actuation_work: accumulated.first().copied(),
-            drag_dissipation: accumulated.get(1).copied(),
-        };
+        let sample = network_sample(self.model, t, &angles, &rates, accumulated, &mut ws.data, &mut ws.drive);
         ws.angles = angles;
         ws.rates = rates;
         Ok(sample)
@@ -512,7 +429,146 @@ impl Plant for NetworkPlant<'_> {
         q: &'a mut [f64],
         path: &'a mut dyn FnMut(f64, &mut [f64]),
     ) -> Box<dyn ContactProbe + 'a> {
-        Box::new(NetworkProbe::new(self.model, &self.contacts, &mut ws.data, q, path))
+        Box::new(NetworkProbe::new(
+            self.model,
+            &self.contacts,
+            &mut ws.data,
+            q,
+            Box::new(move |u: f64, x: &mut [f64]| path(u, x)),
+        ))
+    }
+}
+
+/// Time scales from natural angular frequencies (rad/s, every one > 0) against the forcing;
+/// `none` says why there are none.
+pub(crate) fn time_scales_of(omegas: &[f64], forcing: &Forcing, none: &str) -> Result<TimeScales> {
+    let fastest = omegas.iter().copied().fold(0.0, f64::max);
+    let slowest = omegas.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(fastest > 0.0 && slowest.is_finite()) {
+        return Err(NumericalError::NonFinite {
+            what: "natural periods",
+            detail: none.into(),
+        }
+        .into());
+    }
+    let duration = forcing.duration();
+    Ok(TimeScales {
+        fastest_period_s: TAU / fastest,
+        slowest_period_s: TAU / slowest,
+        forcing_time_s: duration,
+        ratio: duration * fastest / TAU,
+    })
+}
+
+/// The fastest drive rate of any actuated hinge with a target, rad/s (a ramp's, at release).
+pub(crate) fn fastest_drive_rate(forcing: &Forcing) -> f64 {
+    forcing
+        .hinges
+        .iter()
+        .enumerate()
+        .map(|(c, hinge)| {
+            if hinge.actuated && hinge.target != 0.0 {
+                forcing.drive_rate(c, hinge.release_time).abs()
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// A network run's report from its samples: closure residuals, the energy balance, the
+/// pairs meeting at the first contact (`contact`: the run ended at one).
+pub(crate) fn network_report(
+    model: &NetworkModel,
+    contacts: &NetworkContacts,
+    branch: Option<String>,
+    samples: &[Sample],
+    contact: bool,
+) -> NetworkReport {
+    let max_closure_residual = samples
+        .iter()
+        .map(|s| worst_residual(model, s.angles.as_slice()))
+        .fold(0.0, f64::max);
+    let balances: Option<Vec<f64>> = samples.iter().map(|s| s.energy_balance()).collect();
+    let energy_balance_error = balances.and_then(|b| {
+        let first = *b.first()?;
+        let scale = samples
+            .iter()
+            .map(|s| {
+                s.kinetic_energy
+                    .max(s.elastic_energy)
+                    .max(s.actuation_work.unwrap_or(0.0).abs())
+            })
+            .fold(0.0, f64::max);
+        let drift = b.iter().map(|x| (x - first).abs()).fold(0.0, f64::max);
+        Some(if scale > 0.0 { drift / scale } else { 0.0 })
+    });
+    let meeting_at_contact = match (contact, samples.last()) {
+        (true, Some(last)) => {
+            let mut data = NetworkData::new(model);
+            contacts.meeting(model, last.angles.as_slice(), &mut data, 1e-6)
+        }
+        _ => Vec::new(),
+    };
+    NetworkReport {
+        meeting_at_contact,
+        touching_at_start: contacts.touching_at_start().to_vec(),
+        panels: model.panels(),
+        creases: model.columns(),
+        anchored_face: model.anchored_face,
+        branch,
+        max_closure_residual,
+        energy_balance_error,
+        reduced: None,
+    }
+}
+
+/// ½ Σ K θ_target² over the creases (or ½ Σ K when nothing has a target), J: the scale of a
+/// network's energies.
+pub(crate) fn energy_scale(model: &NetworkModel) -> f64 {
+    let scale: f64 = model
+        .hinges
+        .iter()
+        .zip(&model.forcing.hinges)
+        .map(|(h, d)| 0.5 * h.stiffness * d.target * d.target)
+        .sum();
+    if scale > 0.0 {
+        scale
+    } else {
+        0.5 * model.hinges.iter().map(|h| h.stiffness).sum::<f64>()
+    }
+}
+
+/// The sample at (t, ρ, ρ̇) (on the closures) with the accumulated work and dissipation.
+pub(crate) fn network_sample(
+    model: &NetworkModel,
+    t: f64,
+    angles: &[f64],
+    rates: &[f64],
+    accumulated: &[f64],
+    data: &mut NetworkData,
+    drive: &mut [f64],
+) -> Sample {
+    update_kinematics(model, angles, data);
+    update_velocities(model, rates, data);
+    model.forcing.drive_angles(t, drive);
+    let (mut elastic, mut potential) = (0.0, 0.0);
+    for (c, &angle) in angles.iter().enumerate() {
+        let k = model.hinges[c].stiffness;
+        elastic += 0.5 * k * angle * angle;
+        if model.forcing.hinges[c].actuated {
+            potential -= k * drive[c] * angle;
+        }
+    }
+    Sample {
+        time: t,
+        angles: DVector::from_column_slice(angles),
+        rates: DVector::from_column_slice(rates),
+        kinetic_energy: kinetic_energy(model, data),
+        elastic_energy: elastic,
+        actuator_potential: potential,
+        actuation_work: accumulated.first().copied(),
+        drag_dissipation: accumulated.get(1).copied(),
     }
 }
 
