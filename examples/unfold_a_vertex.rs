@@ -16,7 +16,7 @@ fn main() -> Result<()> {
             b.crease(Assignment::Unassigned, r)
         })
         .build()?;
-    let report = unfold(&pattern, &UnfoldSettings::default())?;
+    let report = unfold_vertex(&pattern, &UnfoldSettings::default())?;
     println!("{}: {} ({})", pattern.name, report.verdict.as_str(), report.evidence);
     println!(
         "{} steps in {:.2} ms; largest arc residual on the way {:.1e} rad; {:.1e} from the flat layout",

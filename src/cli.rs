@@ -489,7 +489,7 @@ fn unfold_one(
     let settings = solver.settings()?;
     let pattern = match nanofold::io::load_pattern(pattern_path, &solver.load_options()) {
         Ok(pattern) => pattern,
-        Err(e) if takes_many_vertices(&e, pattern_path) => {
+        Err(e) if nanofold::commands::takes_many_vertices(&e, pattern_path) => {
             return folding::unfold_network_one(pattern_path, solver, dir)
         }
         Err(e) => return Err(reading(pattern_path, e)),
@@ -648,7 +648,7 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
     parallel.all(&files, |path| {
         let outcome = nanofold::io::load_pattern(path, &solver.load_options());
         if let Err(e) = &outcome {
-            if takes_many_vertices(e, path) {
+            if nanofold::commands::takes_many_vertices(e, path) {
                 return match folding::check_json(path, solver.closure_tol, solver.project) {
                     Ok((value, _)) if as_json => {
                         println!("{value}");
@@ -683,26 +683,6 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
         }
         true
     })
-}
-
-/// Does a pattern the single-vertex loader refused go to the crease-pattern commands? Yes
-/// when the refusal says it is not a single vertex (several vertices or none, a 3D folded
-/// form, no fold angles, a mesh larger than a vertex's): then the crease-pattern reader's
-/// own errors are the ones to show. Otherwise (a vertex whose folded state does not close,
-/// say) only if it reads as a crease pattern.
-fn takes_many_vertices(error: &nanofold::NanofoldError, path: &Path) -> bool {
-    use nanofold::NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
-    let not_a_vertex = match error {
-        MultipleVertices { .. } => true,
-        MissingField { field, .. } => field == "edges_foldAngle",
-        InvalidField { value, reason, .. } => {
-            value == "no vertex with two or more creases"
-                || reason.contains("3D folded forms are read as crease patterns")
-                || reason.contains("a single-vertex pattern (its outputs repeat the mesh")
-        }
-        _ => false,
-    };
-    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && nanofold::io::load_crease_pattern(path).is_ok())
 }
 
 /// Parses "J=C0,C1,..." into (crease index, coefficients in degrees).
@@ -792,7 +772,9 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     options.validate().map_err(constraints_flags)?;
     let pattern = match nanofold::io::load_pattern(&args.pattern, &options) {
         Ok(pattern) => pattern,
-        Err(e) if takes_many_vertices(&e, &args.pattern) => return folding::run_network_constraints(args, degree),
+        Err(e) if nanofold::commands::takes_many_vertices(&e, &args.pattern) => {
+            return folding::run_network_constraints(args, degree)
+        }
         Err(e) => return Err(reading(&args.pattern, e)),
     };
     let driver = crease_index(&pattern, args.drive, "--drive")?;

@@ -275,7 +275,7 @@ pub fn held_pattern(pattern: &Pattern, setup: &Setup) -> Result<Pattern> {
 /// # let pattern = load_pattern("patterns/corner_cube.fold".as_ref(), &LoadOptions::default())?;
 /// let setup = Setup::new(&pattern, 0, &[(1, pattern.creases[1].folded_angle)])?;
 /// let settings = UnfoldSettings::default();
-/// let report = unfold(&held_pattern(&pattern, &setup)?, &settings)?;
+/// let report = unfold_vertex(&held_pattern(&pattern, &setup)?, &settings)?;
 /// let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
 /// let samples = trajectory_samples(&pattern, &setup, None, &states, report.verdict.as_str(), settings.flat_tol)?;
 /// # Ok::<(), NanofoldError>(())

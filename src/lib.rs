@@ -1,11 +1,14 @@
 #![warn(missing_docs)]
 //! # nanofold
 //!
-//! Rigid origami of single-vertex crease patterns: unfolding a folded vertex to flat by
-//! constrained energy minimisation on the sphere, the holonomic constraint curves between
-//! its fold angles, and the folding dynamics of plates on stress-actuated hinges (strips and
-//! closed vertices). The model — every equation, and the readings chosen where the thesis
-//! it comes from is ambiguous — is in `docs/model.md`; code cites its anchors.
+//! Rigid origami: unfolding a folded crease pattern to flat by constrained energy
+//! minimisation (a single vertex on the sphere, many vertices on their closures), checking
+//! and folding crease patterns of any number of vertices, the holonomic constraint curves
+//! between fold angles, and the folding dynamics of plates on stress-actuated hinges
+//! (strips, closed vertices, networks of panels). The model — every equation, and the
+//! readings chosen where the thesis it comes from is ambiguous — is in `docs/model.md`;
+//! code cites its anchors. The front door is [`commands`]: one [`commands::Pattern`], one
+//! `check`, `fold` and `unfold`.
 //!
 //! ## A pattern from numbers, unfolded
 //!
@@ -23,10 +26,13 @@
 //!         b.crease(Assignment::Unassigned, r)
 //!     })
 //!     .build()?;
-//! let report = unfold(&pattern, &UnfoldSettings::default())?;
+//! // A single vertex is a pattern too: the same `unfold` takes it and a sheet of many.
+//! let report = unfold(&Pattern::from(pattern), &Settings::default())?;
 //! assert_eq!(report.verdict, Verdict::Flat);
-//! // Reversed, the recorded trajectory is a folding path.
-//! assert!(report.trajectory.len() > 2 && report.max_arc_residual < 1e-10);
+//! assert!(report.max_closure_residual_rad < 1e-10);
+//! // Reversed, the engine's recorded trajectory is a folding path.
+//! let Detail::VertexUnfold(engine) = &report.detail else { unreachable!() };
+//! assert!(engine.trajectory.len() > 2);
 //! # let _ = FRAC_PI_2;
 //! # Ok::<(), NanofoldError>(())
 //! ```
@@ -57,6 +63,7 @@
 //! `nanofold` binary (feature `cli`). [`error`] sits beneath them all; [`prelude`] gathers
 //! the names most programs need.
 
+pub mod commands;
 pub mod constraints;
 pub mod dynamics;
 pub mod error;
@@ -70,3 +77,8 @@ pub mod prelude;
 pub mod unfold;
 
 pub use error::{NanofoldError, Result};
+
+/// README's Rust example, compiled and run as a doc-test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExample;

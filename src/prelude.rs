@@ -1,13 +1,22 @@
-//! The names most programs need, in one `use nanofold::prelude::*;`.
+//! The names most programs need, in one `use nanofold::prelude::*;`: the front door
+//! ([`Pattern`], [`check`], [`fold`], [`unfold`] over any pattern, one [`Verdict`] and one
+//! [`Report`]), scenes and their simulation, and the single vertex's builder and engine
+//! (under `VertexPattern`, `unfold_vertex`, `VertexReport`, `VertexVerdict`).
 
+pub use crate::commands::{
+    check, fold, unfold, Command, Detail, Engine, Pattern, Report, Settings, Verdict, VertexPattern,
+};
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::Method;
 pub use crate::dynamics::scene::{Scene, SceneSpec, System};
 pub use crate::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
 pub use crate::dynamics::spec::{ClosedSpec, StripSpec};
 pub use crate::error::{NanofoldError, NumericalError, Result};
+pub use crate::folding::{CheckSettings, FoldSettings};
 pub use crate::io::{load_pattern, load_scene};
-pub use crate::pattern::{Assignment, Chain, LoadOptions, Pattern, VertexBuilder};
+pub use crate::pattern::{Assignment, Chain, LoadOptions, VertexBuilder};
 pub use crate::unfold::energy::EnergyKind;
 pub use crate::unfold::qp::QpMethod;
-pub use crate::unfold::{unfold, UnfoldReport, UnfoldSettings, Verdict};
+pub use crate::unfold::{
+    unfold as unfold_vertex, UnfoldReport as VertexReport, UnfoldSettings, Verdict as VertexVerdict,
+};

@@ -132,8 +132,8 @@ pub struct UnfoldReport {
 ///     .crease(Assignment::Valley, 1.0)
 ///     .crease(Assignment::Unassigned, 0.0)
 ///     .build()?;
-/// let report = unfold(&pattern, &UnfoldSettings::default())?;
-/// assert_eq!(report.verdict, Verdict::Flat);
+/// let report = unfold_vertex(&pattern, &UnfoldSettings::default())?;
+/// assert_eq!(report.verdict, VertexVerdict::Flat);
 /// assert!(report.flat_layout_error < 1e-10);
 /// # Ok::<(), NanofoldError>(())
 /// ```

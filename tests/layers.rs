@@ -1,5 +1,5 @@
 //! The library's layers depend one way (README, "How it works"): geometry → pattern →
-//! folding → unfold and constraints → dynamics → io → plot, with `error` beneath them all and the
+//! folding → unfold and constraints → dynamics → io → commands → plot, with `error` beneath them all and the
 //! crate root and prelude above. This reads every library source file, collects the
 //! `crate::…` and `super::…` paths it uses (unit tests aside), and fails on an import of a
 //! higher layer, on unfold and constraints importing each other, and on any cycle between
@@ -18,7 +18,8 @@ fn rank(module: &str) -> Option<usize> {
         "unfold" | "constraints" => 4,
         "dynamics" => 5,
         "io" => 6,
-        "plot" => 7,
+        "commands" => 7,
+        "plot" => 8,
         _ => return None,
     })
 }

@@ -1,0 +1,562 @@
+//! The library's front door: one [`Pattern`] (a single vertex is a pattern with one interior
+//! vertex), one [`check`], [`fold`] and [`unfold`] that take any pattern, one verdict
+//! vocabulary ([`Verdict`]) and one report shape ([`Report`]). Behind it the two engines
+//! stay as they are: the single vertex's unfolding on the sphere
+//! (`docs/model.md#unfolding`) and the many-vertex folding layer
+//! (`docs/model.md#rigid-folding`); a pattern goes to the single-vertex engine whenever that
+//! engine reads it, as the command line does.
+//!
+//! ```
+//! use nanofold::prelude::*;
+//! let options = LoadOptions::default();
+//! let settings = Settings::default();
+//! // A single vertex and a crease pattern of many, through the same calls.
+//! let vertex = Pattern::open("patterns/miura_vertex.fold".as_ref(), &options)?;
+//! let sheet = Pattern::open("patterns/many/miura_4x4_folded.fold".as_ref(), &options)?;
+//! assert_eq!((vertex.engine(), sheet.engine()), (Engine::Vertex, Engine::Network));
+//! for pattern in [&vertex, &sheet] {
+//!     let report = unfold(pattern, &settings)?;
+//!     assert_eq!(report.verdict, Verdict::Flat);
+//!     assert!(report.final_fold_angles_rad.iter().all(|a| a.abs() <= 1e-6));
+//! }
+//! // The flat Miura-ori's assignment folds rigidly; folding it reaches 100%.
+//! let flat = Pattern::open("patterns/many/miura_4x4.fold".as_ref(), &options)?;
+//! assert_eq!(check(&flat, &settings)?.verdict, Verdict::RigidlyFoldable);
+//! assert_eq!(fold(&flat, &settings)?.verdict, Verdict::Reached);
+//! # Ok::<(), NanofoldError>(())
+//! ```
+
+use crate::error::{NanofoldError, Result};
+use crate::folding::{check_pattern, fold_path, CheckReport, CheckSettings, FoldPath, FoldSettings, FoldingModel};
+use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
+use crate::pattern::{Assignment, Chain, LoadOptions, RayRole};
+use crate::unfold::network::{unfold_network, NetworkReport, NetworkUnfoldSettings, NetworkVerdict};
+use crate::unfold::{UnfoldReport, UnfoldSettings};
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// The single-vertex pattern type of the engine behind the door.
+pub use crate::pattern::Pattern as VertexPattern;
+
+/// Which engine answers for a pattern.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Engine {
+    /// The single vertex on the sphere.
+    Vertex,
+    /// The crease pattern of many vertices (panels, stars, closures).
+    Network,
+}
+
+impl Engine {
+    /// The engine's name in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Engine::Vertex => "vertex",
+            Engine::Network => "network",
+        }
+    }
+}
+
+/// Any crease pattern nanofold reads: a single vertex (the single-vertex engine's, with
+/// its sheet when it has one) or a crease pattern of many vertices.
+#[derive(Debug, Clone)]
+pub struct Pattern {
+    vertex: Option<VertexPattern>,
+    sheet: Option<FoldingModel>,
+}
+
+impl Pattern {
+    /// Reads a FOLD file or a native vertex file: the single-vertex engine takes it when it
+    /// reads it, the many-vertex reader otherwise (its errors are then the ones returned).
+    pub fn open(path: &Path, options: &LoadOptions) -> Result<Pattern> {
+        match crate::io::load_pattern(path, options) {
+            Ok(vertex) => {
+                let sheet = crate::io::load_crease_pattern(path)
+                    .ok()
+                    .and_then(|p| FoldingModel::new(p).ok())
+                    .or_else(|| sheet_of_vertex(&vertex).ok());
+                Ok(Pattern {
+                    vertex: Some(vertex),
+                    sheet,
+                })
+            }
+            Err(e) if takes_many_vertices(&e, path) => {
+                let sheet = FoldingModel::new(crate::io::load_crease_pattern(path)?)?;
+                Ok(Pattern {
+                    vertex: None,
+                    sheet: Some(sheet),
+                })
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// A crease pattern of any number of vertices (validated, its stars and panels found).
+    pub fn from_crease_pattern(pattern: CreasePattern) -> Result<Pattern> {
+        Ok(Pattern {
+            vertex: None,
+            sheet: Some(FoldingModel::new(pattern)?),
+        })
+    }
+
+    /// The pattern's name.
+    pub fn name(&self) -> &str {
+        match (&self.vertex, &self.sheet) {
+            (Some(v), _) => &v.name,
+            (None, Some(s)) => &s.pattern.name,
+            (None, None) => unreachable!("a pattern has one form or both"),
+        }
+    }
+
+    /// The engine that checks and unfolds it.
+    pub fn engine(&self) -> Engine {
+        if self.vertex.is_some() {
+            Engine::Vertex
+        } else {
+            Engine::Network
+        }
+    }
+
+    /// Its single vertex, when the single-vertex engine takes it.
+    pub fn vertex(&self) -> Option<&VertexPattern> {
+        self.vertex.as_ref()
+    }
+
+    /// Its sheet of panels (None: a vertex whose sectors do not close a flat sheet, a cone).
+    pub fn sheet(&self) -> Option<&FoldingModel> {
+        self.sheet.as_ref()
+    }
+
+    /// Crease labels in the order of every fold-angle vector the reports give.
+    pub fn crease_labels(&self) -> Vec<String> {
+        match (&self.vertex, &self.sheet) {
+            (Some(v), _) => v.creases.iter().map(|c| c.label.clone()).collect(),
+            (None, Some(s)) => s.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
+            (None, None) => unreachable!("a pattern has one form or both"),
+        }
+    }
+
+    /// The state the pattern carries, rad (file order of the creases).
+    pub fn fold_angles(&self) -> Vec<f64> {
+        match (&self.vertex, &self.sheet) {
+            (Some(v), _) => v.creases.iter().map(|c| c.folded_angle).collect(),
+            (None, Some(s)) => s.given_fold_angles(),
+            (None, None) => unreachable!("a pattern has one form or both"),
+        }
+    }
+}
+
+impl From<VertexPattern> for Pattern {
+    /// A single vertex, with its sheet when its sectors close one (unit rays about the
+    /// origin, ray 0 along its mesh's direction or +x).
+    fn from(vertex: VertexPattern) -> Pattern {
+        let sheet = sheet_of_vertex(&vertex).ok();
+        Pattern {
+            vertex: Some(vertex),
+            sheet,
+        }
+    }
+}
+
+/// The sheet of a single vertex: the vertex at the origin, a unit ray per crease (virtual
+/// rays as flat facet lines, an open chain's end rays as boundary), the rays' tips joined
+/// by the paper's outline.
+fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
+    if !vertex.flat_foldable {
+        return Err(NanofoldError::invalid(
+            "sector_angles",
+            format!("Σα = {:.6}°", vertex.angle_sum.to_degrees()),
+            "a closed vertex whose sectors do not sum to 360° (a cone) has no flat sheet",
+        ));
+    }
+    let n = vertex.rays.len();
+    let start = vertex.mesh.as_ref().map_or(0.0, |m| m.ray0_direction);
+    let mut vertices = vec![[0.0, 0.0]];
+    let mut direction = start;
+    for k in 0..n {
+        vertices.push([direction.cos(), direction.sin()]);
+        if let Some(alpha) = vertex.sector_angles.get(k) {
+            direction += alpha;
+        }
+    }
+    let mut builder = CreasePatternBuilder {
+        name: vertex.name.clone(),
+        vertices,
+        angle_field: "creases[*].folded_angle".into(),
+        ..CreasePatternBuilder::default()
+    };
+    let mut locked = Vec::new();
+    for (k, role) in vertex.rays.iter().enumerate() {
+        let (kind, angle, lock) = match *role {
+            RayRole::Crease(i) => {
+                let crease = &vertex.creases[i];
+                let kind = match crease.assignment {
+                    Assignment::Flat if crease.folded_angle == 0.0 => EdgeKind::Facet,
+                    Assignment::Flat => EdgeKind::Crease(Assignment::Unassigned),
+                    a => EdgeKind::Crease(a),
+                };
+                (kind, crease.folded_angle, crease.locked)
+            }
+            RayRole::Virtual => (EdgeKind::Facet, 0.0, false),
+            RayRole::Boundary => (EdgeKind::Boundary, 0.0, false),
+        };
+        builder.edges.push([0, k + 1]);
+        builder.kinds.push(kind);
+        builder
+            .fold_angles
+            .push(if kind == EdgeKind::Facet { 0.0 } else { angle });
+        locked.push(lock);
+    }
+    let outline = match vertex.chain {
+        Chain::Closed => n,
+        Chain::Open => n - 1,
+    };
+    for k in 0..outline {
+        builder.edges.push([k + 1, (k + 1) % n + 1]);
+        builder.kinds.push(EdgeKind::Boundary);
+        builder.fold_angles.push(0.0);
+        locked.push(false);
+    }
+    if locked.iter().any(|&l| l) {
+        builder.locked = locked;
+    }
+    FoldingModel::new(builder.build()?)
+}
+
+/// Does a pattern the single-vertex loader refused (with `error`) go to the many-vertex
+/// reader? Yes when the refusal says it is not a single vertex (several vertices or none, a
+/// 3D folded form, no fold angles, a mesh larger than a vertex's); otherwise (a vertex whose
+/// folded state does not close, say) only if it reads as a crease pattern.
+pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
+    use NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
+    let not_a_vertex = match error {
+        MultipleVertices { .. } => true,
+        MissingField { field, .. } => field == "edges_foldAngle",
+        InvalidField { value, reason, .. } => {
+            value == "no vertex with two or more creases"
+                || reason.contains("3D folded forms are read as crease patterns")
+                || reason.contains("a single-vertex pattern (its outputs repeat the mesh")
+        }
+        _ => false,
+    };
+    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && crate::io::load_crease_pattern(path).is_ok())
+}
+
+/// Every answer any command gives, in one vocabulary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Unfolded to the flat state along a rigid path.
+    Flat,
+    /// Stopped away from flat with restarts disabled: no evidence either way.
+    Stuck,
+    /// No rigid motion at the state (0 degrees of freedom).
+    Locked,
+    /// Motion is possible, but descent and its restarts end away from flat.
+    LocalMinimum,
+    /// A closed vertex whose sectors do not sum to 360° has no flat state.
+    NotFlatFoldable,
+    /// Panels would pass through each other on the way.
+    Blocked,
+    /// The iteration budget ran out.
+    IterationLimit,
+    /// The state does not close at some vertex.
+    NotRigid,
+    /// The state closes at every vertex and no two panels cross.
+    Rigid,
+    /// The state closes but panels pass through each other.
+    SelfIntersecting,
+    /// The assignment folds rigidly from flat (a witness path exists).
+    RigidlyFoldable,
+    /// The assignment cannot fold rigidly from flat.
+    NotRigidlyFoldable,
+    /// Neither could be shown.
+    Unknown,
+    /// A fold reached its goal.
+    Reached,
+    /// A fold stopped at a branch point or the end of its branch.
+    BranchPoint,
+    /// A fold's step budget ran out.
+    StepLimit,
+}
+
+impl Verdict {
+    /// The verdict's name in outputs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Flat => "flat",
+            Verdict::Stuck => "stuck",
+            Verdict::Locked => "locked",
+            Verdict::LocalMinimum => "local_minimum",
+            Verdict::NotFlatFoldable => "not_flat_foldable",
+            Verdict::Blocked => "blocked",
+            Verdict::IterationLimit => "iteration_limit",
+            Verdict::NotRigid => "not_rigid",
+            Verdict::Rigid => "rigid",
+            Verdict::SelfIntersecting => "self_intersecting",
+            Verdict::RigidlyFoldable => "rigidly_foldable",
+            Verdict::NotRigidlyFoldable => "not_rigidly_foldable",
+            Verdict::Unknown => "unknown",
+            Verdict::Reached => "reached",
+            Verdict::BranchPoint => "branch_point",
+            Verdict::StepLimit => "step_limit",
+        }
+    }
+}
+
+impl From<crate::unfold::Verdict> for Verdict {
+    fn from(v: crate::unfold::Verdict) -> Verdict {
+        use crate::unfold::Verdict as V;
+        match v {
+            V::Flat => Verdict::Flat,
+            V::Stuck => Verdict::Stuck,
+            V::Locked => Verdict::Locked,
+            V::LocalMinimum => Verdict::LocalMinimum,
+            V::NotFlatFoldable => Verdict::NotFlatFoldable,
+        }
+    }
+}
+
+impl From<NetworkVerdict> for Verdict {
+    fn from(v: NetworkVerdict) -> Verdict {
+        match v {
+            NetworkVerdict::Flat => Verdict::Flat,
+            NetworkVerdict::Locked => Verdict::Locked,
+            NetworkVerdict::LocalMinimum => Verdict::LocalMinimum,
+            NetworkVerdict::Blocked => Verdict::Blocked,
+            NetworkVerdict::IterationLimit => Verdict::IterationLimit,
+            NetworkVerdict::NotRigid => Verdict::NotRigid,
+        }
+    }
+}
+
+impl From<crate::folding::PatternVerdict> for Verdict {
+    fn from(v: crate::folding::PatternVerdict) -> Verdict {
+        use crate::folding::PatternVerdict as V;
+        match v {
+            V::Rigid => Verdict::Rigid,
+            V::NotRigid => Verdict::NotRigid,
+            V::SelfIntersecting => Verdict::SelfIntersecting,
+            V::RigidlyFoldable => Verdict::RigidlyFoldable,
+            V::NotRigidlyFoldable => Verdict::NotRigidlyFoldable,
+            V::Unknown => Verdict::Unknown,
+        }
+    }
+}
+
+impl From<&crate::folding::StopReason> for Verdict {
+    fn from(stop: &crate::folding::StopReason) -> Verdict {
+        use crate::folding::StopReason as S;
+        match stop {
+            S::Reached => Verdict::Reached,
+            S::Blocked { .. } => Verdict::Blocked,
+            S::Locked => Verdict::Locked,
+            S::BranchPoint { .. } => Verdict::BranchPoint,
+            S::StepLimit => Verdict::StepLimit,
+        }
+    }
+}
+
+/// Which command a report answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Command {
+    /// [`check`].
+    Check,
+    /// [`fold`].
+    Fold,
+    /// [`unfold`].
+    Unfold,
+}
+
+/// What the engine behind the door reported in full.
+#[derive(Debug, Clone)]
+pub enum Detail {
+    /// The single-vertex unfolding (also `check` of a single vertex).
+    VertexUnfold(Box<UnfoldReport>),
+    /// The many-vertex unfolding.
+    NetworkUnfold(Box<NetworkReport>),
+    /// The many-vertex check.
+    NetworkCheck(Box<CheckReport>),
+    /// A folding path.
+    Fold(Box<FoldPath>),
+}
+
+/// One report shape for every command and engine.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// The pattern's name.
+    pub pattern: String,
+    /// The command answered.
+    pub command: Command,
+    /// The engine that answered.
+    pub engine: Engine,
+    /// The answer.
+    pub verdict: Verdict,
+    /// Why, in words.
+    pub evidence: String,
+    /// Steps the engine took (descent steps, path steps).
+    pub steps: usize,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// Every crease's label, in the order of the angle vectors.
+    pub crease_labels: Vec<String>,
+    /// Fold angles at the start, rad.
+    pub start_fold_angles_rad: Vec<f64>,
+    /// Fold angles at the end (the state judged, for `check`), rad.
+    pub final_fold_angles_rad: Vec<f64>,
+    /// Largest constraint residual over the run, rad (the sphere's arcs for a single
+    /// vertex, the vertex closures for a network).
+    pub max_closure_residual_rad: f64,
+    /// The engine's own report.
+    pub detail: Detail,
+}
+
+/// Settings of every command, each validated where it is used.
+#[derive(Debug, Clone, Default)]
+pub struct Settings {
+    /// Unfolding (both engines: the network takes its energy, exponent, flat tolerance,
+    /// iteration budget and restarts from here).
+    pub unfold: UnfoldSettings,
+    /// A many-vertex check.
+    pub check: CheckSettings,
+    /// A folding path.
+    pub fold: FoldSettings,
+}
+
+impl Settings {
+    fn network_unfold(&self) -> NetworkUnfoldSettings {
+        let u = &self.unfold;
+        NetworkUnfoldSettings {
+            energy: u.energy,
+            p: u.p,
+            flat_tol: u.flat_tol,
+            max_iterations: u.max_iterations,
+            restarts: u.restarts,
+            ..NetworkUnfoldSettings::default()
+        }
+    }
+}
+
+fn sheet_of<'p>(pattern: &'p Pattern, command: &str) -> Result<&'p FoldingModel> {
+    pattern.sheet().ok_or_else(|| {
+        NanofoldError::invalid(
+            "pattern",
+            pattern.name(),
+            format!("a cone (a closed vertex whose sectors do not sum to 360°) has no flat sheet to {command}"),
+        )
+    })
+}
+
+/// Unfolds a folded pattern to flat: the single vertex by the sphere's energy descent, a
+/// crease pattern of many vertices by descent on its closures.
+pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+    match pattern.vertex() {
+        Some(vertex) => vertex_report(pattern, vertex, Command::Unfold, settings),
+        None => {
+            let model = sheet_of(pattern, "unfold")?;
+            let start = model.given_fold_angles();
+            let clock = Instant::now();
+            let report = unfold_network(model, &start, &settings.network_unfold())?;
+            let last = report
+                .steps
+                .last()
+                .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+            Ok(Report {
+                pattern: pattern.name().to_string(),
+                command: Command::Unfold,
+                engine: Engine::Network,
+                verdict: report.verdict.into(),
+                evidence: report.evidence.clone(),
+                steps: report.iterations,
+                seconds: clock.elapsed().as_secs_f64(),
+                crease_labels: pattern.crease_labels(),
+                start_fold_angles_rad: start,
+                final_fold_angles_rad: last,
+                max_closure_residual_rad: report.max_closure_residual,
+                detail: Detail::NetworkUnfold(Box::new(report)),
+            })
+        }
+    }
+}
+
+/// Judges a pattern: a single vertex by unfolding it (flat, locked, a local minimum, …), a
+/// crease pattern of many vertices by its state (rigid, not rigid, self-intersecting) or,
+/// flat, by its assignment (rigidly foldable or not, with a witness path).
+pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+    match pattern.vertex() {
+        Some(vertex) => vertex_report(pattern, vertex, Command::Check, settings),
+        None => {
+            let model = sheet_of(pattern, "check")?;
+            let clock = Instant::now();
+            let report = check_pattern(model, &settings.check)?;
+            let start = model.given_fold_angles();
+            let judged = report
+                .witness
+                .as_ref()
+                .and_then(|w| w.steps.last())
+                .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+            Ok(Report {
+                pattern: pattern.name().to_string(),
+                command: Command::Check,
+                engine: Engine::Network,
+                verdict: report.verdict.into(),
+                evidence: report.evidence.clone(),
+                steps: report.witness.as_ref().map_or(0, |w| w.steps.len()),
+                seconds: clock.elapsed().as_secs_f64(),
+                crease_labels: pattern.crease_labels(),
+                start_fold_angles_rad: start,
+                final_fold_angles_rad: judged,
+                max_closure_residual_rad: report.max_vertex_residual_rad,
+                detail: Detail::NetworkCheck(Box::new(report)),
+            })
+        }
+    }
+}
+
+/// Folds a pattern from its state (flat: along its assignment) by the many-vertex path
+/// (a single vertex on its sheet), as `settings.fold` drives it.
+pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+    let model = sheet_of(pattern, "fold")?;
+    let start = model.given_fold_angles();
+    let clock = Instant::now();
+    let path = fold_path(model, &start, &settings.fold)?;
+    let last = path
+        .steps
+        .last()
+        .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+    Ok(Report {
+        pattern: pattern.name().to_string(),
+        command: Command::Fold,
+        engine: Engine::Network,
+        verdict: (&path.stop).into(),
+        evidence: path.evidence.clone(),
+        steps: path.steps.len().saturating_sub(1),
+        seconds: clock.elapsed().as_secs_f64(),
+        crease_labels: model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
+        start_fold_angles_rad: start,
+        final_fold_angles_rad: last,
+        max_closure_residual_rad: path.max_closure_residual,
+        detail: Detail::Fold(Box::new(path)),
+    })
+}
+
+fn vertex_report(pattern: &Pattern, vertex: &VertexPattern, command: Command, settings: &Settings) -> Result<Report> {
+    let report = crate::unfold::unfold(vertex, &settings.unfold)?;
+    Ok(Report {
+        pattern: pattern.name().to_string(),
+        command,
+        engine: Engine::Vertex,
+        verdict: report.verdict.into(),
+        evidence: report.evidence.clone(),
+        steps: report.iterations,
+        seconds: report.seconds,
+        crease_labels: pattern.crease_labels(),
+        start_fold_angles_rad: pattern.fold_angles(),
+        final_fold_angles_rad: report.final_fold_angles_rad.clone(),
+        max_closure_residual_rad: report.max_arc_residual,
+        detail: Detail::VertexUnfold(Box::new(report)),
+    })
+}
