@@ -81,7 +81,26 @@ pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions
     } else {
         native::read_native(&value, name)?
     };
-    builder.build_with(options)
+    let mut pattern = builder.build_with(options)?;
+    pattern.adjustments.extend(frames_note(&value));
+    Ok(pattern)
+}
+
+/// A note when a FOLD file carries more frames than its key frame, which is the one read.
+pub fn frames_note(value: &serde_json::Value) -> Option<String> {
+    let frames = value.get("file_frames")?.as_array()?.len();
+    (frames > 0).then(|| {
+        format!(
+            "the file has {} frames: the key frame (its top-level state) was read, its {frames} file_frames were not",
+            frames + 1
+        )
+    })
+}
+
+/// [`frames_note`] of a file (None when it cannot be read or has no other frames).
+pub fn file_frames_note(path: &Path) -> Option<String> {
+    let text = input::read_text(path, input::MAX_PATTERN_BYTES).ok()?;
+    frames_note(&input::parse_json(&text, "").ok()?)
 }
 
 /// Loads a FOLD file as a crease pattern of any number of vertices
@@ -101,6 +120,13 @@ pub fn load_crease_pattern(path: &Path) -> Result<CreasePattern> {
 /// Parses FOLD text as a crease pattern; `origin` names it in errors.
 pub fn parse_crease_pattern(text: &str, name: &str, origin: &str) -> Result<CreasePattern> {
     let value = input::parse_json(text, origin)?;
+    if is_scene_object(&value) {
+        return Err(NanofoldError::invalid(
+            origin,
+            "a scene file",
+            "this is a scene (it has materials, hinges or time): run it with `simulate` or `modes`",
+        ));
+    }
     if !is_fold_object(&value) {
         return Err(NanofoldError::invalid(
             origin,

@@ -1133,3 +1133,83 @@ fn the_frame_unit_is_kept_on_every_output() {
     assert!(!out.status.success() && text.contains("frame_unit"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Two degree-3 vertices (a crease between them, two more from each to the sheet's
+/// corners): Kawasaki's condition has no meaning there, and the check says so in words
+/// (it wrote `"inf"` before) and lists the vertices.
+#[test]
+fn odd_degree_vertices_are_named_not_infinite() {
+    let dir = temp_dir("odd-degree");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("two_degree3.fold");
+    let fold = serde_json::json!({
+        "file_spec": 1.1,
+        "vertices_coords": [[-1, -1], [1, -1], [1, 1], [-1, 1], [-0.5, 0], [0.5, 0]],
+        "edges_vertices": [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [4, 3], [4, 0], [5, 2], [5, 1]],
+        "edges_assignment": ["B", "B", "B", "B", "V", "M", "M", "M", "M"],
+    });
+    std::fs::write(&file, fold.to_string()).unwrap();
+    let out = nanofold().args(["check", "--json"]).arg(&file).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(!text.contains("inf"), "{text}");
+    let value: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+    assert_eq!(
+        value["flat_foldability"]["odd_degree_vertices"],
+        serde_json::json!([4, 5]),
+        "{value}"
+    );
+    assert!(value["flat_foldability"]["worst_kawasaki"].is_null(), "{value}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `fold` given a scene says it is a scene, as `unfold` does.
+#[test]
+fn fold_of_a_scene_says_it_is_a_scene() {
+    let out = nanofold()
+        .args([
+            "fold",
+            "patterns/devices/miura_sheet.scene.json",
+            "--out",
+            "/nonexistent/never",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("this is a scene") && err.contains("simulate"), "{err}");
+}
+
+/// Unfolding a FOLD animation (nanofold's own `unfold.fold`) reads its key frame and says
+/// that its other frames were not read, for a vertex and for a sheet.
+#[test]
+fn unfold_of_an_animation_says_its_frames_were_not_read() {
+    for pattern in ["patterns/corner_cube.fold", "patterns/many/miura_4x4_folded.fold"] {
+        let dir = temp_dir("animation");
+        let first = nanofold()
+            .args(["unfold", pattern, "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(first.status.success());
+        let animation = dir.join("unfold.fold");
+        let frames = serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&animation).unwrap()).unwrap()
+            ["file_frames"]
+            .as_array()
+            .unwrap()
+            .len();
+        let again = nanofold()
+            .args(["unfold", "--json"])
+            .arg(&animation)
+            .arg("--out")
+            .arg(dir.join("again"))
+            .output()
+            .unwrap();
+        let value: serde_json::Value = serde_json::from_slice(&again.stdout).unwrap();
+        let notes = value["adjustments"].to_string();
+        assert!(
+            notes.contains(&format!("its {frames} file_frames were not")),
+            "{pattern}: {notes}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

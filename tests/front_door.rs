@@ -62,7 +62,11 @@ fn the_door_unfolds_as_the_command_line_does() {
             .unwrap();
         let _ = std::fs::remove_dir_all(&dir);
         let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        let report = unfold(&Pattern::open(Path::new(path), &LoadOptions::default()).unwrap(), &settings).unwrap();
+        let report = unfold(
+            &Pattern::open(Path::new(path), &LoadOptions::default()).unwrap(),
+            &settings,
+        )
+        .unwrap();
         assert_eq!(report.verdict.as_str(), line["verdict"], "{path}");
         assert_eq!(report.steps as u64, line["iterations"].as_u64().unwrap(), "{path}");
         let theirs: Vec<f64> = serde_json::from_value(line["final_fold_angles_rad"].clone()).unwrap();
@@ -96,7 +100,12 @@ fn a_vertex_from_numbers_folds_on_its_own_sheet() {
         .zip(&b.final_fold_angles_rad)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
-    assert!(gap < 1e-9, "{gap:e}: {:?} vs {:?}", a.final_fold_angles_rad, b.final_fold_angles_rad);
+    assert!(
+        gap < 1e-9,
+        "{gap:e}: {:?} vs {:?}",
+        a.final_fold_angles_rad,
+        b.final_fold_angles_rad
+    );
     let checked = check(&from_numbers, &settings).unwrap();
     let engine = unfold_vertex(from_numbers.vertex().unwrap(), &settings.unfold).unwrap();
     assert_eq!(checked.verdict, Verdict::from(engine.verdict));

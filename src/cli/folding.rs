@@ -520,6 +520,7 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
         "tried": report.tried,
         "flat_foldability": json!({
             "worst_kawasaki": report.flat_foldability.worst_kawasaki.map(|(v, r)| json!({"vertex": v, "residual_rad": number(r)})),
+            "odd_degree_vertices": report.flat_foldability.odd_degree,
             "maekawa_failures": report.flat_foldability.maekawa_failures,
         }),
         "folded_form": report.folded_form.map(|f| json!({
@@ -682,6 +683,7 @@ pub fn unfold_network_one(
     use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
     use std::fmt::Write as _;
     let (model, projection) = load_projected(pattern_path, solver.project)?;
+    let frames_note = nanofold::io::file_frames_note(pattern_path);
     let settings = NetworkUnfoldSettings {
         energy: solver.energy.into(),
         p: solver.p,
@@ -772,13 +774,13 @@ pub fn unfold_network_one(
         "restarts_used": report.restarts_used,
         "crossings_refused": report.crossings_refused,
         "radial_steps": report.radial_steps,
-        "adjustments": projection.iter().map(|(note, _)| note.clone()).collect::<Vec<_>>(),
+        "adjustments": projection.iter().map(|(note, _)| note.clone()).chain(frames_note.clone()).collect::<Vec<_>>(),
         "projection": projection.as_ref().map_or(Value::Null, |(_, json)| json.clone()),
         "max_closure_residual_rad": report.max_closure_residual,
         "out": dir.display().to_string(),
     });
     let mut text = String::new();
-    if let Some((note, _)) = &projection {
+    for note in projection.iter().map(|(note, _)| note).chain(&frames_note) {
         writeln!(text, "{}: {note}", model.pattern.name)?;
     }
     writeln!(

@@ -103,8 +103,12 @@ pub struct CheckReport {
 /// sector angles sum to π, and mountains and valleys differ by two.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlatFoldability {
-    /// The vertex farthest from Kawasaki's condition and its |Σ alternate sectors − π|, rad.
+    /// The even-degree vertex farthest from Kawasaki's condition and its |Σ alternate
+    /// sectors − π|, rad.
     pub worst_kawasaki: Option<(usize, f64)>,
+    /// Vertices of odd degree: no flat folding exists there (Kawasaki's condition has no
+    /// alternation to hold).
+    pub odd_degree: Vec<usize>,
     /// Vertices whose assignment breaks Maekawa's condition (vertices with a U crease are
     /// not judged).
     pub maekawa_failures: Vec<usize>,
@@ -114,16 +118,17 @@ impl FlatFoldability {
     /// The conditions at every star of the model.
     pub fn of(model: &FoldingModel) -> FlatFoldability {
         let mut worst_kawasaki: Option<(usize, f64)> = None;
+        let mut odd_degree = Vec::new();
         let mut maekawa_failures = Vec::new();
         for star in &model.stars {
-            let alternating: f64 = star.sector_angles.iter().step_by(2).sum();
-            let residual = if star.sector_angles.len() % 2 == 0 {
-                (alternating - std::f64::consts::PI).abs()
+            if star.sector_angles.len() % 2 == 1 {
+                odd_degree.push(star.vertex);
             } else {
-                f64::INFINITY
-            };
-            if worst_kawasaki.is_none_or(|(_, r)| residual > r) {
-                worst_kawasaki = Some((star.vertex, residual));
+                let alternating: f64 = star.sector_angles.iter().step_by(2).sum();
+                let residual = (alternating - std::f64::consts::PI).abs();
+                if worst_kawasaki.is_none_or(|(_, r)| residual > r) {
+                    worst_kawasaki = Some((star.vertex, residual));
+                }
             }
             let signs: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
             if signs.iter().all(|&x| x != 0.0) {
@@ -136,17 +141,35 @@ impl FlatFoldability {
         }
         FlatFoldability {
             worst_kawasaki,
+            odd_degree,
             maekawa_failures,
         }
     }
 
     /// One line for the evidence.
     pub fn summary(&self, vertices: usize) -> String {
-        let kawasaki = match self.worst_kawasaki {
-            None => "no interior vertex".to_string(),
-            Some((_, r)) if r <= 1e-9 => format!("Kawasaki holds at all {vertices} vertices"),
+        let even = vertices - self.odd_degree.len();
+        let mut kawasaki = match self.worst_kawasaki {
+            None if self.odd_degree.is_empty() => "no interior vertex".to_string(),
+            None => String::new(),
+            Some((_, r)) if r <= 1e-9 && self.odd_degree.is_empty() => {
+                format!("Kawasaki holds at all {vertices} vertices")
+            }
+            Some((_, r)) if r <= 1e-9 => format!("Kawasaki holds at the {even} of even degree"),
             Some((v, r)) => format!("Kawasaki fails by up to {r:.3e} rad (vertex {v})"),
         };
+        if !self.odd_degree.is_empty() {
+            let odd = format!(
+                "odd degree at {} vertices (first {:?}): no flat folding there",
+                self.odd_degree.len(),
+                &self.odd_degree[..self.odd_degree.len().min(5)]
+            );
+            kawasaki = if kawasaki.is_empty() {
+                odd
+            } else {
+                format!("{odd}; {kawasaki}")
+            };
+        }
         let maekawa = if self.maekawa_failures.is_empty() {
             "Maekawa holds".to_string()
         } else {
