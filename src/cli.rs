@@ -13,7 +13,7 @@ use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::{Scene, System};
 use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, SimulationSettings};
-use nanofold::io::folder::{folder_name, write_folder};
+use nanofold::io::folder::{folder_name, write_folder_of};
 use nanofold::io::output::{
     closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
 };
@@ -35,6 +35,10 @@ use std::path::{Path, PathBuf};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Replace an output folder that holds the results of another input file (without it,
+    /// such a run is refused, naming the folder and the input it holds).
+    #[arg(long, global = true)]
+    pub force: bool,
 }
 
 #[derive(Subcommand)]
@@ -506,7 +510,13 @@ fn unfold_one(
         ("unfold.fold", fold.as_bytes()),
         ("unfold.svg", svg.as_bytes()),
     ];
-    write_folder(&dir, &files).with_context(|| format!("writing {}", dir.display()))?;
+    write_folder_of(
+        &dir,
+        pattern_path,
+        FORCE.load(std::sync::atomic::Ordering::Relaxed),
+        &files,
+    )
+    .with_context(|| format!("writing {}", dir.display()))?;
     let mut summary = summary(&pattern, pattern_path, &report);
     summary["out"] = json!(dir.display().to_string());
     let mut text = String::new();
@@ -915,7 +925,7 @@ fn constraints_after_setup(
     if args.format == ExportFormat::Mujoco {
         files.push(("constraints.xml", mujoco_snippet(&report).map_err(constraints_flags)?));
     }
-    write_outputs(&dir, &files)?;
+    write_outputs(&dir, &args.pattern, &files)?;
     Ok((report, dir, files))
 }
 
@@ -989,13 +999,17 @@ fn default_folder(name: &str, file: &Path) -> PathBuf {
 
 /// Writes the (file name, contents) set into `dir` as one (see `io::folder`); everything is
 /// rendered first.
-fn write_outputs(dir: &Path, files: &[(&str, String)]) -> Result<()> {
+fn write_outputs(dir: &Path, input: &Path, files: &[(&str, String)]) -> Result<()> {
     let files: Vec<(&str, &[u8])> = files
         .iter()
         .map(|(name, contents)| (*name, contents.as_bytes()))
         .collect();
-    write_folder(dir, &files).with_context(|| format!("writing {}", dir.display()))
+    write_folder_of(dir, input, FORCE.load(std::sync::atomic::Ordering::Relaxed), &files)
+        .with_context(|| format!("writing {}", dir.display()))
 }
+
+/// `--force`: replace an output folder that holds another input's results.
+static FORCE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// The "wrote DIR/{a, b}" line.
 fn print_written(dir: &Path, files: &[(&str, String)]) {
@@ -1134,7 +1148,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
             serde_json::to_string(&nanofold::io::folding_output::network_motion_fold(model, response))?,
         ));
     }
-    write_outputs(&dir, &files)?;
+    write_outputs(&dir, &args.scene, &files)?;
     if args.json {
         println!("{}", response_summary(&scene, &settings, &simulation));
         return Ok(());
@@ -1340,7 +1354,7 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
                 let file_name = nanofold::io::scene::scene_name(path);
                 PathBuf::from("output").join(folder_name(&scene.name, &file_name))
             });
-            return run_modes_network(&scene.name, model, json, &dir);
+            return run_modes_network(&scene.name, path, model, json, &dir);
         }
         System::Strip(chain) => chain,
     };
@@ -1391,6 +1405,7 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
 
 fn run_modes_network(
     name: &str,
+    input: &Path,
     model: &nanofold::dynamics::network::NetworkModel,
     json: bool,
     dir: &Path,
@@ -1398,7 +1413,7 @@ fn run_modes_network(
     let result = nanofold::dynamics::network::modes::folded_modes(model)?;
     let fold = nanofold::io::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
     let files = [("modes.fold", serde_json::to_string(&fold)?)];
-    write_outputs(dir, &files)?;
+    write_outputs(dir, input, &files)?;
     if json {
         let mut value = nanofold::io::output::network_modes_json(name, model, &result);
         value["out"] = serde_json::json!(dir.display().to_string());
@@ -1551,6 +1566,7 @@ fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain,
 
 /// Runs the parsed command; Ok(false) means "finished, but exit non-zero".
 pub fn run(cli: Cli) -> Result<bool> {
+    FORCE.store(cli.force, std::sync::atomic::Ordering::Relaxed);
     match cli.command {
         Command::Unfold {
             patterns,

@@ -400,7 +400,7 @@ fn simulate_writes_response_files_and_the_documented_json_keys() {
     let (_, summary) = json_run(
         nanofold()
             .args(["simulate", "patterns/bridge_ramp.scene.json", "--json", "--out"])
-            .arg(&dir),
+            .arg(temp_dir("simulate-ramp")),
     );
     assert_eq!(summary["model"], "quasi_static");
     assert!(summary["time_scale_ratio"].as_f64().unwrap() > 1e8);
@@ -1212,4 +1212,49 @@ fn unfold_of_an_animation_says_its_frames_were_not_read() {
         );
         let _ = std::fs::remove_dir_all(&dir);
     }
+}
+
+/// Two inputs with one file name (`a/folded.fold`, `b/folded.fold`) share a default output
+/// folder: the second run is refused, naming the folder, the input it holds and what to do,
+/// and the first run's results stay; `--force` replaces them; the same input again may.
+#[test]
+fn an_output_folder_of_another_input_is_not_replaced() {
+    let dir = temp_dir("owner");
+    for (sub, source) in [("a", "patterns/corner_cube.fold"), ("b", "patterns/waterbomb.fold")] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::copy(source, dir.join(sub).join("folded.fold")).unwrap();
+    }
+    let run = |file: &str, force: bool| {
+        let mut command = nanofold();
+        command.current_dir(&dir).args(["unfold", file]);
+        if force {
+            command.arg("--force");
+        }
+        command.output().unwrap()
+    };
+    let results = dir.join("output/folded/trajectory.json");
+    assert!(run("a/folded.fold", false).status.success());
+    let first = std::fs::read_to_string(&results).unwrap();
+    let refused = run("b/folded.fold", false);
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        message.contains("output/folded") && message.contains("a/folded.fold") && message.contains("--force"),
+        "{message}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&results).unwrap(),
+        first,
+        "the first results stay"
+    );
+    assert!(
+        run("a/folded.fold", false).status.success(),
+        "the same input may replace its own"
+    );
+    assert!(run("b/folded.fold", true).status.success());
+    assert_ne!(std::fs::read_to_string(&results).unwrap(), first);
+    let owner: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("output/folded/nanofold.json")).unwrap()).unwrap();
+    assert!(owner["input"].as_str().unwrap().ends_with("b/folded.fold"), "{owner}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -241,7 +241,9 @@ fn mujoco_runs_the_exported_bridge_to_nanofolds_first_contact() {
             scene.contains("thesis"),
             "{scene}: the triangle-inequality note"
         );
-        let reference = simulate(Path::new(scene), &dir.join("sim"));
+        // One output folder per scene: a folder holds one input's results.
+        let stem = Path::new(scene).file_stem().unwrap().to_string_lossy().to_string();
+        let reference = simulate(Path::new(scene), &dir.join(&stem));
         let t_nanofold = reference["collision"]["time_s"].as_f64().unwrap() * 1e6;
         assert_eq!(reference["collision"]["pair"][0], "plate 3");
         let result = run_mujoco(&python, &model, 1.05 * t_nanofold);
@@ -260,7 +262,7 @@ fn mujoco_runs_the_exported_bridge_to_nanofolds_first_contact() {
         let lag = (result["final_time_us"].as_f64().unwrap() - t_mujoco) * 1e-6;
         let event_gap = (t_mujoco - t_nanofold).abs() * 1e-6;
         let response: Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("sim/response.json")).unwrap()).unwrap();
+            serde_json::from_str(&std::fs::read_to_string(dir.join(&stem).join("response.json")).unwrap()).unwrap();
         let rates = response["velocities_rad_s"]
             .as_array()
             .unwrap()

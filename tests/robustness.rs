@@ -177,6 +177,7 @@ fn a_run_replaces_its_own_files_and_keeps_the_other_commands() {
         [
             "constraints.json",
             "constraints.svg",
+            "nanofold.json",
             "trajectory.json",
             "unfold.fold",
             "unfold.svg"
@@ -686,7 +687,7 @@ fn a_flat_sheet_without_creases_is_flat_and_a_non_rigid_start_prints_no_nan() {
         r#"{"vertices_coords":[[0,0],[2,0],[2,2],[0,2],[1,1]],"edges_vertices":[[0,1],[1,2],[2,3],[3,0],[0,4]],"edges_assignment":["B","B","B","B","V"],"edges_foldAngle":[0,0,0,0,90]}"#,
     )
     .unwrap();
-    let (code, stdout, stderr) = run_in(&dir, &["unfold", "slit.fold", "--out", "out"]);
+    let (code, stdout, stderr) = run_in(&dir, &["unfold", "slit.fold", "--out", "out-slit"]);
     assert_eq!(code, Some(0), "{stderr}");
     assert!(
         stdout.contains("not_rigid") && stdout.contains("energy not evaluated"),

@@ -403,7 +403,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         ),
         ("fold.svg", fold_svg(&model, &path, &title)?),
     ];
-    write_outputs(&dir, &files)?;
+    write_outputs(&dir, &args.pattern, &files)?;
     let mut summary = fold_summary(&model, &args.pattern, &path, dof, seconds);
     summary["frames"] = json!(chosen.len());
     summary["out"] = json!(dir.display().to_string());
@@ -649,7 +649,7 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
             network_mujoco(&curves).map_err(|e| flags(e, &[("degree", "--degree")]))?,
         ));
     }
-    write_outputs(&dir, &files)?;
+    write_outputs(&dir, &args.pattern, &files)?;
     if args.json {
         println!("{}", serde_json::to_string(&curves)?);
         return Ok(());
@@ -755,7 +755,7 @@ pub fn unfold_network_one(
         ("unfold.fold", serde_json::to_string_pretty(&fold)?),
         ("unfold.svg", svg),
     ];
-    write_outputs(&dir, &files)?;
+    write_outputs(&dir, pattern_path, &files)?;
     let summary = json!({
         "pattern": model.pattern.name,
         "file": pattern_path.display().to_string(),

@@ -26,7 +26,11 @@ pub const OUTPUT_FILES: &[&str] = &[
     "snapshots.svg",
     "motion.fold",
     "modes.fold",
+    OWNER_FILE,
 ];
+
+/// The file in every output folder that names the input its results are of.
+pub const OWNER_FILE: &str = "nanofold.json";
 
 /// Marks temporary and retired folders beside the target: `.{name}.nanofold-{kind}-{pid}-{n}`.
 const MARK: &str = ".nanofold-";
@@ -109,6 +113,38 @@ fn fill(temporary: &Path, dir: &Path, files: &[(&str, &[u8])]) -> std::result::R
         }
     }
     Ok(())
+}
+
+/// [`write_folder`] for the results of `input`: the folder also gets [`OWNER_FILE`] naming
+/// the input (its canonical path), and a folder that holds another input's results is
+/// refused unless `replace_other` (the command line's `--force`).
+pub fn write_folder_of(dir: &Path, input: &Path, replace_other: bool, files: &[(&str, &[u8])]) -> Result<()> {
+    let input = std::fs::canonicalize(input).unwrap_or_else(|_| input.to_path_buf());
+    let shown = input.display().to_string();
+    if let Some(other) = owner(dir) {
+        if other != shown && !replace_other {
+            return Err(NanofoldError::invalid(
+                dir.display().to_string(),
+                format!("holds the results of {other}"),
+                format!("this run is of {shown}: give another output folder (--out DIR), or --force to replace them"),
+            ));
+        }
+    }
+    let marker = serde_json::json!({
+        "input": shown,
+        "written_by": format!("nanofold {}", env!("CARGO_PKG_VERSION")),
+    })
+    .to_string();
+    let mut all: Vec<(&str, &[u8])> = files.to_vec();
+    all.push((OWNER_FILE, marker.as_bytes()));
+    write_folder(dir, &all)
+}
+
+/// The input an output folder's results are of, as its [`OWNER_FILE`] names it.
+pub fn owner(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join(OWNER_FILE)).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("input")?.as_str().map(str::to_string)
 }
 
 /// Writes `files` (name, contents) into `dir` atomically: afterwards `dir` holds exactly
