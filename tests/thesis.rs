@@ -111,6 +111,58 @@ fn a_checked_quartic_measures_what_the_fit_reports() {
     );
 }
 
+/// Table 2 (eq. 5.19): the printed quartics of corner-cube step 1, degrees in degrees of the
+/// driving crease θ1, constant first: θ3 (the crease opposite the merged sector, `edges[3]`)
+/// and θ4 (`edges[2]`; `edges[4]` folds equal and opposite), as transcribed.
+pub const THESIS_TABLE2_THETA3: [f64; 5] = [0.0089, 0.71, 3.1e-5, -3e-6, -1.8e-8];
+/// θ4's row of Table 2, constant first.
+pub const THESIS_TABLE2_THETA4: [f64; 5] = [-0.015, 0.37, -6.2e-4, 1.2e-5, -2.4e-8];
+
+/// The thesis's printed Table 2 against exact loop closure: off by 2.42° (θ3) and 1.29° (θ4)
+/// at θ1 = 180°, as the transcription's note computes independently; with θ3's t² sign
+/// flipped, 0.48° at worst; and nanofold's own least-squares quartic has that flipped sign
+/// (and θ4's printed signs), the evidence that the table's a33 lost its minus sign.
+#[test]
+fn table_2_measured_against_exact_closure() {
+    let pattern = load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
+    let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
+    let samples = sweep_samples(&pattern, &setup, [0.0, PI], 201).unwrap();
+    let crease = |edge: usize| pattern.crease_from_user_index(edge).unwrap();
+    let theta3 = check_curve(&pattern, &samples, crease(3), &THESIS_TABLE2_THETA3).unwrap();
+    let theta4 = check_curve(&pattern, &samples, crease(2), &THESIS_TABLE2_THETA4).unwrap();
+    for (checked, printed_error) in [(&theta3, 2.42), (&theta4, 1.29)] {
+        assert_eq!(checked.folded_end_deg, 180.0);
+        assert!(
+            (checked.folded_end_error_rad.to_degrees() - printed_error).abs() < 0.005,
+            "{checked:?}"
+        );
+        assert!((checked.max_error_rad - checked.folded_end_error_rad.abs()).abs() < 1e-12);
+    }
+    let mut flipped = THESIS_TABLE2_THETA3;
+    flipped[2] = -flipped[2];
+    let repaired = check_curve(&pattern, &samples, crease(3), &flipped).unwrap();
+    assert!((repaired.max_error_rad.to_degrees() - 0.48).abs() < 0.005, "{repaired:?}");
+    let poly = ConstraintPoly::fit(&pattern, &samples, 4).unwrap();
+    let report = ConstraintReport::new(&pattern, &samples, &poly).unwrap();
+    let fitted = |edge: usize| {
+        report
+            .curves
+            .iter()
+            .find(|c| c.crease == edge)
+            .map(|c| c.coeffs_deg.clone())
+            .unwrap()
+    };
+    for (printed, fit) in [(flipped, fitted(3)), (THESIS_TABLE2_THETA4, fitted(2))] {
+        // Every term but the constant has the printed sign and lies within 20% of it.
+        for k in 1..5 {
+            assert!(
+                printed[k].signum() == fit[k].signum() && ((fit[k] - printed[k]) / printed[k]).abs() < 0.2,
+                "term {k}: printed {printed:?}, fitted {fit:?}"
+            );
+        }
+    }
+}
+
 /// Splits text into words and numbers, each number with its printed decimals.
 fn tokens(text: &str) -> Vec<Result<(f64, i32), String>> {
     let mut out = Vec::new();
