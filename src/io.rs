@@ -135,7 +135,57 @@ pub fn parse_crease_pattern(text: &str, name: &str, origin: &str) -> Result<Crea
         ));
     }
     let unflattened = fold::unflatten_folded_form(&value)?;
-    fold::read_crease_pattern(unflattened.as_ref().unwrap_or(&value), name)?.build()
+    let mut pattern = fold::read_crease_pattern(unflattened.as_ref().unwrap_or(&value), name)?.build()?;
+    // A flat-folded form (fold-convert's) states its fold: its ±180° are the state.
+    if unflattened.is_none() {
+        angles_as_targets(&mut pattern)?;
+    }
+    Ok(pattern)
+}
+
+/// A vertex closes when its residual is at most this, rad (`check`'s default tolerance).
+const STATE_CLOSURE: f64 = 1e-6;
+
+/// Flat coordinates with fold angles that are targets, not a state, read as the flat crease
+/// pattern with those targets: every crease at exactly ±180° (the convention of Origami
+/// Simulator's and other solvers' exports), or angles that close no vertex of three or more
+/// creases (a state closes at least where it is not bent). A state that closes somewhere
+/// stays a state.
+fn angles_as_targets(pattern: &mut CreasePattern) -> Result<()> {
+    if pattern.folded_form.is_some() || !pattern.reading.is_empty() {
+        return Ok(());
+    }
+    let angles: Vec<f64> = pattern.creases.iter().map(|&e| pattern.fold_angles[e]).collect();
+    if angles.iter().all(|a| *a == 0.0) || pattern.locked.iter().any(|&l| l) {
+        return Ok(());
+    }
+    let full = angles.iter().all(|a| (a.abs().to_degrees() - 180.0).abs() <= 1e-9);
+    let why = if full {
+        "every crease at ±180° (the targets' convention of Origami Simulator and other solvers)".to_string()
+    } else {
+        let model = crate::folding::FoldingModel::new(pattern.clone())?;
+        let residuals = crate::folding::vertex_residuals(&model, &model.given_fold_angles());
+        // A vertex of two creases (one crease line through it) closes whenever they are equal:
+        // it says nothing of a state.
+        let closing = residuals
+            .iter()
+            .zip(&model.stars)
+            .filter(|(_, star)| star.columns.len() >= 3)
+            .map(|(r, _)| *r)
+            .fold(f64::INFINITY, f64::min);
+        if !closing.is_finite() || closing <= STATE_CLOSURE {
+            return Ok(());
+        }
+        format!("they close no vertex (the best closes to {closing:.2e} rad, above {STATE_CLOSURE:e})")
+    };
+    pattern.reading.push(format!(
+        "flat coordinates with edges_foldAngle that are targets, not a state: {why}; read as the flat crease pattern with its assignment"
+    ));
+    pattern.target_angles = Some(std::mem::replace(
+        &mut pattern.fold_angles,
+        vec![0.0; pattern.edges.len()],
+    ));
+    Ok(())
 }
 
 /// Does this JSON object look like a scene file (keys only scenes have)?

@@ -141,7 +141,10 @@ fn table_2_measured_against_exact_closure() {
     let mut flipped = THESIS_TABLE2_THETA3;
     flipped[2] = -flipped[2];
     let repaired = check_curve(&pattern, &samples, crease(3), &flipped).unwrap();
-    assert!((repaired.max_error_rad.to_degrees() - 0.48).abs() < 0.005, "{repaired:?}");
+    assert!(
+        (repaired.max_error_rad.to_degrees() - 0.48).abs() < 0.005,
+        "{repaired:?}"
+    );
     let poly = ConstraintPoly::fit(&pattern, &samples, 4).unwrap();
     let report = ConstraintReport::new(&pattern, &samples, &poly).unwrap();
     let fitted = |edge: usize| {

@@ -337,6 +337,8 @@ fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, 
         "max_closure_residual_rad": path.max_closure_residual,
         "min_panel_clearance": path.min_panel_clearance.map_or(Value::Null, number),
         "newton_iterations": path.newton_iterations,
+        "reading": model.pattern.reading,
+        "target_angles_rad": target_angles(model),
         "seconds": seconds,
     })
 }
@@ -421,6 +423,9 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     );
     if let Some(branch) = &path.branch {
         println!("  branch: {branch}");
+    }
+    for note in &model.pattern.reading {
+        println!("  read: {note}");
     }
     println!(
         "  {} creases, {} interior vertices, {} panels; {} DOF at the end; progress {:.4}",
@@ -530,8 +535,16 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
             "mirrored": f.mirrored,
             "assignment_conflicts": f.assignment_conflicts,
         })),
+        "reading": model.pattern.reading,
+        "target_angles_rad": target_angles(model),
         "seconds": seconds,
     })
+}
+
+/// The file's angles read as targets, per crease (None: the file gave a state or none).
+fn target_angles(model: &FoldingModel) -> Option<Vec<f64>> {
+    let targets = model.pattern.target_angles.as_ref()?;
+    Some(model.pattern.creases.iter().map(|&e| targets[e]).collect())
 }
 
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
@@ -774,7 +787,7 @@ pub fn unfold_network_one(
         "restarts_used": report.restarts_used,
         "crossings_refused": report.crossings_refused,
         "radial_steps": report.radial_steps,
-        "adjustments": projection.iter().map(|(note, _)| note.clone()).chain(frames_note.clone()).collect::<Vec<_>>(),
+        "adjustments": projection.iter().map(|(note, _)| note.clone()).chain(frames_note.clone()).chain(model.pattern.reading.iter().cloned()).collect::<Vec<_>>(),
         "projection": projection.as_ref().map_or(Value::Null, |(_, json)| json.clone()),
         "max_closure_residual_rad": report.max_closure_residual,
         "out": dir.display().to_string(),

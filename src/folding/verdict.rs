@@ -185,6 +185,17 @@ impl FlatFoldability {
 
 /// Checks the state the pattern carries or, when it is flat, its assignment.
 pub fn check_pattern(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> {
+    let mut report = judge(model, settings)?;
+    // How the file was read (a noisy flat sheet, angles taken as targets) is part of the
+    // evidence: the verdict rests on it.
+    for note in &model.pattern.reading {
+        report.evidence.push_str(&format!("; read: {note}"));
+    }
+    Ok(report)
+}
+
+/// [`check_pattern`] before the reading's notes.
+fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> {
     settings.contact.validate()?;
     let rho = model.given_fold_angles();
     let has_state = rho.iter().any(|&r| r != 0.0);

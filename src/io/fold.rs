@@ -4,7 +4,7 @@
 
 use crate::error::{NanofoldError, Result};
 use crate::io::input::short_json;
-use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind, FoldedFormFit};
+use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind, FoldedFormFit, ReadBuilder};
 use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
 use serde_json::Value;
 use std::f64::consts::TAU;
@@ -539,7 +539,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
 /// Reads the key frame of a FOLD object into a crease pattern of any number of vertices
 /// (`docs/model.md#crease-patterns`). Fold angles may be absent (the flat state) or `null`
 /// on boundary and facet edges, as Origami Simulator writes them.
-pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePatternBuilder> {
+pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuilder> {
     let graph = parse_graph(value, PATTERN_LIMITS)?;
     // Lengths far from 1 leave no digits for the planarity tolerances (1e-12 of the size).
     if let Some(i) = graph
@@ -569,8 +569,16 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
             other => EdgeKind::Crease(Assignment::from_letter(other, &field)?),
         });
     }
+    let mut graph = graph;
+    let mut reading = None;
     if graph.is_3d {
-        return read_folded_form(graph, kinds, name);
+        match flat_within_noise(&graph.coords3, graph.faces_vertices.as_deref()) {
+            Some((coords, planarity)) => {
+                graph.coords = coords;
+                reading = Some(planarity);
+            }
+            None => return read_folded_form(graph, kinds, name).map(Into::into),
+        }
     }
     let mut fold_angles = Vec::with_capacity(graph.edges.len());
     for (e, &kind) in kinds.iter().enumerate() {
@@ -594,6 +602,30 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
             0.0
         });
     }
+    if let Some(planarity) = reading {
+        // The sheet is the state (flat); its angles can only be targets.
+        let targets = std::mem::replace(&mut fold_angles, vec![0.0; graph.edges.len()]);
+        let any_target = targets.iter().any(|a| *a != 0.0);
+        return Ok(CreasePatternBuilder {
+            name: name.to_string(),
+            vertices: graph.coords,
+            edges: graph.edges,
+            kinds,
+            fold_angles,
+            faces: None,
+            angle_field: graph.angle_key.to_string(),
+            folded_form: None,
+            locked: graph.locked,
+            unit: graph.unit,
+        }
+        .with_reading(
+            format!(
+                "a 3D sheet flat within its noise (every vertex within {planarity:.1e} of the sheet's size of one plane; tolerance {FLAT_NOISE:.0e}): read as the flat crease pattern with its assignment{}",
+                if any_target { format!(", its {} read as targets", graph.angle_key) } else { String::new() }
+            ),
+            any_target.then_some(targets),
+        ));
+    }
     Ok(CreasePatternBuilder {
         name: name.to_string(),
         vertices: graph.coords,
@@ -605,7 +637,73 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<CreasePat
         folded_form: None,
         locked: graph.locked,
         unit: graph.unit,
-    })
+    }
+    .into())
+}
+
+/// A 3D sheet whose vertices all lie within this fraction of its size of one plane is flat
+/// (float noise of an exporter), not a folded state.
+pub const FLAT_NOISE: f64 = 1e-4;
+
+/// The 2D coordinates of a 3D sheet that is flat within [`FLAT_NOISE`] (in its best-fit
+/// plane, turned so the listed faces run counter-clockwise), and its planarity relative to
+/// its size; None when it is folded.
+fn flat_within_noise(coords: &[[f64; 3]], faces: Option<&[Vec<usize>]>) -> Option<(Vec<[f64; 2]>, f64)> {
+    use nalgebra::{Matrix3, Vector3};
+    let n = coords.len();
+    if n < 3 {
+        return None;
+    }
+    let points: Vec<Vector3<f64>> = coords.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect();
+    let centre = points.iter().sum::<Vector3<f64>>() / n as f64;
+    let size = points.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+    if !(size > 0.0 && size.is_finite()) {
+        return None;
+    }
+    let mut scatter = Matrix3::zeros();
+    for p in &points {
+        let d = (p - centre) / size;
+        scatter += d * d.transpose();
+    }
+    let eigen = scatter.symmetric_eigen();
+    let order = {
+        let mut k = [0, 1, 2];
+        k.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
+        k
+    };
+    let mut normal: Vector3<f64> = eigen.eigenvectors.column(order[0]).into_owned();
+    let planarity = points
+        .iter()
+        .map(|p| (p - centre).dot(&normal).abs())
+        .fold(0.0, f64::max)
+        / size;
+    if planarity > FLAT_NOISE {
+        return None;
+    }
+    // Faces listed counter-clockwise about the normal (FOLD's convention): pick its sign so
+    // most of them are.
+    if let Some(faces) = faces {
+        let turn: f64 = faces
+            .iter()
+            .filter(|f| f.len() >= 3 && f.iter().all(|&v| v < n))
+            .map(|f| {
+                let (a, b, c) = (points[f[0]], points[f[1]], points[f[2]]);
+                (b - a).cross(&(c - a)).dot(&normal).signum()
+            })
+            .sum();
+        if turn < 0.0 {
+            normal = -normal;
+        }
+    }
+    let u: Vector3<f64> = eigen.eigenvectors.column(order[2]).into_owned();
+    let v = normal.cross(&u);
+    Some((
+        points
+            .iter()
+            .map(|p| [(p - centre).dot(&u), (p - centre).dot(&v)])
+            .collect(),
+        planarity,
+    ))
 }
 
 /// A 3D folded form: the crease pattern developed from its faces, the state from its

@@ -117,6 +117,11 @@ pub struct CreasePattern {
     pub locked: Vec<bool>,
     /// The file's `frame_unit` (None: unstated), written back on the outputs.
     pub unit: Option<String>,
+    /// How the file was read where it could be read more than one way (a 3D sheet flat
+    /// within its noise, angles taken as targets), for the evidence.
+    pub reading: Vec<String>,
+    /// Per edge, the file's angles when they were read as targets, not a state, rad.
+    pub target_angles: Option<Vec<f64>>,
 }
 
 impl CreasePattern {
@@ -126,7 +131,47 @@ impl CreasePattern {
     }
 }
 
+/// A builder with a note on how its file was read, and the file's angles as targets.
+#[derive(Debug, Clone)]
+pub struct ReadBuilder {
+    /// The pattern.
+    pub builder: CreasePatternBuilder,
+    /// How the file was read.
+    pub reading: Vec<String>,
+    /// The file's angles, read as targets (rad, per edge).
+    pub target_angles: Option<Vec<f64>>,
+}
+
+impl ReadBuilder {
+    /// Validates and builds the pattern, with the reading's notes and targets.
+    pub fn build(self) -> Result<CreasePattern> {
+        let mut pattern = self.builder.build()?;
+        pattern.reading = self.reading;
+        pattern.target_angles = self.target_angles;
+        Ok(pattern)
+    }
+}
+
+impl From<CreasePatternBuilder> for ReadBuilder {
+    fn from(builder: CreasePatternBuilder) -> ReadBuilder {
+        ReadBuilder {
+            builder,
+            reading: Vec::new(),
+            target_angles: None,
+        }
+    }
+}
+
 impl CreasePatternBuilder {
+    /// This builder with a note on how the file was read and the targets it gave.
+    pub fn with_reading(self, note: String, target_angles: Option<Vec<f64>>) -> ReadBuilder {
+        ReadBuilder {
+            builder: self,
+            reading: vec![note],
+            target_angles,
+        }
+    }
+
     /// Validates the graph, finds its faces, panels and vertex stars.
     pub fn build(self) -> Result<CreasePattern> {
         let CreasePatternBuilder {
@@ -272,6 +317,8 @@ impl CreasePatternBuilder {
             folded_form,
             locked,
             unit,
+            reading: Vec::new(),
+            target_angles: None,
         })
     }
 }
