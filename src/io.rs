@@ -77,13 +77,67 @@ pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions
     }
     let builder = if is_fold_object(&value) {
         let unflattened = fold::unflatten_folded_form(&value)?;
-        fold::read_fold(unflattened.as_ref().unwrap_or(&value), name)?
+        let developed = match unflattened {
+            Some(_) => None,
+            None => developed_vertex(&value, name, options.closure_tol),
+        };
+        fold::read_fold(developed.as_ref().or(unflattened.as_ref()).unwrap_or(&value), name)?
     } else {
         native::read_native(&value, name)?
     };
     let mut pattern = builder.build_with(options)?;
     pattern.adjustments.extend(frames_note(&value));
     Ok(pattern)
+}
+
+/// A 3D folded form of one interior vertex (Origami Simulator's export of a vertex in a
+/// square sheet, say), developed into its flat crease pattern with its state as a 2D FOLD
+/// object, so the single-vertex engine (which unfolds states folded flat) reads it. None
+/// when the value is not such a form, or its state does not close within `closure_tol`
+/// (then the many-vertex reader takes it, with `check`'s and `--project`'s evidence).
+fn developed_vertex(value: &serde_json::Value, name: &str, closure_tol: f64) -> Option<serde_json::Value> {
+    let coords = value.get("vertices_coords")?.as_array()?;
+    let is_3d = coords.iter().any(|p| {
+        p.as_array()
+            .and_then(|p| p.get(2))
+            .and_then(|z| z.as_f64())
+            .is_some_and(|z| z != 0.0)
+    });
+    if !is_3d {
+        return None;
+    }
+    let pattern = fold::read_crease_pattern(value, name).ok()?.build().ok()?;
+    if pattern.stars.len() != 1 || pattern.folded_form.is_none() {
+        return None;
+    }
+    let model = crate::folding::FoldingModel::new(pattern.clone()).ok()?;
+    let residual = crate::folding::vertex_residuals(&model, &model.given_fold_angles())
+        .into_iter()
+        .fold(0.0, f64::max);
+    if residual > closure_tol {
+        return None;
+    }
+    let letters: Vec<&str> = pattern
+        .kinds
+        .iter()
+        .map(|k| match k {
+            crate::pattern::crease_pattern::EdgeKind::Boundary => "B",
+            crate::pattern::crease_pattern::EdgeKind::Facet => "F",
+            crate::pattern::crease_pattern::EdgeKind::Crease(a) => a.letter(),
+        })
+        .collect();
+    let mut developed = serde_json::json!({
+        "file_spec": 1.1,
+        "vertices_coords": pattern.vertices,
+        "edges_vertices": pattern.edges,
+        "edges_assignment": letters,
+        "edges_foldAngle": pattern.fold_angles.iter().map(|a| a.to_degrees()).collect::<Vec<f64>>(),
+        "faces_vertices": pattern.faces,
+    });
+    if let Some(unit) = &pattern.unit {
+        developed["frame_unit"] = serde_json::json!(unit);
+    }
+    Some(developed)
 }
 
 /// A note when a FOLD file carries more frames than its key frame, which is the one read.

@@ -188,3 +188,99 @@ fn noise_no_longer_picks_the_branch() {
         );
     }
 }
+
+/// The Miura vertex of `patterns/miura_vertex.fold` folded flat (every crease at ±180°) as an
+/// exporter writes it at +100% and −100%: each sector's corners reflected across the crease
+/// lines crossed from sector 0, in 3D with 1e-7 of noise, faces stacked.
+fn vertex_folded_flat(sign: f64, seed: u64) -> Value {
+    let mut value = with_targets(bundled("patterns/miura_vertex.fold"));
+    let coords: Vec<[f64; 2]> = value["vertices_coords"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+        .collect();
+    let reflect = |p: [f64; 2], a: [f64; 2]| {
+        let n = a[0].hypot(a[1]);
+        let (x, y) = (a[0] / n, a[1] / n);
+        let dot = p[0] * x + p[1] * y;
+        [2.0 * dot * x - p[0], 2.0 * dot * y - p[1]]
+    };
+    let (r1, r2, r3) = (coords[2], coords[3], coords[4]);
+    // Faces: [0,1,5,2] fixed, [0,2,6,3] across ray 2, [0,3,7,4] across rays 3 then 2, and
+    // [0,4,8,1] across rays 4, 3, 2.
+    let folded = |v: usize| match v {
+        0 | 1 | 2 | 5 => coords[v],
+        3 | 6 => reflect(coords[v], r1),
+        4 | 7 => reflect(reflect(coords[v], r2), r1),
+        _ => reflect(reflect(reflect(coords[v], r3), r2), r1),
+    };
+    let mut noise = Noise(seed);
+    let points: Vec<Value> = (0..coords.len())
+        .map(|v| {
+            let [x, y] = folded(v);
+            json!([x + noise.next(1e-7), noise.next(1e-7), -sign * y + noise.next(1e-7)])
+        })
+        .collect();
+    value["vertices_coords"] = json!(points);
+    value["frame_classes"] = json!(["foldedForm"]);
+    value["frame_attributes"] = json!(["3D"]);
+    value
+}
+
+/// Fully folded exports of a flat-foldable degree-4 vertex, both signs: read as the flat
+/// vertex with every crease at ±180° by its assignment (the dihedral's sign is noise when two
+/// faces' normals are opposite), the single vertex's engine unfolds them flat. Before, they
+/// went to the many-vertex engine, which stopped at the singular start.
+#[test]
+fn fully_folded_vertex_exports_unfold_flat() {
+    use nanofold::prelude::*;
+    let dir = std::env::temp_dir().join(format!("nanofold-field-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (sign, name) in [(1.0, "plus_100.fold"), (-1.0, "minus_100.fold")] {
+        let path = dir.join(name);
+        std::fs::write(&path, vertex_folded_flat(sign, 5).to_string()).unwrap();
+        let pattern = Pattern::open(&path, &LoadOptions::default()).unwrap();
+        assert_eq!(pattern.engine(), Engine::Vertex, "{name}");
+        let start = pattern.fold_angles();
+        assert!(
+            start.iter().all(|a| (a.abs() - std::f64::consts::PI).abs() < 1e-12),
+            "{name}: {start:?}"
+        );
+        let report = unfold(&pattern, &Settings::default()).unwrap();
+        assert_eq!(report.verdict, Verdict::Flat, "{name}: {}", report.evidence);
+        assert!(report.final_fold_angles_rad.iter().all(|a| a.abs() <= 1e-6));
+    }
+    // A sheet of many vertices folded flat: every crease read at ±180° by its assignment, none
+    // turned unassigned by the noise's sign.
+    let miura = bundled("tests/fixtures/fold-convert/miura_4x4-flat.fold");
+    let mut noise = Noise(9);
+    let coords: Vec<Value> = miura["vertices_coords"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            json!([
+                p[0].as_f64().unwrap() + noise.next(1e-7),
+                noise.next(1e-7),
+                -p[1].as_f64().unwrap() + noise.next(1e-7)
+            ])
+        })
+        .collect();
+    let mut export = json!({
+        "file_spec": 1.1,
+        "frame_classes": ["foldedForm"],
+        "vertices_coords": coords,
+    });
+    for key in ["edges_vertices", "edges_assignment", "faces_vertices"] {
+        export[key] = miura[key].clone();
+    }
+    let sheet = parse_crease_pattern(&export.to_string(), "miura", "miura.fold").unwrap();
+    let fit = sheet.folded_form.unwrap();
+    assert_eq!(
+        (fit.folded_flat, fit.assignment_conflicts),
+        (sheet.creases.len(), 0),
+        "{fit:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

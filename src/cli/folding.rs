@@ -534,6 +534,7 @@ fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds:
             "max_facet_angle_rad": f.max_facet_angle,
             "mirrored": f.mirrored,
             "assignment_conflicts": f.assignment_conflicts,
+            "folded_flat_creases": f.folded_flat,
         })),
         "reading": model.pattern.reading,
         "target_angles_rad": target_angles(model),

@@ -641,6 +641,10 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
     .into())
 }
 
+/// A crease of a 3D folded form within this of ±π is folded flat (its faces' normals
+/// opposite, the dihedral's sign noise), rad: it is read at ±π with its assignment's sign.
+pub const FOLDED_FLAT: f64 = 1e-4;
+
 /// A 3D sheet whose vertices all lie within this fraction of its size of one plane is flat
 /// (float noise of an exporter), not a folded state.
 pub const FLAT_NOISE: f64 = 1e-4;
@@ -681,17 +685,28 @@ fn flat_within_noise(coords: &[[f64; 3]], faces: Option<&[Vec<usize>]>) -> Optio
         return None;
     }
     // Faces listed counter-clockwise about the normal (FOLD's convention): pick its sign so
-    // most of them are.
+    // they are. A sheet folded flat has faces turned over (every 180° fold flips a layer):
+    // it is a folded form, not a flat sheet.
     if let Some(faces) = faces {
-        let turn: f64 = faces
+        let turns: Vec<f64> = faces
             .iter()
             .filter(|f| f.len() >= 3 && f.iter().all(|&v| v < n))
             .map(|f| {
-                let (a, b, c) = (points[f[0]], points[f[1]], points[f[2]]);
-                (b - a).cross(&(c - a)).dot(&normal).signum()
+                // Newell's normal: robust for any simple polygon.
+                let mut area = Vector3::zeros();
+                for (k, &v) in f.iter().enumerate() {
+                    area += (points[v] - centre).cross(&(points[f[(k + 1) % f.len()]] - centre));
+                }
+                area.dot(&normal)
             })
-            .sum();
-        if turn < 0.0 {
+            .collect();
+        let scale = turns.iter().map(|t| t.abs()).fold(0.0, f64::max);
+        let up = turns.iter().filter(|t| **t > 1e-9 * scale).count();
+        let down = turns.iter().filter(|t| **t < -1e-9 * scale).count();
+        if up > 0 && down > 0 {
+            return None;
+        }
+        if down > up {
             normal = -normal;
         }
     }
@@ -735,10 +750,21 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
     let flip = if mirrored { -1.0 } else { 1.0 };
     let vertices = development.vertices.iter().map(|p| [flip * p[0], p[1]]).collect();
     let mut max_facet_angle: f64 = 0.0;
+    let mut snapped = 0usize;
     let fold_angles: Vec<f64> = kinds
         .iter()
         .zip(&development.fold_angles)
         .map(|(kind, &rho)| match kind {
+            // Folded flat, two faces' normals are opposite and the dihedral's sign is noise:
+            // the assignment says which way it folded.
+            EdgeKind::Crease(a) if std::f64::consts::PI - rho.abs() <= FOLDED_FLAT => {
+                snapped += 1;
+                match a {
+                    Assignment::Valley => std::f64::consts::PI,
+                    Assignment::Mountain => -std::f64::consts::PI,
+                    _ => flip * rho.signum() * std::f64::consts::PI,
+                }
+            }
             EdgeKind::Crease(_) => flip * rho,
             EdgeKind::Facet => {
                 max_facet_angle = max_facet_angle.max(rho.abs());
@@ -777,6 +803,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
             max_facet_angle,
             mirrored,
             assignment_conflicts,
+            folded_flat: snapped,
         }),
     })
 }

@@ -67,6 +67,8 @@ pub struct FoldedFormFit {
     /// Creases whose dihedral angle has the sign opposite to their assignment (read as
     /// unassigned: the file's assignment is the target, the angle the state).
     pub assignment_conflicts: usize,
+    /// Creases read folded flat (within 1e-4 rad of ±π, set to ±π by their assignment).
+    pub folded_flat: usize,
 }
 
 /// The creases around one interior vertex, counter-clockwise.

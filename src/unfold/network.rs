@@ -524,11 +524,10 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
     let mut ws = EnergyWorkspace::default();
     let mut rho = start.to_vec();
     if restore_closure(model, &mut rho, settings.closure_tol, &mut solver)?.is_none() {
-        return Err(NanofoldError::invalid(
-            "start",
-            format!("closure residual {residual:.3e} rad"),
-            "Newton could not close every vertex from it",
-        ));
+        // At a singular state (folded flat, say) Newton's steps need not converge, but the
+        // start closes within the tolerance (above): descend from it as it is; every step
+        // after it is closed to `closure_tol`.
+        rho = start.to_vec();
     }
     let worst = |rho: &[f64]| vertex_residuals(model, rho).into_iter().fold(0.0, f64::max);
     let mut gradient = vec![0.0; n];
