@@ -4,7 +4,7 @@
 # output/figures/ first, then are copied over docs/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet --examples
+cargo build --release --quiet --bins --examples
 bin=target/release/nanofold
 out=output/figures
 rm -rf "$out"

@@ -1,7 +1,7 @@
 //! The closed chain's timing figures, drawn from the report the example measures (so a kept
 //! report redraws them exactly: `tests/docs_figures.rs` checks the docs' copy).
 
-use nanofold::plot::work_precision::{work_precision_svg, WorkPoint, WorkSeries};
+use nanofold::plot::work_precision::{error_by_parameter_svg, work_precision_svg, ErrorSeries, WorkPoint, WorkSeries};
 use serde_json::Value;
 
 fn number(row: &Value, key: &str) -> f64 {
@@ -16,40 +16,40 @@ pub fn figures(report: &Value) -> Vec<(&'static str, String)> {
     let exact = rows.iter().find(|row| row["source"] == "exact").expect("the exact run");
     let exact_contact = number(exact, "contact_time_s");
     let polys: Vec<&Value> = rows.iter().filter(|row| row["source"] == "poly").collect();
-    let series = |error: &dyn Fn(&Value) -> f64| -> Vec<WorkPoint> {
-        polys
-            .iter()
-            .map(|row| WorkPoint {
-                label: format!("{}", row["degree"]),
-                seconds: number(row, "seconds"),
-                error: error(row),
-            })
-            .collect()
+    // Error against degree: the fits all take about the same time (stated in the title), so
+    // a time axis piled their labels on each other.
+    let by_degree = |error: &dyn Fn(&Value) -> f64| -> Vec<(f64, f64)> {
+        polys.iter().map(|row| (number(row, "degree"), error(row))).collect()
     };
-    let mut drift = series(&|row| number(row, "max_closure_residual"));
-    // Exact last: the line runs from the cheapest fit to the reference.
-    drift.push(WorkPoint {
-        label: "exact".into(),
-        seconds: number(exact, "seconds"),
-        error: number(exact, "max_closure_residual"),
-    });
-    let poly_vs_exact = work_precision_svg(
-        "corner cube step 1: f = poly (degree beside each point) against f = exact",
+    let times: Vec<f64> = polys.iter().map(|row| number(row, "seconds") * 1e3).collect();
+    let (fastest, slowest) = times
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    let poly_vs_exact = error_by_parameter_svg(
+        &format!(
+            "corner cube step 1: f = poly against f = exact (poly runs {fastest:.1}–{slowest:.1} ms, exact {:.0} ms)",
+            number(exact, "seconds") * 1e3
+        ),
+        "degree of the fitted polynomial f",
         "error against the exact run",
         &[
-            WorkSeries {
-                name: "max loop-closure residual (rad; exact at its own)".into(),
-                points: drift,
+            ErrorSeries {
+                name: "max loop-closure residual (rad)".into(),
+                points: by_degree(&|row| number(row, "max_closure_residual")),
             },
-            WorkSeries {
+            ErrorSeries {
                 name: "angles at contact − exact (rad)".into(),
-                points: series(&|row| number(row, "contact_angle_error_rad")),
+                points: by_degree(&|row| number(row, "contact_angle_error_rad")),
             },
-            WorkSeries {
+            ErrorSeries {
                 name: "|contact time − exact| / contact time".into(),
-                points: series(&|row| number(row, "contact_time_error_s").abs() / exact_contact),
+                points: by_degree(&|row| number(row, "contact_time_error_s").abs() / exact_contact),
             },
         ],
+        &[(
+            "exact's own loop-closure residual (rad)".to_string(),
+            number(exact, "max_closure_residual"),
+        )],
     )
     .expect("figure");
     let ramp_points = report["ramp"]["rows"]

@@ -242,7 +242,15 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .margin_right(px(LEGEND_MARGIN))
             .x_label_area_size(px(36))
             .y_label_area_size(px(56))
-            .build_cartesian_2d(axis_range(0.0, t_max, 0.0), y_range.clone())
+            // A run that ends at a contact leaves room past it, so its line shows.
+            .build_cartesian_2d(
+                if response.collision.is_some() {
+                    0.0..t_max * 1.02
+                } else {
+                    axis_range(0.0, t_max, 0.0)
+                },
+                y_range.clone(),
+            )
             .map_err(plot_error)?;
         chart
             .configure_mesh()
@@ -259,6 +267,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .collect();
         let same = coinciding(&series, 1e-9);
         let mut entries = Vec::new();
+        let mut targets = Vec::new();
         for (i, label) in view.labels.iter().enumerate() {
             let label = match same[i] {
                 Some(j) => format!("{label} (= {})", view.names[j]),
@@ -272,17 +281,23 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 .collect();
             let (label, colour, kind) = draw_series_line(&mut chart, points, i, label)?;
             entries.push((label, colour, kind));
-            let Some(target) = view.targets[i].map(f64::to_degrees) else {
-                continue;
-            };
-            let dashes = (0..40).map(|k| {
-                let a = t_max * k as f64 / 40.0;
-                PathElement::new(
-                    vec![(a, target), (a + 0.5 * t_max / 40.0, target)],
-                    colour.mix(0.6).stroke_width(1),
-                )
-            });
-            chart.draw_series(dashes).map_err(plot_error)?;
+            if let Some(target) = view.targets[i].map(f64::to_degrees) {
+                targets.push((target, colour));
+            }
+        }
+        // Targets over every series (a fast ringing hinge would hide them), on a white
+        // underlay so they show on any band.
+        for (target, colour) in targets {
+            for (width, shade) in [(4, WHITE), (2, colour)] {
+                let dashes = (0..40).map(|k| {
+                    let a = t_max * k as f64 / 40.0;
+                    PathElement::new(
+                        vec![(a, target), (a + 0.5 * t_max / 40.0, target)],
+                        shade.stroke_width(width),
+                    )
+                });
+                chart.draw_series(dashes).map_err(plot_error)?;
+            }
         }
         if let Some(c) = &response.collision {
             // Black, dotted: no hinge's colour.
@@ -297,7 +312,7 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
                 .map_err(plot_error)?;
             entries.push(("first contact".into(), BLACK, LineKind::Dotted));
         }
-        entries.push(("target (thin dashes)".into(), RGBColor(150, 150, 150), LineKind::Dashed));
+        entries.push(("target (dashes)".into(), RGBColor(150, 150, 150), LineKind::Dashed));
         draw_side_legend(&top, 44, &entries)?;
 
         // Energies in the unit that suits them.
@@ -354,7 +369,14 @@ pub fn response_view_svg(view: &ResponseView, response: &Response) -> Result<Str
             .margin_right(px(LEGEND_MARGIN))
             .x_label_area_size(px(36))
             .y_label_area_size(px(56))
-            .build_cartesian_2d(axis_range(0.0, t_max, 0.0), axis_range(e_lo, e_hi, 0.06))
+            .build_cartesian_2d(
+                if response.collision.is_some() {
+                    0.0..t_max * 1.02
+                } else {
+                    axis_range(0.0, t_max, 0.0)
+                },
+                axis_range(e_lo, e_hi, 0.06),
+            )
             .map_err(plot_error)?;
         energy
             .configure_mesh()
@@ -412,7 +434,6 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
     let model = &chain.model;
     let mut data = Data::new(model);
     let picks = snapshot_samples(response, count);
-    let (scale, unit) = time_unit(response.t_end);
     // Centre lines of the plates in µm, per snapshot.
     let mut outlines: Vec<(f64, Vec<(f64, f64)>)> = Vec::new();
     for &k in &picks {
@@ -501,7 +522,7 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
                     colour.stroke_width(3),
                 )))
                 .map_err(plot_error)?;
-            entries.push((format!("t = {:.4} {unit}", time / scale), colour, LineKind::Solid));
+            entries.push((format!("t = {}", time_label(*time)), colour, LineKind::Solid));
             chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, px(3), colour.filled())))
                 .map_err(plot_error)?;
@@ -517,6 +538,29 @@ fn strip_snapshots_svg(name: &str, chain: &StripChain, count: usize, response: &
         root.present().map_err(plot_error)?;
     }
     Ok(shown_at(svg))
+}
+
+/// A time in the unit that shows it with four significant digits, trailing zeros dropped:
+/// "27.22 µs", "252 s", "0 s".
+pub fn time_label(seconds: f64) -> String {
+    if seconds == 0.0 || !seconds.is_finite() {
+        return format!("{seconds} s");
+    }
+    let (scale, unit) = match seconds.abs() {
+        t if t >= 1.0 => (1.0, "s"),
+        t if t >= 1e-3 => (1e-3, "ms"),
+        t if t >= 1e-6 => (1e-6, "µs"),
+        _ => (1e-9, "ns"),
+    };
+    let value = seconds / scale;
+    let decimals = (3 - value.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{value:.decimals$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    };
+    format!("{text} {unit}")
 }
 
 /// A closed chain's `snapshots.svg`: the sector plates in 3D (the anchored one grey) at
@@ -547,12 +591,13 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
         title
             .titled(
                 &format!(
-                    "{}: the plates in 3D (grey: anchored sector; µm){}",
+                    "{}: the plates in 3D (grey: anchored sector; each view {:.0} µm across){}",
                     name,
-                    response
-                        .collision
-                        .as_ref()
-                        .map_or(String::new(), |c| format!(", first contact at t = {:.4e} s", c.time))
+                    2.0 * reach,
+                    response.collision.as_ref().map_or(String::new(), |c| format!(
+                        ", first contact at t = {}",
+                        time_label(c.time)
+                    ))
                 ),
                 ("sans-serif", 18),
             )
@@ -566,7 +611,7 @@ fn closed_snapshots_svg(name: &str, chain: &ClosedChain, response: &Response, co
             update_poses(model, &joint_angles, &mut data);
             update_corners(model, &mut data);
             let mut view = ChartBuilder::on(panel)
-                .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
+                .caption(format!("t = {}", time_label(sample.time)), ("sans-serif", 14))
                 .margin(px(4))
                 .build_cartesian_3d(-reach..reach, -reach..reach, -reach..reach)
                 .map_err(plot_error)?;
@@ -636,12 +681,13 @@ fn network_snapshots_svg(name: &str, model: &NetworkModel, response: &Response, 
         title
             .titled(
                 &format!(
-                    "{}: the panels in 3D (grey: anchored panel; µm){}",
+                    "{}: the panels in 3D (grey: anchored panel; each view {:.0} µm across){}",
                     name,
-                    response
-                        .collision
-                        .as_ref()
-                        .map_or(String::new(), |c| format!(", first contact at t = {:.4e} s", c.time))
+                    2.0 * reach,
+                    response.collision.as_ref().map_or(String::new(), |c| format!(
+                        ", first contact at t = {}",
+                        time_label(c.time)
+                    ))
                 ),
                 ("sans-serif", 18),
             )
@@ -653,7 +699,7 @@ fn network_snapshots_svg(name: &str, model: &NetworkModel, response: &Response, 
             place_panels(model, sample.angles.as_slice(), &mut data);
             // plotters' 3D y axis is vertical: (x, z, y) so the pattern's z is up.
             let mut view = ChartBuilder::on(area)
-                .caption(format!("t = {:.3e} s", sample.time), ("sans-serif", 14))
+                .caption(format!("t = {}", time_label(sample.time)), ("sans-serif", 14))
                 .margin(px(4))
                 .build_cartesian_3d(
                     centre[0] - reach..centre[0] + reach,

@@ -57,8 +57,8 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
     if t_hi == 0.0 {
         (t_lo, t_hi, e_lo, e_hi) = (0.1, 1.0, 1e-16, 1.0);
     }
-    // A decade of room on both sides for the labels.
-    let (t_lo, t_hi) = (t_lo / 2.0, t_hi * 3.0);
+    // Room for the labels, which sit right of their points.
+    let (t_lo, t_hi) = (t_lo / 1.6, t_hi * 1.6);
     let (e_lo, e_hi) = (e_lo / 10.0, e_hi * 10.0);
     let mut svg = String::new();
     {
@@ -76,10 +76,11 @@ pub fn work_precision_svg(title: &str, error_label: &str, series: &[WorkSeries])
         chart
             .configure_mesh()
             .set_all_tick_mark_size(px(5))
+            .max_light_lines(4)
             .x_desc(format!("wall time ({unit_name})"))
             .y_desc(error_label)
             .y_label_formatter(&|v| format!("{v:.0e}"))
-            .x_label_formatter(&|v| tick(*v))
+            .x_label_formatter(&|v| sparse_tick(*v))
             .draw()
             .map_err(plot_error)?;
         let mut pending_labels = Vec::new();
@@ -198,6 +199,20 @@ fn triangles(i: usize) -> bool {
     (i / 10) % 2 == 1
 }
 
+/// A log axis's label only at 1, 2 and 5 times a power of ten (the ticks between would
+/// print over each other near the top of a decade).
+fn sparse_tick(v: f64) -> String {
+    if v.is_nan() || v <= 0.0 {
+        return String::new();
+    }
+    let mantissa = v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0, 10.0].iter().any(|m| (mantissa - m).abs() < 1e-6 * m) {
+        tick(v)
+    } else {
+        String::new()
+    }
+}
+
 /// An axis number without trailing zeros ("10", "0.25", "3e-4").
 fn tick(v: f64) -> String {
     if v != 0.0 && v.abs() < 1e-2 {
@@ -310,6 +325,100 @@ pub fn scaling_svg(title: &str, size_label: &str, series: &[ScalingSeries]) -> R
             chart
                 .draw_series(points.iter().map(|&p| Circle::new(p, px(4), colour.filled())))
                 .map_err(plot_error)?;
+        }
+        draw_legend_in_margin(&root, SCALING_LEGEND, 44, &entries)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(shown_at(svg))
+}
+
+/// One line of an error-by-parameter figure: (parameter, error) pairs.
+#[derive(Debug, Clone)]
+pub struct ErrorSeries {
+    /// Legend entry.
+    pub name: String,
+    /// (parameter, error) pairs; errors ≤ 0 are left out of the log axis.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// SVG of errors (log axis) against an integer parameter (a fit's degree, say), each series
+/// joined, with optional horizontal reference lines (label, value) dashed across the plot.
+pub fn error_by_parameter_svg(
+    title: &str,
+    parameter_label: &str,
+    error_label: &str,
+    series: &[ErrorSeries],
+    references: &[(String, f64)],
+) -> Result<String> {
+    let shown = |e: f64| e > 0.0 && e.is_finite();
+    let (mut x_lo, mut x_hi, mut e_lo, mut e_hi) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, 0.0_f64);
+    for &(x, e) in series.iter().flat_map(|s| s.points.iter()).filter(|p| shown(p.1)) {
+        x_lo = x_lo.min(x);
+        x_hi = x_hi.max(x);
+        e_lo = e_lo.min(e);
+        e_hi = e_hi.max(e);
+    }
+    for (_, value) in references.iter().filter(|r| shown(r.1)) {
+        e_lo = e_lo.min(*value);
+        e_hi = e_hi.max(*value);
+    }
+    if !x_hi.is_finite() {
+        (x_lo, x_hi, e_lo, e_hi) = (0.0, 1.0, 1e-16, 1.0);
+    }
+    let mut svg = String::new();
+    {
+        let root = canvas(&mut svg, (1100, 600));
+        root.fill(&WHITE).map_err(plot_error)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(px(14))
+            .margin_right(px(SCALING_LEGEND))
+            .x_label_area_size(px(40))
+            .y_label_area_size(px(70))
+            .build_cartesian_2d(x_lo - 0.5..x_hi + 0.5, (e_lo / 10.0..e_hi * 10.0).log_scale())
+            .map_err(plot_error)?;
+        chart
+            .configure_mesh()
+            .set_all_tick_mark_size(px(5))
+            .disable_x_mesh()
+            .x_labels((x_hi - x_lo) as usize + 2)
+            .x_desc(parameter_label)
+            .y_desc(error_label)
+            .x_label_formatter(&|v| {
+                if (v - v.round()).abs() < 1e-9 {
+                    format!("{v:.0}")
+                } else {
+                    String::new()
+                }
+            })
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(plot_error)?;
+        let mut entries = Vec::new();
+        for (i, line) in series.iter().enumerate() {
+            let colour = series_colour(i);
+            let points: Vec<(f64, f64)> = line.points.iter().copied().filter(|p| shown(p.1)).collect();
+            chart
+                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                .map_err(plot_error)?;
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, px(4), colour.filled())))
+                .map_err(plot_error)?;
+            entries.push((line.name.clone(), colour, LineKind::Solid));
+        }
+        for (k, (label, value)) in references.iter().enumerate().filter(|(_, r)| shown(r.1)) {
+            let colour = series_colour(series.len() + k);
+            let mut dashes = Vec::new();
+            let mut x = x_lo - 0.5;
+            while x < x_hi + 0.5 {
+                dashes.push(PathElement::new(
+                    vec![(x, *value), ((x + 0.15).min(x_hi + 0.5), *value)],
+                    colour.stroke_width(2),
+                ));
+                x += 0.3;
+            }
+            chart.draw_series(dashes).map_err(plot_error)?;
+            entries.push((label.clone(), colour, LineKind::Dashed));
         }
         draw_legend_in_margin(&root, SCALING_LEGEND, 44, &entries)?;
         root.present().map_err(plot_error)?;
