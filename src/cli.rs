@@ -459,27 +459,8 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 /// Most pattern files one `unfold` run takes.
 const MAX_BATCH_FILES: usize = 10_000;
 
-/// The `--json` summary of one run.
 fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json::Value {
-    json!({
-        "pattern": pattern.name,
-        "file": path.display().to_string(),
-        "verdict": report.verdict,
-        "evidence": report.evidence,
-        "iterations": report.iterations,
-        "seconds": report.seconds,
-        "energy_initial": report.energy_initial,
-        "energy_final": report.energy_final,
-        "initial_fold_angles_rad": report.initial_fold_angles_rad,
-        "final_fold_angles_rad": report.final_fold_angles_rad,
-        "crease_labels": pattern.creases.iter().map(|c| c.label.clone()).collect::<Vec<_>>(),
-        "max_arc_residual": report.max_arc_residual,
-        "planarity_residual": report.planarity_residual,
-        "flat_layout_error": report.flat_layout_error,
-        "restarts_used": report.restarts_used,
-        "crossings_refused": report.crossings_refused,
-        "adjustments": report.adjustments,
-    })
+    nanofold::io::output::vertex_unfold_summary(pattern, &path.display().to_string(), report)
 }
 
 /// Unfolds one pattern into `dir`; returns its JSON summary and its human-readable lines.

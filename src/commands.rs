@@ -65,6 +65,8 @@ impl Engine {
 pub struct Pattern {
     vertex: Option<VertexPattern>,
     sheet: Option<FoldingModel>,
+    /// The file it was read from.
+    source: Option<String>,
 }
 
 impl Pattern {
@@ -80,6 +82,7 @@ impl Pattern {
                 Ok(Pattern {
                     vertex: Some(vertex),
                     sheet,
+                    source: Some(path.display().to_string()),
                 })
             }
             Err(e) if takes_many_vertices(&e, path) => {
@@ -87,6 +90,7 @@ impl Pattern {
                 Ok(Pattern {
                     vertex: None,
                     sheet: Some(sheet),
+                    source: Some(path.display().to_string()),
                 })
             }
             Err(e) => Err(e),
@@ -98,7 +102,13 @@ impl Pattern {
         Ok(Pattern {
             vertex: None,
             sheet: Some(FoldingModel::new(pattern)?),
+            source: None,
         })
+    }
+
+    /// The file it was read from (None: built in code).
+    pub fn source(&self) -> Option<&str> {
+        self.source.as_deref()
     }
 
     /// The pattern's name.
@@ -156,6 +166,7 @@ impl From<VertexPattern> for Pattern {
         Pattern {
             vertex: Some(vertex),
             sheet,
+            source: None,
         }
     }
 }
@@ -378,8 +389,8 @@ pub enum Detail {
     VertexUnfold(Box<UnfoldReport>),
     /// The many-vertex unfolding.
     NetworkUnfold(Box<NetworkReport>),
-    /// The many-vertex check.
-    NetworkCheck(Box<CheckReport>),
+    /// The many-vertex check, with the unfolding by energy a rigid folded state also gets.
+    NetworkCheck(Box<CheckReport>, Option<Box<NetworkReport>>),
     /// A folding path.
     Fold(Box<FoldPath>),
 }
@@ -412,6 +423,53 @@ pub struct Report {
     pub max_closure_residual_rad: f64,
     /// The engine's own report.
     pub detail: Detail,
+}
+
+impl Report {
+    /// The report as `nanofold <command> --json` prints it for `pattern` (the one it
+    /// answers), less the command line's own keys (`out`, `frames`).
+    pub fn to_json(&self, pattern: &Pattern) -> serde_json::Value {
+        use crate::io::folding_output::{check_summary, fold_summary, network_unfold_summary};
+        let file = pattern.source().unwrap_or(pattern.name());
+        match (&self.detail, pattern.vertex(), pattern.sheet()) {
+            (Detail::VertexUnfold(report), Some(vertex), _) => {
+                crate::io::output::vertex_unfold_summary(vertex, file, report)
+            }
+            (Detail::NetworkUnfold(report), _, Some(model)) => {
+                let adjustments: Vec<String> = pattern
+                    .source()
+                    .and_then(|f| crate::io::file_frames_note(Path::new(f)))
+                    .into_iter()
+                    .chain(model.pattern.reading.iter().cloned())
+                    .collect();
+                network_unfold_summary(
+                    model,
+                    file,
+                    report,
+                    &self.start_fold_angles_rad,
+                    self.seconds,
+                    &adjustments,
+                    None,
+                )
+            }
+            (Detail::NetworkCheck(report, unfolding), _, Some(model)) => {
+                check_summary(model, file, report, unfolding.as_deref(), self.seconds)
+            }
+            (Detail::Fold(path), _, Some(model)) => {
+                let dof = crate::folding::jacobian_rank(&crate::folding::closure_jacobian(
+                    model,
+                    &self.final_fold_angles_rad,
+                ))
+                .map_or(0, |r| r.dof);
+                fold_summary(model, file, path, dof, self.seconds)
+            }
+            _ => serde_json::json!({
+                "pattern": self.pattern,
+                "verdict": self.verdict.as_str(),
+                "evidence": self.evidence,
+            }),
+        }
+    }
 }
 
 /// Settings of every command, each validated where it is used.
@@ -493,6 +551,16 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
             let clock = Instant::now();
             let report = check_pattern(model, &settings.check)?;
             let start = model.given_fold_angles();
+            // A rigid folded state is also unfolded by energy, as the command line does.
+            let unfolding = if report.has_state && report.verdict == crate::folding::PatternVerdict::Rigid {
+                Some(Box::new(unfold_network(
+                    model,
+                    &start,
+                    &NetworkUnfoldSettings::default(),
+                )?))
+            } else {
+                None
+            };
             let judged = report
                 .witness
                 .as_ref()
@@ -510,7 +578,7 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
                 start_fold_angles_rad: start,
                 final_fold_angles_rad: judged,
                 max_closure_residual_rad: report.max_vertex_residual_rad,
-                detail: Detail::NetworkCheck(Box::new(report)),
+                detail: Detail::NetworkCheck(Box::new(report), unfolding),
             })
         }
     }

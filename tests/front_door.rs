@@ -38,9 +38,16 @@ fn the_door_checks_every_bundled_pattern_as_the_command_line_does() {
     let mut compared = 0;
     for path in library_patterns() {
         let line = &cli[&path];
-        match Pattern::open(Path::new(&path), &LoadOptions::default()).and_then(|p| check(&p, &settings)) {
-            Ok(report) => {
+        let opened = Pattern::open(Path::new(&path), &LoadOptions::default());
+        match opened.and_then(|p| check(&p, &settings).map(|r| (p, r))) {
+            Ok((pattern, report)) => {
                 assert_eq!(report.verdict.as_str(), line["verdict"], "{path}");
+                // The whole report, as the command line prints it (its own timing aside).
+                assert_eq!(
+                    without(report.to_json(&pattern), &["seconds"]),
+                    without(line.clone(), &["seconds"]),
+                    "{path}"
+                );
                 compared += 1;
             }
             Err(e) => assert!(line.get("error").is_some(), "{path}: the door says {e}, the CLI {line}"),
@@ -72,7 +79,36 @@ fn the_door_unfolds_as_the_command_line_does() {
         let theirs: Vec<f64> = serde_json::from_value(line["final_fold_angles_rad"].clone()).unwrap();
         assert_eq!(report.final_fold_angles_rad, theirs, "{path}");
         assert_eq!(report.crease_labels.len(), theirs.len());
+        let pattern = Pattern::open(Path::new(path), &LoadOptions::default()).unwrap();
+        assert_eq!(
+            without(report.to_json(&pattern), &["seconds"]),
+            without(line.clone(), &["seconds", "out"]),
+            "{path}"
+        );
     }
+    // `fold --json` likewise (its frames and folder are the command's).
+    let dir = std::env::temp_dir().join(format!("nanofold-door-fold-{}", std::process::id()));
+    let out = Process::new(env!("CARGO_BIN_EXE_nanofold"))
+        .args(["fold", "--json", "patterns/many/miura_4x4.fold", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let pattern = Pattern::open(Path::new("patterns/many/miura_4x4.fold"), &LoadOptions::default()).unwrap();
+    let report = fold(&pattern, &settings).unwrap();
+    assert_eq!(
+        without(report.to_json(&pattern), &["seconds"]),
+        without(line, &["seconds", "out", "frames"])
+    );
+}
+
+/// A JSON object without some keys.
+fn without(mut value: serde_json::Value, keys: &[&str]) -> serde_json::Value {
+    for key in keys {
+        value.as_object_mut().unwrap().remove(*key);
+    }
+    value
 }
 
 /// A single vertex built from numbers has a sheet (unit rays, the outline through their

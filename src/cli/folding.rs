@@ -4,9 +4,7 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use nanofold::folding::{
-    check_pattern, fold_path, CheckReport, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel,
-};
+use nanofold::folding::{check_pattern, fold_path, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
 use nanofold::pattern::crease_pattern::CreasePatternBuilder;
@@ -320,27 +318,7 @@ fn parse_drive(model: &FoldingModel, text: &str) -> Result<(usize, f64)> {
 }
 
 fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, seconds: f64) -> Value {
-    let last = path.steps.last().expect("a path has its start");
-    json!({
-        "pattern": model.pattern.name,
-        "file": file.display().to_string(),
-        "stop_reason": path.stop.as_str(),
-        "evidence": path.evidence,
-        "branch": path.branch,
-        "steps": path.steps.len(),
-        "frames": 0,
-        "dof": dof,
-        "creases": model.crease_count(),
-        "vertices": model.stars.len(),
-        "panels": model.pattern.panel_count,
-        "progress": last.progress,
-        "max_closure_residual_rad": path.max_closure_residual,
-        "min_panel_clearance": path.min_panel_clearance.map_or(Value::Null, number),
-        "newton_iterations": path.newton_iterations,
-        "reading": model.pattern.reading,
-        "target_angles_rad": target_angles(model),
-        "seconds": seconds,
-    })
+    nanofold::io::folding_output::fold_summary(model, &file.display().to_string(), path, dof, seconds)
 }
 
 /// `nanofold fold PATTERN`.
@@ -475,7 +453,13 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
         seconds * 1e3,
         report.evidence
     );
-    let mut value = check_value(&model, path, &report, seconds);
+    let mut value = nanofold::io::folding_output::check_summary(
+        &model,
+        &path.display().to_string(),
+        &report,
+        unfolding.as_ref(),
+        seconds,
+    );
     if let Some((note, json)) = &projection {
         line.push_str(&format!("; {note}"));
         value["projection"] = json.clone();
@@ -486,66 +470,8 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
             unfolding.verdict.as_str(),
             unfolding.evidence
         ));
-        value["unfold"] = json!({
-            "verdict": unfolding.verdict.as_str(),
-            "evidence": unfolding.evidence,
-            "iterations": unfolding.iterations,
-            "max_closure_residual_rad": unfolding.max_closure_residual,
-        });
     }
     Ok((value, line))
-}
-
-fn check_value(model: &FoldingModel, path: &Path, report: &CheckReport, seconds: f64) -> Value {
-    json!({
-        "pattern": model.pattern.name,
-        "file": path.display().to_string(),
-        "verdict": report.verdict.as_str(),
-        "evidence": report.evidence,
-        "state": if report.has_state { "given" } else { "flat (assignment only)" },
-        "dof": report.rank.dof,
-        "rank": report.rank.rank,
-        "rank_threshold": report.rank.threshold,
-        "creases": model.crease_count(),
-        "vertices": model.stars.len(),
-        "panels": model.pattern.panel_count,
-        "max_vertex_residual_rad": report.max_vertex_residual_rad,
-        "worst_vertices": report.worst_vertices.iter().map(|(v, r)| json!({"vertex": v, "residual_rad": r})).collect::<Vec<_>>(),
-        "intersecting_pairs": report.intersecting_pairs,
-        "contacts": report.contacts,
-        "min_panel_clearance": report.min_panel_clearance.map_or(Value::Null, number),
-        "tree_mismatch": report.tree_mismatch,
-        "witness": report.witness.as_ref().map(|w| json!({
-            "stop_reason": w.stop.as_str(),
-            "evidence": w.evidence,
-            "steps": w.steps.len(),
-            "progress": w.steps.last().map_or(0.0, |s| s.progress),
-            "max_closure_residual_rad": w.max_closure_residual,
-        })),
-        "tried": report.tried,
-        "flat_foldability": json!({
-            "worst_kawasaki": report.flat_foldability.worst_kawasaki.map(|(v, r)| json!({"vertex": v, "residual_rad": number(r)})),
-            "odd_degree_vertices": report.flat_foldability.odd_degree,
-            "maekawa_failures": report.flat_foldability.maekawa_failures,
-        }),
-        "folded_form": report.folded_form.map(|f| json!({
-            "development_error": f.development_error,
-            "face_nonplanarity": f.face_nonplanarity,
-            "max_facet_angle_rad": f.max_facet_angle,
-            "mirrored": f.mirrored,
-            "assignment_conflicts": f.assignment_conflicts,
-            "folded_flat_creases": f.folded_flat,
-        })),
-        "reading": model.pattern.reading,
-        "target_angles_rad": target_angles(model),
-        "seconds": seconds,
-    })
-}
-
-/// The file's angles read as targets, per crease (None: the file gave a state or none).
-fn target_angles(model: &FoldingModel) -> Option<Vec<f64>> {
-    let targets = model.pattern.target_angles.as_ref()?;
-    Some(model.pattern.creases.iter().map(|&e| targets[e]).collect())
 }
 
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
@@ -712,16 +638,6 @@ pub fn unfold_network_one(
     let seconds = clock.elapsed().as_secs_f64();
     let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);
     let last = report.steps.last().expect("the start is recorded");
-    // How far the end lies from the flat crease pattern and from the plane.
-    let mut poses = Vec::new();
-    nanofold::folding::panel_poses(&model, &last.fold_angles, &mut poses);
-    let placed = nanofold::folding::vertex_positions(&model, &poses);
-    let flat_layout_error = placed
-        .iter()
-        .zip(&model.pattern.vertices)
-        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + p[2] * p[2]).sqrt())
-        .fold(0.0, f64::max);
-    let planarity = placed.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
     // Outputs: 11 snapshots, the trajectory thinned to 1000 steps.
     let snapshots = evenly(report.steps.len(), 11);
     let frames: Vec<(String, &[f64])> = snapshots
@@ -770,29 +686,23 @@ pub fn unfold_network_one(
         ("unfold.svg", svg),
     ];
     write_outputs(&dir, pattern_path, &files)?;
-    let summary = json!({
-        "pattern": model.pattern.name,
-        "file": pattern_path.display().to_string(),
-        "verdict": report.verdict.as_str(),
-        "evidence": report.evidence,
-        "iterations": report.iterations,
-        "seconds": seconds,
-        "energy_initial": number(report.steps[0].energy),
-        "energy_final": number(last.energy),
-        "initial_fold_angles_rad": start_state,
-        "final_fold_angles_rad": last.fold_angles,
-        "crease_labels": model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect::<Vec<_>>(),
-        "max_arc_residual": Value::Null,
-        "planarity_residual": planarity,
-        "flat_layout_error": flat_layout_error,
-        "restarts_used": report.restarts_used,
-        "crossings_refused": report.crossings_refused,
-        "radial_steps": report.radial_steps,
-        "adjustments": projection.iter().map(|(note, _)| note.clone()).chain(frames_note.clone()).chain(model.pattern.reading.iter().cloned()).collect::<Vec<_>>(),
-        "projection": projection.as_ref().map_or(Value::Null, |(_, json)| json.clone()),
-        "max_closure_residual_rad": report.max_closure_residual,
-        "out": dir.display().to_string(),
-    });
+    let adjustments: Vec<String> = projection
+        .iter()
+        .map(|(note, _)| note.clone())
+        .chain(frames_note.clone())
+        .chain(model.pattern.reading.iter().cloned())
+        .collect();
+    let mut summary = nanofold::io::folding_output::network_unfold_summary(
+        &model,
+        &pattern_path.display().to_string(),
+        &report,
+        &start_state,
+        seconds,
+        &adjustments,
+        projection.as_ref().map(|(_, json)| json),
+    );
+    summary["out"] = json!(dir.display().to_string());
+    let flat_layout_error = summary["flat_layout_error"].as_f64().unwrap_or(f64::NAN);
     let mut text = String::new();
     for note in projection.iter().map(|(note, _)| note).chain(&frames_note) {
         writeln!(text, "{}: {note}", model.pattern.name)?;

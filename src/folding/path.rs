@@ -46,7 +46,8 @@ impl Default for FoldSettings {
     fn default() -> Self {
         FoldSettings {
             drive: Drive::Assignment { to: 1.0 },
-            max_step: 0.05,
+            // The command line's default too (`fold --max-step 2.5`, degrees).
+            max_step: 2.5 * std::f64::consts::PI / 180.0,
             closure_tol: 1e-11,
             max_steps: 100_000,
             kick: 1e-3,

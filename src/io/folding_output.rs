@@ -8,7 +8,7 @@ use crate::dynamics::network::modes::NetworkModes;
 use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::simulate::Response;
 use crate::error::Result;
-use crate::folding::{panel_poses, vertex_positions, FoldPath, FoldingModel};
+use crate::folding::{panel_poses, vertex_positions, CheckReport, FoldPath, FoldingModel};
 use crate::io::output::number;
 use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
 use crate::pattern::Assignment;
@@ -290,4 +290,148 @@ pub fn network_modes_fold(model: &NetworkModel, modes: &NetworkModes, amplitude:
         &frames,
         "a network's modes written by nanofold modes: the folded equilibrium, then each mode's shape either way",
     ))
+}
+
+/// `check --json` of a crease pattern of many vertices (`file`: the input's path;
+/// `unfolding`: the unfolding by energy a rigid folded state also gets).
+pub fn check_summary(
+    model: &FoldingModel,
+    file: &str,
+    report: &CheckReport,
+    unfolding: Option<&crate::unfold::network::NetworkReport>,
+    seconds: f64,
+) -> Value {
+    let mut value = check_fields(model, file, report, seconds);
+    if let Some(unfolding) = unfolding {
+        value["unfold"] = json!({
+            "verdict": unfolding.verdict.as_str(),
+            "evidence": unfolding.evidence,
+            "iterations": unfolding.iterations,
+            "max_closure_residual_rad": unfolding.max_closure_residual,
+        });
+    }
+    value
+}
+
+fn check_fields(model: &FoldingModel, file: &str, report: &CheckReport, seconds: f64) -> Value {
+    json!({
+        "pattern": model.pattern.name,
+        "file": file,
+        "verdict": report.verdict.as_str(),
+        "evidence": report.evidence,
+        "state": if report.has_state { "given" } else { "flat (assignment only)" },
+        "dof": report.rank.dof,
+        "rank": report.rank.rank,
+        "rank_threshold": report.rank.threshold,
+        "creases": model.crease_count(),
+        "vertices": model.stars.len(),
+        "panels": model.pattern.panel_count,
+        "max_vertex_residual_rad": report.max_vertex_residual_rad,
+        "worst_vertices": report.worst_vertices.iter().map(|(v, r)| json!({"vertex": v, "residual_rad": r})).collect::<Vec<_>>(),
+        "intersecting_pairs": report.intersecting_pairs,
+        "contacts": report.contacts,
+        "min_panel_clearance": report.min_panel_clearance.map_or(Value::Null, number),
+        "tree_mismatch": report.tree_mismatch,
+        "witness": report.witness.as_ref().map(|w| json!({
+            "stop_reason": w.stop.as_str(),
+            "evidence": w.evidence,
+            "steps": w.steps.len(),
+            "progress": w.steps.last().map_or(0.0, |s| s.progress),
+            "max_closure_residual_rad": w.max_closure_residual,
+        })),
+        "tried": report.tried,
+        "flat_foldability": json!({
+            "worst_kawasaki": report.flat_foldability.worst_kawasaki.map(|(v, r)| json!({"vertex": v, "residual_rad": number(r)})),
+            "odd_degree_vertices": report.flat_foldability.odd_degree,
+            "maekawa_failures": report.flat_foldability.maekawa_failures,
+        }),
+        "folded_form": report.folded_form.map(|f| json!({
+            "development_error": f.development_error,
+            "face_nonplanarity": f.face_nonplanarity,
+            "max_facet_angle_rad": f.max_facet_angle,
+            "mirrored": f.mirrored,
+            "assignment_conflicts": f.assignment_conflicts,
+            "folded_flat_creases": f.folded_flat,
+        })),
+        "reading": model.pattern.reading,
+        "target_angles_rad": target_angles(model),
+        "seconds": seconds,
+    })
+}
+
+/// The file's angles read as targets, per crease (None: the file gave a state or none).
+fn target_angles(model: &FoldingModel) -> Option<Vec<f64>> {
+    let targets = model.pattern.target_angles.as_ref()?;
+    Some(model.pattern.creases.iter().map(|&e| targets[e]).collect())
+}
+
+/// `fold --json` (`file`: the input's path; `frames` and `out` are the command's).
+pub fn fold_summary(model: &FoldingModel, file: &str, path: &FoldPath, dof: usize, seconds: f64) -> Value {
+    let last = path.steps.last().expect("a path has its start");
+    json!({
+        "pattern": model.pattern.name,
+        "file": file,
+        "stop_reason": path.stop.as_str(),
+        "evidence": path.evidence,
+        "branch": path.branch,
+        "steps": path.steps.len(),
+        "dof": dof,
+        "creases": model.crease_count(),
+        "vertices": model.stars.len(),
+        "panels": model.pattern.panel_count,
+        "progress": last.progress,
+        "max_closure_residual_rad": path.max_closure_residual,
+        "min_panel_clearance": path.min_panel_clearance.map_or(Value::Null, number),
+        "newton_iterations": path.newton_iterations,
+        "reading": model.pattern.reading,
+        "target_angles_rad": target_angles(model),
+        "seconds": seconds,
+    })
+}
+
+/// `unfold --json` of a crease pattern of many vertices (`file`: the input's path;
+/// `adjustments`: how the input was read or moved; `projection`: `--project`'s figures; `out`
+/// is the command's): the single vertex's keys where they apply, with the end's distance
+/// from the flat crease pattern (`flat_layout_error`) and from the plane.
+pub fn network_unfold_summary(
+    model: &FoldingModel,
+    file: &str,
+    report: &crate::unfold::network::NetworkReport,
+    start: &[f64],
+    seconds: f64,
+    adjustments: &[String],
+    projection: Option<&Value>,
+) -> Value {
+    let last = report.steps.last().expect("the start is recorded");
+    let mut poses = Vec::new();
+    panel_poses(model, &last.fold_angles, &mut poses);
+    let placed = vertex_positions(model, &poses);
+    let flat_layout_error = placed
+        .iter()
+        .zip(&model.pattern.vertices)
+        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + p[2] * p[2]).sqrt())
+        .fold(0.0, f64::max);
+    let planarity = placed.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+    json!({
+        "pattern": model.pattern.name,
+        "file": file,
+        "verdict": report.verdict.as_str(),
+        "evidence": report.evidence,
+        "iterations": report.iterations,
+        "seconds": seconds,
+        "energy_initial": number(report.steps[0].energy),
+        "energy_final": number(last.energy),
+        "initial_fold_angles_rad": start,
+        "final_fold_angles_rad": last.fold_angles,
+        "crease_labels": model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect::<Vec<_>>(),
+        "max_arc_residual": Value::Null,
+        "planarity_residual": planarity,
+        "flat_layout_error": flat_layout_error,
+        "restarts_used": report.restarts_used,
+        "crossings_refused": report.crossings_refused,
+        "radial_steps": report.radial_steps,
+        "adjustments": adjustments,
+        "projection": projection.cloned().unwrap_or(Value::Null),
+        "max_closure_residual_rad": report.max_closure_residual,
+    })
 }
