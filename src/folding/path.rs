@@ -419,18 +419,32 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 newton_iterations,
             );
         }
-        let kick = noise_kick(model, settings.kick);
-        let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
-        let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? else {
+        // The noise's kick first; where Newton finds nothing from it, the plain one.
+        let raised = noise_kick(model, settings.kick);
+        let mut landed = None;
+        for kick in [raised, settings.kick] {
+            let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
+            if let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? {
+                newton_iterations += k;
+                landed = Some((kick, trial));
+                break;
+            }
+            if raised == settings.kick {
+                break;
+            }
+        }
+        let Some((kick, trial)) = landed else {
             return finish(
                 steps,
                 StopReason::BranchPoint { creases: vec![] },
-                format!("Newton found no rigid state {kick:.0e} rad from flat along the projected direction"),
+                format!(
+                    "Newton found no rigid state {:.0e} rad from flat along the projected direction",
+                    settings.kick
+                ),
                 None,
                 newton_iterations,
             );
         };
-        newton_iterations += k;
         let wrong = against_assignment(&trial, &signs, 1e-3 * kick);
         if !wrong.is_empty() {
             let evidence = format!(
