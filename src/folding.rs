@@ -17,6 +17,7 @@ pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{
     fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep, Projection, StopReason,
+    MIN_GOAL, MIN_STEP,
 };
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{

@@ -1258,3 +1258,99 @@ fn an_output_folder_of_another_input_is_not_replaced() {
     assert!(owner["input"].as_str().unwrap().ends_with("b/folded.fold"), "{owner}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 30's settings at their edges and inputs that broke the many-vertex commands: each
+/// refused by name, or answered as what it is (each failed before: a step of 1e-300 stopped
+/// `locked`, a goal of 1e-300 reported progress 3e298, an all-locked check wrote a null
+/// threshold, a non-rigid start's energies were "nan", a 258 × 258 Miura-ori was refused as
+/// over 200 000 edges, a 1e-300 bird base failed with "enclose no region", and a vertex no
+/// edge uses made `fold` and `unfold` panic).
+#[test]
+fn many_vertex_settings_and_inputs_at_their_edges() {
+    let dir = temp_dir("edges30");
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |args: &[&str]| {
+        let out = nanofold().args(args).output().unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let out = dir.join("out").display().to_string();
+    let (ok, _, err) = run(&[
+        "fold",
+        "patterns/many/miura_4x4.fold",
+        "--max-step",
+        "1e-300",
+        "--out",
+        &out,
+    ]);
+    assert!(
+        !ok && err.contains("--max-step 1e-300") && err.contains("degrees"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&["fold", "patterns/many/miura_4x4.fold", "--to", "1e-300", "--out", &out]);
+    assert!(
+        !ok && err.contains("--to 1e-300") && err.contains("[0.1, 100]"),
+        "{err}"
+    );
+    // Every crease locked: rank 0 with a threshold of 0, not null.
+    let mut locked: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/many/miura_4x4_folded.fold").unwrap()).unwrap();
+    let all: Vec<bool> = locked["edges_assignment"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a == "M" || a == "V")
+        .collect();
+    locked["edges_nanofold:locked"] = serde_json::json!(all);
+    let file = dir.join("locked.fold");
+    std::fs::write(&file, locked.to_string()).unwrap();
+    let (ok, stdout, _) = run(&["check", "--json", &file.display().to_string()]);
+    let value: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert!(ok && value["rank_threshold"] == 0.0 && value["dof"] == 0, "{value}");
+    // A start that is not rigid: not_rigid, its energies absent.
+    let (ok, stdout, _) = run(&["unfold", "--json", "patterns/many/miura_4x4_bent.fold", "--out", &out]);
+    let value: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert!(ok && value["verdict"] == "not_rigid", "{value}");
+    assert!(
+        value["energy_initial"].is_null() && value["energy_final"].is_null(),
+        "{value}"
+    );
+    // Generators: the edge count is the pattern's own; a length far below the tolerances is
+    // refused by its range.
+    let miura = dir.join("miura.fold").display().to_string();
+    let (ok, stdout, err) = run(&["generate", "miura", "--rows", "258", "--cols", "258", "--out", &miura]);
+    assert!(ok && stdout.contains("132612 creases"), "{stdout}{err}");
+    let (ok, _, err) = run(&["generate", "bird-base", "--half-side", "1e-300", "--out", &miura]);
+    assert!(!ok && err.contains("half_side") && err.contains("[1e-6, 1e6]"), "{err}");
+    // A vertex that no edge uses: refused by name, no panic.
+    let mut stray: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/many/miura_4x4_folded.fold").unwrap()).unwrap();
+    stray["vertices_coords"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!([0.3, 0.3]));
+    let file = dir.join("stray.fold");
+    std::fs::write(&file, stray.to_string()).unwrap();
+    for command in ["check", "fold", "unfold"] {
+        let path = file.display().to_string();
+        let args: Vec<&str> = if command == "check" {
+            vec![command, &path]
+        } else {
+            vec![command, &path, "--out", &out]
+        };
+        let (ok, stdout, err) = run(&args);
+        let said = format!("{stdout}{err}");
+        assert!(!said.contains("panicked"), "{command}: {said}");
+        assert!(
+            said.contains("vertices_coords[25]") && said.contains("no edge uses"),
+            "{command}: {said}"
+        );
+        if command != "check" {
+            assert!(!ok);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

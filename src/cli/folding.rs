@@ -23,13 +23,14 @@ pub struct FoldArgs {
     /// without it, every mountain and valley folds towards ±180° as assigned.
     #[arg(long, value_name = "EDGE=DEG", allow_negative_numbers = true)]
     pub drive: Vec<String>,
-    /// Stop when the most folded crease reaches this percentage of 180° (assignment drive).
+    /// Stop when the most folded crease reaches this percentage of 180° (assignment drive;
+    /// 0.1 to 100).
     #[arg(long, default_value_t = 100.0)]
     pub to: f64,
     /// Number of snapshots written as FOLD frames (start and end included).
     #[arg(long, default_value_t = 11, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1000))]
     pub frames: usize,
-    /// Largest change of any fold angle in one step (degrees).
+    /// Largest change of any fold angle in one step (degrees; 5.7e-5 to 28.6).
     #[arg(long, default_value_t = 2.5)]
     pub max_step: f64,
     /// Output folder (default: output/<pattern name>/).
@@ -334,6 +335,24 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
                 .collect::<Result<_>>()?,
         )
     };
+    // The flags in their own units (percent, degrees), before the library's radians.
+    let (lowest_to, lowest_step) = (
+        100.0 * nanofold::folding::MIN_GOAL,
+        nanofold::folding::MIN_STEP.to_degrees(),
+    );
+    if !(args.to >= lowest_to && args.to <= 100.0) {
+        bail!(
+            "--to {:e}: must lie in [{lowest_to}, 100] (percent of a full fold)",
+            args.to
+        );
+    }
+    if !(args.max_step >= lowest_step && args.max_step <= 0.5f64.to_degrees()) {
+        bail!(
+            "--max-step {:e}: must lie in [{lowest_step:.1e}, {:.1}] degrees",
+            args.max_step,
+            0.5f64.to_degrees()
+        );
+    }
     let settings = FoldSettings {
         drive,
         max_step: args.max_step.to_radians(),

@@ -65,8 +65,13 @@ impl FoldSettings {
     pub fn validate(&self, model: &FoldingModel) -> Result<()> {
         match &self.drive {
             Drive::Assignment { to } => {
-                if !(*to > 0.0 && *to <= 1.0) {
-                    return Err(NanofoldError::invalid("drive.to", to, "must lie in (0, 1]"));
+                // A goal below the kick that leaves flat would be passed by the first step.
+                if !(*to >= MIN_GOAL && *to <= 1.0) {
+                    return Err(NanofoldError::invalid(
+                        "drive.to",
+                        format!("{to:e}"),
+                        format!("must lie in [{MIN_GOAL:e}, 1]"),
+                    ));
                 }
             }
             Drive::Creases(list) => {
@@ -110,11 +115,13 @@ impl FoldSettings {
                 }
             }
         }
-        if !(self.max_step > 0.0 && self.max_step <= 0.5) {
+        // A step far below the closure's own tolerance cannot move the path: it would stop
+        // as `locked` for want of progress, which it is not.
+        if !(self.max_step >= MIN_STEP && self.max_step <= 0.5) {
             return Err(NanofoldError::invalid(
                 "max_step",
-                self.max_step,
-                "must lie in (0, 0.5] rad",
+                format!("{:e}", self.max_step),
+                format!("must lie in [{MIN_STEP:e}, 0.5] rad"),
             ));
         }
         if !(self.closure_tol >= 1e-14 && self.closure_tol <= 1e-3) {
@@ -205,6 +212,12 @@ pub struct FoldPath {
     /// Newton iterations over the whole path.
     pub newton_iterations: usize,
 }
+
+/// The smallest step a path takes, rad.
+pub const MIN_STEP: f64 = 1e-6;
+/// The smallest goal of an assignment drive, as a fraction of a full fold: above the kick
+/// that leaves flat (1e-3 rad), so a path can stop at its goal, not past it.
+pub const MIN_GOAL: f64 = 1e-3;
 
 /// Kawasaki residuals below this, rad, are a flat-foldable design's noise, not its geometry.
 const DESIGN_NOISE: f64 = 1e-4;

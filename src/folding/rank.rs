@@ -89,7 +89,10 @@ pub fn jacobian_rank(jacobian: &ClosureJacobian) -> Result<RankReport> {
 /// count is.
 pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
     let (rows, cols) = (jacobian.rows, jacobian.cols);
-    if rows == 0 || cols == 0 {
+    // Nothing free (no rows, no columns, or every column held): rank 0, and no threshold is
+    // needed (a QR of the zero matrix gives NaN).
+    let free = jacobian.entries.iter().any(|e| e.2 != 0.0);
+    if rows == 0 || cols == 0 || !free {
         return RankReport {
             rank: 0,
             dof: cols - jacobian.held,

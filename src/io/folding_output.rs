@@ -412,6 +412,8 @@ pub fn network_unfold_summary(
         .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + p[2] * p[2]).sqrt())
         .fold(0.0, f64::max);
     let planarity = placed.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+    let not_rigid = report.verdict == crate::unfold::network::NetworkVerdict::NotRigid;
+    let energy = |u: f64| if not_rigid { Value::Null } else { number(u) };
     json!({
         "pattern": model.pattern.name,
         "file": file,
@@ -419,8 +421,9 @@ pub fn network_unfold_summary(
         "evidence": report.evidence,
         "iterations": report.iterations,
         "seconds": seconds,
-        "energy_initial": number(report.steps[0].energy),
-        "energy_final": number(last.energy),
+        // A start that is not rigid has no energy (it is not a state on the closures): absent.
+        "energy_initial": energy(report.steps[0].energy),
+        "energy_final": energy(last.energy),
         "initial_fold_angles_rad": start,
         "final_fold_angles_rad": last.fold_angles,
         "crease_labels": model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect::<Vec<_>>(),

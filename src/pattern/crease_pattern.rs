@@ -250,6 +250,19 @@ impl CreasePatternBuilder {
                 "only a crease (M, V, U) can be locked",
             ));
         }
+        // A vertex no edge uses belongs to no face and no panel: nothing could place it.
+        let mut used = vec![false; nv];
+        for &[a, b] in &edges {
+            used[a] = true;
+            used[b] = true;
+        }
+        if let Some(v) = used.iter().position(|u| !u) {
+            return Err(NanofoldError::invalid(
+                format!("vertices_coords[{v}]"),
+                format!("{:?}", vertices[v]),
+                "no edge uses this vertex: remove it (a vertex of the paper lies on its edges)",
+            ));
+        }
         let duplicates = duplicate_edge(&edges);
         if let Some((first, second)) = duplicates {
             return Err(NanofoldError::invalid(

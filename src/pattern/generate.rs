@@ -2,6 +2,13 @@
 //! with its folded state in closed form.
 
 use super::crease_pattern::{CreasePatternBuilder, EdgeKind, MAX_EDGES};
+
+/// The shortest length a generator takes: the crease-pattern reader's planarity tolerances
+/// are fixed fractions of 1, so patterns far smaller lose their faces to rounding.
+pub const MIN_LENGTH: f64 = 1e-6;
+/// The longest.
+pub const MAX_LENGTH: f64 = 1e6;
+const LENGTH_RANGE: &str = "a length in [1e-6, 1e6]";
 use super::Assignment;
 use crate::error::{NanofoldError, Result};
 
@@ -38,12 +45,13 @@ impl Default for MiuraSpec {
 impl MiuraSpec {
     /// Checks every parameter.
     pub fn validate(&self) -> Result<()> {
-        let edges = 3 * (self.rows + 1) * (self.cols + 1);
+        // Horizontal segments (rows + 1 lines of cols) and zigzag ones (cols + 1 of rows).
+        let edges = (self.rows + 1).saturating_mul(self.cols) + self.rows.saturating_mul(self.cols + 1);
         if self.rows < 1 || self.cols < 1 || edges > MAX_EDGES {
             return Err(NanofoldError::invalid(
                 "rows, cols",
-                format!("{} × {}", self.rows, self.cols),
-                format!("at least 1 × 1, and at most {MAX_EDGES} edges (about 3 per vertex)"),
+                format!("{} × {} ({edges} edges)", self.rows, self.cols),
+                format!("at least 1 × 1, and at most {MAX_EDGES} edges ((rows + 1)·cols + rows·(cols + 1))"),
             ));
         }
         let gamma = self.sector_angle;
@@ -55,9 +63,17 @@ impl MiuraSpec {
             ));
         }
         for (field, value) in [("width", self.width), ("slant", self.slant)] {
-            if !(value.is_finite() && value > 0.0 && value <= 1e6) {
-                return Err(NanofoldError::invalid(field, value, "must lie in (0, 1e6]"));
+            if !(value.is_finite() && (MIN_LENGTH..=MAX_LENGTH).contains(&value)) {
+                return Err(NanofoldError::invalid(field, format!("{value:e}"), LENGTH_RANGE));
             }
+        }
+        let ratio = self.width / self.slant;
+        if !(1e-3..=1e3).contains(&ratio) {
+            return Err(NanofoldError::invalid(
+                "width",
+                self.width,
+                format!("width / slant = {ratio:.3e}: must lie in [1e-3, 1e3] (thinner panels have no room for the folding tolerances)"),
+            ));
         }
         let rho = self.zigzag_fold_angle;
         if !(rho.is_finite() && (0.0..std::f64::consts::PI).contains(&rho)) {
@@ -212,10 +228,10 @@ impl Default for SquareTwistSpec {
 impl SquareTwistSpec {
     /// Checks every parameter.
     pub fn validate(&self) -> Result<()> {
-        if !(self.side.is_finite() && self.side > 0.0 && self.side <= 1e6) {
-            return Err(NanofoldError::invalid("side", self.side, "must lie in (0, 1e6]"));
+        if !(self.side.is_finite() && (MIN_LENGTH..=MAX_LENGTH).contains(&self.side)) {
+            return Err(NanofoldError::invalid("side", format!("{:e}", self.side), LENGTH_RANGE));
         }
-        if !(self.half_sheet.is_finite() && self.half_sheet >= self.side && self.half_sheet <= 1e6) {
+        if !(self.half_sheet.is_finite() && self.half_sheet >= self.side && self.half_sheet <= MAX_LENGTH) {
             return Err(NanofoldError::invalid(
                 "half_sheet",
                 self.half_sheet,
@@ -454,8 +470,8 @@ impl BirdBaseSpec {
     /// 112.5°, 67.5° (three mountains, one valley): Kawasaki and Maekawa hold at all five.
     pub fn build(&self) -> Result<CreasePatternBuilder> {
         let s = self.half_side;
-        if !(s > 0.0 && s <= 1e6) {
-            return Err(NanofoldError::invalid("half_side", s, "a length in (0, 1e6]"));
+        if !(s.is_finite() && (MIN_LENGTH..=MAX_LENGTH).contains(&s)) {
+            return Err(NanofoldError::invalid("half_side", format!("{s:e}"), LENGTH_RANGE));
         }
         let d = (2.0 - std::f64::consts::SQRT_2) * s;
         let axes = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]];
