@@ -59,9 +59,9 @@
 //! ## Layers
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
-//! [`unfold`] and [`constraints`] → [`dynamics`] → [`io`] → `plot` (feature `plot`) → the
-//! `nanofold` binary (feature `cli`). [`error`] sits beneath them all; [`prelude`] gathers
-//! the names most programs need.
+//! [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`] → [`io`] → [`commands`] (the
+//! front door) → `plot` (feature `plot`) → the `nanofold` binary (feature `cli`). [`error`]
+//! sits beneath them all; [`prelude`] gathers the names most programs need.
 
 pub mod commands;
 pub mod constraints;
