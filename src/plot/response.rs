@@ -79,7 +79,7 @@ impl ResponseView {
     }
 
     /// A network's creases with their assignments and roles; with a response and more than
-    /// [`MAX_SERIES`] creases, the ones whose angle ranges furthest over the run.
+    /// `MAX_SERIES` creases, the ones whose angle ranges furthest over the run.
     pub fn of_network(name: &str, model: &NetworkModel, response: Option<&Response>) -> Self {
         let n = model.columns();
         let mut columns: Vec<usize> = (0..n).collect();

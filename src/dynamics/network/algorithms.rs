@@ -65,7 +65,7 @@ pub struct SpatialInertia {
     pub mass: f64,
     /// m c, kg·m.
     pub first_moment: Vector3<f64>,
-    /// I_c − m [c]ₓ², kg·m².
+    /// I_c − m \[c\]ₓ², kg·m².
     pub rotational: Matrix3<f64>,
 }
 

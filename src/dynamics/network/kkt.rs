@@ -1,8 +1,10 @@
 //! The regularised saddle-point system of a panel network's dynamics
 //! (`docs/model.md#panel-networks`):
 //!
+//! ```text
 //!   [ M/μ + JᵀJ   Jᵀ ] [ρ̈]   [ Q/μ + Jᵀb ]
 //!   [ J         −εI  ] [λ ] = [ b          ]
+//! ```
 //!
 //! with M the tree's mass matrix (zero on the creases off the tree) scaled by its largest
 //! diagonal entry μ, J the stars' closure rows each scaled to unit length, and
