@@ -549,18 +549,9 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
         None => {
             let model = sheet_of(pattern, "check")?;
             let clock = Instant::now();
-            let report = check_pattern(model, &settings.check)?;
+            let (report, unfolding) = check_sheet(model, &settings.check)?;
+            let unfolding = unfolding.map(Box::new);
             let start = model.given_fold_angles();
-            // A rigid folded state is also unfolded by energy, as the command line does.
-            let unfolding = if report.has_state && report.verdict == crate::folding::PatternVerdict::Rigid {
-                Some(Box::new(unfold_network(
-                    model,
-                    &start,
-                    &NetworkUnfoldSettings::default(),
-                )?))
-            } else {
-                None
-            };
             let judged = report
                 .witness
                 .as_ref()
@@ -582,6 +573,22 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
             })
         }
     }
+}
+
+/// The many-vertex check, and a rigid folded state's unfolding by energy beside it
+/// (`docs/model.md#energy-unfolding-of-many-vertices`): what `check` answers for a sheet.
+pub fn check_sheet(model: &FoldingModel, settings: &CheckSettings) -> Result<(CheckReport, Option<NetworkReport>)> {
+    let report = check_pattern(model, settings)?;
+    let unfolding = if report.has_state && report.verdict == crate::folding::PatternVerdict::Rigid {
+        Some(unfold_network(
+            model,
+            &model.given_fold_angles(),
+            &NetworkUnfoldSettings::default(),
+        )?)
+    } else {
+        None
+    };
+    Ok((report, unfolding))
 }
 
 /// Folds a pattern from its state (flat: along its assignment) by the many-vertex path

@@ -103,7 +103,7 @@ fn developed_vertex(value: &serde_json::Value, name: &str, closure_tol: f64) -> 
             .and_then(|z| z.as_f64())
             .is_some_and(|z| z != 0.0)
     });
-    if !is_3d {
+    if !is_3d || !creases_share_a_vertex(value) {
         return None;
     }
     let pattern = fold::read_crease_pattern(value, name).ok()?.build().ok()?;
@@ -138,6 +138,37 @@ fn developed_vertex(value: &serde_json::Value, name: &str, closure_tol: f64) -> 
         developed["frame_unit"] = serde_json::json!(unit);
     }
     Some(developed)
+}
+
+/// Whether every crease (M, V, U) of a FOLD object ends at one vertex: the cheap test that
+/// it can be a single vertex, before a 3D form is developed.
+fn creases_share_a_vertex(value: &serde_json::Value) -> bool {
+    let (Some(edges), Some(letters)) = (
+        value.get("edges_vertices").and_then(|e| e.as_array()),
+        value.get("edges_assignment").and_then(|a| a.as_array()),
+    ) else {
+        return false;
+    };
+    let mut common: Option<Vec<u64>> = None;
+    for (edge, letter) in edges.iter().zip(letters) {
+        if !matches!(letter.as_str(), Some("M" | "m" | "V" | "v" | "U" | "u")) {
+            continue;
+        }
+        let ends: Vec<u64> = edge
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|v| v.as_u64())
+            .collect();
+        common = Some(match common {
+            None => ends,
+            Some(shared) => shared.into_iter().filter(|v| ends.contains(v)).collect(),
+        });
+        if common.as_ref().is_some_and(|c| c.is_empty()) {
+            return false;
+        }
+    }
+    common.is_some()
 }
 
 /// A note when a FOLD file carries more frames than its key frame, which is the one read.

@@ -4,7 +4,7 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use nanofold::folding::{check_pattern, fold_path, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
+use nanofold::folding::{fold_path, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
 use nanofold::pattern::crease_pattern::CreasePatternBuilder;
@@ -450,18 +450,7 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
         ..CheckSettings::default()
     };
     let start = Instant::now();
-    let report = check_pattern(&model, &settings)?;
-    // A rigid folded state is also unfolded by energy (docs/model.md#energy-unfolding-of-many-vertices).
-    let unfolding = if report.has_state && report.verdict == nanofold::folding::PatternVerdict::Rigid {
-        use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
-        Some(unfold_network(
-            &model,
-            &model.given_fold_angles(),
-            &NetworkUnfoldSettings::default(),
-        )?)
-    } else {
-        None
-    };
+    let (report, unfolding) = nanofold::commands::check_sheet(&model, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     let mut line = format!(
         "{}: {} ({} DOF at the {} state, {:.3} ms) {}",

@@ -546,12 +546,7 @@ pub fn time_label(seconds: f64) -> String {
     if seconds == 0.0 || !seconds.is_finite() {
         return format!("{seconds} s");
     }
-    let (scale, unit) = match seconds.abs() {
-        t if t >= 1.0 => (1.0, "s"),
-        t if t >= 1e-3 => (1e-3, "ms"),
-        t if t >= 1e-6 => (1e-6, "µs"),
-        _ => (1e-9, "ns"),
-    };
+    let (unit, scale) = super::work_precision::time_unit(seconds.abs());
     let value = seconds / scale;
     let decimals = (3 - value.abs().log10().floor() as i32).max(0) as usize;
     let text = format!("{value:.decimals$}");

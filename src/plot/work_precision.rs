@@ -29,7 +29,7 @@ pub struct WorkSeries {
 
 /// The unit that shows times best: (name, seconds per unit), chosen so the largest time is
 /// at least 1.
-fn time_unit(largest_seconds: f64) -> (&'static str, f64) {
+pub(crate) fn time_unit(largest_seconds: f64) -> (&'static str, f64) {
     [("s", 1.0), ("ms", 1e-3), ("µs", 1e-6), ("ns", 1e-9)]
         .into_iter()
         .find(|&(_, unit)| largest_seconds >= unit)

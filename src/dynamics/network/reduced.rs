@@ -197,7 +197,12 @@ pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<Redu
         .fold(0.0, f64::max);
     // The reduced equation's own balance and frequency under the final drive.
     let (q, omega) = {
-        let reduced = ReducedPlant::new(model, &reduction, false)?;
+        // The exact plant already found the branch and the balance: reuse it.
+        let reduced = ReducedPlant {
+            model,
+            reduction: &reduction,
+            exact: plant,
+        };
         let mut ws = reduced.workspace();
         let rest = final_rest(model);
         let mut q = [e];
