@@ -1469,8 +1469,7 @@ fn run_modes_network(
     Ok(())
 }
 
-/// Each mode's frames in modes.fold move its largest crease this far either way, rad.
-const MODE_AMPLITUDE: f64 = 0.1;
+use nanofold::commands::MODE_AMPLITUDE;
 
 fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain, json: bool) -> Result<()> {
     let result = chain.folded_modes()?;

@@ -36,6 +36,14 @@ use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
 
+mod constraints;
+mod generate;
+mod scene;
+
+pub use constraints::{constraints, ConstraintSettings, Constraints, Degree};
+pub use generate::Generator;
+pub use scene::{modes, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
+
 /// The single-vertex pattern type of the engine behind the door.
 pub use crate::pattern::Pattern as VertexPattern;
 
@@ -67,32 +75,47 @@ pub struct Pattern {
     sheet: Option<FoldingModel>,
     /// The file it was read from.
     source: Option<String>,
+    /// What was ignored of a FOLD animation's frames.
+    frames_note: Option<String>,
 }
 
 impl Pattern {
     /// Reads a FOLD file or a native vertex file: the single-vertex engine takes it when it
     /// reads it, the many-vertex reader otherwise (its errors are then the ones returned).
     pub fn open(path: &Path, options: &LoadOptions) -> Result<Pattern> {
-        match crate::io::load_pattern(path, options) {
+        let text = crate::io::input::read_text(path, crate::io::input::MAX_PATTERN_BYTES)?;
+        let origin = path.display().to_string();
+        let mut pattern = Pattern::parse(&text, &crate::io::pattern_name(path), &origin, options)?;
+        pattern.source = Some(origin);
+        Ok(pattern)
+    }
+
+    /// Reads pattern text (FOLD or a native vertex) as [`Pattern::open`] reads a file;
+    /// `name` names the pattern when the text has no title, `origin` names it in errors.
+    pub fn parse(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
+        let frames_note = crate::io::input::parse_json(text, origin)
+            .ok()
+            .and_then(|v| crate::io::frames_note(&v));
+        let sheet_of_text = || crate::io::parse_crease_pattern(text, name, origin);
+        match crate::io::parse_pattern(text, name, origin, options) {
             Ok(vertex) => {
-                let sheet = crate::io::load_crease_pattern(path)
+                let sheet = sheet_of_text()
                     .ok()
                     .and_then(|p| FoldingModel::new(p).ok())
                     .or_else(|| sheet_of_vertex(&vertex).ok());
                 Ok(Pattern {
                     vertex: Some(vertex),
                     sheet,
-                    source: Some(path.display().to_string()),
+                    source: None,
+                    frames_note,
                 })
             }
-            Err(e) if takes_many_vertices(&e, path) => {
-                let sheet = FoldingModel::new(crate::io::load_crease_pattern(path)?)?;
-                Ok(Pattern {
-                    vertex: None,
-                    sheet: Some(sheet),
-                    source: Some(path.display().to_string()),
-                })
-            }
+            Err(e) if refused_as_vertex(&e, || sheet_of_text().is_ok()) => Ok(Pattern {
+                vertex: None,
+                sheet: Some(FoldingModel::new(sheet_of_text()?)?),
+                source: None,
+                frames_note,
+            }),
             Err(e) => Err(e),
         }
     }
@@ -103,7 +126,14 @@ impl Pattern {
             vertex: None,
             sheet: Some(FoldingModel::new(pattern)?),
             source: None,
+            frames_note: None,
         })
+    }
+
+    /// The same pattern, read from `source` (the file its reports name).
+    pub fn with_source(mut self, source: impl Into<String>) -> Pattern {
+        self.source = Some(source.into());
+        self
     }
 
     /// The file it was read from (None: built in code).
@@ -167,6 +197,7 @@ impl From<VertexPattern> for Pattern {
             vertex: Some(vertex),
             sheet,
             source: None,
+            frames_note: None,
         }
     }
 }
@@ -241,6 +272,11 @@ fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
 /// 3D folded form, no fold angles, a mesh larger than a vertex's); otherwise (a vertex whose
 /// folded state does not close, say) only if it reads as a crease pattern.
 pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
+    refused_as_vertex(error, || crate::io::load_crease_pattern(path).is_ok())
+}
+
+/// [`takes_many_vertices`] with the crease-pattern reading as a closure.
+fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: impl FnOnce() -> bool) -> bool {
     use NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
     let not_a_vertex = match error {
         MultipleVertices { .. } => true,
@@ -252,7 +288,7 @@ pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
         }
         _ => false,
     };
-    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && crate::io::load_crease_pattern(path).is_ok())
+    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && reads_as_sheet())
 }
 
 /// Every answer any command gives, in one vocabulary.
@@ -437,8 +473,8 @@ impl Report {
             }
             (Detail::NetworkUnfold(report), _, Some(model)) => {
                 let adjustments: Vec<String> = pattern
-                    .source()
-                    .and_then(|f| crate::io::file_frames_note(Path::new(f)))
+                    .frames_note
+                    .clone()
                     .into_iter()
                     .chain(model.pattern.reading.iter().cloned())
                     .collect();

@@ -7,7 +7,6 @@ use clap::{Args, Subcommand};
 use nanofold::folding::{fold_path, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
-use nanofold::pattern::crease_pattern::CreasePatternBuilder;
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
 use serde_json::{json, Value};
@@ -117,7 +116,8 @@ pub enum GenerateKind {
 
 /// `nanofold generate KIND ...`
 pub fn run_generate(kind: &GenerateKind) -> Result<()> {
-    match kind {
+    use nanofold::commands::Generator;
+    let (generator, out, table): (Generator, &Path, &[(&str, &str)]) = match kind {
         GenerateKind::Miura {
             rows,
             cols,
@@ -126,104 +126,64 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
             slant,
             fold,
             out,
-        } => {
-            let spec = MiuraSpec {
+        } => (
+            Generator::Miura(MiuraSpec {
                 rows: *rows,
                 cols: *cols,
                 sector_angle: angle.to_radians(),
                 width: *width,
                 slant: *slant,
                 zigzag_fold_angle: fold.unwrap_or(0.0).to_radians(),
-            };
-            let pattern = spec
-                .build()
-                .map_err(|e| {
-                    flags(
-                        e,
-                        &[
-                            ("sector_angle", "--angle"),
-                            ("zigzag_fold_angle", "--fold"),
-                            ("rows, cols", "--rows, --cols"),
-                            ("width", "--width"),
-                            ("slant", "--slant"),
-                        ],
-                    )
-                })?
-                .build()?;
-            let model = FoldingModel::new(pattern)?;
-            let state = fold.map(|_| model.given_fold_angles());
-            let note = format!(
-                "Miura-ori {rows} x {cols}, angle {angle} deg, width {width}, slant {slant}{}; written by nanofold generate",
-                fold.map_or(String::new(), |f| format!(", zigzag creases at {f} deg"))
-            );
-            let value = crease_pattern_fold(&model.pattern, state.as_deref(), &note);
-            write_file(out, &value)?;
-            report(&model, fold.is_some(), out);
-        }
+            }),
+            out,
+            &[
+                ("sector_angle", "--angle"),
+                ("zigzag_fold_angle", "--fold"),
+                ("rows, cols", "--rows, --cols"),
+                ("width", "--width"),
+                ("slant", "--slant"),
+            ],
+        ),
         GenerateKind::SquareTwist {
             side,
             half_sheet,
             twist,
             flip_pleats,
             out,
-        } => {
-            let spec = SquareTwistSpec {
+        } => (
+            Generator::SquareTwist(SquareTwistSpec {
                 side: *side,
                 half_sheet: *half_sheet,
                 twist: twist.to_radians(),
                 flip_pleats: *flip_pleats,
-            };
-            let builder = spec.build().map_err(|e| {
-                flags(
-                    e,
-                    &[("side", "--side"), ("half_sheet", "--half-sheet"), ("twist", "--twist")],
-                )
-            })?;
-            let note = format!(
-                "square twist, side {side}, sheet half-side {half_sheet}, twist {twist} deg, {} assignment; written by nanofold generate",
-                if *flip_pleats { "pleats flipped" } else { "classic" }
-            );
-            write_pattern(builder, &note, out)?;
-        }
+            }),
+            out,
+            &[("side", "--side"), ("half_sheet", "--half-sheet"), ("twist", "--twist")],
+        ),
         GenerateKind::Waterbomb {
             rows,
             cols,
             row_height,
             out,
-        } => {
-            let builder = WaterbombSpec {
+        } => (
+            Generator::Waterbomb(WaterbombSpec {
                 rows: *rows,
                 cols: *cols,
                 row_height: *row_height,
-            }
-            .build()
-            .map_err(|e| flags(e, &[("rows, cols", "--rows, --cols"), ("row_height", "--row-height")]))?;
-            write_pattern(
-                builder,
-                &format!(
-                    "waterbomb tessellation {rows} x {cols}, row height {row_height}; written by nanofold generate"
-                ),
-                out,
-            )?;
-        }
-        GenerateKind::BirdBase { half_side, out } => {
-            let builder = BirdBaseSpec { half_side: *half_side }
-                .build()
-                .map_err(|e| flags(e, &[("half_side", "--half-side")]))?;
-            write_pattern(
-                builder,
-                &format!("bird base, half side {half_side}; written by nanofold generate"),
-                out,
-            )?;
-        }
-    }
-    Ok(())
-}
-
-fn write_pattern(builder: CreasePatternBuilder, note: &str, out: &Path) -> Result<()> {
-    let model = FoldingModel::new(builder.build()?)?;
-    write_file(out, &crease_pattern_fold(&model.pattern, None, note))?;
-    report(&model, false, out);
+            }),
+            out,
+            &[("rows, cols", "--rows, --cols"), ("row_height", "--row-height")],
+        ),
+        GenerateKind::BirdBase { half_side, out } => (
+            Generator::BirdBase(BirdBaseSpec { half_side: *half_side }),
+            out,
+            &[("half_side", "--half-side")],
+        ),
+    };
+    let (model, state) = generator.build().map_err(|e| flags(e, table))?;
+    let value = crease_pattern_fold(&model.pattern, state.as_deref(), &generator.note());
+    write_file(out, &value)?;
+    report(&model, state.is_some(), out);
     Ok(())
 }
 
@@ -295,27 +255,33 @@ fn load_model(path: &Path) -> Result<FoldingModel> {
 
 /// Parses "EDGE=DEG" into (crease column, rad).
 fn parse_drive(model: &FoldingModel, text: &str) -> Result<(usize, f64)> {
-    let (edge, degrees) = text
-        .split_once('=')
-        .with_context(|| format!("--drive {text}: expected EDGE=DEG, e.g. 12=-90"))?;
-    let edge: usize = edge
-        .trim()
-        .parse()
-        .with_context(|| format!("--drive {text}: the edge index"))?;
-    let degrees: f64 = degrees
-        .trim()
-        .parse()
-        .with_context(|| format!("--drive {text}: the angle (degrees)"))?;
+    let (edge, degrees) = parse_edge_angle(text, "--drive")?;
     let Some(column) = model.column_of_edge.get(edge).copied().flatten() else {
         bail!(
             "--drive {text}: edge {edge} is not a crease (the pattern has {} edges; creases are M, V or U)",
             model.pattern.edges.len()
         );
     };
-    if !(degrees.is_finite() && degrees.abs() <= 180.0) {
-        bail!("--drive {text}: the angle must lie in [-180, 180] degrees");
-    }
     Ok((column, degrees.to_radians()))
+}
+
+/// `EDGE=DEG` of `flag`: a FOLD edge index and an angle in [-180, 180] degrees.
+fn parse_edge_angle(text: &str, flag: &str) -> Result<(usize, f64)> {
+    let (edge, degrees) = text
+        .split_once('=')
+        .with_context(|| format!("{flag} {text}: expected EDGE=DEG, e.g. 12=-90"))?;
+    let edge: usize = edge
+        .trim()
+        .parse()
+        .with_context(|| format!("{flag} {text}: the edge index"))?;
+    let degrees: f64 = degrees
+        .trim()
+        .parse()
+        .with_context(|| format!("{flag} {text}: the angle (degrees)"))?;
+    if !(degrees.is_finite() && degrees.abs() <= 180.0) {
+        bail!("{flag} {text}: the angle must lie in [-180, 180] degrees");
+    }
+    Ok((edge, degrees))
 }
 
 fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, seconds: f64) -> Value {
@@ -484,102 +450,63 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
 
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
 pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usize>) -> Result<()> {
-    use nanofold::constraints::network::{fit_network, fit_network_to_tolerance, network_mujoco, network_sweep};
+    use nanofold::commands::{constraints, ConstraintSettings, Constraints, Degree};
+    use nanofold::constraints::network::network_mujoco;
     if !args.checks.is_empty() {
         bail!("--check is for single vertices; for a crease pattern of many vertices compare with the sweep in constraints.json");
     }
     if args.source != super::SourceArg::Sweep {
         bail!("--source unfold is for single vertices; a crease pattern of many vertices is swept exactly");
     }
-    let mut model = load_model(&args.pattern)?;
-    let mut rho = model.given_fold_angles();
-    // --lock EDGE=DEG: hold that crease at that angle, and close every vertex around it.
-    for text in &args.locks {
-        let (column, angle) =
-            parse_drive(&model, text).map_err(|e| anyhow::anyhow!("{}", e.to_string().replace("--drive", "--lock")))?;
-        model.locked_columns[column] = true;
-        rho[column] = angle;
-    }
-    if !args.locks.is_empty() {
-        let mut solver = nanofold::folding::normal::NormalSolver::new(1e-10);
-        if nanofold::folding::restore_closure(&model, &mut rho, 1e-12, &mut solver)?.is_none() {
-            bail!(
-                "--lock {}: no rigid state near the file's with these creases held",
-                args.locks.join(" ")
-            );
-        }
-    }
-    let driver = model.column_of_edge.get(args.drive).copied().flatten().with_context(|| {
-        format!(
-            "invalid --drive {}: edge {} is not a crease of {} (for a crease pattern of many vertices --drive is a FOLD edge index)",
-            args.drive, args.drive, model.pattern.name
-        )
-    })?;
-    // --free I,J,...: every crease but these and the driver held at its folded angle.
-    if !args.free.is_empty() {
-        let mut free = vec![false; model.crease_count()];
-        for &edge in &args.free {
-            let column = model.column_of_edge.get(edge).copied().flatten().with_context(|| {
-                format!(
-                    "invalid --free {edge}: edge {edge} is not a crease of {}",
-                    model.pattern.name
-                )
-            })?;
-            free[column] = true;
-        }
-        for (column, locked) in model.locked_columns.iter_mut().enumerate() {
-            if column != driver && !free[column] {
-                *locked = true;
-            }
-        }
-    }
-    if rho.iter().all(|&r| r == 0.0) {
-        bail!(
-            "{}: constraint curves of many vertices start from a folded state (e.g. folded.fold written by `nanofold fold`); this pattern is flat",
-            args.pattern.display()
-        );
-    }
-    let domain = match args.range.as_deref() {
-        Some(text) => super::parse_range(text)?,
-        None => {
-            let theta = rho[driver];
-            let (a, b) = (0.05 * theta, theta);
-            [a.min(b), a.max(b)]
-        }
+    let model = load_model(&args.pattern)?;
+    let locks = args
+        .locks
+        .iter()
+        .map(|text| {
+            let (edge, degrees) = parse_edge_angle(text, "--lock")?;
+            Ok((edge, degrees.to_radians()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mujoco = args.format == super::ExportFormat::Mujoco;
+    let settings = ConstraintSettings {
+        driver: args.drive,
+        locks,
+        free: args.free.clone(),
+        degree: match degree {
+            Some(d) => Degree::Fixed(d),
+            None => Degree::Auto {
+                tol: args.tol.unwrap_or_default(),
+                at_most: if mujoco { 4 } else { nanofold::constraints::MAX_DEGREE },
+            },
+        },
+        domain: args.range.as_deref().map(super::parse_range).transpose()?,
+        samples: args.samples,
     };
-    let samples = args.samples.div_ceil(2).max(2);
-    let sweep = network_sweep(&model, &rho, driver, domain, samples).map_err(|e| {
+    let pattern = nanofold::commands::Pattern::from_crease_pattern(model.pattern.clone())?;
+    let result = constraints(&pattern, &settings).map_err(|e| {
         flags(
             e,
-            &[("domain", "--range"), ("samples", "--samples"), ("driver", "--drive")],
+            &[
+                ("domain", "--range"),
+                ("samples", "--samples"),
+                ("driver", "--drive"),
+                ("locks", "--lock"),
+                ("free", "--free"),
+                ("degree", "--degree"),
+                ("tolerance", "--tol"),
+            ],
         )
     })?;
-    let mujoco = args.format == super::ExportFormat::Mujoco;
-    let curves = match degree {
-        Some(d) => fit_network(&model, &sweep, d),
-        // MuJoCo takes a quartic at most: the smallest degree ≤ 4 meeting --tol, else 4.
-        None if mujoco => {
-            let tol = args.tol.unwrap_or_default();
-            let mut chosen = fit_network(&model, &sweep, 1);
-            for d in 2..=4 {
-                if chosen.as_ref().is_ok_and(|c| c.max_fit_error_rad <= tol) {
-                    break;
-                }
-                chosen = fit_network(&model, &sweep, d);
-            }
-            if let Ok(c) = &chosen {
-                if c.max_fit_error_rad > tol {
-                    eprintln!(
-                        "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
-                        c.max_fit_error_rad
-                    );
-                }
-            }
-            chosen
-        }
-        None => fit_network_to_tolerance(&model, &sweep, args.tol.unwrap_or_default()),
+    let Constraints::Network { sweep, curves } = result else {
+        bail!("{}: read as a single vertex", args.pattern.display());
+    };
+    if mujoco && curves.max_fit_error_rad > args.tol.unwrap_or(f64::INFINITY) {
+        eprintln!(
+            "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {:e}",
+            curves.max_fit_error_rad,
+            args.tol.unwrap_or_default()
+        );
     }
-    .map_err(|e| flags(e, &[("degree", "--degree"), ("tolerance", "--tol")]))?;
     let dir = args
         .out
         .clone()

@@ -1,0 +1,422 @@
+"""Patterns, scenes and the commands on them, over the library's front door."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, TypeVar, Union
+
+import numpy as np
+
+from . import _native
+from ._results import FoldResult, PatternResult, Result, SimulationResult
+from .errors import from_native
+
+T = TypeVar("T")
+PathLike = Union[str, "os.PathLike[str]"]
+
+# The library's own limits on a pattern and a scene file (io::input).
+MAX_FILE_BYTES = {"pattern": 16 << 20, "scene": 1 << 20}
+
+
+def _call(function: Callable[..., T], *args: Any) -> T:
+    try:
+        return function(*args)
+    except _native.NativeError as error:
+        raise from_native(error) from None
+
+
+def _settings(values: Mapping[str, Any]) -> str:
+    """Keywords as the JSON the extension reads; None means "the library's default"."""
+    def plain(v: Any) -> Any:
+        if isinstance(v, np.generic):
+            return v.item()
+        if isinstance(v, np.ndarray):
+            return v.tolist()
+        if isinstance(v, Mapping):
+            return {str(k): plain(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [plain(x) for x in v]
+        return v
+
+    return json.dumps({k: plain(v) for k, v in values.items() if v is not None}, allow_nan=True)
+
+
+def _read_text(path: Path, what: str) -> str:
+    try:
+        size = path.stat().st_size
+    except OSError as error:
+        from .errors import FileReadError
+
+        raise FileReadError(f"cannot read {path}: {error.strerror}", "io", "path", str(path)) from None
+    if size > MAX_FILE_BYTES[what]:
+        from .errors import InvalidFieldError
+
+        raise InvalidFieldError(
+            f"invalid `{what}`: {path} ({size} bytes; a {what} file is at most {MAX_FILE_BYTES[what]} bytes)",
+            "invalid_field",
+            what,
+            str(path),
+        )
+    return path.read_text(encoding="utf-8")
+
+
+class Pattern:
+    """A crease pattern: a single vertex or a sheet of many vertices, as nanofold reads it.
+
+    Built from a file (:meth:`open`), a FOLD dict (:meth:`from_fold`), arrays
+    (:meth:`from_arrays`) or a generator (:mod:`nanofold.generate`). It keeps its text, so it
+    pickles and travels to workers.
+
+    >>> import nanofold
+    >>> p = nanofold.Pattern.open("patterns/many/miura_4x4.fold")
+    >>> (p.name, p.engine, len(p.crease_labels))
+    ('miura_4x4', 'network', 24)
+    """
+
+    def __init__(
+        self,
+        text: str,
+        name: str = "pattern",
+        *,
+        origin: Optional[str] = None,
+        source: Optional[str] = None,
+        closure_tol: Optional[float] = None,
+        angle_sum_tol: Optional[float] = None,
+    ):
+        self._text = text
+        self._name = name
+        self._origin = origin or name
+        self._source = source
+        self._options = {"closure_tol": closure_tol, "angle_sum_tol": angle_sum_tol}
+        self._handle = _call(
+            _native.parse_pattern, text, name, self._origin, _settings(self._options), source
+        )
+
+    @classmethod
+    def open(cls, path: PathLike, *, closure_tol: Optional[float] = None, angle_sum_tol: Optional[float] = None) -> "Pattern":
+        """Reads a FOLD file (``.fold``) or a native vertex (``.json``)."""
+        path = Path(path)
+        text = _read_text(path, "pattern")
+        name = path.name
+        for suffix in (".fold", ".json"):
+            if name.endswith(suffix):
+                name = name[: -len(suffix)]
+                break
+        return cls(text, name, origin=str(path), source=str(path), closure_tol=closure_tol, angle_sum_tol=angle_sum_tol)
+
+    @classmethod
+    def from_fold(cls, fold: Mapping[str, Any], name: Optional[str] = None, **options: Optional[float]) -> "Pattern":
+        """A FOLD object given as a dict (its ``file_title`` names it, else ``name``)."""
+        title = name or str(fold.get("file_title") or fold.get("frame_title") or "pattern")
+        return cls(json.dumps(fold), title, origin=f"<FOLD dict {title}>", **options)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        vertices: Iterable[Sequence[float]],
+        edges: Iterable[Sequence[int]],
+        assignments: Iterable[str],
+        fold_angles_deg: Optional[Iterable[float]] = None,
+        faces: Optional[Iterable[Sequence[int]]] = None,
+        name: str = "pattern",
+        **options: Optional[float],
+    ) -> "Pattern":
+        """A pattern from arrays: vertex coordinates (2D flat, or 3D), edges as vertex pairs,
+        FOLD assignments (``"M"``, ``"V"``, ``"F"``, ``"B"``, ``"U"``), optional fold angles in
+        degrees (FOLD's convention) and faces.
+
+        >>> import nanofold
+        >>> p = nanofold.Pattern.from_arrays(
+        ...     [[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]],
+        ...     [[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [2, 3], [3, 4], [4, 1]],
+        ...     ["M", "V", "V", "V", "B", "B", "B", "B"], name="cross")
+        >>> p.engine
+        'vertex'
+        """
+        fold: Dict[str, Any] = {
+            "file_spec": 1.1,
+            "file_creator": "nanofold (Python)",
+            "file_title": name,
+            "vertices_coords": np.asarray(vertices, dtype=float).tolist(),
+            "edges_vertices": np.asarray(edges, dtype=int).tolist(),
+            "edges_assignment": list(assignments),
+        }
+        if fold_angles_deg is not None:
+            fold["edges_foldAngle"] = np.asarray(fold_angles_deg, dtype=float).tolist()
+        if faces is not None:
+            fold["faces_vertices"] = [list(map(int, f)) for f in faces]
+        return cls.from_fold(fold, name, **options)
+
+    @property
+    def name(self) -> str:
+        """The pattern's name."""
+        return str(self._handle.name)
+
+    @property
+    def engine(self) -> str:
+        """``"vertex"`` (the single-vertex engine answers) or ``"network"``."""
+        return str(self._handle.engine)
+
+    @property
+    def source(self) -> Optional[str]:
+        """The file it was read from."""
+        return self._source
+
+    @property
+    def crease_labels(self) -> list:
+        """Every crease's label, in the order of the angle arrays."""
+        return list(self._handle.crease_labels())
+
+    @property
+    def fold_angles(self) -> np.ndarray:
+        """The fold angles the input gives, rad."""
+        return np.asarray(self._handle.fold_angles(), dtype=float)
+
+    def describe(self) -> Dict[str, Any]:
+        """Counts (vertices, creases, interior vertices, panels) and the reader's notes."""
+        return dict(json.loads(self._handle.describe()))
+
+    def to_fold(self) -> Dict[str, Any]:
+        """The input as a dict (the FOLD object or native vertex it was read from)."""
+        return dict(json.loads(self._text))
+
+    def __reduce__(self) -> Any:
+        return (
+            _restore_pattern,
+            (self._text, self._name, self._origin, self._source, self._options),
+        )
+
+    def __repr__(self) -> str:
+        return f"<Pattern {self.name} ({self.engine}, {len(self.crease_labels)} creases)>"
+
+
+def _restore_pattern(text: str, name: str, origin: str, source: Optional[str], options: Dict[str, Any]) -> Pattern:
+    return Pattern(text, name, origin=origin, source=source, **options)
+
+
+class Scene:
+    """A scene (``*.scene.json``): a strip of plates, a closed chain or a network of panels
+    with materials, hinges and actuation. Built from a file or a dict; a ``pattern`` path in
+    it is read relative to ``base`` (the scene file's folder), which workers must also see.
+
+    >>> import nanofold
+    >>> s = nanofold.Scene.open("patterns/bridge_step.scene.json")
+    >>> (s.name, s.kind)
+    ('bridge_step', 'strip')
+    """
+
+    def __init__(self, spec: Mapping[str, Any], *, base: PathLike = ".", name: Optional[str] = None, source: Optional[str] = None):
+        self._spec = json.loads(json.dumps(spec))
+        self._base = str(base)
+        self._fallback = name or str(self._spec.get("name") or "scene")
+        self._source = source or f"<scene dict {self._fallback}>"
+        self._handle = _call(
+            _native.parse_scene, json.dumps(self._spec), self._source, self._fallback, self._base
+        )
+
+    @classmethod
+    def open(cls, path: PathLike) -> "Scene":
+        """Reads a scene file."""
+        path = Path(path)
+        spec = json.loads(_read_text(path, "scene"))
+        name = path.name
+        for suffix in (".scene.json", ".json"):
+            if name.endswith(suffix):
+                name = name[: -len(suffix)]
+                break
+        return cls(spec, base=path.parent, name=name, source=str(path))
+
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+        return str(self._handle.name)
+
+    @property
+    def kind(self) -> str:
+        """``"strip"``, ``"closed"`` or ``"network"``."""
+        return str(self._handle.kind)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The scene's specification."""
+        return json.loads(json.dumps(self._spec))
+
+    def replace(self, changes: Mapping[str, Any]) -> "Scene":
+        """A copy with fields changed, each named by its dotted path (list items by index):
+        ``scene.replace({"actuation.etch_rate_um_per_min": 3.0,
+        "hinges.0.layers.1.thickness_um": 0.05})``. A path that is not in the scene is refused."""
+        spec = self.to_dict()
+        for dotted, value in changes.items():
+            node: Any = spec
+            keys = dotted.split(".")
+            for key in keys[:-1]:
+                node = _child(node, key, dotted)
+            _child(node, keys[-1], dotted)
+            if isinstance(node, list):
+                node[int(keys[-1])] = value
+            else:
+                node[keys[-1]] = value
+        return Scene(spec, base=self._base, name=self._fallback, source=self._source)
+
+    def __reduce__(self) -> Any:
+        return (_restore_scene, (self._spec, self._base, self._fallback, self._source))
+
+    def __repr__(self) -> str:
+        return f"<Scene {self.name} ({self.kind})>"
+
+
+def _child(node: Any, key: str, dotted: str) -> Any:
+    from .errors import InvalidFieldError
+
+    try:
+        return node[int(key)] if isinstance(node, list) else node[key]
+    except (KeyError, IndexError, ValueError, TypeError):
+        raise InvalidFieldError(
+            f"invalid `{dotted}`: no such field in the scene ({key!r} not found)", "invalid_field", dotted, key
+        ) from None
+
+
+def _restore_scene(spec: Dict[str, Any], base: str, name: str, source: str) -> Scene:
+    return Scene(spec, base=base, name=name, source=source)
+
+
+def _pattern(pattern: Union[Pattern, PathLike]) -> Pattern:
+    return pattern if isinstance(pattern, Pattern) else Pattern.open(pattern)
+
+
+def _scene(scene: Union[Scene, PathLike]) -> Scene:
+    return scene if isinstance(scene, Scene) else Scene.open(scene)
+
+
+def check(pattern: Union[Pattern, PathLike], *, closure_tol: Optional[float] = None) -> PatternResult:
+    """The pattern's verdict: a single vertex by unfolding it; a sheet of many vertices by its
+    state (``rigid``, ``not_rigid``, ``self_intersecting``) or, flat, its assignment
+    (``rigidly_foldable``, ``not_rigidly_foldable``, ``unknown``), with evidence.
+
+    >>> import nanofold
+    >>> nanofold.check("patterns/many/miura_4x4.fold").verdict
+    'rigidly_foldable'
+    """
+    p = _pattern(pattern)
+    payload = json.loads(_call(_native.check, p._handle, _settings({"closure_tol": closure_tol})))
+    return PatternResult("check", payload)
+
+
+def unfold(
+    pattern: Union[Pattern, PathLike],
+    *,
+    energy: Optional[str] = None,
+    p: Optional[float] = None,
+    qp: Optional[str] = None,
+    flat_tol: Optional[float] = None,
+    max_iterations: Optional[int] = None,
+    bending_metric: Optional[float] = None,
+    restarts: Optional[int] = None,
+    seed: Optional[int] = None,
+) -> PatternResult:
+    """Unfolds a folded pattern to flat by energy descent; ``verdict`` is ``flat``, ``locked``,
+    ``local_minimum``, ``not_rigid``, … Keywords are the library's ``UnfoldSettings``
+    (``energy``: ``"separable"`` or ``"non_separable"``; ``qp``: ``"clarabel"`` or ``"direct"``).
+
+    >>> import nanofold
+    >>> r = nanofold.unfold("patterns/miura_vertex.fold")
+    >>> r.verdict, bool(abs(r.final_fold_angles_rad).max() < 1e-6)
+    ('flat', True)
+    """
+    pat = _pattern(pattern)
+    keywords = dict(energy=energy, p=p, qp=qp, flat_tol=flat_tol, max_iterations=max_iterations,
+                    bending_metric=bending_metric, restarts=restarts, seed=seed)
+    payload = json.loads(_call(_native.unfold, pat._handle, _settings(keywords)))
+    return PatternResult("unfold", payload)
+
+
+def fold(
+    pattern: Union[Pattern, PathLike],
+    *,
+    to: Optional[float] = None,
+    drive: Optional[Mapping[int, float]] = None,
+    frames: Optional[int] = None,
+    max_step: Optional[float] = None,
+    max_steps: Optional[int] = None,
+) -> FoldResult:
+    """Folds a pattern rigidly: from flat along its assignment until the most folded crease
+    reaches ``to`` × 180° (a fraction, default 1), or ``drive`` = {FOLD edge index: angle in
+    rad}. ``frames`` snapshots go into the FOLD animation (``fold_file()``); ``max_step`` is
+    the largest change of any fold angle in one step, rad.
+
+    >>> import nanofold
+    >>> r = nanofold.fold("patterns/many/miura_4x4.fold", to=0.5, frames=5)
+    >>> r.verdict, r.dof, len(r.fold_file()["file_frames"])
+    ('reached', 1, 5)
+    """
+    pat = _pattern(pattern)
+    keywords = dict(to=to, drive=drive, frames=frames, max_step=max_step, max_steps=max_steps)
+    payload = json.loads(_call(_native.fold, pat._handle, _settings(keywords)))
+    return FoldResult("fold", payload)
+
+
+def constraints(
+    pattern: Union[Pattern, PathLike],
+    *,
+    driver: int,
+    locks: Optional[Mapping[int, float]] = None,
+    free: Optional[Sequence[int]] = None,
+    degree: Union[int, str, None] = None,
+    tol: Optional[float] = None,
+    domain: Optional[Sequence[float]] = None,
+    samples: Optional[int] = None,
+) -> Result:
+    """Constraint curves: every free crease as a polynomial of the ``driver`` crease (the
+    file's crease index: a FOLD edge index), swept by exact loop closure over ``domain``
+    (rad), with each curve's error. ``degree`` is 1..20 or ``"auto"`` with ``tol`` (rad).
+
+    >>> import nanofold
+    >>> c = nanofold.constraints("patterns/miura_vertex.fold", driver=0, degree=6)
+    >>> bool(c.max_closure_residual < 1e-3)
+    True
+    """
+    pat = _pattern(pattern)
+    keywords = dict(driver=driver, locks=locks, free=list(free) if free is not None else None,
+                    degree=degree, tol=tol, domain=list(domain) if domain is not None else None, samples=samples)
+    payload = json.loads(_call(_native.constraints, pat._handle, _settings(keywords)))
+    return Result("constraints", payload)
+
+
+def simulate(
+    scene: Union[Scene, PathLike],
+    *,
+    model: Optional[str] = None,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    t_end: Optional[float] = None,
+    ignore_collisions: Optional[bool] = None,
+    max_steps: Optional[int] = None,
+) -> SimulationResult:
+    """A scene's response to its actuation (``model``: ``"auto"``, ``"dynamic"``,
+    ``"quasi_static"``; ``method``: ``"auto"``, ``"bdf"``, ``"esdirk34"``, ``"tr_bdf2"``,
+    ``"tsit45"``); ``times`` and ``angles`` are the samples, ``collision`` the first contact.
+
+    >>> import nanofold
+    >>> r = nanofold.simulate("patterns/bridge_ramp.scene.json")
+    >>> r.model, r.collision["pair"]
+    ('quasi_static', ['plate 3', 'substrate'])
+    """
+    s = _scene(scene)
+    keywords = dict(model=model, method=method, rtol=rtol, t_end=t_end,
+                    ignore_collisions=ignore_collisions, max_steps=max_steps)
+    payload = json.loads(_call(_native.simulate, s._handle, _settings(keywords)))
+    return SimulationResult("simulate", payload)
+
+
+def modes(scene: Union[Scene, PathLike]) -> Result:
+    """Natural frequencies (Hz), mode shapes and stability at the scene's folded equilibrium.
+
+    >>> import nanofold
+    >>> m = nanofold.modes("patterns/bridge_step.scene.json")
+    >>> m.stable, len(m.frequencies_hz)
+    (True, 4)
+    """
+    s = _scene(scene)
+    payload = json.loads(_call(_native.modes, s._handle))
+    return Result("modes", payload)

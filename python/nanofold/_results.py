@@ -1,0 +1,132 @@
+"""Results of nanofold's commands: the command line's ``--json`` object as attributes, its
+numeric lists as numpy arrays, and what the command writes beside it (FOLD files as dicts)."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+
+
+def _as_array(value: Any) -> Any:
+    """A list of numbers (or of equal-length lists of numbers) as a float array."""
+    if isinstance(value, list) and value:
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            return np.asarray(value, dtype=float)
+        if all(isinstance(v, list) for v in value):
+            try:
+                array = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                return value
+            return array if array.ndim == 2 else value
+    return value
+
+
+class Result:
+    """One command's answer. Every key of ``to_dict()`` is an attribute (numeric lists as
+    numpy arrays); ``trajectory`` holds the fold angles of every recorded step (rad)."""
+
+    command: str
+
+    def __init__(self, command: str, payload: Dict[str, Any]):
+        self.command = command
+        self._summary: Dict[str, Any] = payload.get("summary") or {}
+        self._payload = payload
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The result as the command line's ``--json`` prints it (less its ``out`` folder)."""
+        return copy.deepcopy(self._summary)
+
+    def keys(self) -> List[str]:
+        """The result's fields."""
+        return list(self._summary)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        try:
+            return _as_array(self._summary[name])
+        except KeyError:
+            raise AttributeError(
+                f"{type(self).__name__} of {self.command!r} has no field {name!r}; its fields: {', '.join(self._summary)}"
+            ) from None
+
+    def __getitem__(self, name: str) -> Any:
+        return self.__getattr__(name)
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._summary
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self._summary))
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return {"command": self.command, "payload": self._payload}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__init__(state["command"], state["payload"])  # type: ignore[misc]
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Result) and self.command == other.command and self._payload == other._payload
+
+    def __repr__(self) -> str:
+        head = self._summary.get("pattern") or self._summary.get("scene") or ""
+        verdict = self._summary.get("verdict") or self._summary.get("stop_reason") or self._summary.get("model")
+        return f"<{type(self).__name__} {self.command} {head}: {verdict}>"
+
+    @property
+    def trajectory(self) -> np.ndarray:
+        """Fold angles of every recorded step, rad (steps × creases)."""
+        return np.asarray(self._payload.get("trajectory") or [], dtype=float)
+
+    def fold_file(self) -> Optional[Dict[str, Any]]:
+        """The FOLD animation the command writes (``fold.fold``, a network's ``motion.fold``
+        or ``modes.fold``), as a dict; None where it writes none."""
+        value = self._payload.get("fold_file")
+        return copy.deepcopy(value) if value is not None else None
+
+
+class PatternResult(Result):
+    """``check``, ``fold``, ``unfold``: ``verdict`` and ``evidence`` always."""
+
+    @property
+    def verdict(self) -> str:
+        """The answer, in the command line's words (``flat``, ``rigid``, ``reached``, …)."""
+        return str(self._summary.get("verdict") or self._summary.get("stop_reason"))
+
+    @property
+    def evidence(self) -> str:
+        """Why, in words."""
+        return str(self._summary.get("evidence", ""))
+
+
+class FoldResult(PatternResult):
+    """``fold``: the path's progress per step and its end state as FOLD."""
+
+    @property
+    def progress_per_step(self) -> np.ndarray:
+        """Progress (fraction of full folding) at every step."""
+        return np.asarray(self._payload.get("progress") or [], dtype=float)
+
+    def folded_file(self) -> Dict[str, Any]:
+        """The end state as a FOLD crease pattern with its fold angles (``folded.fold``)."""
+        return copy.deepcopy(self._payload["folded_file"])
+
+
+class SimulationResult(Result):
+    """``simulate``: the summary, and ``response.json`` with every sample."""
+
+    def response(self) -> Dict[str, Any]:
+        """``response.json`` as a dict."""
+        return copy.deepcopy(self._payload["response"])
+
+    @property
+    def times(self) -> np.ndarray:
+        """Sample times, s."""
+        return np.asarray(self._payload["response"].get("time_s") or [], dtype=float)
+
+    @property
+    def angles(self) -> np.ndarray:
+        """Fold angles at every sample, rad (samples × hinges)."""
+        return np.asarray(self._payload["response"].get("angles_rad") or [], dtype=float)

@@ -1,0 +1,403 @@
+//! `nanofold._native`: the library's front door (`nanofold::commands`) for the Python
+//! package. Every call takes and returns JSON text that the package's Python layer turns into
+//! objects, so a result from Python is the command line's `--json` by construction. Long calls
+//! run on a worker thread with the GIL released, and Ctrl-C returns at once (the abandoned
+//! run finishes within the library's own bounds and its result is dropped).
+
+mod settings;
+
+use nanofold::commands::{self, Pattern};
+use nanofold::dynamics::scene::Scene;
+use nanofold::NanofoldError;
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use serde_json::{json, Value};
+use std::path::Path;
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::Duration;
+
+create_exception!(
+    _native,
+    NativeError,
+    PyException,
+    "An error of the library: args are (kind, field, value, message)."
+);
+
+/// The library's error as (kind, field, value, message), the message with its sources.
+fn to_py(error: NanofoldError) -> PyErr {
+    let (kind, field, value) = match &error {
+        NanofoldError::InvalidField { field, value, .. } => ("invalid_field", field.clone(), value.clone()),
+        NanofoldError::MissingField { field, .. } => ("missing_field", field.clone(), String::new()),
+        NanofoldError::ClosureViolated { field, .. } => ("closure_violated", field.clone(), String::new()),
+        NanofoldError::Io { path, .. } => ("io", "path".to_string(), path.clone()),
+        NanofoldError::Output { path, .. } => ("output", "path".to_string(), path.clone()),
+        NanofoldError::Json { path, .. } => ("json", "path".to_string(), path.clone()),
+        NanofoldError::MultipleVertices { .. } => ("multiple_vertices", String::new(), String::new()),
+        NanofoldError::OutsideFitDomain { .. } => ("outside_fit_domain", String::new(), String::new()),
+        NanofoldError::Numerical(_) | NanofoldError::Unreachable { .. } => ("numerical", String::new(), String::new()),
+        _ => ("other", String::new(), String::new()),
+    };
+    let mut message = error.to_string();
+    let mut source = std::error::Error::source(&error);
+    while let Some(cause) = source {
+        message.push_str(": ");
+        message.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    NativeError::new_err((kind, field, value, message))
+}
+
+/// Runs `work` on a worker thread with the GIL released, checking for Ctrl-C (and other
+/// signals) every 20 ms.
+fn run_detached<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce() -> nanofold::Result<T> + Send + 'static,
+) -> PyResult<T> {
+    let (sender, receiver) = mpsc::channel();
+    std::thread::Builder::new()
+        .name("nanofold".into())
+        .spawn(move || {
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work));
+            let _ = sender.send(outcome);
+        })
+        .map_err(|e| NativeError::new_err(("other", "", "", format!("cannot start a worker thread: {e}"))))?;
+    let mut receiver = receiver;
+    loop {
+        let (back, received) = py.detach(move || {
+            let received = receiver.recv_timeout(Duration::from_millis(20));
+            (receiver, received)
+        });
+        receiver = back;
+        match received {
+            Ok(Ok(result)) => return result.map_err(to_py),
+            Ok(Err(_)) => {
+                return Err(NativeError::new_err((
+                    "panic",
+                    "",
+                    "",
+                    "the library panicked (a bug: please report it with the input)",
+                )))
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(NativeError::new_err((
+                    "panic",
+                    "",
+                    "",
+                    "the worker thread ended without a result",
+                )))
+            }
+        }
+    }
+}
+
+fn parse_json(text: &str, what: &'static str) -> PyResult<Value> {
+    serde_json::from_str(text)
+        .map_err(|e| NativeError::new_err(("invalid_field", what, "", format!("{what}: not JSON ({e})"))))
+}
+
+/// A pattern read by the library (a single vertex or a crease pattern of many).
+#[pyclass(frozen, module = "nanofold._native")]
+struct PatternHandle {
+    pattern: Arc<Pattern>,
+}
+
+#[pymethods]
+impl PatternHandle {
+    /// The pattern's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.pattern.name().to_string()
+    }
+    /// "vertex" or "network": the engine that answers for it.
+    #[getter]
+    fn engine(&self) -> &'static str {
+        self.pattern.engine().as_str()
+    }
+    /// The file it was read from, if any.
+    #[getter]
+    fn source(&self) -> Option<String> {
+        self.pattern.source().map(str::to_string)
+    }
+    /// Every crease's label, in the order of the angle vectors.
+    fn crease_labels(&self) -> Vec<String> {
+        self.pattern.crease_labels()
+    }
+    /// The fold angles the file gives, rad.
+    fn fold_angles(&self) -> Vec<f64> {
+        self.pattern.fold_angles()
+    }
+    /// Counts of the pattern's sheet as JSON: vertices, creases, interior vertices, panels,
+    /// and the reader's notes.
+    fn describe(&self) -> String {
+        let p = &self.pattern;
+        let mut value = json!({"name": p.name(), "engine": p.engine().as_str(), "creases": p.crease_labels().len()});
+        if let Some(model) = p.sheet() {
+            value["vertices"] = json!(model.pattern.vertices.len());
+            value["interior_vertices"] = json!(model.stars.len());
+            value["panels"] = json!(model.pattern.panel_count);
+            value["reading"] = json!(model.pattern.reading);
+        }
+        value.to_string()
+    }
+}
+
+/// Reads a pattern file (FOLD or a native vertex).
+#[pyfunction]
+fn open_pattern(py: Python<'_>, path: String, options: &str) -> PyResult<PatternHandle> {
+    let options = settings::load_options(&parse_json(options, "options")?).map_err(to_py)?;
+    let pattern = run_detached(py, move || Pattern::open(Path::new(&path), &options))?;
+    Ok(PatternHandle {
+        pattern: Arc::new(pattern),
+    })
+}
+
+/// Reads pattern text (FOLD or a native vertex); `name` names it when it has no title,
+/// `origin` in errors, `source` (when given) is the file its reports name.
+#[pyfunction]
+#[pyo3(signature = (text, name, origin, options, source=None))]
+fn parse_pattern(
+    py: Python<'_>,
+    text: String,
+    name: String,
+    origin: String,
+    options: &str,
+    source: Option<String>,
+) -> PyResult<PatternHandle> {
+    let options = settings::load_options(&parse_json(options, "options")?).map_err(to_py)?;
+    let pattern = run_detached(py, move || {
+        let pattern = Pattern::parse(&text, &name, &origin, &options)?;
+        Ok(match source {
+            Some(source) => pattern.with_source(source),
+            None => pattern,
+        })
+    })?;
+    Ok(PatternHandle {
+        pattern: Arc::new(pattern),
+    })
+}
+
+/// `check`: the report's JSON.
+#[pyfunction]
+fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+    let settings =
+        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Check).map_err(to_py)?;
+    let pattern = pattern.pattern.clone();
+    run_detached(py, move || {
+        let report = commands::check(&pattern, &settings.settings)?;
+        Ok(json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report)}).to_string())
+    })
+}
+
+/// `unfold`: the report's JSON and the fold angles of every recorded step.
+#[pyfunction]
+fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+    let settings =
+        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Unfold).map_err(to_py)?;
+    let pattern = pattern.pattern.clone();
+    run_detached(py, move || {
+        let report = commands::unfold(&pattern, &settings.settings)?;
+        Ok(json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report)}).to_string())
+    })
+}
+
+/// `fold`: the report's JSON, the path's fold angles and progress, its FOLD animation with
+/// `frames` frames and its end state as FOLD.
+#[pyfunction]
+fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+    use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold};
+    let mut settings =
+        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Fold).map_err(to_py)?;
+    let pattern = pattern.pattern.clone();
+    if !settings.drive_edges.is_empty() {
+        let model = pattern.sheet().ok_or_else(|| {
+            to_py(NanofoldError::invalid(
+                "pattern",
+                pattern.name(),
+                "a cone has no flat sheet to fold",
+            ))
+        })?;
+        let columns = settings
+            .drive_edges
+            .iter()
+            .map(
+                |&(edge, angle)| match model.column_of_edge.get(edge).copied().flatten() {
+                    Some(column) => Ok((column, angle)),
+                    None => Err(to_py(NanofoldError::invalid(
+                        "drive",
+                        edge,
+                        format!(
+                            "edge {edge} is not a crease of {} (keys are FOLD edge indices)",
+                            pattern.name()
+                        ),
+                    ))),
+                },
+            )
+            .collect::<PyResult<Vec<_>>>()?;
+        settings.settings.fold.drive = nanofold::folding::Drive::Creases(columns);
+    }
+    run_detached(py, move || {
+        let report = commands::fold(&pattern, &settings.settings)?;
+        let (commands::Detail::Fold(path), Some(model)) = (&report.detail, pattern.sheet()) else {
+            unreachable!("fold answers with a path on the sheet");
+        };
+        let chosen = evenly(path.steps.len(), settings.frames);
+        let mut summary = report.to_json(&pattern);
+        summary["frames"] = json!(chosen.len());
+        Ok(json!({
+            "summary": summary,
+            "trajectory": trajectory(&report),
+            "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
+            "fold_file": fold_path_fold(model, path, &chosen),
+            "folded_file": crease_pattern_fold(
+                &model.pattern,
+                Some(&report.final_fold_angles_rad),
+                "end state of nanofold fold (a crease pattern with its fold angles)",
+            ),
+        })
+        .to_string())
+    })
+}
+
+/// The fold angles of every step the engine recorded.
+fn trajectory(report: &commands::Report) -> Vec<Vec<f64>> {
+    match &report.detail {
+        commands::Detail::VertexUnfold(r) => r.trajectory.iter().map(|s| s.fold_angles.clone()).collect(),
+        commands::Detail::NetworkUnfold(r) => r.steps.iter().map(|s| s.fold_angles.clone()).collect(),
+        commands::Detail::NetworkCheck(r, _) => r
+            .witness
+            .as_ref()
+            .map(|w| w.steps.iter().map(|s| s.fold_angles.clone()).collect())
+            .unwrap_or_default(),
+        commands::Detail::Fold(path) => path.steps.iter().map(|s| s.fold_angles.clone()).collect(),
+    }
+}
+
+/// `constraints`: the curves' report as `constraints --json` prints it, and the samples.
+#[pyfunction]
+fn constraints(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+    let settings = settings::constraint_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
+    let pattern = pattern.pattern.clone();
+    run_detached(py, move || {
+        let result = commands::constraints(&pattern, &settings)?;
+        Ok(json!({"summary": result.to_json()}).to_string())
+    })
+}
+
+/// Builds a generated pattern: its FOLD text.
+#[pyfunction]
+fn generate(py: Python<'_>, kind: String, parameters: &str) -> PyResult<String> {
+    let generator = settings::generator(&kind, &parse_json(parameters, "parameters")?).map_err(to_py)?;
+    run_detached(py, move || Ok(generator.to_fold()?.to_string()))
+}
+
+/// A scene, built and validated by the library (behind a lock: a closed chain keeps a
+/// cache of its last loop closure, so one scene runs one call at a time).
+#[pyclass(frozen, module = "nanofold._native")]
+struct SceneHandle {
+    scene: Arc<Mutex<Scene>>,
+}
+
+impl SceneHandle {
+    fn with<T>(&self, read: impl FnOnce(&Scene) -> T) -> T {
+        read(&self.scene.lock().unwrap_or_else(|poisoned| poisoned.into_inner()))
+    }
+}
+
+/// Runs `work` on the scene on the worker thread.
+fn on_scene<T: Send + 'static>(
+    py: Python<'_>,
+    scene: &SceneHandle,
+    work: impl FnOnce(&Scene) -> nanofold::Result<T> + Send + 'static,
+) -> PyResult<T> {
+    let scene = scene.scene.clone();
+    run_detached(py, move || {
+        work(&scene.lock().unwrap_or_else(|poisoned| poisoned.into_inner()))
+    })
+}
+
+#[pymethods]
+impl SceneHandle {
+    /// The scene's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.with(|s| s.name.clone())
+    }
+    /// "strip", "closed" or "network".
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.with(|s| match s.system {
+            nanofold::dynamics::scene::System::Strip(_) => "strip",
+            nanofold::dynamics::scene::System::Closed(_) => "closed",
+            nanofold::dynamics::scene::System::Network(_) => "network",
+        })
+    }
+}
+
+/// Reads scene text; `base` is the folder its `pattern` path is relative to.
+#[pyfunction]
+fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base: String) -> PyResult<SceneHandle> {
+    let scene = run_detached(py, move || {
+        nanofold::io::scene::parse_scene(&text, &source, &name, Path::new(&base))?.build()
+    })?;
+    Ok(SceneHandle {
+        scene: Arc::new(Mutex::new(scene)),
+    })
+}
+
+/// `simulate`: the summary, response.json and a network's motion.fold.
+#[pyfunction]
+fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<String> {
+    let settings = settings::simulation_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
+    on_scene(py, scene, move |scene| {
+        let report = commands::simulate(scene, &settings)?;
+        Ok(json!({"summary": report.summary, "response": report.response, "fold_file": report.fold}).to_string())
+    })
+}
+
+/// `modes`: the summary and a network's modes.fold.
+#[pyfunction]
+fn modes(py: Python<'_>, scene: &SceneHandle) -> PyResult<String> {
+    on_scene(py, scene, |scene| {
+        let report = commands::modes(scene)?;
+        Ok(json!({"summary": report.summary, "fold_file": report.fold}).to_string())
+    })
+}
+
+/// A call that does nothing but cross the boundary: the per-call overhead's floor.
+#[pyfunction]
+fn noop(py: Python<'_>) -> PyResult<String> {
+    run_detached(py, || Ok(String::new()))
+}
+
+/// The library's version.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// The extension module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("NativeError", m.py().get_type::<NativeError>())?;
+    m.add_class::<PatternHandle>()?;
+    m.add_class::<SceneHandle>()?;
+    for function in [
+        wrap_pyfunction!(open_pattern, m)?,
+        wrap_pyfunction!(parse_pattern, m)?,
+        wrap_pyfunction!(check, m)?,
+        wrap_pyfunction!(unfold, m)?,
+        wrap_pyfunction!(fold, m)?,
+        wrap_pyfunction!(constraints, m)?,
+        wrap_pyfunction!(generate, m)?,
+        wrap_pyfunction!(parse_scene, m)?,
+        wrap_pyfunction!(simulate, m)?,
+        wrap_pyfunction!(modes, m)?,
+        wrap_pyfunction!(noop, m)?,
+        wrap_pyfunction!(version, m)?,
+    ] {
+        m.add_function(function)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,256 @@
+//! Constraint curves behind the door (`docs/model.md#constraint-curves`): every free crease
+//! as a polynomial of one driving crease, swept exactly, for a single vertex or a folded
+//! crease pattern of many vertices with one degree of freedom.
+
+use super::Pattern;
+use crate::constraints::network::{fit_network, fit_network_to_tolerance, network_sweep, NetworkCurves, NetworkSweep};
+use crate::constraints::{
+    default_domain, fit_to_tolerance, sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup,
+};
+use crate::error::{NanofoldError, Result};
+use crate::folding::FoldingModel;
+use serde_json::Value;
+
+/// How the curves' degree is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Degree {
+    /// This degree (1 to 20).
+    Fixed(usize),
+    /// The lowest degree whose fit error is at most `tol` rad. Below 20, `at_most` caps it:
+    /// none meeting `tol` gives `at_most` with the error it has (MuJoCo takes a quartic at
+    /// most); at 20, none meeting `tol` is an error.
+    Auto {
+        /// Largest accepted fit error, rad.
+        tol: f64,
+        /// Highest degree tried.
+        at_most: usize,
+    },
+}
+
+/// What `constraints` sweeps and fits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintSettings {
+    /// The driving crease, by the file's index (a FOLD edge index; for a native vertex its
+    /// position in `creases`).
+    pub driver: usize,
+    /// Creases held at angles (file index, rad); the others close every vertex around them.
+    pub locks: Vec<(usize, f64)>,
+    /// When not empty: the only creases left free besides the driver (every other held at
+    /// its folded angle, unless `locks` sets its angle).
+    pub free: Vec<usize>,
+    /// The curves' degree.
+    pub degree: Degree,
+    /// The driving angle's range, rad (None: flat to the folded angle; for many vertices
+    /// from 5% of it, as the flat state is a branch point).
+    pub domain: Option<[f64; 2]>,
+    /// Sweep samples (2 to 100 000).
+    pub samples: usize,
+}
+
+impl Default for ConstraintSettings {
+    fn default() -> Self {
+        ConstraintSettings {
+            driver: 0,
+            locks: Vec::new(),
+            free: Vec::new(),
+            degree: Degree::Fixed(4),
+            domain: None,
+            samples: 201,
+        }
+    }
+}
+
+/// The curves with the samples they were fitted to.
+#[derive(Debug, Clone)]
+pub enum Constraints {
+    /// A single vertex's curves.
+    Vertex {
+        /// The exact sweep.
+        samples: Box<CurveSamples>,
+        /// The fitted polynomials.
+        poly: Box<ConstraintPoly>,
+        /// Their errors against loop closure.
+        report: Box<ConstraintReport>,
+    },
+    /// A crease pattern's curves.
+    Network {
+        /// The exact sweep.
+        sweep: Box<NetworkSweep>,
+        /// The fitted curves with their errors.
+        curves: Box<NetworkCurves>,
+    },
+}
+
+impl Constraints {
+    /// As `nanofold constraints --json` prints it.
+    pub fn to_json(&self) -> Value {
+        match self {
+            Constraints::Vertex { report, .. } => serde_json::to_value(report.as_ref()),
+            Constraints::Network { curves, .. } => serde_json::to_value(curves.as_ref()),
+        }
+        .unwrap_or(Value::Null)
+    }
+
+    /// The largest fit error of any curve, rad.
+    pub fn max_fit_error_rad(&self) -> f64 {
+        match self {
+            Constraints::Vertex { report, .. } => report.max_fit_error(),
+            Constraints::Network { curves, .. } => curves.max_fit_error_rad,
+        }
+    }
+}
+
+/// Sweeps the driver across its range by exact loop closure and fits every free crease.
+pub fn constraints(pattern: &Pattern, settings: &ConstraintSettings) -> Result<Constraints> {
+    match pattern.vertex() {
+        Some(vertex) => vertex_constraints(vertex, settings),
+        None => {
+            let model = pattern
+                .sheet()
+                .ok_or_else(|| NanofoldError::invalid("pattern", pattern.name(), "has neither a vertex nor a sheet"))?;
+            network_constraints(model, settings)
+        }
+    }
+}
+
+fn vertex_constraints(pattern: &crate::pattern::Pattern, settings: &ConstraintSettings) -> Result<Constraints> {
+    let index = |i: usize, field: &str| {
+        pattern.crease_from_user_index(i).ok_or_else(|| {
+            NanofoldError::invalid(
+                field,
+                i,
+                format!(
+                    "no crease with this index in {} (its creases are {:?})",
+                    pattern.name,
+                    pattern.user_indices()
+                ),
+            )
+        })
+    };
+    let driver = index(settings.driver, "driver")?;
+    let mut locks = settings
+        .locks
+        .iter()
+        .map(|&(i, angle)| Ok((index(i, "locks")?, angle)))
+        .collect::<Result<Vec<_>>>()?;
+    if !settings.free.is_empty() {
+        let free = settings
+            .free
+            .iter()
+            .map(|&i| index(i, "free"))
+            .collect::<Result<Vec<_>>>()?;
+        for (c, crease) in pattern.creases.iter().enumerate() {
+            if c != driver && !free.contains(&c) && !locks.iter().any(|(l, _)| *l == c) {
+                locks.push((c, crease.folded_angle));
+            }
+        }
+    }
+    let setup = Setup::new(pattern, driver, &locks)?;
+    let domain = match settings.domain {
+        Some(d) => d,
+        None => default_domain(pattern, driver)?,
+    };
+    let samples = sweep_samples(pattern, &setup, domain, settings.samples)?;
+    let (poly, report) = match settings.degree {
+        Degree::Fixed(d) => {
+            let poly = ConstraintPoly::fit(pattern, &samples, d)?;
+            let report = ConstraintReport::new(pattern, &samples, &poly)?;
+            (poly, report)
+        }
+        Degree::Auto { tol, at_most } if at_most < crate::constraints::MAX_DEGREE => {
+            let mut chosen = None;
+            for d in 1..=at_most.max(1) {
+                let poly = ConstraintPoly::fit(pattern, &samples, d)?;
+                let report = ConstraintReport::new(pattern, &samples, &poly)?;
+                let met = report.max_fit_error() <= tol;
+                chosen = Some((poly, report));
+                if met {
+                    break;
+                }
+            }
+            chosen.expect("degree 1 at least was fitted")
+        }
+        Degree::Auto { tol, .. } => fit_to_tolerance(pattern, &samples, tol)?,
+    };
+    Ok(Constraints::Vertex {
+        samples: Box::new(samples),
+        poly: Box::new(poly),
+        report: Box::new(report),
+    })
+}
+
+fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> Result<Constraints> {
+    let mut model = model.clone();
+    let column = |edge: usize, field: &str| {
+        model.column_of_edge.get(edge).copied().flatten().ok_or_else(|| {
+            NanofoldError::invalid(
+                field,
+                edge,
+                format!(
+                    "edge {edge} is not a crease of {} (a FOLD edge index)",
+                    model.pattern.name
+                ),
+            )
+        })
+    };
+    let mut rho = model.given_fold_angles();
+    let mut locked = Vec::new();
+    for &(edge, angle) in &settings.locks {
+        locked.push((column(edge, "locks")?, angle));
+    }
+    let driver = column(settings.driver, "driver")?;
+    let mut free = vec![settings.free.is_empty(); model.crease_count()];
+    for &edge in &settings.free {
+        free[column(edge, "free")?] = true;
+    }
+    for &(c, angle) in &locked {
+        model.locked_columns[c] = true;
+        rho[c] = angle;
+    }
+    for (c, is_free) in free.iter().enumerate() {
+        if c != driver && !is_free {
+            model.locked_columns[c] = true;
+        }
+    }
+    if !locked.is_empty() {
+        let mut solver = crate::folding::normal::NormalSolver::new(1e-10);
+        if crate::folding::restore_closure(&model, &mut rho, 1e-12, &mut solver)?.is_none() {
+            return Err(NanofoldError::invalid(
+                "locks",
+                format!("{:?}", settings.locks),
+                "no rigid state near the file's with these creases held",
+            ));
+        }
+    }
+    if rho.iter().all(|&r| r == 0.0) {
+        return Err(NanofoldError::invalid(
+            "pattern",
+            &model.pattern.name,
+            "constraint curves of many vertices start from a folded state (e.g. folded.fold written by `nanofold fold`); this pattern is flat",
+        ));
+    }
+    let domain = settings.domain.unwrap_or_else(|| {
+        let (a, b) = (0.05 * rho[driver], rho[driver]);
+        [a.min(b), a.max(b)]
+    });
+    // The sweep's points are fitted and the midpoints between them checked.
+    let sweep = network_sweep(&model, &rho, driver, domain, settings.samples.div_ceil(2).max(2))?;
+    let curves = match settings.degree {
+        Degree::Fixed(d) => fit_network(&model, &sweep, d)?,
+        Degree::Auto { tol, at_most } if at_most < crate::constraints::MAX_DEGREE => {
+            let mut chosen = fit_network(&model, &sweep, 1)?;
+            for d in 2..=at_most {
+                if chosen.max_fit_error_rad <= tol {
+                    break;
+                }
+                chosen = fit_network(&model, &sweep, d)?;
+            }
+            chosen
+        }
+        Degree::Auto { tol, .. } => fit_network_to_tolerance(&model, &sweep, tol)?,
+    };
+    Ok(Constraints::Network {
+        sweep: Box::new(sweep),
+        curves: Box::new(curves),
+    })
+}

@@ -1,0 +1,79 @@
+//! Scenes behind the door: a scene's natural modes at its folded equilibrium and its
+//! simulated response, each with the summary `nanofold modes --json` and
+//! `nanofold simulate --json` print (`docs/model.md#dynamics`).
+
+use crate::dynamics::scene::{Scene, System};
+use crate::dynamics::simulate::{simulate as simulate_scene, Simulation, SimulationSettings};
+use crate::error::Result;
+use crate::io::folding_output::{network_modes_fold, network_motion_fold};
+use crate::io::output::{closed_modes_json, modes_json, network_modes_json, response_json, response_summary};
+use serde_json::Value;
+
+/// Each mode's frames in modes.fold move its largest crease this far either way, rad.
+pub const MODE_AMPLITUDE: f64 = 0.1;
+
+/// A scene's modes: the summary and, for a network, each mode as a pair of FOLD frames.
+#[derive(Debug, Clone)]
+pub struct ModesReport {
+    /// As `nanofold modes --json` prints it (less the command line's `out`).
+    pub summary: Value,
+    /// A network's modes.fold.
+    pub fold: Option<Value>,
+}
+
+/// Natural frequencies, mode shapes and stability at the scene's folded equilibrium.
+pub fn modes(scene: &Scene) -> Result<ModesReport> {
+    Ok(match &scene.system {
+        System::Strip(chain) => {
+            let result = crate::dynamics::modes::modes(&chain.model, chain.target_angles().as_slice())?;
+            ModesReport {
+                summary: modes_json(scene, &result),
+                fold: None,
+            }
+        }
+        System::Closed(chain) => {
+            let result = chain.folded_modes()?;
+            let eta = chain.torque_magnification()?;
+            ModesReport {
+                summary: closed_modes_json(&scene.name, chain, &result, eta),
+                fold: None,
+            }
+        }
+        System::Network(model) => {
+            let result = crate::dynamics::network::modes::folded_modes(model)?;
+            ModesReport {
+                summary: network_modes_json(&scene.name, model, &result),
+                fold: Some(network_modes_fold(model, &result, MODE_AMPLITUDE)?),
+            }
+        }
+    })
+}
+
+/// A scene's simulated response in the forms the command line writes.
+#[derive(Debug, Clone)]
+pub struct SimulationReport {
+    /// As `nanofold simulate --json` prints it.
+    pub summary: Value,
+    /// response.json: the settings, the model chosen and every sample.
+    pub response: Value,
+    /// A network's motion.fold.
+    pub fold: Option<Value>,
+    /// The run itself.
+    pub simulation: Simulation,
+}
+
+/// Simulates a scene (`settings` validated first) and renders its summaries.
+pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<SimulationReport> {
+    settings.validate()?;
+    let simulation = simulate_scene(scene, settings)?;
+    let fold = match &scene.system {
+        System::Network(model) => Some(network_motion_fold(model, &simulation.response)),
+        _ => None,
+    };
+    Ok(SimulationReport {
+        summary: response_summary(scene, settings, &simulation),
+        response: response_json(scene, settings, &simulation),
+        fold,
+        simulation,
+    })
+}
