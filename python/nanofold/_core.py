@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, TypeVar, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, TypeVar, Union
 
 import numpy as np
 
@@ -107,10 +107,17 @@ class Pattern:
         return cls(text, name, origin=str(path), source=str(path), closure_tol=closure_tol, angle_sum_tol=angle_sum_tol)
 
     @classmethod
-    def from_fold(cls, fold: Mapping[str, Any], name: Optional[str] = None, **options: Optional[float]) -> "Pattern":
+    def from_fold(
+        cls,
+        fold: Mapping[str, Any],
+        name: Optional[str] = None,
+        *,
+        closure_tol: Optional[float] = None,
+        angle_sum_tol: Optional[float] = None,
+    ) -> "Pattern":
         """A FOLD object given as a dict (its ``file_title`` names it, else ``name``)."""
         title = name or str(fold.get("file_title") or fold.get("frame_title") or "pattern")
-        return cls(json.dumps(fold), title, origin=f"<FOLD dict {title}>", **options)
+        return cls(json.dumps(fold), title, origin=f"<FOLD dict {title}>", closure_tol=closure_tol, angle_sum_tol=angle_sum_tol)
 
     @classmethod
     def from_arrays(
@@ -121,7 +128,9 @@ class Pattern:
         fold_angles_deg: Optional[Iterable[float]] = None,
         faces: Optional[Iterable[Sequence[int]]] = None,
         name: str = "pattern",
-        **options: Optional[float],
+        *,
+        closure_tol: Optional[float] = None,
+        angle_sum_tol: Optional[float] = None,
     ) -> "Pattern":
         """A pattern from arrays: vertex coordinates (2D flat, or 3D), edges as vertex pairs,
         FOLD assignments (``"M"``, ``"V"``, ``"F"``, ``"B"``, ``"U"``), optional fold angles in
@@ -132,8 +141,8 @@ class Pattern:
         ...     [[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]],
         ...     [[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [2, 3], [3, 4], [4, 1]],
         ...     ["M", "V", "V", "V", "B", "B", "B", "B"], name="cross")
-        >>> p.engine
-        'vertex'
+        >>> p.engine, nanofold.check(p).verdict
+        ('network', 'rigidly_foldable')
         """
         fold: Dict[str, Any] = {
             "file_spec": 1.1,
@@ -147,7 +156,7 @@ class Pattern:
             fold["edges_foldAngle"] = np.asarray(fold_angles_deg, dtype=float).tolist()
         if faces is not None:
             fold["faces_vertices"] = [list(map(int, f)) for f in faces]
-        return cls.from_fold(fold, name, **options)
+        return cls.from_fold(fold, name, closure_tol=closure_tol, angle_sum_tol=angle_sum_tol)
 
     @property
     def name(self) -> str:
@@ -165,7 +174,7 @@ class Pattern:
         return self._source
 
     @property
-    def crease_labels(self) -> list:
+    def crease_labels(self) -> List[str]:
         """Every crease's label, in the order of the angle arrays."""
         return list(self._handle.crease_labels())
 
@@ -240,7 +249,7 @@ class Scene:
 
     def to_dict(self) -> Dict[str, Any]:
         """The scene's specification."""
-        return json.loads(json.dumps(self._spec))
+        return dict(json.loads(json.dumps(self._spec)))
 
     def replace(self, changes: Mapping[str, Any]) -> "Scene":
         """A copy with fields changed, each named by its dotted path (list items by index):

@@ -25,7 +25,10 @@ def _as_array(value: Any) -> Any:
 
 class Result:
     """One command's answer. Every key of ``to_dict()`` is an attribute (numeric lists as
-    numpy arrays); ``trajectory`` holds the fold angles of every recorded step (rad)."""
+    numpy arrays); ``trajectory`` holds the fold angles of every recorded step (rad). The
+    pattern commands also give ``crease_labels``, ``start_fold_angles_rad``,
+    ``final_fold_angles_rad``, ``max_closure_residual_rad`` and ``engine`` whether or not
+    their ``--json`` shows them."""
 
     command: str
 
@@ -48,6 +51,10 @@ class Result:
         try:
             return _as_array(self._summary[name])
         except KeyError:
+            pass
+        try:
+            return _as_array(self._payload["extra"][name])
+        except (KeyError, TypeError):
             raise AttributeError(
                 f"{type(self).__name__} of {self.command!r} has no field {name!r}; its fields: {', '.join(self._summary)}"
             ) from None
@@ -59,7 +66,8 @@ class Result:
         return name in self._summary
 
     def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._summary))
+        extra = self._payload.get("extra") or {}
+        return sorted(set(super().__dir__()) | set(self._summary) | set(extra))
 
     def __getstate__(self) -> Dict[str, Any]:
         return {"command": self.command, "payload": self._payload}

@@ -238,7 +238,7 @@ class _Store:
         return self.path(k).exists()
 
     def write(self, k: int, rows: List[Dict[str, Any]]) -> None:
-        import pandas as pd
+        import pandas as pd  # type: ignore[import-untyped]
 
         target = self.path(k)
         temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
@@ -246,7 +246,7 @@ class _Store:
         os.replace(temporary, target)
 
     def read(self, k: int) -> List[Dict[str, Any]]:
-        import pandas as pd
+        import pandas as pd  # type: ignore[import-untyped]
 
         return list(pd.read_parquet(self.path(k)).to_dict(orient="records"))
 
@@ -382,7 +382,7 @@ def sweep(
             own_client.close()
             if cluster is not None:
                 cluster.close()
-    import pandas as pd
+    import pandas as pd  # type: ignore[import-untyped]
 
     table = _frame(pd, rows)
     if store is not None:
@@ -475,7 +475,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     import argparse
     import importlib
 
-    parser = argparse.ArgumentParser(prog="python -m nanofold.sweep", description=main.__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m nanofold.sweep", description="Run a nanofold sweep described by a JSON file.")
     parser.add_argument("spec", help="the sweep's JSON description")
     parser.add_argument("--scheduler", help="a Dask scheduler address (overrides the spec's)")
     parser.add_argument("--serial", action="store_true", help="run in this process, without Dask")
@@ -510,7 +510,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if "grid" in spec:
         grid: Any = {k: [located(k, v) for v in values] for k, values in spec["grid"].items()}
     else:
-        import pandas as pd
+        import pandas as pd  # type: ignore[import-untyped]
 
         table_path = base / spec["table"]
         frame = pd.read_parquet(table_path) if table_path.suffix == ".parquet" else pd.read_csv(table_path)

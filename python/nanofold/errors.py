@@ -14,7 +14,7 @@ rows, cols
 
 from __future__ import annotations
 
-from typing import Optional
+from typing import Any, Optional, Tuple
 
 
 class NanofoldError(Exception):
@@ -27,7 +27,7 @@ class NanofoldError(Exception):
         self.field = field or None
         self.value = value or None
 
-    def __reduce__(self):  # errors travel from workers to the client
+    def __reduce__(self) -> Tuple[Any, ...]:  # errors travel from workers to the client
         return (type(self), (self.message, self.kind, self.field, self.value))
 
 

@@ -186,7 +186,10 @@ fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<St
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
         let report = commands::check(&pattern, &settings.settings)?;
-        Ok(json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report)}).to_string())
+        Ok(
+            json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report), "extra": extra(&report)})
+                .to_string(),
+        )
     })
 }
 
@@ -198,7 +201,10 @@ fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<S
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
         let report = commands::unfold(&pattern, &settings.settings)?;
-        Ok(json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report)}).to_string())
+        Ok(
+            json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report), "extra": extra(&report)})
+                .to_string(),
+        )
     })
 }
 
@@ -248,6 +254,7 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<Str
         Ok(json!({
             "summary": summary,
             "trajectory": trajectory(&report),
+            "extra": extra(&report),
             "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
             "fold_file": fold_path_fold(model, path, &chosen),
             "folded_file": crease_pattern_fold(
@@ -257,6 +264,17 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<Str
             ),
         })
         .to_string())
+    })
+}
+
+/// What every command's report has, whether or not its `--json` shows it.
+fn extra(report: &commands::Report) -> Value {
+    json!({
+        "crease_labels": report.crease_labels,
+        "start_fold_angles_rad": report.start_fold_angles_rad,
+        "final_fold_angles_rad": report.final_fold_angles_rad,
+        "max_closure_residual_rad": report.max_closure_residual_rad,
+        "engine": report.engine.as_str(),
     })
 }
 

@@ -1,0 +1,198 @@
+"""The Python API: patterns from every kind of input, results as arrays, errors naming their
+field, pickling, the GIL released and Ctrl-C honoured during long calls."""
+
+import json
+import os
+import pickle
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import nanofold
+
+CROSS = dict(
+    vertices=[[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]],
+    edges=[[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [2, 3], [3, 4], [4, 1]],
+    assignments=["M", "V", "V", "V", "B", "B", "B", "B"],
+)
+
+
+def test_a_pattern_from_a_path_a_dict_and_arrays_is_the_same_pattern():
+    from_path = nanofold.Pattern.open("patterns/many/miura_4x4.fold")
+    with open("patterns/many/miura_4x4.fold") as f:
+        fold = json.load(f)
+    from_dict = nanofold.Pattern.from_fold(fold)
+    from_arrays = nanofold.Pattern.from_arrays(
+        fold["vertices_coords"], fold["edges_vertices"], fold["edges_assignment"], name="miura_4x4"
+    )
+    verdicts = [nanofold.check(p).to_dict() for p in (from_path, from_dict, from_arrays)]
+    for v in verdicts:
+        v.pop("seconds"), v.pop("file"), v.pop("pattern")
+    assert verdicts[0] == verdicts[1] == verdicts[2]
+    assert verdicts[0]["verdict"] == "rigidly_foldable"
+
+
+def test_a_cross_of_four_creases_folds_and_its_folded_state_unfolds_as_a_single_vertex():
+    cross = nanofold.Pattern.from_arrays(**CROSS, name="cross")
+    # Flat, with no fold angles, it is a crease pattern (an assignment to fold).
+    assert cross.engine == "network" and len(cross.crease_labels) == 4
+    folded = nanofold.fold(cross, to=0.5)
+    assert folded.verdict == "reached"
+    # The folded state read back through FOLD unfolds flat by the single-vertex engine.
+    state = nanofold.Pattern.from_fold(folded.folded_file(), "cross_folded")
+    assert state.engine == "vertex"
+    unfolded = nanofold.unfold(state)
+    assert unfolded.verdict == "flat"
+    assert np.abs(unfolded.final_fold_angles_rad).max() < 1e-6
+    assert unfolded.trajectory.shape[1] == 4 and unfolded.trajectory.shape[0] >= 2
+
+
+def test_results_give_arrays_and_plain_dicts():
+    r = nanofold.fold(nanofold.generate.miura(3, 3), to=0.4, frames=4)
+    assert isinstance(r.to_dict(), dict) and isinstance(r.to_dict()["progress"], float)
+    assert r.trajectory.ndim == 2 and r.trajectory.shape[1] == r.creases
+    assert np.all(np.diff(r.progress_per_step) > 0)
+    # Progress is the fraction of the goal (40% of a full fold) reached.
+    assert abs(r.progress_per_step[-1] - 1.0) < 1e-9 and r.progress_per_step[0] == 0.0
+    assert abs(np.abs(r.final_fold_angles_rad).max() - 0.4 * np.pi) < 1e-9
+    assert len(r.fold_file()["file_frames"]) == 4
+    with pytest.raises(AttributeError, match="no field 'nonsense'"):
+        r.nonsense
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: nanofold.generate.miura(2, 3, angle_deg=75, fold_deg=40),
+        lambda: nanofold.generate.square_twist(twist_deg=20),
+        lambda: nanofold.generate.waterbomb(2, 2, row_height=1.5),
+        lambda: nanofold.generate.bird_base(2.0),
+    ],
+)
+def test_every_generator_builds_a_pattern_that_checks(make):
+    pattern = make()
+    assert pattern.engine == "network"
+    assert nanofold.check(pattern).verdict in {
+        "rigid", "rigidly_foldable", "not_rigidly_foldable", "unknown"
+    }
+
+
+def test_a_folded_miura_from_the_generator_is_rigid_and_unfolds_flat():
+    folded = nanofold.generate.miura(3, 3, fold_deg=60)
+    assert nanofold.check(folded).verdict == "rigid"
+    assert nanofold.unfold(folded).verdict == "flat"
+
+
+@pytest.mark.parametrize(
+    "call, error, field",
+    [
+        (lambda: nanofold.generate.miura(0, 4), nanofold.InvalidFieldError, "rows, cols"),
+        (lambda: nanofold.generate.miura(4, 4, angle_deg=95), nanofold.InvalidFieldError, "sector_angle"),
+        (lambda: nanofold.unfold("patterns/miura_vertex.fold", p=-1), nanofold.InvalidFieldError, "p"),
+        (lambda: nanofold.unfold("patterns/miura_vertex.fold", energy="quadratic"), nanofold.InvalidFieldError, "energy"),
+        (lambda: nanofold.fold("patterns/many/miura_4x4.fold", to=2.0), nanofold.InvalidFieldError, "drive.to"),
+        (lambda: nanofold.fold("patterns/many/miura_4x4.fold", drive={3: 1.0}), nanofold.InvalidFieldError, "drive"),
+        (lambda: nanofold.simulate("patterns/bridge_step.scene.json", rtol=-1), nanofold.InvalidFieldError, "rtol"),
+        (lambda: nanofold.constraints("patterns/miura_vertex.fold", driver=9), nanofold.InvalidFieldError, "driver"),
+        (lambda: nanofold.Pattern.open("patterns/nothing.fold"), nanofold.FileReadError, "path"),
+        (lambda: nanofold.Pattern.open("patterns/bridge_step.scene.json"), nanofold.InputError, None),
+        (lambda: nanofold.Scene.open("patterns/bridge_step.scene.json").replace({"plates.9.length_um": 1}),
+         nanofold.InvalidFieldError, "plates.9.length_um"),
+    ],
+)
+def test_errors_are_one_hierarchy_that_names_the_field(call, error, field):
+    with pytest.raises(error) as caught:
+        call()
+    assert isinstance(caught.value, nanofold.NanofoldError)
+    if field is not None:
+        assert caught.value.field == field, caught.value
+    assert str(caught.value)
+
+
+def test_a_drive_key_that_is_a_crease_folds_to_its_angle():
+    sheet = nanofold.Pattern.open("patterns/many/miura_4x4.fold")
+    edge = int(sheet.crease_labels[0].split("[")[1].rstrip("]"))
+    # The target's sign is the crease's assignment's (a mountain folds to negative angles).
+    sign = np.sign(nanofold.fold(sheet, to=0.1).final_fold_angles_rad[0])
+    r = nanofold.fold(sheet, drive={edge: sign * 1.0})
+    assert r.verdict == "reached"
+    assert abs(r.final_fold_angles_rad[0] - sign * 1.0) < 1e-9
+    with pytest.raises(nanofold.InvalidFieldError, match="contradicts the crease's assignment"):
+        nanofold.fold(sheet, drive={edge: -sign * 1.0})
+
+
+def test_objects_pickle_and_answer_the_same_after():
+    pattern = nanofold.Pattern.open("patterns/many/miura_4x4.fold")
+    scene = nanofold.Scene.open("patterns/bridge_step.scene.json").replace({"time.t_end_s": 1e-4})
+    result = nanofold.check(pattern)
+    again = pickle.loads(pickle.dumps((pattern, scene, result)))
+    assert again[0].source == pattern.source and again[0].crease_labels == pattern.crease_labels
+    a, b = nanofold.check(again[0]).to_dict(), result.to_dict()
+    a.pop("seconds"), b.pop("seconds")
+    assert a == b
+    assert again[1].to_dict()["time"]["t_end_s"] == 1e-4
+    assert again[2] == result
+    error = pickle.loads(pickle.dumps(nanofold.InvalidFieldError("m", "invalid_field", "rows", "0")))
+    assert (type(error), error.field, error.value) == (nanofold.InvalidFieldError, "rows", "0")
+
+
+def test_a_scene_changed_by_dotted_paths_changes_its_answer():
+    scene = nanofold.Scene.open("patterns/bridge_ramp.scene.json")
+    slow = nanofold.simulate(scene)
+    fast = nanofold.simulate(scene.replace({"actuation.etch_rate_um_per_min": 3.0}))
+    # Twice the etch rate: the front reaches every hinge in half the time.
+    assert fast.collision["time_s"] == pytest.approx(slow.collision["time_s"] / 2, rel=1e-6)
+
+
+def _long_call():
+    return nanofold.fold(nanofold.generate.miura(16, 16), max_step=0.002)
+
+
+def test_long_calls_release_the_gil():
+    ticks = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks[0] += 1
+
+    counter = threading.Thread(target=count)
+    counter.start()
+    clock = time.perf_counter()
+    before = ticks[0]
+    nanofold.fold(nanofold.generate.miura(10, 10), max_step=0.004)
+    during = ticks[0] - before
+    seconds = time.perf_counter() - clock
+    stop.set()
+    counter.join()
+    # A thread that holds the GIL for the whole call would leave the counter near zero.
+    assert seconds > 0.2 and during > 10_000 * seconds, (seconds, during)
+
+
+def test_ctrl_c_interrupts_a_long_call():
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    clock = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        _long_call()
+    assert time.perf_counter() - clock < 1.5
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    rows=st.integers(3, 5),
+    cols=st.integers(2, 4),
+    angle=st.floats(20, 85),
+    fold_deg=st.floats(10, 150),
+)
+def test_generated_miura_sheets_fold_rigidly_and_their_folded_states_are_rigid(rows, cols, angle, fold_deg):
+    flat = nanofold.generate.miura(rows, cols, angle_deg=angle)
+    assert nanofold.check(flat).verdict == "rigidly_foldable"
+    folded = nanofold.generate.miura(rows, cols, angle_deg=angle, fold_deg=fold_deg)
+    state = nanofold.check(folded)
+    assert state.verdict == "rigid" and state.max_vertex_residual_rad < 1e-9
+    assert pickle.loads(pickle.dumps(folded)).fold_angles.tolist() == folded.fold_angles.tolist()
