@@ -141,8 +141,9 @@ class Pattern:
         ...     [[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]],
         ...     [[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [2, 3], [3, 4], [4, 1]],
         ...     ["M", "V", "V", "V", "B", "B", "B", "B"], name="cross")
+        >>> # Four right angles fold along one line at a time, so not with all four creases.
         >>> p.engine, nanofold.check(p).verdict
-        ('network', 'rigidly_foldable')
+        ('network', 'not_rigidly_foldable')
         """
         fold: Dict[str, Any] = {
             "file_spec": 1.1,
@@ -308,8 +309,8 @@ def check(pattern: Union[Pattern, PathLike], *, closure_tol: Optional[float] = N
     'rigidly_foldable'
     """
     p = _pattern(pattern)
-    payload = json.loads(_call(_native.check, p._handle, _settings({"closure_tol": closure_tol})))
-    return PatternResult("check", payload)
+    summary, rest = _call(_native.check, p._handle, _settings({"closure_tol": closure_tol}))
+    return PatternResult("check", summary, rest)
 
 
 def unfold(
@@ -336,8 +337,8 @@ def unfold(
     pat = _pattern(pattern)
     keywords = dict(energy=energy, p=p, qp=qp, flat_tol=flat_tol, max_iterations=max_iterations,
                     bending_metric=bending_metric, restarts=restarts, seed=seed)
-    payload = json.loads(_call(_native.unfold, pat._handle, _settings(keywords)))
-    return PatternResult("unfold", payload)
+    summary, rest = _call(_native.unfold, pat._handle, _settings(keywords))
+    return PatternResult("unfold", summary, rest)
 
 
 def fold(
@@ -361,8 +362,8 @@ def fold(
     """
     pat = _pattern(pattern)
     keywords = dict(to=to, drive=drive, frames=frames, max_step=max_step, max_steps=max_steps)
-    payload = json.loads(_call(_native.fold, pat._handle, _settings(keywords)))
-    return FoldResult("fold", payload)
+    summary, rest = _call(_native.fold, pat._handle, _settings(keywords))
+    return FoldResult("fold", summary, rest)
 
 
 def constraints(
@@ -388,8 +389,8 @@ def constraints(
     pat = _pattern(pattern)
     keywords = dict(driver=driver, locks=locks, free=list(free) if free is not None else None,
                     degree=degree, tol=tol, domain=list(domain) if domain is not None else None, samples=samples)
-    payload = json.loads(_call(_native.constraints, pat._handle, _settings(keywords)))
-    return Result("constraints", payload)
+    summary, rest = _call(_native.constraints, pat._handle, _settings(keywords))
+    return Result("constraints", summary, rest)
 
 
 def simulate(
@@ -414,8 +415,8 @@ def simulate(
     s = _scene(scene)
     keywords = dict(model=model, method=method, rtol=rtol, t_end=t_end,
                     ignore_collisions=ignore_collisions, max_steps=max_steps)
-    payload = json.loads(_call(_native.simulate, s._handle, _settings(keywords)))
-    return SimulationResult("simulate", payload)
+    summary, rest = _call(_native.simulate, s._handle, _settings(keywords))
+    return SimulationResult("simulate", summary, rest)
 
 
 def modes(scene: Union[Scene, PathLike]) -> Result:
@@ -427,5 +428,5 @@ def modes(scene: Union[Scene, PathLike]) -> Result:
     (True, 4)
     """
     s = _scene(scene)
-    payload = json.loads(_call(_native.modes, s._handle))
-    return Result("modes", payload)
+    summary, rest = _call(_native.modes, s._handle)
+    return Result("modes", summary, rest)

@@ -4,6 +4,7 @@ numeric lists as numpy arrays, and what the command writes beside it (FOLD files
 from __future__ import annotations
 
 import copy
+import json
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -32,10 +33,19 @@ class Result:
 
     command: str
 
-    def __init__(self, command: str, payload: Dict[str, Any]):
+    def __init__(self, command: str, summary: str, rest: str = "{}"):
         self.command = command
-        self._summary: Dict[str, Any] = payload.get("summary") or {}
-        self._payload = payload
+        self._summary_text = summary
+        self._rest_text = rest
+        self._summary: Dict[str, Any] = json.loads(summary)
+        self._rest_cache: Optional[Dict[str, Any]] = None
+
+    @property
+    def _payload(self) -> Dict[str, Any]:
+        """Arrays and files beside the summary, read on first use."""
+        if self._rest_cache is None:
+            self._rest_cache = json.loads(self._rest_text)
+        return self._rest_cache
 
     def to_dict(self) -> Dict[str, Any]:
         """The result as the command line's ``--json`` prints it (less its ``out`` folder)."""
@@ -70,13 +80,23 @@ class Result:
         return sorted(set(super().__dir__()) | set(self._summary) | set(extra))
 
     def __getstate__(self) -> Dict[str, Any]:
-        return {"command": self.command, "payload": self._payload}
+        return {"command": self.command, "summary": self._summary_text, "rest": self._rest_text}
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
-        self.__init__(state["command"], state["payload"])  # type: ignore[misc]
+        self.__init__(state["command"], state["summary"], state["rest"])  # type: ignore[misc]
 
     def __eq__(self, other: object) -> bool:
-        return isinstance(other, Result) and self.command == other.command and self._payload == other._payload
+        return (
+            isinstance(other, Result)
+            and self.command == other.command
+            and self._summary == other._summary
+            and self._payload == other._payload
+        )
+
+    @property
+    def library_seconds(self) -> float:
+        """Wall time in the library for this call, rendering of every output included, s."""
+        return float(self._payload.get("library_seconds", float("nan")))
 
     def __repr__(self) -> str:
         head = self._summary.get("pattern") or self._summary.get("scene") or ""

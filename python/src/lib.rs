@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use serde_json::{json, Value};
 use std::path::Path;
 use std::sync::{mpsc, Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 create_exception!(
     _native,
@@ -180,38 +180,42 @@ fn parse_pattern(
 
 /// `check`: the report's JSON.
 #[pyfunction]
-fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
     let settings =
         settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Check).map_err(to_py)?;
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
+        let clock = Instant::now();
         let report = commands::check(&pattern, &settings.settings)?;
-        Ok(
-            json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report), "extra": extra(&report)})
-                .to_string(),
-        )
+        Ok(payload(
+            report.to_json(&pattern),
+            json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
+            clock,
+        ))
     })
 }
 
 /// `unfold`: the report's JSON and the fold angles of every recorded step.
 #[pyfunction]
-fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
     let settings =
         settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Unfold).map_err(to_py)?;
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
+        let clock = Instant::now();
         let report = commands::unfold(&pattern, &settings.settings)?;
-        Ok(
-            json!({"summary": report.to_json(&pattern), "trajectory": trajectory(&report), "extra": extra(&report)})
-                .to_string(),
-        )
+        Ok(payload(
+            report.to_json(&pattern),
+            json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
+            clock,
+        ))
     })
 }
 
 /// `fold`: the report's JSON, the path's fold angles and progress, its FOLD animation with
 /// `frames` frames and its end state as FOLD.
 #[pyfunction]
-fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
     use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold};
     let mut settings =
         settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Fold).map_err(to_py)?;
@@ -244,6 +248,7 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<Str
         settings.settings.fold.drive = nanofold::folding::Drive::Creases(columns);
     }
     run_detached(py, move || {
+        let clock = Instant::now();
         let report = commands::fold(&pattern, &settings.settings)?;
         let (commands::Detail::Fold(path), Some(model)) = (&report.detail, pattern.sheet()) else {
             unreachable!("fold answers with a path on the sheet");
@@ -251,20 +256,38 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<Str
         let chosen = evenly(path.steps.len(), settings.frames);
         let mut summary = report.to_json(&pattern);
         summary["frames"] = json!(chosen.len());
-        Ok(json!({
-            "summary": summary,
-            "trajectory": trajectory(&report),
-            "extra": extra(&report),
-            "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
-            "fold_file": fold_path_fold(model, path, &chosen),
-            "folded_file": crease_pattern_fold(
-                &model.pattern,
-                Some(&report.final_fold_angles_rad),
-                "end state of nanofold fold (a crease pattern with its fold angles)",
-            ),
-        })
-        .to_string())
+        Ok(payload(
+            summary,
+            json!({
+                "trajectory": trajectory(&report),
+                "extra": extra(&report),
+                "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
+                "fold_file": fold_path_fold(model, path, &chosen),
+                "folded_file": crease_pattern_fold(
+                    &model.pattern,
+                    Some(&report.final_fold_angles_rad),
+                    "end state of nanofold fold (a crease pattern with its fold angles)",
+                ),
+            }),
+            clock,
+        ))
     })
+}
+
+/// A command's answer as two JSON texts: its summary (the command line's `--json`) and the
+/// rest (arrays and FOLD files), which Python reads only when asked.
+/// `clock` started when the worker began: the rest records the library's whole time,
+/// rendering included (`library_seconds`), against which the Python layer's cost is measured.
+fn payload(summary: Value, rest: Value, clock: Instant) -> (String, String) {
+    let summary = summary.to_string();
+    let rest = rest.to_string();
+    // Spliced in after rendering, so the time includes it.
+    let seconds = clock.elapsed().as_secs_f64();
+    let rest = match rest.strip_suffix('}') {
+        Some(open) if open.len() > 1 => format!("{open},\"library_seconds\":{seconds}}}"),
+        _ => format!("{{\"library_seconds\":{seconds}}}"),
+    };
+    (summary, rest)
 }
 
 /// What every command's report has, whether or not its `--json` shows it.
@@ -294,12 +317,13 @@ fn trajectory(report: &commands::Report) -> Vec<Vec<f64>> {
 
 /// `constraints`: the curves' report as `constraints --json` prints it, and the samples.
 #[pyfunction]
-fn constraints(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<String> {
+fn constraints(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
     let settings = settings::constraint_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
+        let clock = Instant::now();
         let result = commands::constraints(&pattern, &settings)?;
-        Ok(json!({"summary": result.to_json()}).to_string())
+        Ok(payload(result.to_json(), json!({}), clock))
     })
 }
 
@@ -366,20 +390,26 @@ fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base:
 
 /// `simulate`: the summary, response.json and a network's motion.fold.
 #[pyfunction]
-fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<String> {
+fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(String, String)> {
     let settings = settings::simulation_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
     on_scene(py, scene, move |scene| {
+        let clock = Instant::now();
         let report = commands::simulate(scene, &settings)?;
-        Ok(json!({"summary": report.summary, "response": report.response, "fold_file": report.fold}).to_string())
+        Ok(payload(
+            report.summary,
+            json!({"response": report.response, "fold_file": report.fold}),
+            clock,
+        ))
     })
 }
 
 /// `modes`: the summary and a network's modes.fold.
 #[pyfunction]
-fn modes(py: Python<'_>, scene: &SceneHandle) -> PyResult<String> {
+fn modes(py: Python<'_>, scene: &SceneHandle) -> PyResult<(String, String)> {
     on_scene(py, scene, |scene| {
+        let clock = Instant::now();
         let report = commands::modes(scene)?;
-        Ok(json!({"summary": report.summary, "fold_file": report.fold}).to_string())
+        Ok(payload(report.summary, json!({"fold_file": report.fold}), clock))
     })
 }
 
