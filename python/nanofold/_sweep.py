@@ -316,7 +316,8 @@ def sweep(
 
     ``grid`` is a dict of value lists (their product), a list of dicts or a DataFrame.
 
-    ``client`` is a ``dask.distributed.Client``, a scheduler address, ``None`` (a
+    ``client`` is a ``dask.distributed.Client``, a scheduler address or scheduler file
+    (``.json``, as ``dask scheduler --scheduler-file`` writes it), ``None`` (a
     ``LocalCluster`` with one single-threaded worker process per core, closed afterwards) or
     ``"serial"`` (this process, no Dask). ``chunk`` runs go in one scheduler task (default:
     about 16 chunks per worker, at most 1000 runs each).
@@ -410,8 +411,11 @@ def _client(client: Any) -> Tuple[Any, Any]:
         )
         made = Client(cluster)
         return made, made
-    if isinstance(client, str):
-        made = Client(client)
+    if isinstance(client, (str, os.PathLike)):
+        # A scheduler file (`dask scheduler --scheduler-file F`, as batch jobs start one) or
+        # an address.
+        target = os.fspath(client)
+        made = Client(scheduler_file=target) if target.endswith(".json") else Client(target)
         return made, made
     return client, None
 
@@ -477,7 +481,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     parser = argparse.ArgumentParser(prog="python -m nanofold.sweep", description="Run a nanofold sweep described by a JSON file.")
     parser.add_argument("spec", help="the sweep's JSON description")
-    parser.add_argument("--scheduler", help="a Dask scheduler address (overrides the spec's)")
+    parser.add_argument("--scheduler", help="a Dask scheduler address or scheduler file (.json); overrides the spec's")
     parser.add_argument("--serial", action="store_true", help="run in this process, without Dask")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)

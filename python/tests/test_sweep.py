@@ -162,3 +162,46 @@ def test_the_examples_run_on_a_local_cluster(example, tmp_path):
     assert figure.exists() and figure.stat().st_size > 5000
     table = pd.read_parquet(tmp_path / "results.parquet")
     assert table["error"].isna().all() and len(table) >= 6
+
+
+def test_the_command_line_form_runs_on_a_scheduler_started_apart(tmp_path):
+    """As a batch job does it: `dask scheduler` and `dask worker` processes, the sweep given
+    the scheduler file."""
+    bin_dir = Path(sys.executable).parent
+    scheduler_file = tmp_path / "scheduler.json"
+    scheduler = subprocess.Popen([str(bin_dir / "dask"), "scheduler", "--scheduler-file", str(scheduler_file),
+                                  "--port", "0", "--dashboard-address", ":0"],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = []
+    try:
+        deadline = time.time() + 60
+        while not scheduler_file.exists() and time.time() < deadline:
+            time.sleep(0.1)
+        workers = [
+            subprocess.Popen([str(bin_dir / "dask"), "worker", "--scheduler-file", str(scheduler_file),
+                              "--nthreads", "1", "--no-dashboard"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
+            for _ in range(2)
+        ]
+        spec = tmp_path / "checks.json"
+        spec.write_text(json.dumps({
+            "task": "check",
+            "grid": {"pattern": [str(ROOT / "patterns/many/miura_4x4.fold"), str(ROOT / "patterns/many/bird_base.fold"),
+                                 str(ROOT / "patterns/many/square_twist.fold")]},
+            "chunk": 1,
+        }))
+        done = subprocess.run([sys.executable, "-m", "nanofold.sweep", str(spec), "--scheduler", str(scheduler_file),
+                               "--quiet"], cwd=ROOT, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        assert "3 runs (0 failed)" in done.stdout
+        table = pd.read_parquet(tmp_path / "checks.sweep" / "results.parquet")
+        serial = nanofold.sweep("check", {"pattern": [str(ROOT / "patterns/many/miura_4x4.fold"),
+                                                      str(ROOT / "patterns/many/bird_base.fold"),
+                                                      str(ROOT / "patterns/many/square_twist.fold")]},
+                                client="serial", progress=False)
+        assert list(table["verdict"]) == list(serial["verdict"])
+    finally:
+        for process in workers + [scheduler]:
+            process.terminate()
+        for process in workers + [scheduler]:
+            process.wait(timeout=30)
