@@ -24,4 +24,6 @@ pub use rank::{
     jacobian_rank, jacobian_rank_dense, jacobian_rank_sparse, null_space, RankMethod, RankReport, DENSE_RANK_LIMIT,
     RANK_TOL,
 };
-pub use verdict::{check_pattern, degree4_modes, CheckReport, CheckSettings, FlatFoldability, PatternVerdict};
+pub use verdict::{
+    check_pattern, degree4_modes, degree4_modes_within, CheckReport, CheckSettings, FlatFoldability, PatternVerdict,
+};

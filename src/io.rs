@@ -128,7 +128,7 @@ fn developed_vertex(value: &serde_json::Value, name: &str, closure_tol: f64) -> 
         .collect();
     let mut developed = serde_json::json!({
         "file_spec": 1.1,
-        "vertices_coords": pattern.vertices,
+        "vertices_coords": pattern.file_vertices(),
         "edges_vertices": pattern.edges,
         "edges_assignment": letters,
         "edges_foldAngle": pattern.fold_angles.iter().map(|a| a.to_degrees()).collect::<Vec<f64>>(),

@@ -21,6 +21,9 @@ pub struct ClosureJacobian {
     pub entries: Vec<(usize, usize, f64)>,
     /// Number of locked columns (zeroed above).
     pub held: usize,
+    /// The pattern's angle precision (`CreasePattern::angle_precision`), rad: a rank count
+    /// allows singular values this small relative to the largest as null.
+    pub angle_precision: f64,
 }
 
 impl ClosureJacobian {
@@ -101,5 +104,6 @@ pub fn closure_jacobian(model: &FoldingModel, fold_angles: &[f64]) -> ClosureJac
         cols: model.crease_count(),
         entries,
         held: model.locked_columns.iter().filter(|&&l| l).count(),
+        angle_precision: model.pattern.angle_precision,
     }
 }

@@ -81,6 +81,10 @@ impl ContactReport {
 /// Tests every pair of panels sharing no vertex, posed by `poses`.
 pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSettings) -> ContactReport {
     let clearance = settings.clearance * model.size;
+    // Panels placed through different creases disagree by the state's closure error: a
+    // crossing shallower than twice that spread is not decided by the state (stacked
+    // layers whose corners land on one point).
+    let depth = model.contact_tolerance().max(2.0 * placement_spread(model, poses));
     let search = settings.search * median_panel_size(model);
     let pattern = &model.pattern;
     let triangles: Vec<Vec<[Point; 3]>> = model
@@ -144,7 +148,7 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
                     distance = distance.min(gap);
                     continue;
                 }
-                let (d, c) = triangle_distance(s, t, 1e-12 * model.size);
+                let (d, c) = triangle_distance(s, t, depth);
                 distance = distance.min(d);
                 crossing |= c;
             }
@@ -160,6 +164,22 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
     }
     report.contacts.sort_by_key(|c| c.panels);
     report
+}
+
+/// The largest distance between two placements of one vertex by the panels that hold it:
+/// zero (to rounding) for a state that closes exactly.
+pub(crate) fn placement_spread(model: &FoldingModel, poses: &[Pose]) -> f64 {
+    let vertices = &model.pattern.vertices;
+    let mut spread: f64 = 0.0;
+    for (p, list) in model.panel_vertices.iter().enumerate() {
+        for &v in list {
+            let home = model.panel_of_vertex[v];
+            if home != p {
+                spread = spread.max((poses[p].place(vertices[v]) - poses[home].place(vertices[v])).norm());
+            }
+        }
+    }
+    spread
 }
 
 /// Pairs of boxes that overlap, smaller index first, from a uniform grid of cells about
@@ -256,13 +276,14 @@ pub(crate) fn share_vertex(a: &[usize], b: &[usize]) -> bool {
     false
 }
 
-/// Distance between two triangles, and whether they cross: an edge of one passes through
-/// the other's interior by more than `tolerance`. Touching (coplanar overlap, an edge
-/// lying on the other) gives distance 0 without a crossing.
+/// Distance between two triangles, and whether they cross: each passes through the other's
+/// plane (vertices more than `tolerance` on both sides) and the two segments so cut overlap
+/// along the planes' common line by more than `tolerance`. The test does not depend on how
+/// a panel was cut into triangles: two panels crossing where their diagonals meet are
+/// found as well as an edge through an interior. Touching (coplanar overlap, an edge lying
+/// on the other) gives distance 0 without a crossing.
 pub(crate) fn triangle_distance(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> (f64, bool) {
-    let crossing = (0..3).any(|k| segment_crosses(&s[k], &s[(k + 1) % 3], t, tolerance))
-        || (0..3).any(|k| segment_crosses(&t[k], &t[(k + 1) % 3], s, tolerance));
-    if crossing {
+    if triangles_cross(s, t, tolerance) {
         return (0.0, true);
     }
     let mut best = f64::INFINITY;
@@ -276,26 +297,59 @@ pub(crate) fn triangle_distance(s: &[Point; 3], t: &[Point; 3], tolerance: f64) 
     (best, false)
 }
 
-/// Does the segment p → q pass through the triangle's interior, both ends more than
-/// `tolerance` off its plane and the crossing point more than `tolerance` inside?
-fn segment_crosses(p: &Point, q: &Point, triangle: &[Point; 3], tolerance: f64) -> bool {
+/// A unit vector along `v`, scaled first so that its squares neither overflow nor
+/// underflow (a pattern 1e-100 across has cross products of 1e-200); None for zero.
+fn unit(v: Point) -> Option<Point> {
+    let largest = v.amax();
+    if largest == 0.0 || !largest.is_finite() {
+        return None;
+    }
+    let scaled = v / largest;
+    Some(scaled / scaled.norm())
+}
+
+/// The unit normal of a triangle (None when it has no area).
+fn unit_normal(triangle: &[Point; 3]) -> Option<Point> {
     let [a, b, c] = triangle;
-    let normal = (b - a).cross(&(c - a));
-    let area2 = normal.norm();
-    if area2 == 0.0 {
+    let (u, v) = (unit(b - a)?, unit(c - a)?);
+    unit(u.cross(&v))
+}
+
+/// Whether two triangles pass through each other (see [`triangle_distance`]).
+fn triangles_cross(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> bool {
+    let (Some(ns), Some(nt)) = (unit_normal(s), unit_normal(t)) else {
+        return false;
+    };
+    let side = |triangle: &[Point; 3], normal: &Point, origin: &Point| triangle.map(|x| normal.dot(&(x - origin)));
+    let (ds, dt) = (side(s, &nt, &t[0]), side(t, &ns, &s[0]));
+    let straddles = |d: [f64; 3]| d.iter().any(|&x| x > tolerance) && d.iter().any(|&x| x < -tolerance);
+    if !straddles(ds) || !straddles(dt) {
         return false;
     }
-    let n = normal / area2;
-    let (dp, dq) = (n.dot(&(p - a)), n.dot(&(q - a)));
-    if !((dp > tolerance && dq < -tolerance) || (dp < -tolerance && dq > tolerance)) {
+    let Some(line) = unit(ns.cross(&nt)) else {
         return false;
-    }
-    let x = p + (q - p) * (dp / (dp - dq));
-    // Signed distances of x from each edge, inside positive.
-    [(a, b), (b, c), (c, a)].iter().all(|&(u, v)| {
-        let edge = v - u;
-        n.cross(&edge).normalize().dot(&(x - u)) > tolerance
-    })
+    };
+    // Where each triangle meets the other's plane, as an interval along the common line.
+    let interval = |triangle: &[Point; 3], d: [f64; 3]| {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut take = |x: Point| {
+            let along = line.dot(&x);
+            lo = lo.min(along);
+            hi = hi.max(along);
+        };
+        for k in 0..3 {
+            let (a, b) = (k, (k + 1) % 3);
+            if d[a].abs() <= tolerance {
+                take(triangle[a]);
+            }
+            if (d[a] > tolerance && d[b] < -tolerance) || (d[a] < -tolerance && d[b] > tolerance) {
+                take(triangle[a] + (triangle[b] - triangle[a]) * (d[a] / (d[a] - d[b])));
+            }
+        }
+        (lo, hi)
+    };
+    let (a, b) = (interval(s, ds), interval(t, dt));
+    a.1.min(b.1) - a.0.max(b.0) > tolerance
 }
 
 /// Closest distance between segments p1q1 and p2q2 (clamped parameters).
@@ -440,5 +494,22 @@ mod tests {
         let tent = [p(0.25, 0.25, 0.4), p(0.25, 0.25, 2.0), p(0.3, 0.3, 2.0)];
         let (d, _) = triangle_distance(&base, &tent, 1e-12);
         assert!((d - 0.4).abs() < 1e-15, "{d}");
+    }
+
+    #[test]
+    fn triangles_crossing_where_their_edges_meet_are_crossing_at_any_scale() {
+        // Planes z = x and z = -x meet along the y axis; each triangle's edge crosses it at
+        // the origin, exactly where the other's does, and both have a corner at (0, 2, 0):
+        // no edge passes through an interior, yet the two cut each other along 0 <= y <= 2.
+        let s = [p(-1.0, 0.0, -1.0), p(1.0, 0.0, 1.0), p(0.0, 2.0, 0.0)];
+        let t = [p(-1.0, 0.0, 1.0), p(1.0, 0.0, -1.0), p(0.0, 2.0, 0.0)];
+        for scale in [1e-100, 1.0, 1e100] {
+            let (s, t) = (s.map(|x| x * scale), t.map(|x| x * scale));
+            assert_eq!(triangle_distance(&s, &t, 1e-12 * scale), (0.0, true), "scale {scale}");
+        }
+        // Moved along the line so the cuts only meet at a point: touching, not crossing.
+        let apart = t.map(|x| x + p(0.0, 2.0, 0.0));
+        let (d, crossing) = triangle_distance(&s, &apart, 1e-12);
+        assert!(!crossing && d < 1e-15, "{d}");
     }
 }

@@ -61,6 +61,22 @@ pub struct FoldingModel {
 }
 
 impl FoldingModel {
+    /// The angle below which a test of exact geometry (Kawasaki's condition, a crease that
+    /// stays flat in a mode) counts a residual as zero, rad: 1e-9, or the pattern's own
+    /// precision where its coordinates hold fewer digits.
+    pub fn exact_angle_tolerance(&self) -> f64 {
+        1e-9_f64.max(self.pattern.angle_precision)
+    }
+
+    /// The least depth by which two panels must pass through each other to cross (shallower
+    /// is touching), in the pattern's length unit: 1e-12 of its size, or where its
+    /// coordinates hold fewer digits, its angle precision over the lever of its size (layers
+    /// folded flat tilt by that much from rounding alone). A contact test may ask for more
+    /// ([`super::ContactSettings::crossing_depth`]).
+    pub fn contact_tolerance(&self) -> f64 {
+        (1e-12 * self.size).max(self.pattern.angle_precision * self.size)
+    }
+
     /// Prepares a validated crease pattern.
     pub fn new(pattern: CreasePattern) -> Result<FoldingModel> {
         let ne = pattern.edges.len();

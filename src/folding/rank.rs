@@ -18,6 +18,13 @@ use faer::{Mat, Par};
 /// so |R_00| is that norm.)
 pub const RANK_TOL: f64 = 1e-9;
 
+/// The relative threshold of a rank count: [`RANK_TOL`], or the pattern's angle precision
+/// where its coordinates hold fewer digits (far from the origin, the rounding of a
+/// Miura-ori's file lifts the singular value of its one DOF above 1e-9).
+pub fn rank_tolerance(jacobian: &ClosureJacobian) -> f64 {
+    RANK_TOL.max(jacobian.angle_precision)
+}
+
 /// How far above the threshold (in eigenvalues of JᵀJ, squared singular values) the first
 /// value counted in the rank must settle before the sparse count stops early.
 const COUNT_GAP: f64 = 1e6;
@@ -40,7 +47,7 @@ const COUNT_REGULARISATION: f64 = 1e-15;
 /// How the rank was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RankMethod {
-    /// Column-pivoted QR of the dense J (threshold [`RANK_TOL`] on |R_ii|/|R_00|).
+    /// Column-pivoted QR of the dense J (threshold [`rank_tolerance`] on |R_ii|/|R_00|).
     PivotedQr,
     /// The smallest singular values of J by subspace iteration on (JᵀJ + μI)⁻¹ (threshold
     /// [`RANK_TOL`] on σ / largest column norm).
@@ -106,7 +113,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
     let qr = dense.col_piv_qr();
     let r = qr.thin_R();
     let diagonal: Vec<f64> = (0..rows.min(cols)).map(|i| r[(i, i)].abs()).collect();
-    let threshold = RANK_TOL * diagonal[0];
+    let threshold = rank_tolerance(jacobian) * diagonal[0];
     let rank = diagonal.iter().take_while(|&&d| d > threshold && d > 0.0).count();
     clear_upper_vector_state();
     RankReport {
@@ -153,7 +160,7 @@ impl SettledBlock {
             rank: jacobian.cols - count,
             // A locked column is zero, so it is in the null space without being a motion.
             dof: count.saturating_sub(jacobian.held),
-            threshold: RANK_TOL * self.scale.sqrt(),
+            threshold: rank_tolerance(jacobian) * self.scale.sqrt(),
             smallest_kept: self.ritz.get(count).map_or(f64::INFINITY, |&l| sigma(l)),
             largest_dropped: if count > 0 { sigma(self.ritz[count - 1]) } else { 0.0 },
             method: RankMethod::SubspaceIteration,
@@ -166,7 +173,7 @@ fn settled_block(jacobian: &ClosureJacobian) -> Result<SettledBlock> {
     let mut solver = NormalSolver::new(COUNT_REGULARISATION);
     let factor = solver.factor(jacobian)?;
     let scale = factor.max_diagonal;
-    let threshold_lambda = RANK_TOL * RANK_TOL * scale;
+    let threshold_lambda = rank_tolerance(jacobian) * rank_tolerance(jacobian) * scale;
     let cluster_lambda = CLUSTER_LEVEL * COUNT_REGULARISATION * scale;
     let mut block = 8.min(n);
     // A fixed pseudo-random start (the count must not depend on the run). A doubled block
@@ -214,7 +221,7 @@ pub fn null_space(jacobian: &ClosureJacobian) -> Result<Mat<f64>> {
         })?;
         let s = svd.S().column_vector();
         let largest = (0..s.nrows()).map(|i| s[i]).fold(0.0_f64, f64::max);
-        let threshold = RANK_TOL * largest;
+        let threshold = rank_tolerance(jacobian) * largest;
         let v = svd.V();
         let null: Vec<usize> = (0..cols).filter(|&j| j >= s.nrows() || s[j] <= threshold).collect();
         let basis = Mat::<f64>::from_fn(cols, null.len(), |i, k| v[(i, null[k])]);

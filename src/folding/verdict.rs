@@ -112,6 +112,9 @@ pub struct FlatFoldability {
     /// Vertices whose assignment breaks Maekawa's condition (vertices with a U crease are
     /// not judged).
     pub maekawa_failures: Vec<usize>,
+    /// The residual below which Kawasaki's condition holds, rad (1e-9, or the pattern's
+    /// own angle precision where that is coarser).
+    pub tolerance: f64,
 }
 
 impl FlatFoldability {
@@ -143,6 +146,7 @@ impl FlatFoldability {
             worst_kawasaki,
             odd_degree,
             maekawa_failures,
+            tolerance: model.exact_angle_tolerance(),
         }
     }
 
@@ -152,10 +156,10 @@ impl FlatFoldability {
         let mut kawasaki = match self.worst_kawasaki {
             None if self.odd_degree.is_empty() => "no interior vertex".to_string(),
             None => String::new(),
-            Some((_, r)) if r <= 1e-9 && self.odd_degree.is_empty() => {
+            Some((_, r)) if r <= self.tolerance && self.odd_degree.is_empty() => {
                 format!("Kawasaki holds at all {vertices} vertices")
             }
-            Some((_, r)) if r <= 1e-9 => format!("Kawasaki holds at the {even} of even degree"),
+            Some((_, r)) if r <= self.tolerance => format!("Kawasaki holds at the {even} of even degree"),
             Some((v, r)) => format!("Kawasaki fails by up to {r:.3e} rad (vertex {v})"),
         };
         if !self.odd_degree.is_empty() {
@@ -303,6 +307,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
 
     // An assignment alone: first the local test at each degree-4 vertex, then the modes'
     // agreement across shared creases, then a witness.
+    let exact = model.exact_angle_tolerance();
     let mut local_checked = 0;
     let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
     for star in &model.stars {
@@ -311,7 +316,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
             chosen.push(None);
             continue;
         }
-        let Some(modes) = degree4_modes(star) else {
+        let Some(modes) = degree4_modes_within(star, exact) else {
             chosen.push(None);
             continue;
         };
@@ -326,7 +331,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
             .enumerate()
             .map(|(k, a)| if k % 2 == 0 { *a } else { -a })
             .sum::<f64>();
-        let flat_foldable = alternating.abs() < 1e-9;
+        let flat_foldable = alternating.abs() < exact;
         let fits = |mode: &&[f64; 4]| {
             mode.iter()
                 .zip(&assigned)
@@ -353,7 +358,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
             "{local_checked} degree-4 vertices: each assignment matches a folding mode"
         ));
     }
-    if let Some(conflict) = mode_conflict(model, &chosen) {
+    if let Some(conflict) = mode_conflict(model, &chosen, exact) {
         report.verdict = PatternVerdict::NotRigidlyFoldable;
         report.evidence = conflict;
         return Ok(report);
@@ -409,7 +414,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
 /// v and w needs t_v·m_v = t_w·m_w. The ratios are propagated over the stars; a cycle whose
 /// ratios disagree leaves only t = 0, and the assignment cannot fold rigidly. Returns the
 /// evidence of such a disagreement.
-fn mode_conflict(model: &FoldingModel, chosen: &[Option<[f64; 4]>]) -> Option<String> {
+fn mode_conflict(model: &FoldingModel, chosen: &[Option<[f64; 4]>], exact: f64) -> Option<String> {
     if chosen.is_empty() || chosen.iter().any(Option::is_none) {
         return None;
     }
@@ -444,7 +449,7 @@ fn mode_conflict(model: &FoldingModel, chosen: &[Option<[f64; 4]>]) -> Option<St
                         }
                         Some(existing) => {
                             let disagreement = (existing / tw).ln().abs();
-                            if disagreement > 1e-9 && worst.is_none_or(|(d, ..)| disagreement > d) {
+                            if disagreement > exact && worst.is_none_or(|(d, ..)| disagreement > d) {
                                 worst = Some((disagreement, c, v, w));
                             }
                         }
@@ -490,6 +495,13 @@ fn letter(sign: f64) -> &'static str {
 /// when the vertex is not degree 4 or a mode has a crease that does not move to first
 /// order (the signs would then be decided at higher order).
 pub fn degree4_modes(star: &Star) -> Option<Vec<[f64; 4]>> {
+    degree4_modes_within(star, 1e-9)
+}
+
+/// [`degree4_modes`], with a crease whose velocity is below `zero_tolerance` of the
+/// largest read as not moving (the pattern's own precision, where its numbers hold fewer
+/// digits than 1e-9 rad).
+pub fn degree4_modes_within(star: &Star, zero_tolerance: f64) -> Option<Vec<[f64; 4]>> {
     if star.columns.len() != 4 {
         return None;
     }
@@ -552,19 +564,18 @@ pub fn degree4_modes(star: &Star) -> Option<Vec<[f64; 4]>> {
     if discriminant <= 1e-12 * scale * scale {
         return Some(Vec::new());
     }
-    let root = discriminant.sqrt();
-    let directions: Vec<(f64, f64)> = if q11.abs() >= q22.abs() {
-        // s = t (−q12 ± √D) / q11
-        [(-q12 + root) / q11, (-q12 - root) / q11]
-            .iter()
-            .map(|&s| (s, 1.0))
-            .collect()
-    } else {
-        [(-q12 + root) / q22, (-q12 - root) / q22]
-            .iter()
-            .map(|&t| (1.0, t))
-            .collect()
-    };
+    // The form is indefinite (λ₁ > 0 > λ₂ with eigenvectors e₁, e₂); its null lines are
+    // √(−λ₂) e₁ ± √λ₁ e₂. No division: the form may be 2 q12 s t with q11 = q22 = 0,
+    // depending on which crease the star lists first.
+    let (mean, radius) = ((q11 + q22) / 2.0, ((q11 - q22) / 2.0).hypot(q12));
+    let (larger, smaller) = (mean + radius, mean - radius);
+    let phi = 0.5 * (2.0 * q12).atan2(q11 - q22);
+    let (e1, e2) = ((phi.cos(), phi.sin()), (-phi.sin(), phi.cos()));
+    let (a, b) = ((-smaller).max(0.0).sqrt(), larger.max(0.0).sqrt());
+    let directions: Vec<(f64, f64)> = [1.0, -1.0]
+        .iter()
+        .map(|sign| (a * e1.0 + sign * b * e2.0, a * e1.1 + sign * b * e2.1))
+        .collect();
     let mut modes = Vec::new();
     for (s, t) in directions {
         let velocity: Vec<f64> = (0..4).map(|k| s * basis[0][k] + t * basis[1][k]).collect();
@@ -572,7 +583,7 @@ pub fn degree4_modes(star: &Star) -> Option<Vec<[f64; 4]>> {
         // A crease that does not move to first order (the straight fold through a pair of
         // collinear creases) gets 0: its sign is not decided here.
         let unit = [0, 1, 2, 3].map(|k| {
-            if velocity[k].abs() < 1e-9 * size {
+            if velocity[k].abs() < zero_tolerance * size {
                 0.0
             } else {
                 velocity[k] / size

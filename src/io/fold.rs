@@ -571,6 +571,7 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
     }
     let mut graph = graph;
     let mut reading = None;
+    let source_magnitude = largest_coordinate(&graph.coords3);
     if graph.is_3d {
         match flat_within_noise(&graph.coords3, graph.faces_vertices.as_deref()) {
             Some((coords, planarity)) => {
@@ -617,6 +618,7 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
             folded_form: None,
             locked: graph.locked,
             unit: graph.unit,
+            source_magnitude,
         }
         .with_reading(
             format!(
@@ -637,6 +639,7 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
         folded_form: None,
         locked: graph.locked,
         unit: graph.unit,
+        source_magnitude,
     }
     .into())
 }
@@ -648,6 +651,11 @@ pub const FOLDED_FLAT: f64 = 1e-4;
 /// A 3D sheet whose vertices all lie within this fraction of its size of one plane is flat
 /// (float noise of an exporter), not a folded state.
 pub const FLAT_NOISE: f64 = 1e-4;
+
+/// The largest |coordinate| of a file's points (what its rounding is relative to).
+fn largest_coordinate(coords: &[[f64; 3]]) -> f64 {
+    coords.iter().flatten().fold(0.0, |m: f64, x| m.max(x.abs()))
+}
 
 /// The 2D coordinates of a 3D sheet that is flat within [`FLAT_NOISE`] (in its best-fit
 /// plane, turned so the listed faces run counter-clockwise), and its planarity relative to
@@ -724,6 +732,7 @@ fn flat_within_noise(coords: &[[f64; 3]], faces: Option<&[Vec<usize>]>) -> Optio
 /// A 3D folded form: the crease pattern developed from its faces, the state from its
 /// dihedral angles (`edges_foldAngle` is ignored: Origami Simulator writes the targets there).
 fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> Result<CreasePatternBuilder> {
+    let source_magnitude = largest_coordinate(&graph.coords3);
     let Some(faces) = graph.faces_vertices else {
         return Err(NanofoldError::missing_with(
             "faces_vertices",
@@ -797,6 +806,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
         angle_field: "dihedral angle of the 3D faces".into(),
         locked: graph.locked,
         unit: graph.unit,
+        source_magnitude,
         folded_form: Some(FoldedFormFit {
             development_error: development.development_error,
             face_nonplanarity: development.face_nonplanarity,

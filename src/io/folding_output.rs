@@ -61,7 +61,7 @@ pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>,
         "frame_classes": ["creasePattern"],
         "frame_attributes": ["2D"],
         "frame_unit": pattern.unit.clone().unwrap_or_else(|| "unit".into()),
-        "vertices_coords": pattern.vertices,
+        "vertices_coords": pattern.file_vertices(),
         "edges_vertices": pattern.edges,
         "edges_assignment": letters,
         "faces_vertices": pattern.faces,
@@ -121,7 +121,7 @@ pub fn states_fold(
                 "frame_attributes": ["3D"],
                 "frame_parent": 0,
                 "frame_inherit": true,
-                "vertices_coords": vertex_positions(model, &poses),
+                "vertices_coords": vertex_positions(model, &poses).into_iter().map(|p| pattern.file_point_3d(p)).collect::<Vec<_>>(),
                 "edges_assignment": letters,
                 "edges_foldAngle": angles,
             })
@@ -198,7 +198,7 @@ pub fn network_states_fold(model: &NetworkModel, frames: &[(String, &[f64])], de
                 .map(|(&[x, y], &panel)| {
                     let p =
                         data.place(panel, &nalgebra::Vector3::new(x * model.unit, y * model.unit, 0.0)) / model.unit;
-                    [p.x, p.y, p.z]
+                    pattern.file_point_3d([p.x, p.y, p.z])
                 })
                 .collect();
             let (angles, letters) = edge_arrays(pattern, fold_angles);

@@ -48,6 +48,10 @@ pub struct CreasePatternBuilder {
     pub locked: Vec<bool>,
     /// The file's `frame_unit` (None: unstated), written back on the outputs.
     pub unit: Option<String>,
+    /// The largest |coordinate| of the file the flat positions were derived from (a 3D form
+    /// developed or projected into the plane), for the pattern's precision; 0 when
+    /// `vertices` are the file's own numbers.
+    pub source_magnitude: f64,
 }
 
 /// What developing a 3D folded form into its crease pattern measured
@@ -124,9 +128,36 @@ pub struct CreasePattern {
     pub reading: Vec<String>,
     /// Per edge, the file's angles when they were read as targets, not a state, rad.
     pub target_angles: Option<Vec<f64>>,
+    /// The centre of the vertices' bounding box in the file's coordinates. `vertices` are
+    /// relative to it, so that nothing computed depends on where the paper lies (a pattern
+    /// 1e8 from the origin keeps its digits); outputs add it back.
+    pub origin: [f64; 2],
+    /// How precisely the file's numbers fix an angle between edges, rad: 16 ε times its
+    /// largest coordinate over its shortest edge. Tests of exact geometry (a flat-foldable
+    /// vertex, a crease that stays straight) allow at least this much, so a pattern moved
+    /// far from the origin, where its coordinates keep fewer digits, keeps its verdicts.
+    pub angle_precision: f64,
+    /// How precisely the file's numbers fix a position, in its length unit: 16 ε times its
+    /// largest coordinate.
+    pub length_precision: f64,
 }
 
 impl CreasePattern {
+    /// A flat position in the file's coordinates.
+    pub fn file_point(&self, p: [f64; 2]) -> [f64; 2] {
+        [p[0] + self.origin[0], p[1] + self.origin[1]]
+    }
+
+    /// A posed (3D) position in the file's coordinates: the flat plane is z = 0.
+    pub fn file_point_3d(&self, p: [f64; 3]) -> [f64; 3] {
+        [p[0] + self.origin[0], p[1] + self.origin[1], p[2]]
+    }
+
+    /// The flat positions in the file's coordinates.
+    pub fn file_vertices(&self) -> Vec<[f64; 2]> {
+        self.vertices.iter().map(|&p| self.file_point(p)).collect()
+    }
+
     /// The face (graph index) the file lists as `faces_vertices[index]`, if any.
     pub fn face_from_file(&self, index: usize) -> Option<usize> {
         self.file_face.iter().position(|&f| f == index)
@@ -187,8 +218,14 @@ impl CreasePatternBuilder {
             folded_form,
             locked,
             unit,
+            source_magnitude,
         } = self;
         let (nv, ne) = (vertices.len(), edges.len());
+        let largest_coordinate = vertices
+            .iter()
+            .flatten()
+            .fold(source_magnitude.abs(), |m, x| m.max(x.abs()));
+        let (origin, vertices) = recentred(vertices);
         if edges.len() > MAX_EDGES {
             return Err(NanofoldError::invalid(
                 "edges_vertices",
@@ -315,6 +352,8 @@ impl CreasePatternBuilder {
                 sector_angles,
             });
         }
+        let length_precision = 16.0 * f64::EPSILON * largest_coordinate;
+        let angle_precision = angle_precision(length_precision, &vertices, &edges);
         Ok(CreasePattern {
             name,
             vertices,
@@ -334,8 +373,47 @@ impl CreasePatternBuilder {
             unit,
             reading: Vec::new(),
             target_angles: None,
+            origin,
+            angle_precision,
+            length_precision,
         })
     }
+}
+
+/// The length precision over the shortest edge: the angle the file's rounding can move
+/// (see [`CreasePattern::angle_precision`]).
+fn angle_precision(length_precision: f64, vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> f64 {
+    let shortest = edges
+        .iter()
+        .map(|&[a, b]| (vertices[b][0] - vertices[a][0]).hypot(vertices[b][1] - vertices[a][1]))
+        .fold(f64::INFINITY, f64::min);
+    if shortest > 0.0 && shortest.is_finite() {
+        length_precision / shortest
+    } else {
+        0.0
+    }
+}
+
+/// The centre of the points' bounding box, and the points relative to it (exact where a
+/// point lies within a factor 2 of the centre, as on a pattern far from the origin).
+fn recentred(mut vertices: Vec<[f64; 2]>) -> ([f64; 2], Vec<[f64; 2]>) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &vertices {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if vertices.is_empty() || !(0..2).all(|k| lo[k].is_finite() && hi[k].is_finite()) {
+        return ([0.0; 2], vertices);
+    }
+    let origin = [0, 1].map(|k| lo[k] / 2.0 + hi[k] / 2.0);
+    for p in &mut vertices {
+        for k in 0..2 {
+            p[k] -= origin[k];
+        }
+    }
+    (origin, vertices)
 }
 
 /// The first pair of edges joining the same two vertices.
@@ -774,6 +852,7 @@ mod tests {
             folded_form: None,
             locked: Vec::new(),
             unit: None,
+            source_magnitude: 0.0,
         };
         let cp = b.build().unwrap();
         assert_eq!(
@@ -851,6 +930,7 @@ mod tests {
             folded_form: None,
             locked: Vec::new(),
             unit: None,
+            source_magnitude: 0.0,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("cross"), "{e}");
@@ -869,6 +949,7 @@ mod tests {
             folded_form: None,
             locked: Vec::new(),
             unit: None,
+            source_magnitude: 0.0,
         };
         let e = b.build().unwrap_err().to_string();
         assert!(e.contains("inside another edge"), "{e}");

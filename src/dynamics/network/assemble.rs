@@ -366,6 +366,7 @@ pub fn from_closed(spec: &ClosedSpec<Pattern>, chain: &ClosedChain) -> Result<Ne
         folded_form: None,
         locked,
         unit: mesh.unit.clone(),
+        source_magnitude: 0.0,
     }
     .build()?;
     let folding = FoldingModel::new(crease_pattern)?;
@@ -515,6 +516,7 @@ pub fn from_strip(name: &str, chain: &StripChain) -> Result<NetworkModel> {
         folded_form: None,
         locked,
         unit: Some("um".to_string()),
+        source_magnitude: 0.0,
     }
     .build()?;
     let folding = FoldingModel::new(pattern)?;
@@ -524,7 +526,10 @@ pub fn from_strip(name: &str, chain: &StripChain) -> Result<NetworkModel> {
         .creases
         .iter()
         .map(|&e| {
-            let y = folding.pattern.vertices[folding.pattern.edges[e][0]][1];
+            // The hinge lines are in the strip's own coordinates, as the file's are.
+            let y = folding
+                .pattern
+                .file_point(folding.pattern.vertices[folding.pattern.edges[e][0]])[1];
             (0..lines.len())
                 .min_by(|&a, &b| (lines[a] - y).abs().total_cmp(&(lines[b] - y).abs()))
                 .expect("a strip has hinges")

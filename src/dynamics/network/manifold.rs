@@ -75,6 +75,7 @@ pub fn tangent_basis(model: &NetworkModel, angles: &[f64]) -> Result<DMatrix<f64
             .map(|&(r, c, v)| (r, position[c], v))
             .collect(),
         held: 0,
+        angle_precision: full.angle_precision,
     };
     let basis = null_space(&reduced)?;
     let mut z = DMatrix::zeros(model.columns(), basis.ncols());
