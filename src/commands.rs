@@ -327,6 +327,8 @@ pub enum Verdict {
     BranchPoint,
     /// A fold's step budget ran out.
     StepLimit,
+    /// A fold stopped where more pairs of panels overlap than its contact test measures.
+    ContactBudget,
 }
 
 impl Verdict {
@@ -349,6 +351,7 @@ impl Verdict {
             Verdict::Reached => "reached",
             Verdict::BranchPoint => "branch_point",
             Verdict::StepLimit => "step_limit",
+            Verdict::ContactBudget => "contact_budget",
         }
     }
 }
@@ -402,6 +405,7 @@ impl From<&crate::folding::StopReason> for Verdict {
             S::Locked => Verdict::Locked,
             S::BranchPoint { .. } => Verdict::BranchPoint,
             S::StepLimit => Verdict::StepLimit,
+            S::ContactBudget { .. } => Verdict::ContactBudget,
         }
     }
 }

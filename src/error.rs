@@ -205,6 +205,17 @@ pub enum NumericalError {
         /// Steps it would still need at this pace.
         projected: f64,
     },
+    /// More pairs of panels overlap than a contact test measures (layers stacked deep).
+    #[error(
+        "more than {pairs} pairs of panels overlap {when} (layers stacked deep), the contact test's budget \
+         (ContactSettings::pairs_per_panel): whether panels cross cannot be decided there"
+    )]
+    ContactBudget {
+        /// The budget passed.
+        pairs: usize,
+        /// Where (e.g. "at the start").
+        when: String,
+    },
     /// An implicit integrator's Newton iterations keep failing.
     #[error(
         "{method}'s Newton iterations failed {failures} times in {steps} steps by t = {reached_s:.6e} s (the fast modes \

@@ -1,5 +1,5 @@
-//! Panels that meet (`docs/model.md#panel-contact`): a uniform-grid broad phase on the
-//! panels' boxes, then exact triangle–triangle tests in 3D. Panels that share a vertex are
+//! Panels that meet (`docs/model.md#panel-contact`): a broad phase on the panels' boxes
+//! (`geometry::broad_phase`), then exact triangle–triangle tests in 3D. Panels that share a vertex are
 //! left to that vertex's spherical order and not tested here.
 
 use super::model::FoldingModel;
@@ -14,16 +14,26 @@ type Point = Vector3<f64>;
 pub struct ContactSettings {
     /// Distance below which a pair is a contact, as a fraction of the pattern's size.
     pub clearance: f64,
-    /// Pairs whose boxes come within this many median panel sizes of each other are
-    /// measured (for the smallest clearance reported); the cost grows with its square.
+    /// Pairs whose boxes come within this many median panel widths (the smaller side of a
+    /// panel's flat box: long thin panels side by side are not all neighbours) of each
+    /// other are measured (for the smallest clearance reported); the cost grows with its
+    /// square.
     pub search: f64,
+    /// Most pairs of panels measured in one test, per panel (at least [`MIN_PAIR_BUDGET`]
+    /// in all): layers stacked deep (an accordion folded nearly flat) overlap in every pair,
+    /// and past this the test stops and says so ([`ContactReport::overflow`]).
+    pub pairs_per_panel: usize,
 }
+
+/// The least pair budget of a contact test, whatever the number of panels.
+pub const MIN_PAIR_BUDGET: usize = 100_000;
 
 impl Default for ContactSettings {
     fn default() -> Self {
         ContactSettings {
             clearance: 1e-9,
             search: 0.5,
+            pairs_per_panel: 64,
         }
     }
 }
@@ -45,7 +55,19 @@ impl ContactSettings {
                 "must lie in [0, 10] (median panel sizes)",
             ));
         }
+        if !(1..=1_000_000).contains(&self.pairs_per_panel) {
+            return Err(NanofoldError::invalid(
+                "pairs_per_panel",
+                self.pairs_per_panel,
+                "must lie in [1, 1e6]",
+            ));
+        }
         Ok(())
+    }
+
+    /// The most pairs one test of `panels` panels measures.
+    pub fn pair_budget(&self, panels: usize) -> usize {
+        self.pairs_per_panel.saturating_mul(panels).max(MIN_PAIR_BUDGET)
     }
 }
 
@@ -69,6 +91,9 @@ pub struct ContactReport {
     pub pairs_measured: usize,
     /// Smallest distance over the measured pairs (None: no pair within the search range).
     pub min_clearance: Option<f64>,
+    /// Some(n): more pairs of panels overlap than the budget (n is the budget + 1, where the
+    /// count stopped), so nothing was measured and whether panels cross is not decided.
+    pub overflow: Option<usize>,
 }
 
 impl ContactReport {
@@ -85,7 +110,7 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
     // crossing shallower than twice that spread is not decided by the state (stacked
     // layers whose corners land on one point).
     let depth = model.contact_tolerance().max(2.0 * placement_spread(model, poses));
-    let search = settings.search * median_panel_size(model);
+    let search = settings.search * median_panel_width(model);
     let pattern = &model.pattern;
     let triangles: Vec<Vec<[Point; 3]>> = model
         .panel_triangles
@@ -127,8 +152,17 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
         contacts: Vec::new(),
         pairs_measured: 0,
         min_clearance: None,
+        overflow: None,
     };
-    for (a, b) in candidate_pairs(&boxes) {
+    let pairs = match crate::geometry::broad_phase::overlapping_pairs_within(&boxes, settings.pair_budget(boxes.len()))
+    {
+        Ok(pairs) => pairs,
+        Err(found) => {
+            report.overflow = Some(found);
+            return report;
+        }
+    };
+    for (a, b) in pairs {
         if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
             continue;
         }
@@ -182,66 +216,25 @@ pub(crate) fn placement_spread(model: &FoldingModel, poses: &[Pose]) -> f64 {
     spread
 }
 
-/// Pairs of boxes that overlap, smaller index first, from a uniform grid of cells about
-/// the size of the median box: each box is entered in the cells it covers, and a pair is
-/// reported from the first cell the two share, so each once. For panels of similar size
-/// this costs O(panels), where a sweep along one axis grows faster once a folded pattern
-/// stacks its panels.
+/// Pairs of boxes that overlap, smaller index first, each once
+/// ([`crate::geometry::broad_phase`]: a grid sized from the boxes themselves, long boxes
+/// swept), so a 50 000-panel strip costs about what a square sheet of as many panels does.
 pub(crate) fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
-    if boxes.len() < 2 {
-        return Vec::new();
-    }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for (l, h) in boxes {
-        for k in 0..3 {
-            lo[k] = lo[k].min(l[k]);
-            hi[k] = hi[k].max(h[k]);
-        }
-    }
-    let mut sizes: Vec<f64> = boxes
-        .iter()
-        .map(|(l, h)| (0..3).map(|k| h[k] - l[k]).fold(0.0, f64::max))
-        .collect();
-    sizes.sort_by(f64::total_cmp);
-    let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
-    // At most 128 cells a side: memory stays bounded whatever the boxes.
-    let cell = sizes[sizes.len() / 2].max(extent / 128.0).max(f64::MIN_POSITIVE);
-    let index = |x: f64, k: usize| (((x - lo[k]) / cell) as i64).clamp(0, 127);
-    let mut cells: std::collections::HashMap<(i64, i64, i64), Vec<usize>> = std::collections::HashMap::new();
-    let ranges: Vec<[(i64, i64); 3]> = boxes
-        .iter()
-        .map(|(l, h)| [0, 1, 2].map(|k| (index(l[k], k), index(h[k], k))))
-        .collect();
-    for (b, r) in ranges.iter().enumerate() {
-        for i in r[0].0..=r[0].1 {
-            for j in r[1].0..=r[1].1 {
-                for k in r[2].0..=r[2].1 {
-                    cells.entry((i, j, k)).or_default().push(b);
-                }
-            }
-        }
-    }
-    let overlap = |a: usize, b: usize| (0..3).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]);
-    let mut pairs = Vec::new();
-    for (&(i, j, k), list) in &cells {
-        for (x, &a) in list.iter().enumerate() {
-            for &b in &list[x + 1..] {
-                // Report from the first cell both cover (the corner of their overlap).
-                let (ra, rb) = (ranges[a], ranges[b]);
-                let first = (ra[0].0.max(rb[0].0), ra[1].0.max(rb[1].0), ra[2].0.max(rb[2].0));
-                if first == (i, j, k) && overlap(a, b) {
-                    pairs.push((a.min(b), a.max(b)));
-                }
-            }
-        }
-    }
-    pairs.sort_unstable();
-    pairs
+    crate::geometry::broad_phase::overlapping_pairs(boxes)
+}
+
+/// The median over panels of their flat bounding boxes' smaller side.
+fn median_panel_width(model: &FoldingModel) -> f64 {
+    median_panel_side(model, f64::min)
 }
 
 /// The median over panels of their flat bounding boxes' larger side.
 pub(crate) fn median_panel_size(model: &FoldingModel) -> f64 {
+    median_panel_side(model, f64::max)
+}
+
+/// The median over panels of one side of their flat bounding boxes (`pick` of the two).
+fn median_panel_side(model: &FoldingModel, pick: fn(f64, f64) -> f64) -> f64 {
     let vertices = &model.pattern.vertices;
     let mut sizes: Vec<f64> = model
         .panel_vertices
@@ -254,7 +247,7 @@ pub(crate) fn median_panel_size(model: &FoldingModel) -> f64 {
                     hi[k] = hi[k].max(vertices[v][k]);
                 }
             }
-            (hi[0] - lo[0]).max(hi[1] - lo[1])
+            pick(hi[0] - lo[0], hi[1] - lo[1])
         })
         .collect();
     if sizes.is_empty() {

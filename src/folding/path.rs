@@ -145,6 +145,14 @@ impl FoldSettings {
     }
 }
 
+/// The evidence of a contact test past its budget.
+fn over_budget(found: usize, when: &str) -> String {
+    format!(
+        "more than {} pairs of panels overlap {when} (layers stacked deep), the contact test's budget: whether panels cross there was not decided",
+        found - 1
+    )
+}
+
 /// Why a folding path stopped.
 #[derive(Debug, Clone, PartialEq)]
 pub enum StopReason {
@@ -166,6 +174,12 @@ pub enum StopReason {
     },
     /// The step budget ran out.
     StepLimit,
+    /// More pairs of panels overlap than the contact test's budget (layers stacked deep):
+    /// whether the next state's panels cross was not decided, so the path stops before it.
+    ContactBudget {
+        /// The budget passed.
+        pairs: usize,
+    },
 }
 
 impl StopReason {
@@ -177,6 +191,7 @@ impl StopReason {
             StopReason::Locked => "locked",
             StopReason::BranchPoint { .. } => "branch_point",
             StopReason::StepLimit => "step_limit",
+            StopReason::ContactBudget { .. } => "contact_budget",
         }
     }
 }
@@ -397,6 +412,15 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             newton_iterations: newton,
         })
     };
+    if let Some(found) = first.overflow {
+        return finish(
+            steps,
+            StopReason::ContactBudget { pairs: found - 1 },
+            over_budget(found, "at the start"),
+            None,
+            newton_iterations,
+        );
+    }
     if let Some(pair) = first.crossing().next() {
         let panels = pair.panels;
         return finish(
@@ -580,6 +604,15 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             );
         }
         let contacts = contact_at(&next, &mut poses);
+        if let Some(found) = contacts.overflow {
+            return finish(
+                steps,
+                StopReason::ContactBudget { pairs: found - 1 },
+                over_budget(found, &format!("after progress {here:.4}")),
+                branch,
+                newton_iterations,
+            );
+        }
         if let Some(pair) = contacts.crossing().next() {
             let panels = pair.panels;
             return finish(

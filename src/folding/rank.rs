@@ -84,6 +84,43 @@ pub struct RankReport {
 /// Rank and degrees of freedom of J: dense pivoted QR for up to [`DENSE_RANK_LIMIT`]
 /// creases, the sparse null-space count above.
 pub fn jacobian_rank(jacobian: &ClosureJacobian) -> Result<RankReport> {
+    // A column without a non-zero entry (a crease that meets no interior vertex, as in a
+    // strip of parallel creases, or a locked one) is a null direction by itself: counted
+    // here, so the rank count only sees the creases the closures tie together.
+    let mut tied = vec![false; jacobian.cols];
+    for &(_, c, v) in &jacobian.entries {
+        if v != 0.0 {
+            tied[c] = true;
+        }
+    }
+    let free = tied.iter().filter(|&&t| !t).count();
+    if free == 0 {
+        return ranked(jacobian);
+    }
+    let mut position = vec![usize::MAX; jacobian.cols];
+    for (k, c) in (0..jacobian.cols).filter(|&c| tied[c]).enumerate() {
+        position[c] = k;
+    }
+    let reduced = ClosureJacobian {
+        residual: jacobian.residual.clone(),
+        rows: jacobian.rows,
+        cols: jacobian.cols - free,
+        entries: jacobian
+            .entries
+            .iter()
+            .filter(|e| tied[e.1])
+            .map(|&(r, c, v)| (r, position[c], v))
+            .collect(),
+        held: 0,
+        angle_precision: jacobian.angle_precision,
+    };
+    let mut report = ranked(&reduced)?;
+    // Locked columns are among the untied ones, and are no motion.
+    report.dof += free - jacobian.held;
+    Ok(report)
+}
+
+fn ranked(jacobian: &ClosureJacobian) -> Result<RankReport> {
     if jacobian.cols <= DENSE_RANK_LIMIT {
         Ok(jacobian_rank_dense(jacobian))
     } else {

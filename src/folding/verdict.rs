@@ -278,6 +278,15 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
                     list.join(", ")
                 ),
             )
+        } else if let Some(found) = contacts.overflow {
+            (
+                PatternVerdict::Unknown,
+                format!(
+                    "every vertex closes within {max_residual:.1e} rad, but more than {} pairs of panels overlap (layers stacked deep), the contact test's budget: whether panels cross is not decided ({} DOF at this state)",
+                    found - 1,
+                    report.rank.dof
+                ),
+            )
         } else if !report.intersecting_pairs.is_empty() {
             let list: Vec<String> = report
                 .intersecting_pairs

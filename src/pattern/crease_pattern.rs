@@ -429,8 +429,9 @@ fn duplicate_edge(edges: &[[usize; 2]]) -> Option<(usize, usize)> {
 }
 
 /// No two edges may cross, and no vertex may lie inside an edge: the graph must be a
-/// planar straight-line graph. Edges are bucketed on a uniform grid (about one edge per
-/// cell), so the test costs O(E) for evenly spread patterns.
+/// planar straight-line graph. Only edges whose boxes overlap are compared
+/// ([`crate::geometry::broad_phase`]), so the test costs about O(E log E) however the edges
+/// are spread (a vertex far from the rest, a long strip).
 fn check_planar(vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> Result<()> {
     if edges.is_empty() {
         return Ok(());
@@ -445,59 +446,49 @@ fn check_planar(vertices: &[[f64; 2]], edges: &[[usize; 2]]) -> Result<()> {
         }
     }
     let size = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-    let cells = ((edges.len() as f64).sqrt().ceil() as usize).clamp(1, 1024);
-    let cell = |x: f64, k: usize| (((x - lo[k]) / size * cells as f64) as usize).min(cells - 1);
-    let mut buckets: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
-    for (e, &[a, b]) in edges.iter().enumerate() {
-        let (p, q) = (vertices[a], vertices[b]);
-        let (i0, i1) = (cell(p[0].min(q[0]), 0), cell(p[0].max(q[0]), 0));
-        let (j0, j1) = (cell(p[1].min(q[1]), 1), cell(p[1].max(q[1]), 1));
-        for i in i0..=i1 {
-            for j in j0..=j1 {
-                buckets.entry((i, j)).or_default().push(e);
-            }
-        }
-    }
     let tolerance = 1e-12 * size;
+    let boxes: Vec<([f64; 2], [f64; 2])> = edges
+        .iter()
+        .map(|&[a, b]| {
+            let (p, q) = (vertices[a], vertices[b]);
+            // Widened by the tolerance: a vertex that far off an axis-aligned edge touches it.
+            (
+                [p[0].min(q[0]) - tolerance, p[1].min(q[1]) - tolerance],
+                [p[0].max(q[0]) + tolerance, p[1].max(q[1]) + tolerance],
+            )
+        })
+        .collect();
     let cross = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
-    let mut checked = std::collections::HashSet::new();
-    for list in buckets.values() {
-        for (x, &e) in list.iter().enumerate() {
-            for &f in &list[x + 1..] {
-                if !checked.insert((e.min(f), e.max(f))) {
-                    continue;
-                }
-                let ([a, b], [c, d]) = (edges[e], edges[f]);
-                let shared = [a, b].iter().filter(|v| [c, d].contains(v)).count();
-                let (p, q, r, t) = (vertices[a], vertices[b], vertices[c], vertices[d]);
-                let length = |u: [f64; 2], v: [f64; 2]| (v[0] - u[0]).hypot(v[1] - u[1]);
-                let (d1, d2) = (cross(p, q, r) / length(p, q), cross(p, q, t) / length(p, q));
-                let (d3, d4) = (cross(r, t, p) / length(r, t), cross(r, t, q) / length(r, t));
-                let crosses = shared == 0
-                    && ((d1 > tolerance && d2 < -tolerance) || (d1 < -tolerance && d2 > tolerance))
-                    && ((d3 > tolerance && d4 < -tolerance) || (d3 < -tolerance && d4 > tolerance));
-                // A vertex of one edge strictly inside the other (a T-junction).
-                let inside = |u: [f64; 2], from: [f64; 2], to: [f64; 2], distance: f64| {
-                    let along = ((u[0] - from[0]) * (to[0] - from[0]) + (u[1] - from[1]) * (to[1] - from[1]))
-                        / length(from, to).powi(2);
-                    distance.abs() <= tolerance && along > 1e-9 && along < 1.0 - 1e-9
-                };
-                let touches = (!([a, b].contains(&c)) && inside(r, p, q, d1))
-                    || (!([a, b].contains(&d)) && inside(t, p, q, d2))
-                    || (!([c, d].contains(&a)) && inside(p, r, t, d3))
-                    || (!([c, d].contains(&b)) && inside(q, r, t, d4));
-                if crosses || touches {
-                    return Err(NanofoldError::invalid(
-                        format!("edges_vertices[{}]", e.max(f)),
-                        format!("edges {} and {}", e.min(f), e.max(f)),
-                        if crosses {
-                            "two edges cross away from a vertex: split them at a shared vertex"
-                        } else {
-                            "a vertex lies inside another edge: split that edge at the vertex"
-                        },
-                    ));
-                }
-            }
+    for (e, f) in crate::geometry::broad_phase::overlapping_pairs(&boxes) {
+        let ([a, b], [c, d]) = (edges[e], edges[f]);
+        let shared = [a, b].iter().filter(|v| [c, d].contains(v)).count();
+        let (p, q, r, t) = (vertices[a], vertices[b], vertices[c], vertices[d]);
+        let length = |u: [f64; 2], v: [f64; 2]| (v[0] - u[0]).hypot(v[1] - u[1]);
+        let (d1, d2) = (cross(p, q, r) / length(p, q), cross(p, q, t) / length(p, q));
+        let (d3, d4) = (cross(r, t, p) / length(r, t), cross(r, t, q) / length(r, t));
+        let crosses = shared == 0
+            && ((d1 > tolerance && d2 < -tolerance) || (d1 < -tolerance && d2 > tolerance))
+            && ((d3 > tolerance && d4 < -tolerance) || (d3 < -tolerance && d4 > tolerance));
+        // A vertex of one edge strictly inside the other (a T-junction).
+        let inside = |u: [f64; 2], from: [f64; 2], to: [f64; 2], distance: f64| {
+            let along = ((u[0] - from[0]) * (to[0] - from[0]) + (u[1] - from[1]) * (to[1] - from[1]))
+                / length(from, to).powi(2);
+            distance.abs() <= tolerance && along > 1e-9 && along < 1.0 - 1e-9
+        };
+        let touches = (!([a, b].contains(&c)) && inside(r, p, q, d1))
+            || (!([a, b].contains(&d)) && inside(t, p, q, d2))
+            || (!([c, d].contains(&a)) && inside(p, r, t, d3))
+            || (!([c, d].contains(&b)) && inside(q, r, t, d4));
+        if crosses || touches {
+            return Err(NanofoldError::invalid(
+                format!("edges_vertices[{}]", e.max(f)),
+                format!("edges {} and {}", e.min(f), e.max(f)),
+                if crosses {
+                    "two edges cross away from a vertex: split them at a shared vertex"
+                } else {
+                    "a vertex lies inside another edge: split that edge at the vertex"
+                },
+            ));
         }
     }
     Ok(())

@@ -4,7 +4,7 @@
 //! energy; the direction is the negative gradient projected onto the null space of the
 //! closure Jacobian; each step is restored by Newton and refused if panels cross.
 
-use crate::error::{NanofoldError, Result};
+use crate::error::{NanofoldError, NumericalError, Result};
 use crate::folding::normal::NormalSolver;
 use crate::folding::{
     closure_jacobian, jacobian_rank, panel_contacts, panel_poses, restore_closure, vertex_residuals, ContactSettings,
@@ -452,7 +452,15 @@ fn try_state(
     if !(value.is_finite() && accept(value)) {
         return Ok(Trial::Refused);
     }
-    if let Some(contact) = panel_contacts(model, poses, &settings.contact).crossing().next() {
+    let contacts = panel_contacts(model, poses, &settings.contact);
+    if let Some(found) = contacts.overflow {
+        return Err(NumericalError::ContactBudget {
+            pairs: found - 1,
+            when: "at a trial step".into(),
+        }
+        .into());
+    }
+    if let Some(contact) = contacts.crossing().next() {
         return Ok(Trial::Crossing(contact.panels));
     }
     Ok(Trial::Accepted((trial, value, gradient)))
@@ -509,10 +517,19 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             restarts_used: 0,
         });
     }
+    let mut poses = Vec::new();
+    panel_poses(model, start, &mut poses);
+    // A start stacked deeper than the contact test measures is refused before the barrier's
+    // own broad phase would list every pair.
+    if let Some(found) = panel_contacts(model, &poses, &settings.contact).overflow {
+        return Err(NumericalError::ContactBudget {
+            pairs: found - 1,
+            when: "at the start".into(),
+        }
+        .into());
+    }
     let mut barrier = settings.barrier.map(|b| PanelBarrier::new(model, &b)).transpose()?;
     if let Some(barrier) = barrier.as_mut() {
-        let mut poses = Vec::new();
-        panel_poses(model, start, &mut poses);
         barrier.exclude_touching(model, &poses);
     }
     let objective = Objective {

@@ -146,8 +146,11 @@ impl NetworkContacts {
         let mut contacts = NetworkContacts {
             candidates,
             outline,
+            // A device's run is bounded by the integrator's step budget; its contact test is
+            // not cut short (a skipped test would miss a contact).
             settings: ContactSettings {
                 search: 0.5,
+                pairs_per_panel: 1_000_000,
                 ..ContactSettings::default()
             },
             dropped: Vec::new(),

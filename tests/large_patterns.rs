@@ -1,0 +1,163 @@
+//! Patterns whose shape once made the broad phases or the DOF count blow up (a vertex far
+//! from the rest, long strips, accordions of thin panels, layers stacked deep): each gets
+//! its answer, and a stacked state says it passed the contact test's budget instead of
+//! measuring every pair. Their times and memory at the limits are in README's Limits table
+//! (measured in release mode, not here).
+
+use nanofold::prelude::*;
+use serde_json::json;
+
+/// A grid of n × n unit squares, horizontal creases valleys and vertical ones mountains;
+/// with `far`, its last corner moved to (far, far).
+fn grid(n: usize, far: Option<f64>) -> String {
+    let index = |i: usize, j: usize| j * (n + 1) + i;
+    let mut vertices: Vec<[f64; 2]> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64]))
+        .collect();
+    let (mut edges, mut letters) = (Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..n {
+            edges.push([index(i, j), index(i + 1, j)]);
+            letters.push(if j == 0 || j == n { "B" } else { "V" });
+        }
+    }
+    for i in 0..=n {
+        for j in 0..n {
+            edges.push([index(i, j), index(i, j + 1)]);
+            letters.push(if i == 0 || i == n { "B" } else { "M" });
+        }
+    }
+    if let Some(far) = far {
+        vertices[index(n, n)] = [far, far];
+    }
+    json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
+        .to_string()
+}
+
+/// A strip of `panels` panels `width` × `height` side by side, creases alternating.
+fn strip(panels: usize, width: f64, height: f64) -> String {
+    let m = panels;
+    let mut vertices: Vec<[f64; 2]> = (0..=m).map(|i| [i as f64 * width, 0.0]).collect();
+    vertices.extend((0..=m).map(|i| [i as f64 * width, height]));
+    let (mut edges, mut letters) = (Vec::new(), Vec::new());
+    for i in 0..m {
+        edges.push([i, i + 1]);
+        letters.push("B");
+        edges.push([m + 1 + i, m + 2 + i]);
+        letters.push("B");
+    }
+    for i in 0..=m {
+        edges.push([i, m + 1 + i]);
+        letters.push(if i == 0 || i == m {
+            "B"
+        } else if i % 2 == 1 {
+            "V"
+        } else {
+            "M"
+        });
+    }
+    json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
+        .to_string()
+}
+
+fn check_text(text: &str) -> Report {
+    let pattern = Pattern::parse(text, "large", "large", &LoadOptions::default()).unwrap();
+    check(&pattern, &Settings::default()).unwrap()
+}
+
+fn dof(report: &Report) -> usize {
+    let Detail::NetworkCheck(engine, _) = &report.detail else {
+        panic!("a crease pattern of many vertices");
+    };
+    engine.rank.dof
+}
+
+fn witness(report: &Report) -> &nanofold::folding::FoldPath {
+    let Detail::NetworkCheck(engine, _) = &report.detail else {
+        panic!("a crease pattern of many vertices");
+    };
+    engine.witness.as_ref().expect("an assignment gets a witness path")
+}
+
+/// A corner moved a million units away leaves the grid's verdict and DOF as they were.
+#[test]
+fn a_vertex_far_from_the_rest_changes_nothing() {
+    let near = check_text(&grid(30, None));
+    let far = check_text(&grid(30, Some(1e6)));
+    assert_eq!(far.verdict, near.verdict, "{}", far.evidence);
+    assert_eq!(dof(&far), dof(&near));
+    // Its edges' broad phase finds the pairs testing every pair would (two long edges
+    // cross the whole grid's box).
+    let value: serde_json::Value = serde_json::from_str(&grid(12, Some(1e6))).unwrap();
+    let coords: Vec<[f64; 2]> = serde_json::from_value(value["vertices_coords"].clone()).unwrap();
+    let edges: Vec<[usize; 2]> = serde_json::from_value(value["edges_vertices"].clone()).unwrap();
+    let boxes: Vec<([f64; 2], [f64; 2])> = edges
+        .iter()
+        .map(|&[a, b]| {
+            let (p, q) = (coords[a], coords[b]);
+            ([p[0].min(q[0]), p[1].min(q[1])], [p[0].max(q[0]), p[1].max(q[1])])
+        })
+        .collect();
+    let mut every = Vec::new();
+    for a in 0..boxes.len() {
+        for b in a + 1..boxes.len() {
+            if (0..2).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]) {
+                every.push((a, b));
+            }
+        }
+    }
+    assert_eq!(nanofold::geometry::broad_phase::overlapping_pairs(&boxes), every);
+}
+
+/// Creases that meet no interior vertex are free each on their own: a strip of n panels
+/// has n − 1 DOF, counted without a rank computation over them.
+#[test]
+fn a_strip_has_one_dof_per_crease() {
+    let report = check_text(&strip(3000, 1.0, 1.0));
+    assert_eq!(dof(&report), 2999);
+}
+
+/// An accordion of thin panels (0.002 × 100) leaves flat and folds: its contact test once
+/// searched around each panel by half its length, so at flat every panel's box met
+/// thousands of others and the test passed its budget before the first step.
+#[test]
+fn an_accordion_of_thin_panels_folds() {
+    let report = check_text(&strip(3000, 0.002, 100.0));
+    assert_eq!(report.verdict, Verdict::RigidlyFoldable, "{}", report.evidence);
+    let path = witness(&report);
+    assert!(path.steps.last().unwrap().progress > 0.9, "{}", path.evidence);
+}
+
+/// Folded until its layers stack, a strip's panels overlap in nearly every pair: the path
+/// stops where its contact test would pass 64 pairs per panel, and says so; the stacked
+/// state's own check is `unknown` for the same reason.
+#[test]
+fn layers_stacked_deep_stop_at_the_contact_budget() {
+    let text = strip(3000, 1.0, 1.0);
+    let report = check_text(&text);
+    let path = witness(&report);
+    assert_eq!(path.stop.as_str(), "contact_budget", "{}", path.evidence);
+    assert!(path.evidence.contains("192000"), "{}", path.evidence);
+    let reached = path.steps.last().unwrap();
+    assert!(reached.progress > 0.9 && reached.progress < 1.0);
+    // The next state's contact test overflows; the last kept state's does not.
+    let pattern = Pattern::parse(&text, "strip", "strip", &LoadOptions::default()).unwrap();
+    let model = pattern.sheet().unwrap();
+    let mut poses = Vec::new();
+    nanofold::folding::panel_poses(model, &reached.fold_angles, &mut poses);
+    let settings = nanofold::folding::ContactSettings::default();
+    assert_eq!(
+        nanofold::folding::panel_contacts(model, &poses, &settings).overflow,
+        None
+    );
+    let folded: Vec<f64> = reached
+        .fold_angles
+        .iter()
+        .map(|r| r.signum() * 0.999 * std::f64::consts::PI)
+        .collect();
+    nanofold::folding::panel_poses(model, &folded, &mut poses);
+    assert_eq!(
+        nanofold::folding::panel_contacts(model, &poses, &settings).overflow,
+        Some(settings.pair_budget(model.pattern.panel_count) + 1)
+    );
+}
