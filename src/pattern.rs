@@ -43,7 +43,7 @@ impl Assignment {
             "C" | "c" | "J" | "j" => Err(NanofoldError::invalid(
                 field,
                 format!("\"{letter}\""),
-                "cut (C) and join (J) edges are not supported by a single-vertex model",
+                "cut (C) and join (J) edges are not supported yet: the paper must be one disc",
             )),
             other => Err(NanofoldError::invalid(
                 field,

@@ -144,3 +144,26 @@ fn creases_on_both_sides_of_the_boundary_edges_are_refused() {
         "{message}"
     );
 }
+
+/// A cut edge is refused for what it is, whichever reader meets it first: no model of
+/// nanofold takes cuts (a single vertex's reader once said "not supported by a
+/// single-vertex model", as if another would).
+#[test]
+fn a_cut_edge_is_refused_for_every_model() {
+    let mut vertex: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/miura_vertex.fold").unwrap()).unwrap();
+    let letters = vertex["edges_assignment"].as_array_mut().unwrap();
+    let first = letters.iter().position(|l| l == "M" || l == "V").unwrap();
+    letters[first] = "C".into();
+    let message = match nanofold::commands::Pattern::parse(
+        &vertex.to_string(),
+        "cut",
+        "cut",
+        &nanofold::pattern::LoadOptions::default(),
+    ) {
+        Ok(_) => panic!("a cut edge was read"),
+        Err(e) => e.to_string(),
+    };
+    assert!(message.contains("edges_assignment") && message.contains("\"C\""), "{message}");
+    assert!(message.contains("one disc") && !message.contains("single-vertex model"), "{message}");
+}
