@@ -164,6 +164,12 @@ fn a_cut_edge_is_refused_for_every_model() {
         Ok(_) => panic!("a cut edge was read"),
         Err(e) => e.to_string(),
     };
-    assert!(message.contains("edges_assignment") && message.contains("\"C\""), "{message}");
-    assert!(message.contains("one disc") && !message.contains("single-vertex model"), "{message}");
+    assert!(
+        message.contains("edges_assignment") && message.contains("\"C\""),
+        "{message}"
+    );
+    assert!(
+        message.contains("one disc") && !message.contains("single-vertex model"),
+        "{message}"
+    );
 }
