@@ -1,7 +1,13 @@
 //! Mutated crease patterns of many vertices (numbers scaled, negated, zeroed, shifted;
-//! letters swapped) through the whole chain — read, model, check with its witness path, and
-//! the energy unfolding: every one is refused with an error or runs to a verdict with finite
-//! numbers; nothing panics. `FUZZ_CASES` sets the count (default 400).
+//! letters swapped; an isolated or duplicated vertex, a far outlier, the whole file moved
+//! or scaled to extremes, contradictory frames) through the whole chain — read, model,
+//! check with its witness path, and the energy unfolding: every one is refused with an
+//! error or runs to a verdict with finite numbers; nothing panics. A quarter of the cases
+//! only move, turn or scale the file, and must keep the original's verdict and DOF.
+//! Besides the bundled files, a 300-panel strip and a 2000-sided face are fuzzed.
+//! `FUZZ_CASES` sets the count (default 400).
+
+mod common;
 
 use nanofold::folding::{check_pattern, CheckSettings, FoldingModel};
 use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
@@ -57,14 +63,33 @@ fn mutated_crease_patterns_are_refused_or_run_without_panicking() {
         "patterns/many/strips_crossing.fold",
         "tests/fixtures/origami-simulator/simple_50.fold",
     ];
-    let originals: Vec<Value> = files
+    let mut originals: Vec<Value> = files
         .iter()
         .map(|f| serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap())
         .collect();
+    originals.push(common::strip_fold(300, 1.0, 1.0));
+    originals.push(polygon(2000));
+    let baselines: Vec<Option<(String, usize)>> = originals.iter().map(|v| verdict_of(v, 200)).collect();
     let mut seed = 12345_u64;
     let mut ran = 0;
+    let mut placed = 0;
     for case in 0..cases {
-        let mut value = originals[case % files.len()].clone();
+        let index = case % originals.len();
+        let mut value = originals[index].clone();
+        if next(&mut seed).is_multiple_of(4) {
+            // Only where the paper lies changes: the verdict must not.
+            move_whole(&mut value, &mut seed);
+            if let Some(expected) = &baselines[index] {
+                let got = verdict_of(&value, 200);
+                assert_eq!(got.as_ref(), Some(expected), "case {case}: {value}");
+                placed += 1;
+                ran += 1;
+            }
+            continue;
+        }
+        if next(&mut seed).is_multiple_of(3) {
+            reshape(&mut value, &mut seed);
+        }
         for key in [
             "vertices_coords",
             "edges_vertices",
@@ -103,4 +128,104 @@ fn mutated_crease_patterns_are_refused_or_run_without_panicking() {
     }
     // The mutations must reach the checks, not only the reader.
     assert!(ran * 5 >= cases, "only {ran} of {cases} cases ran");
+    assert!(
+        placed * 8 >= cases,
+        "only {placed} of {cases} cases compared placements"
+    );
+}
+
+/// `check`'s verdict and DOF of a FOLD object (None when refused).
+fn verdict_of(value: &Value, max_steps: usize) -> Option<(String, usize)> {
+    let pattern = nanofold::io::parse_crease_pattern(&value.to_string(), "fuzz", "fuzz").ok()?;
+    let model = FoldingModel::new(pattern).ok()?;
+    let mut settings = CheckSettings::default();
+    settings.path.max_steps = max_steps;
+    let report = check_pattern(&model, &settings).ok()?;
+    Some((format!("{:?}", report.verdict), report.rank.dof))
+}
+
+fn coords(value: &Value) -> Vec<Vec<f64>> {
+    serde_json::from_value(value["vertices_coords"].clone()).unwrap_or_default()
+}
+
+/// Moves, turns (about z) or scales the whole file, to extremes the reader admits.
+fn move_whole(value: &mut Value, seed: &mut u64) {
+    let points = coords(value);
+    let unit = |seed: &mut u64| (next(seed) % 2001) as f64 / 1000.0 - 1.0;
+    let (a, b) = (unit(seed), unit(seed));
+    let moved: Vec<Vec<f64>> = match next(seed) % 3 {
+        0 => {
+            let shift = 10f64.powi((next(seed) % 9) as i32);
+            points
+                .iter()
+                .map(|p| {
+                    p.iter()
+                        .enumerate()
+                        .map(|(k, x)| x + shift * [a, b, a * b][k])
+                        .collect()
+                })
+                .collect()
+        }
+        1 => {
+            let (c, s) = (a * std::f64::consts::PI).sin_cos();
+            points
+                .iter()
+                .map(|p| {
+                    let mut q = p.clone();
+                    q[0] = c * p[0] - s * p[1];
+                    q[1] = s * p[0] + c * p[1];
+                    q
+                })
+                .collect()
+        }
+        _ => {
+            let factor = 10f64.powi(-((next(seed) % 100) as i32));
+            points.iter().map(|p| p.iter().map(|x| x * factor).collect()).collect()
+        }
+    };
+    value["vertices_coords"] = serde_json::json!(moved);
+}
+
+/// One structural change: an isolated vertex, a vertex duplicated under an edge, a far
+/// outlier, or a second frame that contradicts the first.
+fn reshape(value: &mut Value, seed: &mut u64) {
+    let mut points = coords(value);
+    if points.is_empty() {
+        return;
+    }
+    let pick = (next(seed) as usize) % points.len();
+    match next(seed) % 4 {
+        0 => points.push(points[pick].iter().map(|x| x + 0.25).collect()),
+        1 => {
+            points.push(points[pick].clone());
+            let copy = points.len() - 1;
+            if let Some(edges) = value["edges_vertices"].as_array_mut() {
+                if let Some(edge) = edges.iter_mut().find(|e| e[0] == pick || e[1] == pick) {
+                    let slot = if edge[0] == pick { 0 } else { 1 };
+                    edge[slot] = copy.into();
+                }
+            }
+        }
+        2 => points[pick] = points[pick].iter().map(|x| x + 1e6).collect(),
+        _ => {
+            let fewer: Vec<Vec<f64>> = points.iter().skip(1).cloned().collect();
+            value["file_frames"] = serde_json::json!([{"frame_classes": ["foldedForm"], "vertices_coords": fewer}]);
+        }
+    }
+    value["vertices_coords"] = serde_json::json!(points);
+}
+
+/// A regular polygon of `sides` sides with one valley across it.
+fn polygon(sides: usize) -> Value {
+    let points: Vec<[f64; 2]> = (0..sides)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / sides as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let mut edges: Vec<[usize; 2]> = (0..sides).map(|k| [k, (k + 1) % sides]).collect();
+    let mut letters = vec!["B"; sides];
+    edges.push([0, sides / 2]);
+    letters.push("V");
+    serde_json::json!({"file_spec": 1.1, "vertices_coords": points, "edges_vertices": edges, "edges_assignment": letters})
 }

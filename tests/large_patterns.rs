@@ -4,6 +4,8 @@
 //! measuring every pair. Their times and memory at the limits are in README's Limits table
 //! (measured in release mode, not here).
 
+mod common;
+
 use nanofold::prelude::*;
 use serde_json::json;
 
@@ -36,28 +38,7 @@ fn grid(n: usize, far: Option<f64>) -> String {
 
 /// A strip of `panels` panels `width` × `height` side by side, creases alternating.
 fn strip(panels: usize, width: f64, height: f64) -> String {
-    let m = panels;
-    let mut vertices: Vec<[f64; 2]> = (0..=m).map(|i| [i as f64 * width, 0.0]).collect();
-    vertices.extend((0..=m).map(|i| [i as f64 * width, height]));
-    let (mut edges, mut letters) = (Vec::new(), Vec::new());
-    for i in 0..m {
-        edges.push([i, i + 1]);
-        letters.push("B");
-        edges.push([m + 1 + i, m + 2 + i]);
-        letters.push("B");
-    }
-    for i in 0..=m {
-        edges.push([i, m + 1 + i]);
-        letters.push(if i == 0 || i == m {
-            "B"
-        } else if i % 2 == 1 {
-            "V"
-        } else {
-            "M"
-        });
-    }
-    json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
-        .to_string()
+    common::strip_fold(panels, width, height).to_string()
 }
 
 fn check_text(text: &str) -> Report {

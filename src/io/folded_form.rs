@@ -23,8 +23,15 @@ pub struct Development {
 
 type V3 = Vector3<f64>;
 
-/// A face's unit normal (Newell's method) and an in-plane frame (e1, e2 = n × e1).
-fn face_frame(points: &[V3]) -> Option<(V3, V3, V3)> {
+/// A face's unit normal (Newell's method) and an in-plane frame (e1, e2 = n × e1), found
+/// on the corners relative to the first and divided by their spread, so that neither the
+/// face's size (1e-88 across: its products would underflow) nor its place matters.
+fn face_frame(corners: &[V3]) -> Option<(V3, V3, V3)> {
+    let spread = corners.iter().map(|p| (p - corners[0]).amax()).fold(0.0, f64::max);
+    if !(spread > 0.0 && spread.is_finite()) {
+        return None;
+    }
+    let points: Vec<V3> = corners.iter().map(|p| (p - corners[0]) / spread).collect();
     let mut normal = V3::zeros();
     for k in 0..points.len() {
         let (p, q) = (points[k], points[(k + 1) % points.len()]);

@@ -38,3 +38,27 @@ pub fn full_message(error: &dyn std::error::Error) -> String {
     }
     text
 }
+
+/// A FOLD object of a strip of `panels` panels `width` × `height` side by side, its creases
+/// alternating valley and mountain.
+pub fn strip_fold(panels: usize, width: f64, height: f64) -> serde_json::Value {
+    let m = panels;
+    let mut points: Vec<[f64; 2]> = (0..=m).map(|i| [i as f64 * width, 0.0]).collect();
+    points.extend((0..=m).map(|i| [i as f64 * width, height]));
+    let (mut edges, mut letters) = (Vec::new(), Vec::new());
+    for i in 0..m {
+        edges.extend([[i, i + 1], [m + 1 + i, m + 2 + i]]);
+        letters.extend(["B", "B"]);
+    }
+    for i in 0..=m {
+        edges.push([i, m + 1 + i]);
+        letters.push(if i == 0 || i == m {
+            "B"
+        } else if i % 2 == 1 {
+            "V"
+        } else {
+            "M"
+        });
+    }
+    serde_json::json!({"file_spec": 1.1, "vertices_coords": points, "edges_vertices": edges, "edges_assignment": letters})
+}
