@@ -173,3 +173,23 @@ fn a_cut_edge_is_refused_for_every_model() {
         "{message}"
     );
 }
+
+/// The contact test's pair budget is validated by name: none at all, or past 10⁶ per panel
+/// (a budget that large no longer bounds anything), is refused.
+#[test]
+fn a_contact_pair_budget_out_of_range_is_named() {
+    use nanofold::prelude::*;
+    let pattern = Pattern::open("patterns/many/miura_4x4.fold".as_ref(), &LoadOptions::default()).unwrap();
+    for bad in [0, 2_000_000] {
+        let mut settings = Settings::default();
+        settings.fold.contact.pairs_per_panel = bad;
+        let message = match fold(&pattern, &settings) {
+            Ok(_) => panic!("a budget of {bad} pairs per panel was taken"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            message.contains("pairs_per_panel") && message.contains(&bad.to_string()),
+            "{message}"
+        );
+    }
+}

@@ -27,6 +27,27 @@ pub struct ClosureJacobian {
 }
 
 impl ClosureJacobian {
+    /// The Jacobian over the columns where `keep` is true, in their order (none held).
+    pub fn columns(&self, keep: &[bool]) -> ClosureJacobian {
+        let mut position = vec![usize::MAX; self.cols];
+        for (k, c) in (0..self.cols).filter(|&c| keep[c]).enumerate() {
+            position[c] = k;
+        }
+        ClosureJacobian {
+            residual: self.residual.clone(),
+            rows: self.rows,
+            cols: keep.iter().filter(|&&k| k).count(),
+            entries: self
+                .entries
+                .iter()
+                .filter(|e| keep[e.1])
+                .map(|&(r, c, v)| (r, position[c], v))
+                .collect(),
+            held: 0,
+            angle_precision: self.angle_precision,
+        }
+    }
+
     /// The Jacobian as a faer sparse matrix (duplicate entries summed).
     pub fn to_sparse(&self) -> SparseColMat<usize, f64> {
         let triplets: Vec<Triplet<usize, usize, f64>> =

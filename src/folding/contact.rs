@@ -216,13 +216,6 @@ pub(crate) fn placement_spread(model: &FoldingModel, poses: &[Pose]) -> f64 {
     spread
 }
 
-/// Pairs of boxes that overlap, smaller index first, each once
-/// ([`crate::geometry::broad_phase`]: a grid sized from the boxes themselves, long boxes
-/// swept), so a 50 000-panel strip costs about what a square sheet of as many panels does.
-pub(crate) fn candidate_pairs(boxes: &[([f64; 3], [f64; 3])]) -> Vec<(usize, usize)> {
-    crate::geometry::broad_phase::overlapping_pairs(boxes)
-}
-
 /// The median over panels of their flat bounding boxes' smaller side.
 fn median_panel_width(model: &FoldingModel) -> f64 {
     median_panel_side(model, f64::min)

@@ -71,8 +71,8 @@ impl FoldingModel {
     /// The least depth by which two panels must pass through each other to cross (shallower
     /// is touching), in the pattern's length unit: 1e-12 of its size, or where its
     /// coordinates hold fewer digits, its angle precision over the lever of its size (layers
-    /// folded flat tilt by that much from rounding alone). A contact test may ask for more
-    /// ([`super::ContactSettings::crossing_depth`]).
+    /// folded flat tilt by that much from rounding alone). A contact test asks for more
+    /// where the state's own placement spread is larger (`docs/model.md#panel-contact`).
     pub fn contact_tolerance(&self) -> f64 {
         (1e-12 * self.size).max(self.pattern.angle_precision * self.size)
     }

@@ -50,7 +50,7 @@ pub enum RankMethod {
     /// Column-pivoted QR of the dense J (threshold [`rank_tolerance`] on |R_ii|/|R_00|).
     PivotedQr,
     /// The smallest singular values of J by subspace iteration on (JᵀJ + μI)⁻¹ (threshold
-    /// [`RANK_TOL`] on σ / largest column norm).
+    /// [`rank_tolerance`] on σ / largest column norm).
     SubspaceIteration,
 }
 
@@ -97,24 +97,7 @@ pub fn jacobian_rank(jacobian: &ClosureJacobian) -> Result<RankReport> {
     if free == 0 {
         return ranked(jacobian);
     }
-    let mut position = vec![usize::MAX; jacobian.cols];
-    for (k, c) in (0..jacobian.cols).filter(|&c| tied[c]).enumerate() {
-        position[c] = k;
-    }
-    let reduced = ClosureJacobian {
-        residual: jacobian.residual.clone(),
-        rows: jacobian.rows,
-        cols: jacobian.cols - free,
-        entries: jacobian
-            .entries
-            .iter()
-            .filter(|e| tied[e.1])
-            .map(|&(r, c, v)| (r, position[c], v))
-            .collect(),
-        held: 0,
-        angle_precision: jacobian.angle_precision,
-    };
-    let mut report = ranked(&reduced)?;
+    let mut report = ranked(&jacobian.columns(&tied))?;
     // Locked columns are among the untied ones, and are no motion.
     report.dof += free - jacobian.held;
     Ok(report)

@@ -35,7 +35,7 @@ pub fn overlapping_pairs_within<const D: usize>(
     // when the cell is about their width); boxes that then span many cells are swept.
     let mut cell = cell_size(boxes);
     let mut budget = Budget::new(limit);
-    let ((large, ranges), cells) = loop {
+    let (large, ranges, cells) = loop {
         // Cell indices stay far inside i64 whatever the ratio of extent to cell.
         let index = |x: f64, k: usize| ((x - lo[k]) / cell).floor().clamp(0.0, 4.0e18) as i64;
         let ranges: Vec<[(i64, i64); D]> = boxes
@@ -49,7 +49,7 @@ pub fn overlapping_pairs_within<const D: usize>(
         let cells = hashed(&ranges, &large);
         let work: usize = cells.values().map(|list| list.len() * list.len()).sum();
         if work <= WORK_PER_BOX * boxes.len() || cell <= f64::MIN_POSITIVE * 1e6 {
-            break ((large, ranges), cells);
+            break (large, ranges, cells);
         }
         cell /= 4.0;
     };
@@ -76,6 +76,15 @@ const COMPARISONS_PER_PAIR: usize = 64;
 impl Budget {
     fn new(limit: usize) -> Budget {
         Budget { limit, compared: 0 }
+    }
+
+    /// Adds a pair, or says the limit is passed.
+    fn push(&self, pairs: &mut Vec<(usize, usize)>, a: usize, b: usize) -> std::result::Result<(), usize> {
+        if pairs.len() >= self.limit {
+            return Err(self.limit.saturating_add(1));
+        }
+        pairs.push((a.min(b), a.max(b)));
+        Ok(())
     }
 
     /// One more comparison, or the limit passed.
@@ -110,15 +119,6 @@ fn hashed<const D: usize>(ranges: &[[(i64, i64); D]], large: &[bool]) -> HashMap
         }
     }
     cells
-}
-
-/// Adds a pair, or says the limit is passed.
-fn push(pairs: &mut Vec<(usize, usize)>, a: usize, b: usize, budget: &Budget) -> std::result::Result<(), usize> {
-    if pairs.len() >= budget.limit {
-        return Err(budget.limit.saturating_add(1));
-    }
-    pairs.push((a.min(b), a.max(b)));
-    Ok(())
 }
 
 /// The median of the boxes' largest sides, or where most boxes are points, the extent
@@ -158,7 +158,7 @@ fn grid_pairs<const D: usize>(
                 budget.compare()?;
                 let first: [i64; D] = std::array::from_fn(|k| ranges[a][k].0.max(ranges[b][k].0));
                 if &first == at && overlap(&boxes[a], &boxes[b]) {
-                    push(pairs, a, b, budget)?;
+                    budget.push(pairs, a, b)?;
                 }
             }
         }
@@ -194,7 +194,7 @@ fn swept_pairs<const D: usize>(
         for &a in &active_large {
             budget.compare()?;
             if overlap(&boxes[a], &boxes[b]) {
-                push(pairs, a, b, budget)?;
+                budget.push(pairs, a, b)?;
             }
         }
         if large[b] {
@@ -203,7 +203,7 @@ fn swept_pairs<const D: usize>(
             for &a in &active_small {
                 budget.compare()?;
                 if overlap(&boxes[a], &boxes[b]) {
-                    push(pairs, a, b, budget)?;
+                    budget.push(pairs, a, b)?;
                 }
             }
             active_large.push(b);

@@ -4,8 +4,9 @@
 //! the activation distance d̂, with its gradient in fold angles through the panels' poses.
 
 use crate::error::{NanofoldError, Result};
-use crate::folding::contact::{candidate_pairs, closest_point_on_triangle, median_panel_size, share_vertex};
+use crate::folding::contact::{closest_point_on_triangle, median_panel_size, share_vertex};
 use crate::folding::{FoldingModel, Pose};
+use crate::geometry::broad_phase::overlapping_pairs;
 use nalgebra::Vector3;
 
 type Point = Vector3<f64>;
@@ -168,7 +169,7 @@ impl PanelBarrier {
             })
             .collect();
         let mut total = 0.0;
-        for (a, b) in candidate_pairs(&boxes) {
+        for (a, b) in overlapping_pairs(&boxes) {
             if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) || self.excluded.contains(&(a, b)) {
                 continue;
             }

@@ -15,7 +15,7 @@ use super::model::NetworkModel;
 use crate::dynamics::modes::{generalized_modes, Modes};
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::folding::normal::NormalSolver;
-use crate::folding::{closure_jacobian, null_space, restore_closure, vertex_residuals, ClosureJacobian};
+use crate::folding::{closure_jacobian, null_space, restore_closure, vertex_residuals};
 use nalgebra::{DMatrix, DVector};
 
 /// Closure tolerance of every projected state, rad per vertex.
@@ -60,24 +60,8 @@ pub fn worst_residual(model: &NetworkModel, angles: &[f64]) -> f64 {
 pub fn tangent_basis(model: &NetworkModel, angles: &[f64]) -> Result<DMatrix<f64>> {
     let full = closure_jacobian(&model.folding, angles);
     let free: Vec<usize> = (0..model.columns()).filter(|&c| !model.locked(c)).collect();
-    let mut position = vec![usize::MAX; model.columns()];
-    for (k, &c) in free.iter().enumerate() {
-        position[c] = k;
-    }
-    let reduced = ClosureJacobian {
-        residual: full.residual.clone(),
-        rows: full.rows,
-        cols: free.len(),
-        entries: full
-            .entries
-            .iter()
-            .filter(|&&(_, c, _)| position[c] != usize::MAX)
-            .map(|&(r, c, v)| (r, position[c], v))
-            .collect(),
-        held: 0,
-        angle_precision: full.angle_precision,
-    };
-    let basis = null_space(&reduced)?;
+    let keep: Vec<bool> = (0..model.columns()).map(|c| !model.locked(c)).collect();
+    let basis = null_space(&full.columns(&keep))?;
     let mut z = DMatrix::zeros(model.columns(), basis.ncols());
     for (k, &c) in free.iter().enumerate() {
         for j in 0..basis.ncols() {
