@@ -9,6 +9,7 @@ pub mod normal;
 pub mod path;
 pub mod poses;
 pub mod rank;
+pub mod reduction;
 pub mod simd_state;
 pub mod verdict;
 

@@ -1288,3 +1288,141 @@ fn the_smallest_panel_clearance_matches_a_brute_force_search() {
     }
     assert!(checked >= 3, "{checked} states compared");
 }
+
+/// A grid of n × n squares (horizontal creases valleys, vertical mountains), each interior
+/// vertex moved by up to `jitter` (a seeded sequence) so its lines are not straight.
+fn grid_model(n: usize, jitter: f64) -> FoldingModel {
+    let index = |i: usize, j: usize| j * (n + 1) + i;
+    let mut seed: u64 = 0x2545_F491_4F6C_DD1D;
+    let mut noise = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut vertices = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let inside = i > 0 && i < n && j > 0 && j < n;
+            let (dx, dy) = if inside {
+                (jitter * noise(), jitter * noise())
+            } else {
+                (0.0, 0.0)
+            };
+            vertices.push([i as f64 + dx, j as f64 + dy]);
+        }
+    }
+    let mut edges = Vec::new();
+    let mut letters = Vec::new();
+    for j in 0..=n {
+        for i in 0..n {
+            edges.push([index(i, j), index(i + 1, j)]);
+            letters.push(if j == 0 || j == n { "B" } else { "V" });
+        }
+    }
+    for i in 0..=n {
+        for j in 0..n {
+            edges.push([index(i, j), index(i, j + 1)]);
+            letters.push(if i == 0 || i == n { "B" } else { "M" });
+        }
+    }
+    let text = serde_json::json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges,
+        "edges_assignment": letters})
+    .to_string();
+    let file = nanofold::io::parse_crease_pattern(&text, "grid", "grid").unwrap();
+    FoldingModel::new(file).unwrap()
+}
+
+/// The exact reductions before the rank count (ties merged, rows held by one crease
+/// eliminated) leave the count the SVD of the whole J gives, flat and folded, on straight
+/// lines (where they remove nearly everything) and on jittered ones (where a tie must not
+/// be taken for one).
+#[test]
+fn the_reduced_rank_count_is_the_svds_count() {
+    use nanofold::folding::RANK_TOL;
+    let mut cases: Vec<(String, FoldingModel, Vec<f64>)> = Vec::new();
+    for (n, zigzag) in [(6, 0.0), (8, 30.0), (10, 1e-6), (10, 5e-6), (12, 120.0), (7, 179.0)] {
+        let model = miura(n, n, 60.0, zigzag);
+        let rho = model.given_fold_angles();
+        cases.push((format!("miura {n} at {zigzag}°"), model, rho));
+    }
+    for (n, jitter) in [(6, 0.0), (9, 0.0), (6, 1e-3), (6, 1e-12), (8, 0.2)] {
+        let model = grid_model(n, jitter);
+        let rho = model.given_fold_angles();
+        cases.push((format!("grid {n} jitter {jitter}"), model, rho));
+    }
+    for name in ["square_twist", "waterbomb_4x3", "strips_crossing", "bird_base"] {
+        let path = Path::new("patterns/many").join(format!("{name}.fold"));
+        let Ok(pattern) = nanofold::io::load_crease_pattern(&path) else {
+            continue;
+        };
+        let model = FoldingModel::new(pattern).unwrap();
+        let rho = model.given_fold_angles();
+        // Flat, and part-way along its assignment's path where there is one.
+        let settings = nanofold::folding::FoldSettings {
+            drive: nanofold::folding::Drive::Assignment { to: 0.3 },
+            ..Default::default()
+        };
+        if let Ok(path) = nanofold::folding::fold_path(&model, &rho, &settings) {
+            let folded = path.steps.last().unwrap().fold_angles.clone();
+            cases.push((format!("{name} folded"), model.clone(), folded));
+        }
+        cases.push((name.into(), model, rho));
+    }
+    let mut reduced_somewhere = 0;
+    for (name, model, rho) in cases {
+        let jac = closure_jacobian(&model, &rho);
+        let mut dense = nalgebra::DMatrix::<f64>::zeros(jac.rows, jac.cols);
+        for &(r, c, v) in &jac.entries {
+            dense[(r, c)] += v;
+        }
+        let largest_column = (0..jac.cols).map(|c| dense.column(c).norm()).fold(0.0, f64::max);
+        let singular = if jac.rows == 0 {
+            nalgebra::DVector::zeros(0)
+        } else {
+            dense.singular_values()
+        };
+        let threshold = RANK_TOL * largest_column;
+        let svd_rank = singular.iter().filter(|&&s| s > threshold).count();
+        let report = jacobian_rank(&jac).unwrap();
+        assert_eq!(report.dof, jac.cols - jac.held - report.rank, "{name}: {report:?}");
+        // Within a decade of the threshold the count depends on the method (the pivoted
+        // QR's |R_ii| overestimate small singular values): there it must be the SVD's or
+        // the unreduced QR's.
+        let clear = singular.iter().all(|&s| s < 0.1 * threshold || s > 10.0 * threshold);
+        if clear {
+            assert_eq!(report.rank, svd_rank, "{name}: {report:?}");
+        } else {
+            let qr_rank = nanofold::folding::jacobian_rank_dense(&jac).rank;
+            assert!(
+                report.rank == svd_rank || report.rank == qr_rank,
+                "{name}: {report:?}, SVD {svd_rank}, QR {qr_rank}"
+            );
+        }
+        reduced_somewhere += usize::from(report.reduced > 0);
+    }
+    assert!(
+        reduced_somewhere >= 10,
+        "the reductions removed creases in {reduced_somewhere} cases"
+    );
+}
+
+/// At the flat state every straight crease line of a grid, and every straight and zigzag
+/// line of a Miura-ori, is a first-order motion of its own: 2 (n − 1) DOF, as many as
+/// creases − 2 · interior vertices for any flat sheet of degree-4 vertices. The reductions
+/// find them without a subspace iteration whose block would grow with the count.
+#[test]
+fn flat_sheets_with_hundreds_of_dof_are_counted_by_the_reductions() {
+    // Jittered, no line is straight and nothing is tied: the creases at the boundary are
+    // eliminated star by star, inwards.
+    for (n, jitter) in [(60, 0.0), (150, 0.0), (150, 1e-3)] {
+        let model = grid_model(n, jitter);
+        let report = jacobian_rank(&closure_jacobian(&model, &model.given_fold_angles())).unwrap();
+        assert_eq!(report.dof, 2 * (n - 1), "grid {n} jitter {jitter}: {report:?}");
+        assert!(report.reduced > model.crease_count() / 2, "{report:?}");
+    }
+    let model = miura(100, 100, 60.0, 0.0);
+    let report = jacobian_rank(&closure_jacobian(&model, &model.given_fold_angles())).unwrap();
+    assert_eq!(report.dof, 2 * 99, "miura 100: {report:?}");
+    assert!(report.reduced > model.crease_count() / 2, "{report:?}");
+}

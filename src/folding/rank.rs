@@ -1,10 +1,12 @@
 //! Rank of the closure Jacobian and the degrees of freedom at a state
-//! (`docs/model.md#rigid-folding`): faer's column-pivoted QR up to [`DENSE_RANK_LIMIT`]
-//! creases, above it a count of J's null space by subspace iteration on (JᵀJ + μI)⁻¹ with
+//! (`docs/model.md#rigid-folding`): after the exact reductions of
+//! [`reduce`](super::reduction::reduce), faer's column-pivoted QR up to [`DENSE_RANK_LIMIT`]
+//! columns, above it a count of J's null space by subspace iteration on (JᵀJ + μI)⁻¹ with
 //! a sparse Cholesky factorisation.
 
 use super::closure::ClosureJacobian;
 use super::normal::NormalSolver;
+use super::reduction::reduce;
 use super::simd_state::clear_upper_vector_state;
 use crate::error::{NumericalError, Result};
 use faer::diag::Diag;
@@ -77,37 +79,61 @@ pub struct RankReport {
     pub smallest_kept: f64,
     /// Largest value counted as zero (0 when there is none).
     pub largest_dropped: f64,
-    /// Which method.
+    /// Which method counted what the exact reductions left.
     pub method: RankMethod,
+    /// Creases the exact reductions ([`reduce`]) merged or eliminated before the count.
+    pub reduced: usize,
 }
 
-/// Rank and degrees of freedom of J: dense pivoted QR for up to [`DENSE_RANK_LIMIT`]
-/// creases, the sparse null-space count above.
+/// Rank and degrees of freedom of J: creases no star ties counted at once, the rest reduced
+/// exactly ([`reduce`]: ties merged, rows held by one crease eliminated), and what remains
+/// counted by the dense pivoted QR up to [`DENSE_RANK_LIMIT`] columns, the sparse null-space
+/// count above.
 pub fn jacobian_rank(jacobian: &ClosureJacobian) -> Result<RankReport> {
     // A column without a non-zero entry (a crease that meets no interior vertex, as in a
     // strip of parallel creases, or a locked one) is a null direction by itself: counted
     // here, so the rank count only sees the creases the closures tie together.
     let mut tied = vec![false; jacobian.cols];
+    let mut column_norm = vec![0.0_f64; jacobian.cols];
     for &(_, c, v) in &jacobian.entries {
         if v != 0.0 {
             tied[c] = true;
+            column_norm[c] += v * v;
         }
     }
     let free = tied.iter().filter(|&&t| !t).count();
-    if free == 0 {
-        return ranked(jacobian);
-    }
-    let mut report = ranked(&jacobian.columns(&tied))?;
+    let scale = column_norm.iter().fold(0.0_f64, |a, &b| a.max(b)).sqrt();
+    let reduction = reduce(&jacobian.columns(&tied), rank_tolerance(jacobian), scale);
+    let mut report = if reduction.remainder.cols == 0 {
+        // Nothing left to count: the threshold is still the one the reductions applied.
+        RankReport {
+            rank: 0,
+            dof: 0,
+            threshold: rank_tolerance(jacobian) * scale,
+            smallest_kept: f64::INFINITY,
+            largest_dropped: 0.0,
+            method: RankMethod::PivotedQr,
+            reduced: 0,
+        }
+    } else {
+        ranked(&reduction.remainder, scale)?
+    };
     // Locked columns are among the untied ones, and are no motion.
-    report.dof += free - jacobian.held;
+    report.dof += reduction.free_columns + free - jacobian.held;
+    report.rank = jacobian.cols - jacobian.held - report.dof;
+    report.reduced = reduction.removed_columns;
     Ok(report)
 }
 
-fn ranked(jacobian: &ClosureJacobian) -> Result<RankReport> {
+/// The rank count of what the reductions left, its threshold relative to `scale` (the
+/// largest column norm of the J they started from).
+fn ranked(jacobian: &ClosureJacobian, scale: f64) -> Result<RankReport> {
     if jacobian.cols <= DENSE_RANK_LIMIT {
-        Ok(jacobian_rank_dense(jacobian))
+        Ok(dense_rank(jacobian, Some(scale)))
     } else {
-        jacobian_rank_sparse(jacobian)
+        let report = settled_block(jacobian, Some(scale * scale))?.report(jacobian);
+        clear_upper_vector_state();
+        Ok(report)
     }
 }
 
@@ -115,6 +141,11 @@ fn ranked(jacobian: &ClosureJacobian) -> Result<RankReport> {
 /// counted. The gap between `smallest_kept` and `largest_dropped` says how clear-cut the
 /// count is.
 pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
+    dense_rank(jacobian, None)
+}
+
+/// The pivoted QR's count, its threshold relative to `scale` or else to |R_00|.
+fn dense_rank(jacobian: &ClosureJacobian, scale: Option<f64>) -> RankReport {
     let (rows, cols) = (jacobian.rows, jacobian.cols);
     // Nothing free (no rows, no columns, or every column held): rank 0, and no threshold is
     // needed (a QR of the zero matrix gives NaN).
@@ -127,13 +158,14 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
             smallest_kept: f64::INFINITY,
             largest_dropped: 0.0,
             method: RankMethod::PivotedQr,
+            reduced: 0,
         };
     }
     let dense = jacobian.to_sparse().to_dense();
     let qr = dense.col_piv_qr();
     let r = qr.thin_R();
     let diagonal: Vec<f64> = (0..rows.min(cols)).map(|i| r[(i, i)].abs()).collect();
-    let threshold = rank_tolerance(jacobian) * diagonal[0];
+    let threshold = rank_tolerance(jacobian) * scale.unwrap_or(diagonal[0]);
     let rank = diagonal.iter().take_while(|&&d| d > threshold && d > 0.0).count();
     clear_upper_vector_state();
     RankReport {
@@ -143,6 +175,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
         smallest_kept: if rank > 0 { diagonal[rank - 1] } else { f64::INFINITY },
         largest_dropped: diagonal.get(rank).copied().unwrap_or(0.0),
         method: RankMethod::PivotedQr,
+        reduced: 0,
     }
 }
 
@@ -154,7 +187,7 @@ pub fn jacobian_rank_dense(jacobian: &ClosureJacobian) -> RankReport {
 /// shifted inverse cannot separate (10³ μ), so the count is complete once the
 /// next Ritz value is above the threshold (`docs/model.md#rigid-folding`).
 pub fn jacobian_rank_sparse(jacobian: &ClosureJacobian) -> Result<RankReport> {
-    let report = settled_block(jacobian)?.report(jacobian);
+    let report = settled_block(jacobian, None)?.report(jacobian);
     clear_upper_vector_state();
     Ok(report)
 }
@@ -184,17 +217,20 @@ impl SettledBlock {
             smallest_kept: self.ritz.get(count).map_or(f64::INFINITY, |&l| sigma(l)),
             largest_dropped: if count > 0 { sigma(self.ritz[count - 1]) } else { 0.0 },
             method: RankMethod::SubspaceIteration,
+            reduced: 0,
         }
     }
 }
 
-fn settled_block(jacobian: &ClosureJacobian) -> Result<SettledBlock> {
+/// `reference`: the squared column norm the threshold is relative to (else JᵀJ's largest
+/// diagonal).
+fn settled_block(jacobian: &ClosureJacobian, reference: Option<f64>) -> Result<SettledBlock> {
     let n = jacobian.cols;
     let mut solver = NormalSolver::new(COUNT_REGULARISATION);
     let factor = solver.factor(jacobian)?;
-    let scale = factor.max_diagonal;
+    let scale = reference.unwrap_or(factor.max_diagonal);
     let threshold_lambda = rank_tolerance(jacobian) * rank_tolerance(jacobian) * scale;
-    let cluster_lambda = CLUSTER_LEVEL * COUNT_REGULARISATION * scale;
+    let cluster_lambda = CLUSTER_LEVEL * COUNT_REGULARISATION * factor.max_diagonal;
     let mut block = 8.min(n);
     // A fixed pseudo-random start (the count must not depend on the run). A doubled block
     // keeps the null directions already found and adds fresh columns.
@@ -247,7 +283,7 @@ pub fn null_space(jacobian: &ClosureJacobian) -> Result<Mat<f64>> {
         let basis = Mat::<f64>::from_fn(cols, null.len(), |i, k| v[(i, null[k])]);
         (basis, null.len())
     } else {
-        let settled = settled_block(jacobian)?;
+        let settled = settled_block(jacobian, None)?;
         let count = settled.count();
         // Rotate the block onto the right singular vectors of JX, smallest first.
         let jx = apply_to_columns(jacobian, &settled.x);
