@@ -2,6 +2,8 @@
 //! the single-vertex engine, finite differences, an SVD, the Miura-ori's closed form and
 //! hand-computed panel geometry.
 
+mod common;
+
 use nanofold::folding::{
     closure_jacobian, jacobian_rank, panel_contacts, panel_poses, tree_mismatch, vertex_positions, vertex_residuals,
     ContactSettings, FoldingModel,
@@ -1289,48 +1291,10 @@ fn the_smallest_panel_clearance_matches_a_brute_force_search() {
     assert!(checked >= 3, "{checked} states compared");
 }
 
-/// A grid of n × n squares (horizontal creases valleys, vertical mountains), each interior
-/// vertex moved by up to `jitter` (a seeded sequence) so its lines are not straight.
+/// The grid of `common::grid_fold` as a folding model.
 fn grid_model(n: usize, jitter: f64) -> FoldingModel {
-    let index = |i: usize, j: usize| j * (n + 1) + i;
-    let mut seed: u64 = 0x2545_F491_4F6C_DD1D;
-    let mut noise = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let mut vertices = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let inside = i > 0 && i < n && j > 0 && j < n;
-            let (dx, dy) = if inside {
-                (jitter * noise(), jitter * noise())
-            } else {
-                (0.0, 0.0)
-            };
-            vertices.push([i as f64 + dx, j as f64 + dy]);
-        }
-    }
-    let mut edges = Vec::new();
-    let mut letters = Vec::new();
-    for j in 0..=n {
-        for i in 0..n {
-            edges.push([index(i, j), index(i + 1, j)]);
-            letters.push(if j == 0 || j == n { "B" } else { "V" });
-        }
-    }
-    for i in 0..=n {
-        for j in 0..n {
-            edges.push([index(i, j), index(i, j + 1)]);
-            letters.push(if i == 0 || i == n { "B" } else { "M" });
-        }
-    }
-    let text = serde_json::json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges,
-        "edges_assignment": letters})
-    .to_string();
-    let file = nanofold::io::parse_crease_pattern(&text, "grid", "grid").unwrap();
-    FoldingModel::new(file).unwrap()
+    let text = common::grid_fold(n, jitter, None).to_string();
+    FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "grid", "grid").unwrap()).unwrap()
 }
 
 /// The exact reductions before the rank count (ties merged, rows held by one crease

@@ -7,33 +7,11 @@
 mod common;
 
 use nanofold::prelude::*;
-use serde_json::json;
 
-/// A grid of n × n unit squares, horizontal creases valleys and vertical ones mountains;
-/// with `far`, its last corner moved to (far, far).
+/// A grid of n × n unit squares (`common::grid_fold`); with `far`, its last corner moved
+/// to (far, far).
 fn grid(n: usize, far: Option<f64>) -> String {
-    let index = |i: usize, j: usize| j * (n + 1) + i;
-    let mut vertices: Vec<[f64; 2]> = (0..=n)
-        .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64]))
-        .collect();
-    let (mut edges, mut letters) = (Vec::new(), Vec::new());
-    for j in 0..=n {
-        for i in 0..n {
-            edges.push([index(i, j), index(i + 1, j)]);
-            letters.push(if j == 0 || j == n { "B" } else { "V" });
-        }
-    }
-    for i in 0..=n {
-        for j in 0..n {
-            edges.push([index(i, j), index(i, j + 1)]);
-            letters.push(if i == 0 || i == n { "B" } else { "M" });
-        }
-    }
-    if let Some(far) = far {
-        vertices[index(n, n)] = [far, far];
-    }
-    json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
-        .to_string()
+    common::grid_fold(n, 0.0, far).to_string()
 }
 
 /// A strip of `panels` panels `width` × `height` side by side, creases alternating.

@@ -781,3 +781,37 @@ fn fitted_curves_are_refused_where_they_cannot_hold() {
         full_message(&left)
     );
 }
+
+/// An accordion of 460 thin panels folded to ±179.9°: every pair of panels overlaps in the
+/// contact test's range, more than its budget (10⁵ pairs). The run stops at once with a
+/// contact named for the budget instead of measuring every pair.
+#[test]
+fn layers_stacked_past_the_contact_budget_stop_the_run() {
+    let mut fold = common::strip_fold(460, 0.02, 1.0);
+    let angles: Vec<f64> = fold["edges_assignment"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| match a.as_str() {
+            Some("V") => 179.9,
+            Some("M") => -179.9,
+            _ => 0.0,
+        })
+        .collect();
+    fold["edges_foldAngle"] = serde_json::json!(angles);
+    let dir = std::env::temp_dir().join(format!("nanofold-budget-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("accordion.fold"), fold.to_string()).unwrap();
+    let text = std::fs::read_to_string("patterns/devices/miura_sheet.scene.json")
+        .unwrap()
+        .replace("../many/miura_4x4.fold", "accordion.fold");
+    let scene = nanofold::io::parse_scene(&text, "accordion", "accordion", &dir)
+        .and_then(|s| s.build())
+        .unwrap();
+    let simulation = run(&scene, 1e-8, 1e-6);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let collision = simulation.response.collision.expect("the budget stops the run");
+    assert_eq!(collision.time, 0.0);
+    assert!(collision.pair[0].contains("contact budget"), "{:?}", collision.pair);
+    assert!(collision.pair[1].contains("not decided"), "{:?}", collision.pair);
+}

@@ -62,3 +62,46 @@ pub fn strip_fold(panels: usize, width: f64, height: f64) -> serde_json::Value {
     }
     serde_json::json!({"file_spec": 1.1, "vertices_coords": points, "edges_vertices": edges, "edges_assignment": letters})
 }
+
+/// A FOLD object of a grid of n × n unit squares, horizontal creases valleys and vertical
+/// ones mountains; each interior vertex moved by up to ±`jitter`/2 (a seeded sequence), and
+/// with `far` the last corner moved to (far, far).
+pub fn grid_fold(n: usize, jitter: f64, far: Option<f64>) -> serde_json::Value {
+    let index = |i: usize, j: usize| j * (n + 1) + i;
+    let mut seed: u64 = 0x2545_F491_4F6C_DD1D;
+    let mut noise = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut vertices = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let inside = i > 0 && i < n && j > 0 && j < n;
+            let (dx, dy) = if inside && jitter > 0.0 {
+                (jitter * noise(), jitter * noise())
+            } else {
+                (0.0, 0.0)
+            };
+            vertices.push([i as f64 + dx, j as f64 + dy]);
+        }
+    }
+    let (mut edges, mut letters) = (Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..n {
+            edges.push([index(i, j), index(i + 1, j)]);
+            letters.push(if j == 0 || j == n { "B" } else { "V" });
+        }
+    }
+    for i in 0..=n {
+        for j in 0..n {
+            edges.push([index(i, j), index(i, j + 1)]);
+            letters.push(if i == 0 || i == n { "B" } else { "M" });
+        }
+    }
+    if let Some(far) = far {
+        vertices[index(n, n)] = [far, far];
+    }
+    serde_json::json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
+}

@@ -146,11 +146,10 @@ impl NetworkContacts {
         let mut contacts = NetworkContacts {
             candidates,
             outline,
-            // A device's run is bounded by the integrator's step budget; its contact test is
-            // not cut short (a skipped test would miss a contact).
+            // Past the pair budget a test is not decided: the run stops there and says so
+            // (a contact event named for the budget), rather than measuring every pair.
             settings: ContactSettings {
                 search: 0.5,
-                pairs_per_panel: 1_000_000,
                 ..ContactSettings::default()
             },
             dropped: Vec::new(),
@@ -214,6 +213,12 @@ impl NetworkContacts {
                         ..self.settings
                     };
                     let report = panel_contacts(&model.folding, &self.poses(model, data), &wide);
+                    if let Some(found) = report.overflow {
+                        pairs.push([
+                            format!("contact budget: more than {found} pairs of panels overlap"),
+                            "whether panels cross was not decided".to_string(),
+                        ]);
+                    }
                     for contact in &report.contacts {
                         pairs.push([
                             Self::face_name(model, contact.panels[0]),
@@ -278,7 +283,7 @@ impl NetworkContacts {
             Candidate::Panels => {
                 let Some(report) = report else { return f64::INFINITY };
                 let clearance = self.settings.clearance * model.folding.size;
-                if report.crossing().next().is_some() {
+                if report.crossing().next().is_some() || report.overflow.is_some() {
                     -clearance.max(f64::MIN_POSITIVE)
                 } else {
                     report
@@ -353,6 +358,20 @@ impl NetworkContacts {
                         ),
                     ],
                     point: self.world_vertex(model, *vertex, panel, data),
+                }
+            }
+            Candidate::Panels if report.is_some_and(|r| r.overflow.is_some()) => {
+                let found = report.and_then(|r| r.overflow).unwrap_or(0);
+                Collision {
+                    time: t,
+                    pair: [
+                        format!(
+                            "the contact budget ({} pairs of panels measured at most)",
+                            self.settings.pair_budget(model.panels())
+                        ),
+                        format!("more than {found} overlapping pairs (layers stacked deep; whether panels cross was not decided)"),
+                    ],
+                    point: data.translation[model.anchored_panel],
                 }
             }
             Candidate::Panels => {
