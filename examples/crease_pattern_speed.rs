@@ -112,7 +112,7 @@ fn main() {
         }
     }
     println!();
-    println!("Folding the flat Miura-ori to 95% (max step 0.05 rad); best of 3 runs");
+    println!("Folding the flat Miura-ori to 95% (continuation, steps at most 15°); best of 3 runs");
     println!(
         "{:>4} {:>7} {:>9} {:>6} {:>7} {:>12} {:>12}",
         "n", "creases", "seconds", "steps", "newton", "residual", "clearance"

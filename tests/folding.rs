@@ -1072,12 +1072,15 @@ fn the_bird_base_folds_with_the_flat_foldable_vertex_closed_form() {
         }
     }
     assert_eq!(petals, 4);
-    // And it reaches the flat-folded base: every crease at ±π in the last frame.
+    // And it reaches the flat-folded base: every crease at ±π in the last frame. The path
+    // stops when the most folded crease is within 1e-9·π of π; at a flat-folded state the
+    // others follow on square-root branches, so they lag by at most about √(1e-9·π).
     let last = witness.steps.last().unwrap();
     assert!(last.progress > 0.999, "{}", last.progress);
+    let lag = (1e-9 * std::f64::consts::PI).sqrt();
     for (column, angle) in last.fold_angles.iter().enumerate() {
         assert!(
-            (angle.abs() - std::f64::consts::PI).abs() < 1e-6,
+            (angle.abs() - std::f64::consts::PI).abs() < lag,
             "crease {column}: {angle}"
         );
     }

@@ -99,12 +99,13 @@ fn layers_stacked_deep_stop_at_the_contact_budget() {
     assert!(path.evidence.contains("192000"), "{}", path.evidence);
     let reached = path.steps.last().unwrap();
     assert!(reached.progress > 0.9 && reached.progress < 1.0);
-    // The next state's contact test overflows; the last kept state's does not.
+    // The next state's contact test overflows; the last kept state's (with the path's own
+    // contact settings) does not.
     let pattern = Pattern::parse(&text, "strip", "strip", &LoadOptions::default()).unwrap();
     let model = pattern.sheet().unwrap();
     let mut poses = Vec::new();
     nanofold::folding::panel_poses(model, &reached.fold_angles, &mut poses);
-    let settings = nanofold::folding::ContactSettings::default();
+    let settings = nanofold::folding::FoldSettings::default().contact;
     assert_eq!(
         nanofold::folding::panel_contacts(model, &poses, &settings).overflow,
         None
@@ -112,7 +113,7 @@ fn layers_stacked_deep_stop_at_the_contact_budget() {
     let folded: Vec<f64> = reached
         .fold_angles
         .iter()
-        .map(|r| r.signum() * 0.999 * std::f64::consts::PI)
+        .map(|r| r.signum() * (1.0 - 1e-6) * std::f64::consts::PI)
         .collect();
     nanofold::folding::panel_poses(model, &folded, &mut poses);
     assert_eq!(

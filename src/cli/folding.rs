@@ -29,8 +29,9 @@ pub struct FoldArgs {
     /// Number of snapshots written as FOLD frames (start and end included).
     #[arg(long, default_value_t = 11, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1000))]
     pub frames: usize,
-    /// Largest change of any fold angle in one step (degrees; 5.7e-5 to 28.6).
-    #[arg(long, default_value_t = 2.5)]
+    /// Largest change of any fold angle in one step (degrees; 5.7e-5 to 28.6): a cap, the
+    /// step control chooses each step below it.
+    #[arg(long, default_value_t = 15.0)]
     pub max_step: f64,
     /// Output folder (default: output/<pattern name>/).
     #[arg(long)]

@@ -46,8 +46,9 @@ impl Default for FoldSettings {
     fn default() -> Self {
         FoldSettings {
             drive: Drive::Assignment { to: 1.0 },
-            // The command line's default too (`fold --max-step 2.5`, degrees).
-            max_step: 2.5 * std::f64::consts::PI / 180.0,
+            // The command line's default too (`fold --max-step 15`, degrees): a cap, the step
+            // control chooses below it.
+            max_step: 15.0 * std::f64::consts::PI / 180.0,
             closure_tol: 1e-11,
             max_steps: 100_000,
             kick: 1e-3,
@@ -299,6 +300,23 @@ pub fn restore_closure(
     Ok(None)
 }
 
+/// The first step after leaving flat, rad (the step control takes it from there).
+const INITIAL_STEP: f64 = 0.05;
+
+/// The corrector's first move per unit step (the angle between chord and tangent) the step
+/// control aims at.
+const TARGET_ANGLE: f64 = 0.1;
+
+/// The most a step grows over the one before.
+const MAX_GROWTH: f64 = 2.0;
+
+/// Newton iterations past which the next step does not grow.
+const SLOW_CORRECTOR: usize = 6;
+
+/// How closely an event (a crease reaching flat against its assignment, panels crossing,
+/// the contact budget) is located: the last step before it is at most this long, rad.
+pub const LOCATE: f64 = 1e-6;
+
 /// Steps over which progress must grow by 1e-9, or the path counts as stalled.
 const STALL_STEPS: usize = 200;
 
@@ -514,7 +532,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         });
     }
 
-    let mut h_scale = 1.0;
+    let mut h = settings.max_step.min(INITIAL_STEP);
     for _ in 0..settings.max_steps {
         let here = progress(&settings.drive, start, &rho, &signs);
         if here >= 1.0 - 1e-9 {
@@ -526,6 +544,8 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 newton_iterations,
             );
         }
+        // Predictor: the desired velocity projected onto the tangent space, scaled to a
+        // largest component of 1 (h is then the largest fold-angle change, rad).
         let jac = closure_jacobian(model, &rho);
         let factor = solver.factor(&jac)?;
         let mut d = desired_velocity(&settings.drive, &rho, &signs);
@@ -541,44 +561,90 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 newton_iterations,
             );
         }
-        let mut h = settings.max_step * h_scale / size;
+        let tangent: Vec<f64> = v.iter().map(|x| x / size).collect();
+        h = h.min(settings.max_step);
         if let Drive::Creases(list) = &settings.drive {
             // Do not step past a driven crease's target (to first order).
             for &(c, t) in list {
-                if v[c] * (t - rho[c]) > 0.0 {
-                    h = h.min((t - rho[c]) / v[c]);
+                if tangent[c] * (t - rho[c]) > 0.0 {
+                    h = h.min((t - rho[c]) / tangent[c]);
                 }
             }
         }
+        // Corrector: Newton onto every closure. A trial that fails, overshoots the goal, or
+        // meets an event (a crease against its assignment, panels crossing, the contact
+        // budget) is retried shorter; an event is located to within LOCATE rad.
         let mut accepted = None;
-        for _ in 0..40 {
-            let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + h * x).collect();
-            match restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? {
-                Some(k) if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) => {
-                    newton_iterations += k;
-                    h /= 2.0;
-                }
-                Some(k) => {
-                    newton_iterations += k;
-                    let ahead = progress(&settings.drive, start, &trial, &signs);
-                    if ahead > 1.0 + 1e-10 {
-                        // Overshoot: aim at the goal by the secant on progress.
-                        let fraction = ((1.0 - here) / (ahead - here)).clamp(0.05, 0.999_999);
-                        h *= fraction;
-                        continue;
-                    }
-                    accepted = Some(trial);
+        let mut event: Option<(StopReason, String)> = None;
+        for _ in 0..80 {
+            let mut trial: Vec<f64> = rho.iter().zip(&tangent).map(|(r, x)| r + h * x).collect();
+            let corrected = correct(model, &mut trial, settings.closure_tol, &mut solver)?;
+            let Some(correction) = corrected else {
+                h /= 2.0;
+                if h < settings.max_step.min(MIN_STEP) * 1e-3 {
                     break;
                 }
-                None => h /= 2.0,
+                continue;
+            };
+            newton_iterations += correction.iterations;
+            if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) {
+                h /= 2.0;
+                continue;
             }
-            if h * size < 1e-9 {
+            let ahead = progress(&settings.drive, start, &trial, &signs);
+            if ahead > 1.0 + 1e-10 {
+                // Overshoot: aim at the goal by the secant on progress.
+                let fraction = ((1.0 - here) / (ahead - here)).clamp(0.05, 0.999_999);
+                h *= fraction;
+                continue;
+            }
+            // A crease that passes through flat against its assignment has left the branch.
+            let wrong = against_assignment(&trial, &signs, 1e-9);
+            let found = if !wrong.is_empty() {
+                let evidence = format!(
+                    "creases {:?} would fold against their assignment after progress {here:.6}",
+                    &wrong[..wrong.len().min(8)]
+                );
+                (StopReason::BranchPoint { creases: wrong }, evidence)
+            } else {
+                let contacts = contact_at(&trial, &mut poses);
+                if let Some(found) = contacts.overflow {
+                    (
+                        StopReason::ContactBudget { pairs: found - 1 },
+                        over_budget(found, &format!("after progress {here:.6}")),
+                    )
+                } else if let Some(pair) = contacts.crossing().next() {
+                    let panels = pair.panels;
+                    (
+                        StopReason::Blocked { panels },
+                        format!(
+                            "panels {} and {} would pass through each other after progress {here:.6}",
+                            panels[0], panels[1]
+                        ),
+                    )
+                } else {
+                    accepted = Some((trial, contacts.min_clearance, correction));
+                    break;
+                }
+            };
+            if h <= LOCATE {
+                event = Some(found);
                 break;
             }
+            h /= 2.0;
         }
-        let Some(next) = accepted else {
+        if let Some((stop, evidence)) = event {
+            return finish(
+                steps,
+                stop,
+                format!("{evidence} (located to {LOCATE:.0e} rad)"),
+                branch,
+                newton_iterations,
+            );
+        }
+        let Some((next, min_clearance, correction)) = accepted else {
             let mut creases: Vec<usize> = (0..n).collect();
-            creases.sort_by(|&a, &b| v[b].abs().total_cmp(&v[a].abs()));
+            creases.sort_by(|&a, &b| tangent[b].abs().total_cmp(&tangent[a].abs()));
             creases.truncate(6);
             return finish(
                 steps,
@@ -588,45 +654,15 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 newton_iterations,
             );
         };
-        // A crease that passes through flat against its assignment has left the branch.
-        let wrong = against_assignment(&next, &signs, 1e-9);
-        if !wrong.is_empty() {
-            let evidence = format!(
-                "creases {:?} would fold against their assignment",
-                &wrong[..wrong.len().min(8)]
-            );
-            return finish(
-                steps,
-                StopReason::BranchPoint { creases: wrong },
-                evidence,
-                branch,
-                newton_iterations,
-            );
+        // Step control: the corrector's first move over the step is the angle between the
+        // chord and the tangent, ∝ h (curvature); aim it at TARGET_ANGLE, and shrink where
+        // Newton needed many iterations.
+        let angle = correction.first / h;
+        let mut grow = if angle > 0.0 { TARGET_ANGLE / angle } else { MAX_GROWTH };
+        if correction.iterations > SLOW_CORRECTOR {
+            grow = grow.min(0.7);
         }
-        let contacts = contact_at(&next, &mut poses);
-        if let Some(found) = contacts.overflow {
-            return finish(
-                steps,
-                StopReason::ContactBudget { pairs: found - 1 },
-                over_budget(found, &format!("after progress {here:.4}")),
-                branch,
-                newton_iterations,
-            );
-        }
-        if let Some(pair) = contacts.crossing().next() {
-            let panels = pair.panels;
-            return finish(
-                steps,
-                StopReason::Blocked { panels },
-                format!(
-                    "panels {} and {} would pass through each other after progress {here:.4}",
-                    panels[0], panels[1]
-                ),
-                branch,
-                newton_iterations,
-            );
-        }
-        h_scale = (h * size / settings.max_step * 2.0).min(1.0);
+        h *= grow.clamp(0.25, MAX_GROWTH);
         rho = next;
         let now = progress(&settings.drive, start, &rho, &signs);
         if steps.len() > STALL_STEPS && now - steps[steps.len() - STALL_STEPS].progress < 1e-9 {
@@ -639,10 +675,10 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             );
         }
         steps.push(PathStep {
-            progress: progress(&settings.drive, start, &rho, &signs),
+            progress: now,
             fold_angles: rho.clone(),
-            max_residual: closure_jacobian(model, &rho).worst_residual(),
-            min_clearance: contacts.min_clearance,
+            max_residual: correction.residual,
+            min_clearance,
         });
     }
     finish(
@@ -652,6 +688,61 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         branch,
         newton_iterations,
     )
+}
+
+/// What a corrector did.
+#[derive(Debug, Clone, Copy)]
+struct Correction {
+    /// Newton iterations.
+    iterations: usize,
+    /// Largest change of a fold angle in the first iteration, rad.
+    first: f64,
+    /// Worst vertex residual at the end, rad.
+    residual: f64,
+}
+
+/// Newton's least-norm steps from a predicted state back onto every closure, as
+/// [`restore_closure`], reporting the first correction's size for step control.
+fn correct(
+    model: &FoldingModel,
+    fold_angles: &mut [f64],
+    tol: f64,
+    solver: &mut NormalSolver,
+) -> Result<Option<Correction>> {
+    let mut previous = f64::INFINITY;
+    let mut first = 0.0;
+    for iteration in 0..30 {
+        let jac = closure_jacobian(model, fold_angles);
+        let worst = jac.worst_residual();
+        if !worst.is_finite() {
+            return Ok(None);
+        }
+        if worst <= tol {
+            return Ok(Some(Correction {
+                iterations: iteration,
+                first,
+                residual: worst,
+            }));
+        }
+        if iteration > 3 && worst > 0.5 * previous {
+            return Ok(None);
+        }
+        previous = worst;
+        let factor = solver.factor(&jac)?;
+        let mut step = vec![0.0; jac.cols];
+        jac.apply_transpose(&jac.residual, &mut step);
+        factor.solve(&mut step);
+        if iteration == 0 {
+            first = inf_norm(&step);
+        }
+        for (rho, d) in fold_angles.iter_mut().zip(&step) {
+            *rho -= d;
+        }
+        if fold_angles.iter().any(|r| r.abs() > PI + 0.5) {
+            return Ok(None);
+        }
+    }
+    Ok(None)
 }
 
 /// A nearly rigid state moved onto every vertex closure (`docs/model.md#folded-forms`).
