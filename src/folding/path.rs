@@ -272,32 +272,7 @@ pub fn restore_closure(
     tol: f64,
     solver: &mut NormalSolver,
 ) -> Result<Option<usize>> {
-    let mut previous = f64::INFINITY;
-    for iteration in 0..30 {
-        let jac = closure_jacobian(model, fold_angles);
-        let worst = jac.worst_residual();
-        if !worst.is_finite() {
-            return Ok(None);
-        }
-        if worst <= tol {
-            return Ok(Some(iteration));
-        }
-        if iteration > 3 && worst > 0.5 * previous {
-            return Ok(None);
-        }
-        previous = worst;
-        let factor = solver.factor(&jac)?;
-        let mut step = vec![0.0; jac.cols];
-        jac.apply_transpose(&jac.residual, &mut step);
-        factor.solve(&mut step);
-        for (rho, d) in fold_angles.iter_mut().zip(&step) {
-            *rho -= d;
-        }
-        if fold_angles.iter().any(|r| r.abs() > PI + 0.5) {
-            return Ok(None);
-        }
-    }
-    Ok(None)
+    Ok(correct(model, fold_angles, tol, solver)?.map(|c| c.iterations))
 }
 
 /// The first step after leaving flat, rad (the step control takes it from there).
@@ -701,8 +676,8 @@ struct Correction {
     residual: f64,
 }
 
-/// Newton's least-norm steps from a predicted state back onto every closure, as
-/// [`restore_closure`], reporting the first correction's size for step control.
+/// Newton's least-norm steps back onto every closure ([`restore_closure`]), reporting the
+/// first correction's size for step control.
 fn correct(
     model: &FoldingModel,
     fold_angles: &mut [f64],
