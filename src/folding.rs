@@ -4,6 +4,7 @@
 
 pub mod closure;
 pub mod contact;
+pub mod frames;
 pub mod model;
 pub mod normal;
 pub mod path;
@@ -15,6 +16,7 @@ pub mod verdict;
 
 pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
+pub use frames::{path_frames, PathFrame, FRAME_CLOSURE};
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{
     fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep, Projection, StopReason,

@@ -1393,3 +1393,70 @@ fn flat_sheets_with_hundreds_of_dof_are_counted_by_the_reductions() {
     assert_eq!(report.dof, 2 * 99, "miura 100: {report:?}");
     assert!(report.reduced > model.crease_count() / 2, "{report:?}");
 }
+
+/// Frames placed on a continuation path (between its steps, by a cubic and a Newton
+/// polish) are states of the Miura-ori's closed-form motion (`MiuraSpec` at the frame's
+/// zigzag angle), at evenly spaced progress, rigid to 1e-10 rad, with every edge length of
+/// the spanning tree's coordinates within 1e-12 of the crease pattern's.
+#[test]
+fn frames_between_steps_lie_on_the_miura_oris_closed_form_motion() {
+    use nanofold::folding::{fold_path, path_frames, Drive, FoldSettings};
+    let (n, gamma) = (8, 60.0);
+    let model = miura(n, n, gamma, 0.0);
+    let settings = FoldSettings {
+        drive: Drive::Assignment { to: 0.9 },
+        ..Default::default()
+    };
+    let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+    let count = 41;
+    assert!(
+        path.steps.len() < count,
+        "{} steps: frames must fall between them",
+        path.steps.len()
+    );
+    let frames = path_frames(&model, &path, count).unwrap();
+    assert_eq!(frames.len(), count);
+    let refused = path_frames(&model, &path, 1).unwrap_err().to_string();
+    assert!(refused.contains("frames") && refused.contains('1'), "{refused}");
+    // Zigzag creases: those the closed form folds to its zigzag angle.
+    let reference = miura(n, n, gamma, 30.0).given_fold_angles();
+    let zigzag = (0..reference.len())
+        .find(|&c| (reference[c].abs() - 30f64.to_radians()).abs() < 1e-12)
+        .unwrap();
+    let pattern = &model.pattern;
+    let length =
+        |p: [f64; 3], q: [f64; 3]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+    let mut poses = Vec::new();
+    for (k, frame) in frames.iter().enumerate() {
+        let target = frames[0].progress + (1.0 - frames[0].progress) * k as f64 / (count - 1) as f64;
+        assert!(
+            (frame.progress - target).abs() < 1e-9,
+            "frame {k}: {} for {target}",
+            frame.progress
+        );
+        let worst = vertex_residuals(&model, &frame.fold_angles)
+            .into_iter()
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-10, "frame {k}: closure {worst:e}");
+        let z = frame.fold_angles[zigzag].abs().to_degrees();
+        if z > 1e-3 {
+            let exact = miura(n, n, gamma, z).given_fold_angles();
+            let gap = exact
+                .iter()
+                .zip(&frame.fold_angles)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(gap < 1e-8, "frame {k} (zigzag {z}°): {gap:e} from the closed form");
+        }
+        panel_poses(&model, &frame.fold_angles, &mut poses);
+        let placed = vertex_positions(&model, &poses);
+        for &[a, b] in &pattern.edges {
+            let flat = {
+                let (p, q) = (pattern.vertices[a], pattern.vertices[b]);
+                ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+            };
+            let error = (length(placed[a], placed[b]) - flat).abs() / flat;
+            assert!(error <= 1e-12, "frame {k}: edge {a}-{b} off by {error:e}");
+        }
+    }
+}

@@ -3,7 +3,8 @@
 //! integrator and tolerance against a much tighter reference, the bridge's etch ramp
 //! quasi-static against dynamic, the cost of one unfold iteration against the number of
 //! creases, and panel networks (the folded Miura sheet from 4 × 4 to 32 × 32, time against
-//! error and against panels, beside MuJoCo when NANOFOLD_PYTHON names its venv's python).
+//! error and against panels, beside MuJoCo when NANOFOLD_PYTHON names its venv's python),
+//! and folding paths by continuation (time against closure and size, frames' accuracy).
 //! Each time is the median of several runs.
 //!
 //! `cargo run --release --example work_precision` prints the tables and writes
@@ -11,11 +12,13 @@
 //! bridge_ramp.svg, scaling.svg, networks_*.svg}`; the figures are drawn from the report
 //! (`figures.rs`). `-- --from REPORT.json` redraws a saved report's figures without
 //! measuring; `-- --networks-into REPORT.json` measures the network part alone into a saved
-//! report; `-- --network-sizes 4,8` chooses the sheets.
+//! report; `-- --network-sizes 4,8` chooses the sheets; `-- --folding-into REPORT.json`
+//! measures the folding paths alone (continuation, frames) into a saved report.
 
 #[path = "../common/mod.rs"]
 mod common;
 mod figures;
+mod folding;
 mod networks;
 
 use common::{library_patterns, machine, many_creases, median, timed};
@@ -495,12 +498,29 @@ fn main() {
         );
         return;
     }
+    // --folding-into REPORT: measure the folding paths alone into that saved report.
+    if let Some(at) = args.iter().position(|a| a == "--folding-into") {
+        let path = args.get(at + 1).expect("--folding-into REPORT.json");
+        let mut report: Value =
+            serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+        let mut folding = folding::folding_part();
+        folding["machine"] = machine();
+        report["folding"] = folding;
+        write_atomic(
+            Path::new(path),
+            serde_json::to_string_pretty(&report).expect("json").as_bytes(),
+        )
+        .expect("writing the report");
+        println!("measured the folding paths into {path}");
+        return;
+    }
     let started = Instant::now();
     let unfolding = unfold_part();
     let fits = fits_part();
     let dynamics = dynamics_part();
     let scaling = scaling_part();
     let networks = networks::networks_part(&sizes, python.as_deref());
+    let folding = folding::folding_part();
     let report = json!({
         "machine": machine(),
         "seconds_total": started.elapsed().as_secs_f64(),
@@ -509,6 +529,7 @@ fn main() {
         "dynamics": dynamics,
         "scaling": scaling,
         "networks": networks,
+        "folding": folding,
     });
     write(
         out,

@@ -216,7 +216,7 @@ fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(
 /// `frames` frames and its end state as FOLD.
 #[pyfunction]
 fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold};
+    use nanofold::io::folding_output::{crease_pattern_fold, fold_path_fold};
     let mut settings =
         settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Fold).map_err(to_py)?;
     let pattern = pattern.pattern.clone();
@@ -253,16 +253,16 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(St
         let (commands::Detail::Fold(path), Some(model)) = (&report.detail, pattern.sheet()) else {
             unreachable!("fold answers with a path on the sheet");
         };
-        let chosen = evenly(path.steps.len(), settings.frames);
+        let frames = nanofold::folding::path_frames(model, path, settings.frames)?;
         let mut summary = report.to_json(&pattern);
-        summary["frames"] = json!(chosen.len());
+        summary["frames"] = json!(frames.len());
         Ok(payload(
             summary,
             json!({
                 "trajectory": trajectory(&report),
                 "extra": extra(&report),
                 "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
-                "fold_file": fold_path_fold(model, path, &chosen),
+                "fold_file": fold_path_fold(model, &frames),
                 "folded_file": crease_pattern_fold(
                     &model.pattern,
                     Some(&report.final_fold_angles_rad),

@@ -339,7 +339,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     let end = &path.steps.last().expect("a path has its start").fold_angles;
     let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end))?.dof;
-    let chosen = evenly(path.steps.len(), args.frames);
+    let frames = nanofold::folding::path_frames(&model, &path, args.frames)?;
     let dir = args
         .out
         .clone()
@@ -353,7 +353,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     let files = [
         (
             "fold.fold",
-            serde_json::to_string_pretty(&fold_path_fold(&model, &path, &chosen))?,
+            serde_json::to_string_pretty(&fold_path_fold(&model, &frames))?,
         ),
         (
             "folded.fold",
@@ -371,7 +371,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     ];
     write_outputs(&dir, &args.pattern, &files)?;
     let mut summary = fold_summary(&model, &args.pattern, &path, dof, seconds);
-    summary["frames"] = json!(chosen.len());
+    summary["frames"] = json!(frames.len());
     summary["out"] = json!(dir.display().to_string());
     if args.json {
         println!("{summary}");

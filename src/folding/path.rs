@@ -5,7 +5,7 @@
 use super::closure::closure_jacobian;
 use super::contact::{panel_contacts, ContactSettings};
 use super::model::FoldingModel;
-use super::normal::NormalSolver;
+use super::normal::{NormalFactor, NormalSolver};
 use super::poses::{panel_poses, Pose};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::EdgeKind;
@@ -227,6 +227,8 @@ pub struct FoldPath {
     pub min_panel_clearance: Option<f64>,
     /// Newton iterations over the whole path.
     pub newton_iterations: usize,
+    /// What drove it (frames placed on the path measure their progress by it).
+    pub drive: Drive,
 }
 
 /// The smallest step a path takes, rad.
@@ -299,7 +301,7 @@ const STALL_STEPS: usize = 200;
 const PATH_REGULARISATION: f64 = 1e-10;
 
 /// The sign each crease's assignment asks for (+1 valley, −1 mountain, 0 otherwise).
-fn assigned_signs(model: &FoldingModel) -> Vec<f64> {
+pub(crate) fn assigned_signs(model: &FoldingModel) -> Vec<f64> {
     model
         .pattern
         .creases
@@ -313,7 +315,21 @@ fn assigned_signs(model: &FoldingModel) -> Vec<f64> {
 }
 
 /// Progress of a state towards the drive's goal.
-fn progress(drive: &Drive, start: &[f64], rho: &[f64], signs: &[f64]) -> f64 {
+/// The crease whose angle sets a state's progress (the most folded assigned crease, or the
+/// driven crease furthest from its target).
+pub(crate) fn progress_crease(drive: &Drive, rho: &[f64], signs: &[f64]) -> Option<usize> {
+    match drive {
+        Drive::Assignment { .. } => (0..rho.len())
+            .filter(|&c| signs[c] != 0.0)
+            .max_by(|&a, &b| rho[a].abs().total_cmp(&rho[b].abs())),
+        Drive::Creases(list) => list
+            .iter()
+            .max_by(|x, y| (x.1 - rho[x.0]).abs().total_cmp(&(y.1 - rho[y.0]).abs()))
+            .map(|&(c, _)| c),
+    }
+}
+
+pub(crate) fn progress(drive: &Drive, start: &[f64], rho: &[f64], signs: &[f64]) -> f64 {
     match drive {
         Drive::Assignment { to } => {
             let amount = rho
@@ -403,6 +419,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             max_closure_residual,
             min_panel_clearance,
             newton_iterations: newton,
+            drive: settings.drive.clone(),
         })
     };
     if let Some(found) = first.overflow {
@@ -508,6 +525,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     }
 
     let mut h = settings.max_step.min(INITIAL_STEP);
+    let mut carried: Option<NormalFactor> = None;
     for _ in 0..settings.max_steps {
         let here = progress(&settings.drive, start, &rho, &signs);
         if here >= 1.0 - 1e-9 {
@@ -521,8 +539,12 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         }
         // Predictor: the desired velocity projected onto the tangent space, scaled to a
         // largest component of 1 (h is then the largest fold-angle change, rad).
-        let jac = closure_jacobian(model, &rho);
-        let factor = solver.factor(&jac)?;
+        // The corrector's last factorisation, made within its last (tiny) correction of
+        // here, serves the projection; else a fresh one.
+        let factor = match carried.take() {
+            Some(factor) => factor,
+            None => solver.factor(&closure_jacobian(model, &rho))?,
+        };
         let mut d = desired_velocity(&settings.drive, &rho, &signs);
         model.hold_locked(&mut d);
         let v = factor.project(&d);
@@ -638,6 +660,7 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             grow = grow.min(0.7);
         }
         h *= grow.clamp(0.25, MAX_GROWTH);
+        carried = correction.factor;
         rho = next;
         let now = progress(&settings.drive, start, &rho, &signs);
         if steps.len() > STALL_STEPS && now - steps[steps.len() - STALL_STEPS].progress < 1e-9 {
@@ -666,7 +689,6 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
 }
 
 /// What a corrector did.
-#[derive(Debug, Clone, Copy)]
 struct Correction {
     /// Newton iterations.
     iterations: usize,
@@ -674,6 +696,8 @@ struct Correction {
     first: f64,
     /// Worst vertex residual at the end, rad.
     residual: f64,
+    /// The last factorisation (at the state before the last correction).
+    factor: Option<NormalFactor>,
 }
 
 /// Newton's least-norm steps back onto every closure ([`restore_closure`]), reporting the
@@ -686,6 +710,7 @@ fn correct(
 ) -> Result<Option<Correction>> {
     let mut previous = f64::INFINITY;
     let mut first = 0.0;
+    let mut last = None;
     for iteration in 0..30 {
         let jac = closure_jacobian(model, fold_angles);
         let worst = jac.worst_residual();
@@ -697,6 +722,7 @@ fn correct(
                 iterations: iteration,
                 first,
                 residual: worst,
+                factor: last,
             }));
         }
         if iteration > 3 && worst > 0.5 * previous {
@@ -713,6 +739,7 @@ fn correct(
         for (rho, d) in fold_angles.iter_mut().zip(&step) {
             *rho -= d;
         }
+        last = Some(factor);
         if fold_angles.iter().any(|r| r.abs() > PI + 0.5) {
             return Ok(None);
         }

@@ -8,7 +8,7 @@ use crate::dynamics::network::modes::NetworkModes;
 use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::simulate::Response;
 use crate::error::Result;
-use crate::folding::{panel_poses, vertex_positions, CheckReport, FoldPath, FoldingModel};
+use crate::folding::{panel_poses, vertex_positions, CheckReport, FoldPath, FoldingModel, PathFrame};
 use crate::io::output::number;
 use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
 use crate::pattern::Assignment;
@@ -75,16 +75,16 @@ pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>,
     root
 }
 
-/// The folding path as FOLD: the crease pattern (flat, 2D) is the key frame; each chosen
-/// step is a 3D `foldedForm` frame with its fold angles and the assignments they imply.
-pub fn fold_path_fold(model: &FoldingModel, path: &FoldPath, chosen: &[usize]) -> Value {
-    let frames: Vec<(String, &[f64])> = chosen
+/// The folding path as FOLD: the crease pattern (flat, 2D) is the key frame; each frame
+/// placed on the path ([`path_frames`](crate::folding::path_frames)) is a 3D `foldedForm`
+/// frame with its fold angles and the assignments they imply.
+pub fn fold_path_fold(model: &FoldingModel, frames: &[PathFrame]) -> Value {
+    let frames: Vec<(String, &[f64])> = frames
         .iter()
-        .map(|&i| {
-            let step = &path.steps[i];
+        .map(|frame| {
             (
-                format!("progress {:.4} (step {i})", step.progress),
-                step.fold_angles.as_slice(),
+                format!("progress {:.4} (after step {})", frame.progress, frame.after_step),
+                frame.fold_angles.as_slice(),
             )
         })
         .collect();

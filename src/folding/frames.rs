@@ -1,0 +1,221 @@
+//! Frames placed on a computed folding path (`docs/model.md#folding-paths`): states at
+//! evenly spaced progress, interpolated between the path's accepted steps (a cubic in the
+//! path's chord length) and polished by Newton onto every closure, so a frame costs a
+//! Newton solve, not a path step.
+
+use super::closure::{closure_jacobian, ClosureJacobian};
+use super::model::FoldingModel;
+use super::normal::{NormalFactor, NormalSolver};
+use super::path::{assigned_signs, progress, progress_crease, FoldPath};
+use crate::error::{NanofoldError, Result};
+
+/// The closure a frame is polished to, rad: tight enough that the spanning tree's
+/// coordinates hold every edge length to about 1e-12 (a residual r at each vertex moves
+/// the last panels of a tree of depth d by about d·r of the pattern's size).
+pub const FRAME_CLOSURE: f64 = 1e-14;
+
+/// The residual's fall per chord step below which a frame's polish refactorises.
+const CHORD_CONTRACTION: f64 = 0.1;
+
+/// Most frames one call places.
+pub const MAX_FRAMES: usize = 100_000;
+
+/// One frame on a path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathFrame {
+    /// Progress towards the drive's goal (as the path's steps measure it).
+    pub progress: f64,
+    /// Fold angles, rad (one per crease).
+    pub fold_angles: Vec<f64>,
+    /// Largest vertex closure residual, rad.
+    pub max_residual: f64,
+    /// The accepted step the frame follows (its segment of the path).
+    pub after_step: usize,
+}
+
+/// `count` frames (at least 2) at evenly spaced progress from the path's first state to its
+/// last, both included. Between steps a frame starts from the cubic through the four
+/// nearest steps (in cumulative chord length), placed where its progress is the target,
+/// and Newton moves it onto every closure (to [`FRAME_CLOSURE`], or as close as rounding
+/// allows) with the crease that sets progress held, so the frame keeps its progress. Where
+/// Newton finds no rigid state near it the nearer step is the frame.
+pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Result<Vec<PathFrame>> {
+    if !(2..=MAX_FRAMES).contains(&count) {
+        return Err(NanofoldError::invalid(
+            "frames",
+            count,
+            format!("must lie in [2, {MAX_FRAMES}]"),
+        ));
+    }
+    let steps = &path.steps;
+    let signs = assigned_signs(model);
+    let start = &steps[0].fold_angles;
+    let progress_of = |rho: &[f64]| progress(&path.drive, start, rho, &signs);
+    // Cumulative chord length: the cubic's parameter.
+    let mut chord = vec![0.0];
+    for pair in steps.windows(2) {
+        let d: f64 = pair[0]
+            .fold_angles
+            .iter()
+            .zip(&pair[1].fold_angles)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        chord.push(chord.last().copied().unwrap_or(0.0) + d);
+    }
+    let (first, last) = (steps[0].progress, steps[steps.len() - 1].progress);
+    let mut solver = NormalSolver::new(1e-10);
+    let mut frames = Vec::with_capacity(count);
+    for k in 0..count {
+        let target = first + (last - first) * k as f64 / (count - 1) as f64;
+        // The segment whose steps bracket the target (the last one where progress is flat).
+        let segment = (0..steps.len().saturating_sub(1))
+            .find(|&i| steps[i + 1].progress >= target)
+            .unwrap_or(steps.len().saturating_sub(2).min(steps.len() - 1));
+        let guess = if k == 0 || steps.len() == 1 {
+            steps[0].fold_angles.clone()
+        } else if k == count - 1 {
+            steps[steps.len() - 1].fold_angles.clone()
+        } else {
+            place(steps, &chord, segment, target, &progress_of)
+        };
+        let mut rho = guess;
+        // The crease that sets progress keeps its angle, so the frame stays at its target.
+        let held = if k == 0 || k == count - 1 {
+            None
+        } else {
+            progress_crease(&path.drive, &rho, &signs)
+        };
+        let residual = polish(model, &mut rho, held, &mut solver)?;
+        let (fold_angles, max_residual) = if residual <= path_tolerance(path) {
+            (rho, residual)
+        } else {
+            // No rigid state near the cubic: the nearer step, as the path accepted it.
+            let nearer = if (target - steps[segment].progress).abs()
+                <= (steps[(segment + 1).min(steps.len() - 1)].progress - target).abs()
+            {
+                segment
+            } else {
+                (segment + 1).min(steps.len() - 1)
+            };
+            (steps[nearer].fold_angles.clone(), steps[nearer].max_residual)
+        };
+        frames.push(PathFrame {
+            progress: progress_of(&fold_angles),
+            fold_angles,
+            max_residual,
+            after_step: segment,
+        });
+    }
+    Ok(frames)
+}
+
+/// The closure a frame must reach to be used: the path's own worst, or 1e-10 rad.
+fn path_tolerance(path: &FoldPath) -> f64 {
+    path.max_closure_residual.max(1e-10)
+}
+
+/// The cubic (Lagrange, through up to four steps around `segment`, in chord length) at the
+/// point of the segment where progress is `target` (bisection on the chord length).
+fn place(
+    steps: &[super::path::PathStep],
+    chord: &[f64],
+    segment: usize,
+    target: f64,
+    progress_of: &dyn Fn(&[f64]) -> f64,
+) -> Vec<f64> {
+    let m = steps.len();
+    let lo = segment.saturating_sub(1);
+    let hi = (segment + 2).min(m - 1);
+    let nodes: Vec<usize> = (lo..=hi).collect();
+    let at = |s: f64| -> Vec<f64> {
+        let weights: Vec<f64> = nodes
+            .iter()
+            .map(|&i| {
+                nodes
+                    .iter()
+                    .filter(|&&j| j != i)
+                    .map(|&j| (s - chord[j]) / (chord[i] - chord[j]))
+                    .product()
+            })
+            .collect();
+        (0..steps[0].fold_angles.len())
+            .map(|c| {
+                nodes
+                    .iter()
+                    .zip(&weights)
+                    .map(|(&i, w)| w * steps[i].fold_angles[c])
+                    .sum()
+            })
+            .collect()
+    };
+    let (mut a, mut b) = (chord[segment], chord[(segment + 1).min(m - 1)]);
+    if b <= a {
+        return steps[segment].fold_angles.clone();
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (a + b);
+        if progress_of(&at(mid)) < target {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    at(0.5 * (a + b))
+}
+
+/// Newton's least-norm steps towards [`FRAME_CLOSURE`], with crease `held` (if any) kept
+/// where it is, stopping when the residual no longer halves; leaves the best state found in
+/// `fold_angles` and returns its residual. The factorisation is reused (chord steps) while
+/// the residual falls tenfold per step: a frame starts within the cubic's small error of
+/// the path, where J barely changes.
+fn polish(
+    model: &FoldingModel,
+    fold_angles: &mut [f64],
+    held: Option<usize>,
+    solver: &mut NormalSolver,
+) -> Result<f64> {
+    let mut best = (f64::INFINITY, fold_angles.to_vec());
+    let mut factored: Option<(ClosureJacobian, NormalFactor, bool)> = None;
+    let mut previous = f64::INFINITY;
+    for _ in 0..20 {
+        let mut jac = closure_jacobian(model, fold_angles);
+        if let Some(c) = held {
+            // Zeroed, not removed: the sparsity pattern (and its symbolic analysis) stays.
+            for entry in jac.entries.iter_mut().filter(|e| e.1 == c) {
+                entry.2 = 0.0;
+            }
+        }
+        let worst = jac.worst_residual();
+        if !worst.is_finite() {
+            break;
+        }
+        if worst < best.0 {
+            best = (worst, fold_angles.to_vec());
+        }
+        if worst <= FRAME_CLOSURE {
+            break;
+        }
+        let fresh_before = factored.as_ref().is_some_and(|f| f.2);
+        if factored.is_none() || worst > CHORD_CONTRACTION * previous {
+            // A fresh matrix that could not halve the residual: as close as rounding allows.
+            if fresh_before && worst > 0.5 * previous {
+                break;
+            }
+            let factor = solver.factor(&jac)?;
+            factored = Some((jac.clone(), factor, true));
+        } else if let Some(entry) = factored.as_mut() {
+            entry.2 = false;
+        }
+        previous = worst;
+        let (matrix, factor, _) = factored.as_ref().expect("set above");
+        let mut step = vec![0.0; jac.cols];
+        matrix.apply_transpose(&jac.residual, &mut step);
+        factor.solve(&mut step);
+        for (rho, d) in fold_angles.iter_mut().zip(&step) {
+            *rho -= d;
+        }
+    }
+    fold_angles.copy_from_slice(&best.1);
+    Ok(best.0)
+}
