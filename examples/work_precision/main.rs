@@ -479,16 +479,7 @@ fn main() {
     // and commit) into that saved report, and redraw the report's figures.
     if let Some(at) = args.iter().position(|a| a == "--networks-into") {
         let path = args.get(at + 1).expect("--networks-into REPORT.json");
-        let mut report: Value =
-            serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
-        let mut networks = networks::networks_part(&sizes, python.as_deref());
-        networks["machine"] = machine();
-        report["networks"] = networks;
-        write_atomic(
-            Path::new(path),
-            serde_json::to_string_pretty(&report).expect("json").as_bytes(),
-        )
-        .expect("writing the report");
+        let report = measure_into(path, "networks", networks::networks_part(&sizes, python.as_deref()));
         for (name, svg) in figures::figures(&report) {
             write(out, name, &svg);
         }
@@ -501,16 +492,7 @@ fn main() {
     // --folding-into REPORT: measure the folding paths alone into that saved report.
     if let Some(at) = args.iter().position(|a| a == "--folding-into") {
         let path = args.get(at + 1).expect("--folding-into REPORT.json");
-        let mut report: Value =
-            serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
-        let mut folding = folding::folding_part();
-        folding["machine"] = machine();
-        report["folding"] = folding;
-        write_atomic(
-            Path::new(path),
-            serde_json::to_string_pretty(&report).expect("json").as_bytes(),
-        )
-        .expect("writing the report");
+        measure_into(path, "folding", folding::folding_part());
         println!("measured the folding paths into {path}");
         return;
     }
@@ -544,6 +526,19 @@ fn main() {
         out.display(),
         started.elapsed().as_secs_f64()
     );
+}
+
+/// Puts one part (with this machine) into a saved report, rewrites it, and returns it.
+fn measure_into(path: &str, key: &str, mut part: Value) -> Value {
+    let mut report: Value = serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+    part["machine"] = machine();
+    report[key] = part;
+    write_atomic(
+        Path::new(path),
+        serde_json::to_string_pretty(&report).expect("json").as_bytes(),
+    )
+    .expect("writing the report");
+    report
 }
 
 /// A bundled scene, loaded and built.
