@@ -81,8 +81,11 @@ pub enum Command {
     },
     /// Fold a crease pattern of any number of vertices rigidly (`docs/model.md#folding-paths`):
     /// from flat along its assignment, or driven creases to their angles; writes fold.fold,
-    /// folded.fold, trajectory.json and fold.svg.
+    /// folded.fold, trajectory.json, fold.svg and fold.html (the 3D page).
     Fold(folding::FoldArgs),
+    /// Write the 3D page (view.html: turn, zoom, scrub the frames) of a FOLD file: an
+    /// animation's frames, a 3D folded form, or a crease pattern with its fold angles.
+    View(folding::ViewArgs),
     /// Write a generated crease pattern as a FOLD file.
     Generate {
         #[command(subcommand)]
@@ -1563,6 +1566,7 @@ pub fn run(cli: Cli) -> Result<bool> {
         } => run_check(&patterns, &solver, json, &parallel),
         Command::Constraints(args) => run_constraints(&args).map(|_| true),
         Command::Fold(args) => folding::run_fold(&args).map(|_| true),
+        Command::View(args) => folding::run_view(&args).map(|_| true),
         Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
         Command::Modes { scene, json, out } => run_modes(&scene, json, out.as_deref()).map(|_| true),

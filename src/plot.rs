@@ -3,6 +3,7 @@
 
 mod canvas;
 pub mod folding;
+pub mod page;
 pub mod response;
 pub mod work_precision;
 

@@ -368,6 +368,17 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
             serde_json::to_string(&fold_trajectory_json(&model, &path, 1000))?,
         ),
         ("fold.svg", fold_svg(&model, &path, &title)?),
+        (
+            "fold.html",
+            nanofold::plot::page::page_of_states(
+                &model,
+                &title,
+                &frames
+                    .iter()
+                    .map(|f| (format!("progress {:.4}", f.progress), f.fold_angles.as_slice()))
+                    .collect::<Vec<_>>(),
+            )?,
+        ),
     ];
     write_outputs(&dir, &args.pattern, &files)?;
     let mut summary = fold_summary(&model, &args.pattern, &path, dof, seconds);
@@ -674,4 +685,53 @@ pub fn unfold_network_one(
         dir.display()
     )?;
     Ok((summary, text))
+}
+
+/// Largest FOLD file `view` reads (an animation repeats its mesh in every frame).
+const MAX_VIEW_BYTES: u64 = 128 << 20;
+
+/// `nanofold view FILE.fold`.
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// The FOLD file: frames with 3D coordinates (an animation, a folded form), or a crease
+    /// pattern (with `edges_foldAngle` for its state).
+    pub file: PathBuf,
+    /// Output folder (default: output/<file name>/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// `nanofold view FILE.fold`: a page of the file's frames as written, or, for a crease
+/// pattern (2D, no 3D frame), of its state placed by the spanning tree.
+pub fn run_view(args: &ViewArgs) -> Result<()> {
+    let text = nanofold::io::input::read_text(&args.file, MAX_VIEW_BYTES).map_err(|e| reading(&args.file, e))?;
+    let value: Value = serde_json::from_str(&text).with_context(|| format!("{}: not JSON", args.file.display()))?;
+    let name = nanofold::io::pattern_name(&args.file);
+    let three_d = |frame: &Value| {
+        frame["vertices_coords"].as_array().is_some_and(|v| {
+            v.iter()
+                .any(|p| p.as_array().is_some_and(|p| p.len() == 3 && p[2].as_f64() != Some(0.0)))
+        })
+    };
+    let has_3d = three_d(&value) || value["file_frames"].as_array().is_some_and(|f| f.iter().any(three_d));
+    let html = if has_3d && value.get("faces_vertices").is_some() {
+        nanofold::plot::page::page_of_fold(&value, &name)?
+    } else {
+        let model = load_model(&args.file)?;
+        let state = model.given_fold_angles();
+        nanofold::plot::page::page_of_states(
+            &model,
+            &model.pattern.name,
+            &[("as read".to_string(), state.as_slice())],
+        )?
+    };
+    let dir = args.out.clone().unwrap_or_else(|| default_folder(&name, &args.file));
+    write_outputs(&dir, &args.file, &[("view.html", html.clone())])?;
+    println!(
+        "{}: wrote {}/view.html ({:.1} MB)",
+        args.file.display(),
+        dir.display(),
+        html.len() as f64 / 1e6
+    );
+    Ok(())
 }

@@ -18,6 +18,8 @@ pub const OUTPUT_FILES: &[&str] = &[
     "fold.fold",
     "folded.fold",
     "fold.svg",
+    "fold.html",
+    "view.html",
     "constraints.json",
     "constraints.svg",
     "constraints.xml",
