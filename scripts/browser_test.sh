@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The 3D pages in a real browser (issue 29): headless Chromium loads `fold.html` (written by
-# `fold`) at two frames and `view.html` (written by `view`) of an animation and of a crease
-# pattern with its fold angles. Each page must run without a console error and paint its
+# `fold`), `response.html` (`simulate`, with its first contact marked), `modes.html` and
+# `view.html` (written by `view`) of an animation and of a crease pattern with its angles. Each page must run without a console error and paint its
 # canvas, and moving the frame must change the picture. Installs Debian's chromium when it
 # is missing; where it cannot, says so and skips (fails under NANOFOLD_REQUIRE_CLIENTS=1).
 set -euo pipefail
@@ -51,6 +51,17 @@ check_page() {
 }
 check_page "$work/fold/fold.html"
 check_page "$work/animation/view.html"
+# A device's response: the first contact's panels are marked on the last frame only.
+"$bin" simulate patterns/devices/cube_closes.scene.json --out "$work/cube" >/dev/null
+check_page "$work/cube/response.html"
+start=$(load "$work/cube/response.html#frame=0")
+contact=$(load "$work/cube/response.html#frame=100000")
+[ "$(attr highlighted "$start")" = 0 ] && [ "$(attr highlighted "$contact")" = 2 ] || {
+  echo "response.html: the first contact is not marked on its frame alone ($start / $contact)"; exit 1; }
+echo "browser: the cube's first contact is marked on its frame ($(attr highlighted "$contact") faces)"
+# A network's modes.
+"$bin" modes patterns/devices/miura_sheet.scene.json --out "$work/modes" >/dev/null
+check_page "$work/modes/modes.html"
 # A single state: one frame, painted.
 state=$(load "$work/state/view.html")
 [ "$(attr painted "$state")" -gt 5000 ] || { echo "view of a crease pattern with angles: blank ($state)"; exit 1; }

@@ -1127,10 +1127,22 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         ("snapshots.svg", snapshots_svg(&scene, response)?),
     ];
     if let System::Network(model) = &scene.system {
+        let motion = nanofold::io::folding_output::network_motion_fold(model, response);
+        // The first contact's panels, marked on the last frame (the run stops there).
+        let contact_faces: Vec<usize> = response.collision.as_ref().map_or_else(Vec::new, |c| {
+            let panels: Vec<usize> = (0..model.panels())
+                .filter(|&p| c.pair.contains(&model.panel_names[p]))
+                .collect();
+            let pattern = &model.folding.pattern;
+            (0..pattern.faces.len())
+                .filter(|&f| panels.contains(&pattern.panel_of_face[f]))
+                .collect()
+        });
         files.push((
-            "motion.fold",
-            serde_json::to_string(&nanofold::io::folding_output::network_motion_fold(model, response))?,
+            "response.html",
+            nanofold::plot::page::page_of_fold(&motion, &scene.name, &contact_faces)?,
         ));
+        files.push(("motion.fold", serde_json::to_string(&motion)?));
     }
     write_outputs(&dir, &args.scene, &files)?;
     if args.json {
@@ -1396,7 +1408,10 @@ fn run_modes_network(
 ) -> Result<()> {
     let result = nanofold::dynamics::network::modes::folded_modes(model)?;
     let fold = nanofold::io::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
-    let files = [("modes.fold", serde_json::to_string(&fold)?)];
+    let files = [
+        ("modes.html", nanofold::plot::page::page_of_fold(&fold, name, &[])?),
+        ("modes.fold", serde_json::to_string(&fold)?),
+    ];
     write_outputs(dir, input, &files)?;
     if json {
         let mut value = nanofold::io::output::network_modes_json(name, model, &result);

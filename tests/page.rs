@@ -18,7 +18,7 @@ fn square(frames: usize) -> PageScene {
                     title: format!("frame {k}"),
                     coords: vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, lift], [0.0, 2.0, 0.0]],
                     fold_angles_deg: Some(vec![0.0, 0.0, 0.0, 0.0, 10.0 * k as f64]),
-                    highlight: None,
+                    highlight: Vec::new(),
                 }
             })
             .collect(),
@@ -78,6 +78,9 @@ fn bad_scenes_are_refused_by_name() {
     let mut scene = square(1);
     scene.edges.push([0, 9]);
     assert!(message(scene).contains('9'));
+    let mut scene = square(1);
+    scene.frames[0].highlight = vec![4];
+    assert!(message(scene).contains("highlight"));
     let frames = MAX_PAGE_POINTS / 4 + 1;
     assert!(message(square(frames)).contains("at most"));
 }

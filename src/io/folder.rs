@@ -20,6 +20,8 @@ pub const OUTPUT_FILES: &[&str] = &[
     "fold.svg",
     "fold.html",
     "view.html",
+    "response.html",
+    "modes.html",
     "constraints.json",
     "constraints.svg",
     "constraints.xml",

@@ -19,8 +19,8 @@ pub struct PageFrame {
     pub coords: Vec<[f64; 3]>,
     /// Every edge's fold angle in degrees, where known.
     pub fold_angles_deg: Option<Vec<f64>>,
-    /// Two faces to highlight (a first contact), if any.
-    pub highlight: Option<[usize; 2]>,
+    /// Faces to highlight (the panels of a first contact).
+    pub highlight: Vec<usize>,
 }
 
 /// What a page shows.
@@ -88,6 +88,18 @@ pub fn page_html(scene: &PageScene) -> Result<String> {
             "faces/edges",
             bad,
             format!("vertex indices below {vertices}"),
+        ));
+    }
+    if let Some(bad) = scene
+        .frames
+        .iter()
+        .flat_map(|f| &f.highlight)
+        .find(|&&f| f >= scene.faces.len())
+    {
+        return Err(NanofoldError::invalid(
+            "highlight",
+            bad,
+            format!("face indices below {}", scene.faces.len()),
         ));
     }
     // Centre and half-size over every frame, so the quantised integers stay small.
@@ -200,7 +212,7 @@ function draw(){const r=size();ctx.clearRect(0,0,r.width,r.height);const fr=D.fr
  // What was painted, for a headless browser's check (pixels off the background, a hash).
  const img=ctx.getImageData(0,0,canvas.width,canvas.height).data;let painted=0,hash=0;
  for(let i=0;i<img.length;i+=4){if(img[i+3]>0)painted++;hash=(hash*31+img[i]+7*img[i+1]+13*img[i+2])|0;}
- const root=document.documentElement.dataset;root.painted=painted;root.hash=hash;root.frame=frame;root.draws=(+(root.draws||0))+1;}
+ const root=document.documentElement.dataset;root.painted=painted;root.hash=hash;root.frame=frame;root.highlighted=order.filter(([,i])=>hl.has(i)).length;root.draws=(+(root.draws||0))+1;}
 slider.oninput=()=>{frame=+slider.value;draw();};
 play.onclick=()=>{playing=!playing;play.textContent=playing?"pause":"play";last=performance.now();acc=0;if(playing)requestAnimationFrame(tick);};
 function tick(now){if(!playing)return;acc+=(now-last)/1000*10*(+document.getElementById("speed").value);last=now;
@@ -251,7 +263,7 @@ pub fn page_of_states(
                 title: label.clone(),
                 coords: crate::folding::vertex_positions(model, &poses),
                 fold_angles_deg: Some(angles),
-                highlight: None,
+                highlight: Vec::new(),
             }
         })
         .collect();
@@ -280,8 +292,9 @@ fn letter(kind: crate::pattern::crease_pattern::EdgeKind) -> char {
 
 /// A page of a FOLD object as another tool wrote it: its key frame and its `file_frames`
 /// (a frame without `vertices_coords` or `faces_vertices` takes its parent's), 2D
-/// coordinates at z = 0, `edges_foldAngle` shown where given. Errors name the field.
-pub fn page_of_fold(value: &serde_json::Value, name: &str) -> Result<String> {
+/// coordinates at z = 0, `edges_foldAngle` shown where given; `last_highlight` faces are
+/// marked in the last frame (a first contact). Errors name the field.
+pub fn page_of_fold(value: &serde_json::Value, name: &str, last_highlight: &[usize]) -> Result<String> {
     use serde_json::Value;
     let field = |frame: &Value, key: &str| -> Option<Value> { frame.get(key).cloned() };
     let key_frame = value;
@@ -356,7 +369,7 @@ pub fn page_of_fold(value: &serde_json::Value, name: &str) -> Result<String> {
             title,
             coords,
             fold_angles_deg: angles.filter(|a| a.len() == edges.len()),
-            highlight: None,
+            highlight: Vec::new(),
         });
     }
     // A crease pattern's key frame (2D) before 3D frames is the flat sheet: keep it only
@@ -366,6 +379,9 @@ pub fn page_of_fold(value: &serde_json::Value, name: &str) -> Result<String> {
     }
     let vertices = frames[0].coords.len();
     frames.retain(|f| f.coords.len() == vertices);
+    if let Some(last) = frames.last_mut() {
+        last.highlight = last_highlight.to_vec();
+    }
     page_html(&PageScene {
         title: value
             .get("file_title")
