@@ -1140,7 +1140,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         });
         files.push((
             "response.html",
-            nanofold::plot::page::page_of_fold(&motion, &scene.name, &contact_faces)?,
+            nanofold::plot::page::page_of_fold(&motion, &scene.name, &contact_faces, Some((model.unit * 1e6, "µm")))?,
         ));
         files.push(("motion.fold", serde_json::to_string(&motion)?));
     }
@@ -1409,7 +1409,10 @@ fn run_modes_network(
     let result = nanofold::dynamics::network::modes::folded_modes(model)?;
     let fold = nanofold::io::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
     let files = [
-        ("modes.html", nanofold::plot::page::page_of_fold(&fold, name, &[])?),
+        (
+            "modes.html",
+            nanofold::plot::page::page_of_fold(&fold, name, &[], Some((model.unit * 1e6, "µm")))?,
+        ),
         ("modes.fold", serde_json::to_string(&fold)?),
     ];
     write_outputs(dir, input, &files)?;

@@ -84,3 +84,41 @@ fn bad_scenes_are_refused_by_name() {
     let frames = MAX_PAGE_POINTS / 4 + 1;
     assert!(message(square(frames)).contains("at most"));
 }
+
+/// A FOLD animation as another tool writes it: the 2D key frame is dropped where 3D frames
+/// follow, a frame's missing faces come from the file, the last frame carries the contact
+/// faces, and a physical scale multiplies every coordinate (the scale bar's unit with it).
+#[test]
+fn a_fold_animation_becomes_a_page_in_physical_units() {
+    use nanofold::plot::page::page_of_fold;
+    let fold = serde_json::json!({
+        "file_spec": 1.1,
+        "frame_unit": "unit",
+        "vertices_coords": [[0, 0], [1, 0], [1, 1], [0, 1]],
+        "edges_vertices": [[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]],
+        "edges_assignment": ["B", "B", "B", "B", "V"],
+        "faces_vertices": [[0, 1, 2], [0, 2, 3]],
+        "file_frames": [
+            {"frame_title": "half", "vertices_coords": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0.5, 0.5, 0.7]]},
+            {"frame_title": "shut", "vertices_coords": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 0, 0.0]], "edges_foldAngle": [0, 0, 0, 0, 180]}
+        ]
+    });
+    let html = page_of_fold(&fold, "square", &[0, 1], Some((100.0, "µm"))).unwrap();
+    let value = data(&html);
+    assert_eq!(value["unit"], "µm");
+    let frames = value["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 2, "the flat key frame is left out");
+    assert_eq!(frames[0]["t"], "half");
+    assert_eq!(frames[1]["h"], serde_json::json!([0, 1]));
+    assert!(frames[0]["h"].as_array().unwrap().is_empty());
+    assert_eq!(frames[1]["a"][4].as_f64().unwrap(), 180.0);
+    // Vertex 1 − vertex 0 is one file unit along x: 100 µm on the page.
+    let step = value["step"].as_f64().unwrap();
+    let x = |i: usize| frames[0]["q"][i].as_f64().unwrap() * step;
+    assert!((x(3) - x(0) - 100.0).abs() <= step, "{}", x(3) - x(0));
+    // No faces at all is refused by name.
+    let mut bare = fold.clone();
+    bare.as_object_mut().unwrap().remove("faces_vertices");
+    let message = page_of_fold(&bare, "square", &[], None).unwrap_err().to_string();
+    assert!(message.contains("faces_vertices"), "{message}");
+}

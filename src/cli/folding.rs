@@ -715,7 +715,7 @@ pub fn run_view(args: &ViewArgs) -> Result<()> {
     };
     let has_3d = three_d(&value) || value["file_frames"].as_array().is_some_and(|f| f.iter().any(three_d));
     let html = if has_3d && value.get("faces_vertices").is_some() {
-        nanofold::plot::page::page_of_fold(&value, &name, &[])?
+        nanofold::plot::page::page_of_fold(&value, &name, &[], None)?
     } else {
         let model = load_model(&args.file)?;
         let state = model.given_fold_angles();

@@ -293,8 +293,14 @@ fn letter(kind: crate::pattern::crease_pattern::EdgeKind) -> char {
 /// A page of a FOLD object as another tool wrote it: its key frame and its `file_frames`
 /// (a frame without `vertices_coords` or `faces_vertices` takes its parent's), 2D
 /// coordinates at z = 0, `edges_foldAngle` shown where given; `last_highlight` faces are
-/// marked in the last frame (a first contact). Errors name the field.
-pub fn page_of_fold(value: &serde_json::Value, name: &str, last_highlight: &[usize]) -> Result<String> {
+/// marked in the last frame (a first contact); `scale` = (length of one file unit, its
+/// name) shows the scene in physical units (a device's µm). Errors name the field.
+pub fn page_of_fold(
+    value: &serde_json::Value,
+    name: &str,
+    last_highlight: &[usize],
+    scale: Option<(f64, &str)>,
+) -> Result<String> {
     use serde_json::Value;
     let field = |frame: &Value, key: &str| -> Option<Value> { frame.get(key).cloned() };
     let key_frame = value;
@@ -382,17 +388,25 @@ pub fn page_of_fold(value: &serde_json::Value, name: &str, last_highlight: &[usi
     if let Some(last) = frames.last_mut() {
         last.highlight = last_highlight.to_vec();
     }
+    if let Some((factor, _)) = scale {
+        for p in frames.iter_mut().flat_map(|f| f.coords.iter_mut()) {
+            p.iter_mut().for_each(|x| *x *= factor);
+        }
+    }
     page_html(&PageScene {
         title: value
             .get("file_title")
             .and_then(|v| v.as_str())
             .unwrap_or(name)
             .to_string(),
-        unit: value
-            .get("frame_unit")
-            .and_then(|v| v.as_str())
-            .unwrap_or("(file units)")
-            .to_string(),
+        unit: match scale {
+            Some((_, unit)) => unit.to_string(),
+            None => value
+                .get("frame_unit")
+                .and_then(|v| v.as_str())
+                .unwrap_or("(file units)")
+                .to_string(),
+        },
         faces,
         edges,
         assignments: letters,
