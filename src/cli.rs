@@ -1411,7 +1411,12 @@ fn run_modes_network(
     let files = [
         (
             "modes.html",
-            nanofold::plot::page::page_of_fold(&fold, name, &[], Some((model.unit * 1e6, "µm")))?,
+            nanofold::plot::page::page_of_fold(
+                &nanofold::io::folding_output::network_modes_oscillation_fold(model, &result, MODE_AMPLITUDE, 12)?,
+                name,
+                &[],
+                Some((model.unit * 1e6, "µm")),
+            )?,
         ),
         ("modes.fold", serde_json::to_string(&fold)?),
     ];

@@ -815,3 +815,56 @@ fn layers_stacked_past_the_contact_budget_stop_the_run() {
     assert!(collision.pair[0].contains("contact budget"), "{:?}", collision.pair);
     assert!(collision.pair[1].contains("not decided"), "{:?}", collision.pair);
 }
+
+/// The modes page's oscillation: each mode at 12 phases of one cycle about the folded
+/// equilibrium. At phases 0 and 6 (sin = 0) the sheet is the equilibrium; half a cycle
+/// apart (phases 3 and 9) it is moved by opposite amounts to first order: what is left of
+/// their sum is second order, so it falls as the amplitude squared (relative to the move, as
+/// the amplitude).
+#[test]
+fn the_modes_oscillate_about_the_equilibrium() {
+    let scene = scene_file("patterns/devices/miura_sheet.scene.json");
+    let model = network(&scene);
+    let modes = folded_modes(model).unwrap();
+    let count = modes.modes.crease_shapes.ncols();
+    let gap = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    // For each amplitude, each mode's (move at phase 3, leftover of phases 3 + 9).
+    let measure = |amplitude: f64| -> Vec<(f64, f64)> {
+        let fold = nanofold::io::folding_output::network_modes_oscillation_fold(model, &modes, amplitude, 12).unwrap();
+        let frames = fold["file_frames"].as_array().unwrap();
+        assert_eq!(frames.len(), 1 + 12 * count);
+        let coords = |k: usize| -> Vec<f64> {
+            frames[k]["vertices_coords"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|p| p.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+                .collect()
+        };
+        let equilibrium = coords(0);
+        (0..count)
+            .map(|mode| {
+                let at = |phase: usize| coords(1 + 12 * mode + phase);
+                assert!(gap(&at(0), &equilibrium) < 1e-9, "mode {mode} at phase 0");
+                assert!(gap(&at(6), &equilibrium) < 1e-9, "mode {mode} at phase 6");
+                let (up, down) = (at(3), at(9));
+                let mirror: Vec<f64> = equilibrium.iter().zip(&up).map(|(e, u)| 2.0 * e - u).collect();
+                (gap(&up, &equilibrium), gap(&down, &mirror))
+            })
+            .collect()
+    };
+    let (large, small) = (measure(0.1), measure(0.05));
+    for mode in 0..count {
+        let (moved, left) = large[mode];
+        let (moved_half, left_half) = small[mode];
+        assert!(moved > 1e-3, "mode {mode}: phase 3 moves the sheet ({moved:e})");
+        assert!(
+            (moved_half / moved - 0.5).abs() < 0.05,
+            "mode {mode}: the move is first order"
+        );
+        assert!(
+            left_half / left < 0.3,
+            "mode {mode}: the leftover is second order ({left:e} at 0.1 rad, {left_half:e} at 0.05)"
+        );
+    }
+}

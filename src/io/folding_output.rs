@@ -255,6 +255,51 @@ pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
 /// of frames, the equilibrium moved by ± its shape scaled to `amplitude` rad at its largest
 /// crease and put back onto the closures.
 pub fn network_modes_fold(model: &NetworkModel, modes: &NetworkModes, amplitude: f64) -> Result<Value> {
+    let (plus, minus) = (format!("+ {amplitude} rad"), format!("− {amplitude} rad"));
+    let phases = [(1.0, plus.as_str()), (-1.0, minus.as_str())];
+    modes_states_fold(
+        model,
+        modes,
+        amplitude,
+        &phases,
+        "a network's modes written by nanofold modes: the folded equilibrium, then each mode's shape either way",
+    )
+}
+
+/// The modes as oscillations, for the 3D page: each mode at `phases` evenly spaced phases
+/// of one cycle, the equilibrium moved by amplitude · sin(phase) along its shape.
+pub fn network_modes_oscillation_fold(
+    model: &NetworkModel,
+    modes: &NetworkModes,
+    amplitude: f64,
+    phases: usize,
+) -> Result<Value> {
+    let labels: Vec<(f64, String)> = (0..phases)
+        .map(|j| {
+            let phase = 2.0 * std::f64::consts::PI * j as f64 / phases as f64;
+            (phase.sin(), format!("phase {j}/{phases} of a ±{amplitude} rad cycle"))
+        })
+        .collect();
+    let phases: Vec<(f64, &str)> = labels.iter().map(|(s, l)| (*s, l.as_str())).collect();
+    modes_states_fold(
+        model,
+        modes,
+        amplitude,
+        &phases,
+        "a network's modes as oscillations about the folded equilibrium, written by nanofold modes",
+    )
+}
+
+/// The equilibrium, then each mode at each (factor, label): the equilibrium moved by factor ·
+/// `amplitude` along the mode's shape (its largest crease at `amplitude` rad), put back onto
+/// the closures.
+fn modes_states_fold(
+    model: &NetworkModel,
+    modes: &NetworkModes,
+    amplitude: f64,
+    phases: &[(f64, &str)],
+    description: &str,
+) -> Result<Value> {
     let equilibrium = &modes.modes.equilibrium.angles;
     let shapes = &modes.modes.crease_shapes;
     let mut states: Vec<(String, Vec<f64>)> = vec![("folded equilibrium".to_string(), equilibrium.clone())];
@@ -267,29 +312,21 @@ pub fn network_modes_fold(model: &NetworkModel, modes: &NetworkModes, amplitude:
             .iter()
             .fold(0.0_f64, |m, v| m.max(v.abs()))
             .max(f64::MIN_POSITIVE);
-        for sign in [1.0, -1.0] {
+        for &(factor, label) in phases {
             let mut state: Vec<f64> = equilibrium
                 .iter()
                 .zip(shapes.column(k).iter())
-                .map(|(e, s)| e + sign * amplitude * s / largest)
+                .map(|(e, s)| e + factor * amplitude * s / largest)
                 .collect();
             restore(&released, &mut state, &mut solver)?;
             states.push((
-                format!(
-                    "mode {k} ({:.3} Hz), {} {amplitude} rad",
-                    modes.modes.modes.frequencies_hz[k],
-                    if sign > 0.0 { "+" } else { "−" }
-                ),
+                format!("mode {k} ({:.3} Hz), {label}", modes.modes.modes.frequencies_hz[k]),
                 state,
             ));
         }
     }
     let frames: Vec<(String, &[f64])> = states.iter().map(|(t, s)| (t.clone(), s.as_slice())).collect();
-    Ok(network_states_fold(
-        model,
-        &frames,
-        "a network's modes written by nanofold modes: the folded equilibrium, then each mode's shape either way",
-    ))
+    Ok(network_states_fold(model, &frames, description))
 }
 
 /// `check --json` of a crease pattern of many vertices (`file`: the input's path;
