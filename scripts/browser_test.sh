@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The 3D pages in a real browser (issue 29): headless Chromium loads `fold.html` (written by
-# `fold`), `response.html` (`simulate`, with its first contact marked), `modes.html` and
+# `fold`), `unfold.html`, `response.html` (`simulate`, with its first contact marked), `modes.html` and
 # `view.html` (written by `view`) of an animation and of a crease pattern with its angles. Each page must run without a console error and paint its
 # canvas, and moving the frame must change the picture. Installs Debian's chromium when it
 # is missing; where it cannot, says so and skips (fails under NANOFOLD_REQUIRE_CLIENTS=1).
@@ -62,6 +62,11 @@ echo "browser: the cube's first contact is marked on its frame ($(attr highlight
 # A network's modes.
 "$bin" modes patterns/devices/miura_sheet.scene.json --out "$work/modes" >/dev/null
 check_page "$work/modes/modes.html"
+# Unfoldings: a single vertex and a sheet of many vertices.
+"$bin" unfold patterns/corner_cube.fold --out "$work/vertex" >/dev/null
+check_page "$work/vertex/unfold.html"
+"$bin" unfold patterns/many/miura_4x4_folded.fold --out "$work/sheet" >/dev/null
+check_page "$work/sheet/unfold.html"
 # A single state: one frame, painted.
 state=$(load "$work/state/view.html")
 [ "$(attr painted "$state")" -gt 5000 ] || { echo "view of a crease pattern with angles: blank ($state)"; exit 1; }

@@ -487,12 +487,15 @@ fn unfold_one(
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
     let trajectory = serde_json::to_string(&trajectory_json(&pattern, &settings, &report, 1000))?;
-    let fold = serde_json::to_string_pretty(&fold_animation(&pattern, &model, &report))?;
+    let animation = fold_animation(&pattern, &model, &report);
+    let fold = serde_json::to_string_pretty(&animation)?;
     let svg = unfold_svg(&pattern, &report)?;
+    let page = nanofold::plot::page::page_of_fold(&animation, &pattern.name, &[], None)?;
     let files = [
         ("trajectory.json", trajectory.as_bytes()),
         ("unfold.fold", fold.as_bytes()),
         ("unfold.svg", svg.as_bytes()),
+        ("unfold.html", page.as_bytes()),
     ];
     write_folder_of(
         &dir,
@@ -545,7 +548,7 @@ fn unfold_one(
     }
     write!(
         text,
-        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold}}",
+        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold, unfold.html}}",
         dir.display()
     )?;
     Ok((summary, text))

@@ -627,10 +627,12 @@ pub fn unfold_network_one(
         report.iterations
     );
     let svg = angles_svg(&model, &xs, &states, "step", "step", &title)?;
+    let page = nanofold::plot::page::page_of_fold(&fold, &model.pattern.name, &[], None)?;
     let files = [
         ("trajectory.json", serde_json::to_string(&trajectory)?),
         ("unfold.fold", serde_json::to_string_pretty(&fold)?),
         ("unfold.svg", svg),
+        ("unfold.html", page),
     ];
     write_outputs(&dir, pattern_path, &files)?;
     let adjustments: Vec<String> = projection
@@ -681,7 +683,7 @@ pub fn unfold_network_one(
     )?;
     write!(
         text,
-        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold}}",
+        "  wrote {}/{{trajectory.json, unfold.svg, unfold.fold, unfold.html}}",
         dir.display()
     )?;
     Ok((summary, text))

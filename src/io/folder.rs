@@ -20,6 +20,7 @@ pub const OUTPUT_FILES: &[&str] = &[
     "fold.svg",
     "fold.html",
     "view.html",
+    "unfold.html",
     "response.html",
     "modes.html",
     "constraints.json",
