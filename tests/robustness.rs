@@ -180,6 +180,7 @@ fn a_run_replaces_its_own_files_and_keeps_the_other_commands() {
             "nanofold.json",
             "trajectory.json",
             "unfold.fold",
+            "unfold.html",
             "unfold.svg"
         ]
     );
