@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The 3D pages in a real browser (issue 29): headless Chromium loads `fold.html` (written by
-# `fold`), `unfold.html`, `response.html` (`simulate`, with its first contact marked), `modes.html` and
+# `fold`), `unfold.html`, `response.html` (`simulate` of a device, a strip and a closed chain, with
+# the first contact marked), `modes.html` (a network's, a strip's, a closed chain's) and
 # `view.html` (written by `view`) of an animation and of a crease pattern with its angles. Each page must run without a console error and paint its
 # canvas, and moving the frame must change the picture. Installs Debian's chromium when it
 # is missing; where it cannot, says so and skips (fails under NANOFOLD_REQUIRE_CLIENTS=1).
@@ -59,15 +60,29 @@ contact=$(load "$work/cube/response.html#frame=100000")
 [ "$(attr highlighted "$start")" = 0 ] && [ "$(attr highlighted "$contact")" = 2 ] || {
   echo "response.html: the first contact is not marked on its frame alone ($start / $contact)"; exit 1; }
 echo "browser: the cube's first contact is marked on its frame ($(attr highlighted "$contact") faces)"
-# A network's modes.
+# A strip's response: plate 3 meets the substrate, both marked on the contact frame.
+"$bin" simulate patterns/bridge_step.scene.json --out "$work/bridge" >/dev/null
+check_page "$work/bridge/response.html"
+contact=$(load "$work/bridge/response.html#frame=100000")
+[ "$(attr highlighted "$contact")" = 2 ] || { echo "bridge response.html: contact not marked ($contact)"; exit 1; }
+# Modes: a network's, a strip's and a closed chain's.
 "$bin" modes patterns/devices/miura_sheet.scene.json --out "$work/modes" >/dev/null
 check_page "$work/modes/modes.html"
+"$bin" modes patterns/bridge_step.scene.json --out "$work/strip_modes" >/dev/null
+check_page "$work/strip_modes/modes.html"
+"$bin" modes patterns/corner_cube_step2.scene.json --out "$work/closed_modes" >/dev/null
+check_page "$work/closed_modes/modes.html"
+"$bin" simulate patterns/corner_cube_step2.scene.json --out "$work/closed" >/dev/null
+check_page "$work/closed/response.html"
 # Unfoldings: a single vertex and a sheet of many vertices.
 "$bin" unfold patterns/corner_cube.fold --out "$work/vertex" >/dev/null
 check_page "$work/vertex/unfold.html"
 "$bin" unfold patterns/many/miura_4x4_folded.fold --out "$work/sheet" >/dev/null
 check_page "$work/sheet/unfold.html"
-# A single state: one frame, painted.
+# A single state: one frame, painted; and an Origami Simulator export.
 state=$(load "$work/state/view.html")
 [ "$(attr painted "$state")" -gt 5000 ] || { echo "view of a crease pattern with angles: blank ($state)"; exit 1; }
+"$bin" view tests/fixtures/origami-simulator/simple_50.fold --out "$work/export" >/dev/null
+state=$(load "$work/export/view.html")
+[ "$(attr painted "$state")" -gt 5000 ] || { echo "view of an Origami Simulator export: blank ($state)"; exit 1; }
 echo "browser: the 3D pages load, paint and change with the frame"

@@ -1131,21 +1131,19 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     ];
     if let System::Network(model) = &scene.system {
         let motion = nanofold::io::folding_output::network_motion_fold(model, response);
-        // The first contact's panels, marked on the last frame (the run stops there).
-        let contact_faces: Vec<usize> = response.collision.as_ref().map_or_else(Vec::new, |c| {
-            let panels: Vec<usize> = (0..model.panels())
-                .filter(|&p| c.pair.contains(&model.panel_names[p]))
-                .collect();
-            let pattern = &model.folding.pattern;
-            (0..pattern.faces.len())
-                .filter(|&f| panels.contains(&pattern.panel_of_face[f]))
-                .collect()
-        });
+        let page = nanofold::plot::scene_page::network_response_page(
+            &scene.name,
+            model,
+            &motion,
+            response.collision.as_ref(),
+        )?;
+        files.push(("response.html", page));
+        files.push(("motion.fold", serde_json::to_string(&motion)?));
+    } else {
         files.push((
             "response.html",
-            nanofold::plot::page::page_of_fold(&motion, &scene.name, &contact_faces, Some((model.unit * 1e6, "µm")))?,
+            nanofold::plot::scene_page::response_page(&scene, response)?,
         ));
-        files.push(("motion.fold", serde_json::to_string(&motion)?));
     }
     write_outputs(&dir, &args.scene, &files)?;
     if args.json {
@@ -1346,20 +1344,25 @@ fn run_export(format: &ExportKind) -> Result<()> {
 
 fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     let scene = load_scene(path)?;
+    let dir = out.map(Path::to_path_buf).unwrap_or_else(|| {
+        let file_name = nanofold::io::scene::scene_name(path);
+        PathBuf::from("output").join(folder_name(&scene.name, &file_name))
+    });
     let chain = match &scene.system {
-        System::Closed(chain) => return run_modes_closed(&scene.name, chain, json),
-        System::Network(model) => {
-            let dir = out.map(Path::to_path_buf).unwrap_or_else(|| {
-                let file_name = nanofold::io::scene::scene_name(path);
-                PathBuf::from("output").join(folder_name(&scene.name, &file_name))
-            });
-            return run_modes_network(&scene.name, path, model, json, &dir);
-        }
+        System::Closed(chain) => return run_modes_closed(&scene.name, path, chain, json, &dir),
+        System::Network(model) => return run_modes_network(&scene.name, path, model, json, &dir),
         System::Strip(chain) => chain,
     };
     let result = modes(&chain.model, chain.target_angles().as_slice())?;
+    let files = [(
+        "modes.html",
+        nanofold::plot::scene_page::strip_modes_page(&scene.name, chain, &result, MODE_AMPLITUDE)?,
+    )];
+    write_outputs(&dir, path, &files)?;
     if json {
-        println!("{}", modes_json(&scene, &result));
+        let mut value = modes_json(&scene, &result);
+        value["out"] = serde_json::json!(dir.display().to_string());
+        println!("{value}");
         return Ok(());
     }
     let degrees: Vec<String> = result
@@ -1399,6 +1402,7 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
             "NOT stable: some hinge stiffness or eigenvalue is not positive"
         }
     );
+    print_written(&dir, &files);
     Ok(())
 }
 
@@ -1500,11 +1504,24 @@ fn run_modes_network(
 
 use nanofold::commands::MODE_AMPLITUDE;
 
-fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain, json: bool) -> Result<()> {
+fn run_modes_closed(
+    name: &str,
+    input: &Path,
+    chain: &nanofold::dynamics::closed::ClosedChain,
+    json: bool,
+    dir: &Path,
+) -> Result<()> {
     let result = chain.folded_modes()?;
     let eta = chain.torque_magnification()?;
+    let files = [(
+        "modes.html",
+        nanofold::plot::scene_page::closed_modes_page(name, chain, &result, MODE_AMPLITUDE)?,
+    )];
+    write_outputs(dir, input, &files)?;
     if json {
-        println!("{}", closed_modes_json(name, chain, &result, eta));
+        let mut value = closed_modes_json(name, chain, &result, eta);
+        value["out"] = serde_json::json!(dir.display().to_string());
+        println!("{value}");
         return Ok(());
     }
     let degrees = |angles: &[f64]| {
@@ -1570,6 +1587,7 @@ fn run_modes_closed(name: &str, chain: &nanofold::dynamics::closed::ClosedChain,
             "NOT stable: some eigenvalue of the reduced stiffness is not positive"
         }
     );
+    print_written(dir, &files);
     Ok(())
 }
 

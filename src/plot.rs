@@ -5,6 +5,7 @@ mod canvas;
 pub mod folding;
 pub mod page;
 pub mod response;
+pub mod scene_page;
 pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};

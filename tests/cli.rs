@@ -411,7 +411,11 @@ fn simulate_writes_response_files_and_the_documented_json_keys() {
 
 #[test]
 fn modes_prints_descending_frequencies_and_stability() {
-    let (_, modes) = json_run(nanofold().args(["modes", "patterns/bridge_step.scene.json", "--json"]));
+    let (_, modes) = json_run(
+        nanofold()
+            .args(["modes", "patterns/bridge_step.scene.json", "--json", "--out"])
+            .arg(temp_dir("modes-bridge")),
+    );
     let eigenvalues: Vec<f64> = modes["eigenvalues"]
         .as_array()
         .unwrap()
@@ -472,7 +476,11 @@ fn simulate_of_a_closed_scene_writes_its_figures_and_the_closed_keys() {
 
 #[test]
 fn modes_of_a_closed_scene_release_its_locks_and_report_the_closed_keys() {
-    let (_, modes) = json_run(nanofold().args(["modes", "patterns/corner_cube_step2.scene.json", "--json"]));
+    let (_, modes) = json_run(
+        nanofold()
+            .args(["modes", "patterns/corner_cube_step2.scene.json", "--json", "--out"])
+            .arg(temp_dir("modes-cube-json")),
+    );
     for key in [
         "eigenvalues",
         "frequencies_hz",
@@ -494,7 +502,8 @@ fn modes_of_a_closed_scene_release_its_locks_and_report_the_closed_keys() {
     assert_eq!(modes["eigenvalues"].as_array().unwrap().len(), 2);
     assert_eq!(modes["crease_mode_shapes"][0].as_array().unwrap().len(), 5);
     let table = nanofold()
-        .args(["modes", "patterns/corner_cube_step2.scene.json"])
+        .args(["modes", "patterns/corner_cube_step2.scene.json", "--out"])
+        .arg(temp_dir("modes-cube"))
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&table.stdout);

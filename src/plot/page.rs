@@ -38,6 +38,20 @@ pub struct PageScene {
     pub assignments: Vec<char>,
     /// The frames, at least one.
     pub frames: Vec<PageFrame>,
+    /// Faces that do not move (the substrate, the anchored panel), drawn grey.
+    pub fixed: Vec<usize>,
+}
+
+impl PageScene {
+    /// The scene with every coordinate multiplied by `factor` and the scale bar in `unit`
+    /// (a device's metres shown in µm).
+    pub fn scaled(mut self, factor: f64, unit: &str) -> Self {
+        for p in self.frames.iter_mut().flat_map(|f| f.coords.iter_mut()) {
+            p.iter_mut().for_each(|x| *x *= factor);
+        }
+        self.unit = unit.to_string();
+        self
+    }
 }
 
 /// Coordinates are written as integers of this fraction of the scene's half-size.
@@ -94,10 +108,11 @@ pub fn page_html(scene: &PageScene) -> Result<String> {
         .frames
         .iter()
         .flat_map(|f| &f.highlight)
+        .chain(&scene.fixed)
         .find(|&&f| f >= scene.faces.len())
     {
         return Err(NanofoldError::invalid(
-            "highlight",
+            "highlight/fixed",
             bad,
             format!("face indices below {}", scene.faces.len()),
         ));
@@ -141,6 +156,7 @@ pub fn page_html(scene: &PageScene) -> Result<String> {
         "faces": scene.faces,
         "edges": scene.edges,
         "letters": scene.assignments.iter().collect::<String>(),
+        "fixed": scene.fixed,
         "frames": frames,
     });
     // Inside <script>, "</" would end the element.
@@ -184,6 +200,8 @@ const F=D.frames.length,NV=D.frames[0].q.length/3;
 slider.max=F-1;
 document.getElementById("title").textContent=D.title;
 const edgeOf=new Map();D.edges.forEach((e,i)=>{edgeOf.set(e[0]+","+e[1],i);edgeOf.set(e[1]+","+e[0],i);});
+const fixed=new Set(D.fixed||[]);
+if(fixed.size)document.getElementById("legend").insertAdjacentHTML("beforeend","<br><span class=\"sw\" style=\"background:#bbb;height:10px\"></span>grey: fixed (substrate, anchored panel)");
 const faceEdges=D.faces.map(f=>f.map((v,k)=>edgeOf.get(v+","+f[(k+1)%f.length])).filter(i=>i!==undefined));
 let yaw=-0.6,pitch=0.9,zoom=1,panX=0,panY=0,frame=0,playing=false,selected=-1,last=0,acc=0;
 function reset(){yaw=-0.6;pitch=0.9;zoom=1;panX=0;panY=0;}
@@ -201,7 +219,7 @@ function draw(){const r=size();ctx.clearRect(0,0,r.width,r.height);const fr=D.fr
  const hl=new Set(fr.h||[]);
  for(const[,i]of order){const f=D.faces[i];ctx.beginPath();ctx.moveTo(P[3*f[0]],P[3*f[0]+1]);for(let k=1;k<f.length;k++)ctx.lineTo(P[3*f[k]],P[3*f[k]+1]);ctx.closePath();
   let area=0;for(let k=0;k<f.length;k++){const a=f[k],b=f[(k+1)%f.length];area+=P[3*a]*P[3*b+1]-P[3*b]*P[3*a+1];}
-  ctx.fillStyle=hl.has(i)?"#f66":(area<0?"#f3d38a":"#9dbde0");ctx.fill();ctx.lineWidth=0.5;ctx.strokeStyle="#0003";ctx.stroke();
+  ctx.fillStyle=hl.has(i)?"#f66":fixed.has(i)?(area<0?"#c4c4c4":"#b0b0b0"):(area<0?"#f3d38a":"#9dbde0");ctx.fill();ctx.lineWidth=0.5;ctx.strokeStyle="#0003";ctx.stroke();
   for(const e of faceEdges[i]){const[a,b]=D.edges[e];ctx.beginPath();ctx.moveTo(P[3*a],P[3*a+1]);ctx.lineTo(P[3*b],P[3*b+1]);ctx.strokeStyle=e===selected?"#0c0":colour(e,fr.a);ctx.lineWidth=e===selected?3:1.5;ctx.stroke();}}
  // Scale bar: a round length near 100 px.
  const target=100/s,pow=Math.pow(10,Math.floor(Math.log10(target)));let len=pow;for(const m of[1,2,5,10])if(m*pow<=target)len=m*pow;
@@ -274,6 +292,7 @@ pub fn page_of_states(
         edges: pattern.edges.clone(),
         assignments: pattern.kinds.iter().map(|&k| letter(k)).collect(),
         frames,
+        fixed: Vec::new(),
     })
 }
 
@@ -301,6 +320,19 @@ pub fn page_of_fold(
     last_highlight: &[usize],
     scale: Option<(f64, &str)>,
 ) -> Result<String> {
+    let mut scene = scene_of_fold(value, name)?;
+    if let Some(last) = scene.frames.last_mut() {
+        last.highlight = last_highlight.to_vec();
+    }
+    if let Some((factor, unit)) = scale {
+        scene = scene.scaled(factor, unit);
+    }
+    page_html(&scene)
+}
+
+/// The [`PageScene`] of a FOLD object (see [`page_of_fold`]), for callers that add fixed
+/// faces or highlights before writing it.
+pub fn scene_of_fold(value: &serde_json::Value, name: &str) -> Result<PageScene> {
     use serde_json::Value;
     let field = |frame: &Value, key: &str| -> Option<Value> { frame.get(key).cloned() };
     let key_frame = value;
@@ -385,31 +417,21 @@ pub fn page_of_fold(
     }
     let vertices = frames[0].coords.len();
     frames.retain(|f| f.coords.len() == vertices);
-    if let Some(last) = frames.last_mut() {
-        last.highlight = last_highlight.to_vec();
-    }
-    if let Some((factor, _)) = scale {
-        for p in frames.iter_mut().flat_map(|f| f.coords.iter_mut()) {
-            p.iter_mut().for_each(|x| *x *= factor);
-        }
-    }
-    page_html(&PageScene {
+    Ok(PageScene {
         title: value
             .get("file_title")
             .and_then(|v| v.as_str())
             .unwrap_or(name)
             .to_string(),
-        unit: match scale {
-            Some((_, unit)) => unit.to_string(),
-            None => value
-                .get("frame_unit")
-                .and_then(|v| v.as_str())
-                .unwrap_or("(file units)")
-                .to_string(),
-        },
+        unit: value
+            .get("frame_unit")
+            .and_then(|v| v.as_str())
+            .unwrap_or("(file units)")
+            .to_string(),
         faces,
         edges,
         assignments: letters,
         frames,
+        fixed: Vec::new(),
     })
 }
