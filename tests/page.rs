@@ -303,8 +303,8 @@ fn view_draws_an_origami_simulator_export_where_the_file_puts_it() {
     assert_eq!(shown.len(), given.len());
     let step = value["step"].as_f64().unwrap();
     for (a, b) in [(0, shown.len() - 1), (1, shown.len() / 2)] {
-        for c in 0..3 {
-            let kept = shown[a][c] - shown[b][c];
+        for (c, (x, y)) in shown[a].iter().zip(&shown[b]).enumerate() {
+            let kept = x - y;
             let wanted = given[a].get(c).copied().unwrap_or(0.0) - given[b].get(c).copied().unwrap_or(0.0);
             assert!(
                 (kept - wanted).abs() <= step,
