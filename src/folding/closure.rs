@@ -5,6 +5,7 @@
 
 use super::model::FoldingModel;
 use crate::geometry::kinematics;
+use crate::geometry::sphere::Vec3;
 use faer::sparse::{SparseColMat, Triplet};
 
 /// The stacked closure residual and its Jacobian at one state.
@@ -104,18 +105,21 @@ pub fn vertex_residuals(model: &FoldingModel, fold_angles: &[f64]) -> Vec<f64> {
 pub fn closure_jacobian(model: &FoldingModel, fold_angles: &[f64]) -> ClosureJacobian {
     let mut residual = Vec::with_capacity(3 * model.stars.len());
     let mut entries = Vec::with_capacity(3 * model.stars.iter().map(|s| s.columns.len()).sum::<usize>());
-    let mut by_ray = Vec::new();
-    let mut rays: Vec<usize> = Vec::new();
+    // Each crease's sine and cosine once (two stars hold it), the sectors' from the model.
+    let fold_trig: Vec<(f64, f64)> = fold_angles.iter().map(|a| a.sin_cos()).collect();
+    let (mut by_ray, mut nodes, mut columns) = (Vec::new(), Vec::new(), Vec::new());
     for (s, star) in model.stars.iter().enumerate() {
-        star_angles(&star.columns, fold_angles, &mut by_ray);
-        rays.clear();
-        rays.extend(0..star.columns.len());
-        let (r, jac) = kinematics::closure_jacobian(&star.sector_angles, &by_ray, &rays);
+        by_ray.clear();
+        by_ray.extend(star.columns.iter().map(|&c| fold_trig[c]));
+        let degree = star.columns.len();
+        nodes.resize(degree, Vec3::zeros());
+        columns.resize(degree, Vec3::zeros());
+        let r = kinematics::closure_jacobian_trig(&model.sector_trig[s], &by_ray, &mut nodes, &mut columns);
         residual.extend(r.iter());
         for (j, &column) in star.columns.iter().enumerate() {
             let scale = if model.locked_columns[column] { 0.0 } else { 1.0 };
-            for i in 0..3 {
-                entries.push((3 * s + i, column, scale * jac[(i, j)]));
+            for (i, value) in columns[j].iter().enumerate() {
+                entries.push((3 * s + i, column, scale * value));
             }
         }
     }

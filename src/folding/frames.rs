@@ -6,7 +6,7 @@
 use super::closure::{closure_jacobian, ClosureJacobian};
 use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
-use super::path::{assigned_signs, progress, progress_crease, FoldPath};
+use super::path::{assigned_signs, progress, progress_by_crease, progress_crease, FoldPath};
 use crate::error::{NanofoldError, Result};
 
 /// The closure a frame is polished to, rad: tight enough that the spanning tree's
@@ -77,7 +77,16 @@ pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Resul
         } else if k == count - 1 {
             steps[steps.len() - 1].fold_angles.clone()
         } else {
-            place(steps, &chord, segment, target, &progress_of)
+            // Bisection on the crease that sets progress at the segment's end, checked on the
+            // whole state (and redone on it where another crease sets progress).
+            let end = &steps[(segment + 1).min(steps.len() - 1)].fold_angles;
+            let setter = progress_crease(&path.drive, end, &signs)
+                .map(|c| (c, move |value: f64| progress_by_crease(&path.drive, start, c, value)));
+            let by_setter = setter
+                .as_ref()
+                .map(|(c, f)| place(steps, &chord, segment, target, &Placement::Crease(*c, f)))
+                .filter(|guess| (progress_of(guess) - target).abs() <= 1e-12);
+            by_setter.unwrap_or_else(|| place(steps, &chord, segment, target, &Placement::State(&progress_of)))
         };
         let mut rho = guess;
         // The crease that sets progress keeps its angle, so the frame stays at its target.
@@ -115,21 +124,23 @@ fn path_tolerance(path: &FoldPath) -> f64 {
     path.max_closure_residual.max(1e-10)
 }
 
+/// How [`place`] measures progress on the cubic.
+enum Placement<'a> {
+    /// Progress of the whole state.
+    State(&'a dyn Fn(&[f64]) -> f64),
+    /// Progress set by one crease (its index, its progress as a function of its angle).
+    Crease(usize, &'a dyn Fn(f64) -> f64),
+}
+
 /// The cubic (Lagrange, through up to four steps around `segment`, in chord length) at the
 /// point of the segment where progress is `target` (bisection on the chord length).
-fn place(
-    steps: &[super::path::PathStep],
-    chord: &[f64],
-    segment: usize,
-    target: f64,
-    progress_of: &dyn Fn(&[f64]) -> f64,
-) -> Vec<f64> {
+fn place(steps: &[super::path::PathStep], chord: &[f64], segment: usize, target: f64, by: &Placement) -> Vec<f64> {
     let m = steps.len();
     let lo = segment.saturating_sub(1);
     let hi = (segment + 2).min(m - 1);
     let nodes: Vec<usize> = (lo..=hi).collect();
-    let at = |s: f64| -> Vec<f64> {
-        let weights: Vec<f64> = nodes
+    let weights = |s: f64| -> Vec<f64> {
+        nodes
             .iter()
             .map(|&i| {
                 nodes
@@ -138,7 +149,10 @@ fn place(
                     .map(|&j| (s - chord[j]) / (chord[i] - chord[j]))
                     .product()
             })
-            .collect();
+            .collect()
+    };
+    let at = |s: f64| -> Vec<f64> {
+        let weights = weights(s);
         (0..steps[0].fold_angles.len())
             .map(|c| {
                 nodes
@@ -153,9 +167,19 @@ fn place(
     if b <= a {
         return steps[segment].fold_angles.clone();
     }
+    let progress_at = |s: f64| match by {
+        Placement::State(progress_of) => progress_of(&at(s)),
+        Placement::Crease(c, progress_of) => progress_of(
+            nodes
+                .iter()
+                .zip(weights(s))
+                .map(|(&i, w)| w * steps[i].fold_angles[*c])
+                .sum(),
+        ),
+    };
     for _ in 0..60 {
         let mid = 0.5 * (a + b);
-        if progress_of(&at(mid)) < target {
+        if progress_at(mid) < target {
             a = mid;
         } else {
             b = mid;

@@ -58,6 +58,9 @@ pub struct FoldingModel {
     pub size: f64,
     /// Whether each fold-angle column is held at its angle (`edges_nanofold:locked`).
     pub locked_columns: Vec<bool>,
+    /// (sin, cos) of each star's sector angles, computed when built (closures use them at
+    /// every Newton step).
+    pub(crate) sector_trig: Vec<Vec<(f64, f64)>>,
 }
 
 impl FoldingModel {
@@ -84,7 +87,7 @@ impl FoldingModel {
         for (column, &e) in pattern.creases.iter().enumerate() {
             column_of_edge[e] = Some(column);
         }
-        let stars = pattern
+        let stars: Vec<Star> = pattern
             .stars
             .iter()
             .map(|star| Star {
@@ -193,8 +196,13 @@ impl FoldingModel {
                 == pattern.creases.len()
         );
         let locked_columns = pattern.creases.iter().map(|&e| pattern.locked[e]).collect();
+        let sector_trig = stars
+            .iter()
+            .map(|star: &Star| star.sector_angles.iter().map(|a| a.sin_cos()).collect())
+            .collect();
         Ok(FoldingModel {
             locked_columns,
+            sector_trig,
             pattern,
             stars,
             column_of_edge,

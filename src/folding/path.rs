@@ -274,7 +274,7 @@ pub fn restore_closure(
     tol: f64,
     solver: &mut NormalSolver,
 ) -> Result<Option<usize>> {
-    Ok(correct(model, fold_angles, tol, solver)?.map(|c| c.iterations))
+    Ok(correct(model, fold_angles, tol, solver, None)?.map(|c| c.iterations))
 }
 
 /// The first step after leaving flat, rad (the step control takes it from there).
@@ -326,6 +326,22 @@ pub(crate) fn progress_crease(drive: &Drive, rho: &[f64], signs: &[f64]) -> Opti
             .iter()
             .max_by(|x, y| (x.1 - rho[x.0]).abs().total_cmp(&(y.1 - rho[y.0]).abs()))
             .map(|&(c, _)| c),
+    }
+}
+
+/// The progress a state has when crease `crease`, at `value`, is the one that sets it (see
+/// [`progress_crease`]): the same number [`progress`] gives, from one crease.
+pub(crate) fn progress_by_crease(drive: &Drive, start: &[f64], crease: usize, value: f64) -> f64 {
+    match drive {
+        Drive::Assignment { to } => value.abs() / PI / to,
+        Drive::Creases(list) => {
+            let span = list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - start[c]).abs()));
+            let target = list.iter().find(|&&(c, _)| c == crease).map_or(value, |&(_, t)| t);
+            if span == 0.0 {
+                return 1.0;
+            }
+            1.0 - (target - value).abs() / span
+        }
     }
 }
 
@@ -573,9 +589,12 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
         // budget) is retried shorter; an event is located to within LOCATE rad.
         let mut accepted = None;
         let mut event: Option<(StopReason, String)> = None;
+        // Landing on the goal is tried until a landed state meets an event: at a singular
+        // goal (a flat-folded state) holding one crease there can push another past it.
+        let mut may_land = true;
         for _ in 0..80 {
             let mut trial: Vec<f64> = rho.iter().zip(&tangent).map(|(r, x)| r + h * x).collect();
-            let corrected = correct(model, &mut trial, settings.closure_tol, &mut solver)?;
+            let corrected = correct(model, &mut trial, settings.closure_tol, &mut solver, None)?;
             let Some(correction) = corrected else {
                 h /= 2.0;
                 if h < settings.max_step.min(MIN_STEP) * 1e-3 {
@@ -588,11 +607,31 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 h /= 2.0;
                 continue;
             }
-            let ahead = progress(&settings.drive, start, &trial, &signs);
+            let reached = progress(&settings.drive, start, &trial, &signs);
+            let mut ahead = reached;
+            let mut correction = correction;
+            let mut landed = false;
+            if ahead > 1.0 + 1e-10 && may_land {
+                // Past the goal: onto it directly, the crease that sets progress held there.
+                if let Some(landing) = land_on_goal(
+                    model,
+                    &settings.drive,
+                    &mut trial,
+                    &signs,
+                    settings.closure_tol,
+                    &mut solver,
+                )? {
+                    newton_iterations += landing.iterations;
+                    correction.residual = landing.residual;
+                    correction.factor = None;
+                    ahead = progress(&settings.drive, start, &trial, &signs);
+                    landed = true;
+                }
+            }
+            // Overshoot: aim at the goal by the secant on progress.
+            let secant = ((1.0 - here) / (reached - here)).clamp(0.05, 0.999_999);
             if ahead > 1.0 + 1e-10 {
-                // Overshoot: aim at the goal by the secant on progress.
-                let fraction = ((1.0 - here) / (ahead - here)).clamp(0.05, 0.999_999);
-                h *= fraction;
+                h *= secant;
                 continue;
             }
             // A crease that passes through flat against its assignment has left the branch.
@@ -624,6 +663,12 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                     break;
                 }
             };
+            if landed {
+                // The event is the landing's: approach the goal from before it instead.
+                may_land = false;
+                h *= secant;
+                continue;
+            }
             if h <= LOCATE {
                 event = Some(found);
                 break;
@@ -688,6 +733,35 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
     )
 }
 
+/// Moves a state just past the drive's goal onto it: the crease that sets progress is put
+/// at its goal and held there while Newton closes every vertex (an assignment's drive, or a
+/// single driven crease). None where that does not apply or Newton fails (the caller then
+/// shortens the step); `trial` is left unchanged then.
+fn land_on_goal(
+    model: &FoldingModel,
+    drive: &Drive,
+    trial: &mut [f64],
+    signs: &[f64],
+    tol: f64,
+    solver: &mut NormalSolver,
+) -> Result<Option<Correction>> {
+    let (crease, value) = match drive {
+        Drive::Assignment { to } => match progress_crease(drive, trial, signs) {
+            Some(c) => (c, trial[c].signum() * PI * to),
+            None => return Ok(None),
+        },
+        Drive::Creases(list) if list.len() == 1 => list[0],
+        Drive::Creases(_) => return Ok(None),
+    };
+    let mut state = trial.to_vec();
+    state[crease] = value;
+    let landed = correct(model, &mut state, tol, solver, Some(crease))?;
+    if landed.is_some() {
+        trial.copy_from_slice(&state);
+    }
+    Ok(landed)
+}
+
 /// What a corrector did.
 struct Correction {
     /// Newton iterations.
@@ -707,12 +781,19 @@ fn correct(
     fold_angles: &mut [f64],
     tol: f64,
     solver: &mut NormalSolver,
+    held: Option<usize>,
 ) -> Result<Option<Correction>> {
     let mut previous = f64::INFINITY;
     let mut first = 0.0;
     let mut last = None;
     for iteration in 0..30 {
-        let jac = closure_jacobian(model, fold_angles);
+        let mut jac = closure_jacobian(model, fold_angles);
+        if let Some(c) = held {
+            // Zeroed, not removed: the sparsity pattern (and its symbolic analysis) stays.
+            for entry in jac.entries.iter_mut().filter(|e| e.1 == c) {
+                entry.2 = 0.0;
+            }
+        }
         let worst = jac.worst_residual();
         if !worst.is_finite() {
             return Ok(None);
@@ -789,4 +870,50 @@ pub fn project_to_rigid(model: &FoldingModel, fold_angles: &[f64], tol: f64) -> 
         residual_before,
         iterations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pattern::generate::MiuraSpec;
+
+    /// A state just past the goal lands on it: progress 1 to rounding, every vertex closed,
+    /// and the move is small (the state was within a step of the goal).
+    #[test]
+    fn a_state_past_the_goal_lands_on_it() {
+        let spec = MiuraSpec {
+            rows: 4,
+            cols: 4,
+            ..MiuraSpec::default()
+        };
+        let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to: 0.5 },
+            ..FoldSettings::default()
+        };
+        let start = model.given_fold_angles();
+        let path = fold_path(&model, &start, &settings).unwrap();
+        let past = path.steps.last().unwrap().fold_angles.clone();
+        let signs = assigned_signs(&model);
+        let goal = Drive::Assignment { to: 0.48 };
+        assert!(progress(&goal, &start, &past, &signs) > 1.03);
+        let mut state = past.clone();
+        let mut solver = NormalSolver::new(PATH_REGULARISATION);
+        let landed = land_on_goal(&model, &goal, &mut state, &signs, 1e-12, &mut solver)
+            .unwrap()
+            .expect("Newton lands within a step");
+        assert!(landed.residual <= 1e-12);
+        assert!((progress(&goal, &start, &state, &signs) - 1.0).abs() < 1e-14);
+        let moved = state.iter().zip(&past).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(moved < 0.1, "{moved}");
+        // Several driven creases: no single crease sets the goal, so nothing is done.
+        let several = Drive::Creases(vec![(0, 0.1), (1, 0.1)]);
+        let mut untouched = past.clone();
+        assert!(
+            land_on_goal(&model, &several, &mut untouched, &signs, 1e-12, &mut solver)
+                .unwrap()
+                .is_none()
+        );
+        assert_eq!(untouched, past);
+    }
 }

@@ -53,6 +53,50 @@ fn chain(sector_angles: &[f64], fold_angles: &[f64], mut nodes: Option<&mut [Vec
     frame
 }
 
+/// `frame ← frame · R_x(ρ) · R_z(α)` from (sin, cos) of ρ and of α.
+fn turn_trig(frame: &mut Matrix3<f64>, (s, c): (f64, f64), (sa, ca): (f64, f64)) {
+    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
+    frame.set_column(1, &(c * c1 + s * c2));
+    frame.set_column(2, &(c * c2 - s * c1));
+    let (c0, c1) = (frame.column(0).into_owned(), frame.column(1).into_owned());
+    frame.set_column(0, &(ca * c0 + sa * c1));
+    frame.set_column(1, &(ca * c1 - sa * c0));
+}
+
+/// [`closure_jacobian`] of every ray, from the (sin, cos) of the sector angles and of the
+/// fold angles (ray order), without allocating: returns r and writes ∂r/∂ρ_k into
+/// `columns[k]` (`nodes` is scratch; both as long as the fold angles).
+pub fn closure_jacobian_trig(
+    sector_trig: &[(f64, f64)],
+    fold_trig: &[(f64, f64)],
+    nodes: &mut [Vec3],
+    columns: &mut [Vector3<f64>],
+) -> Vector3<f64> {
+    let n = fold_trig.len();
+    let (s0, c0) = sector_trig[0];
+    let mut frame = Matrix3::new(c0, -s0, 0.0, s0, c0, 0.0, 0.0, 0.0, 1.0);
+    if n > 1 {
+        nodes[1] = frame.column(0).into_owned();
+    }
+    for k in 1..n {
+        turn_trig(&mut frame, fold_trig[k], sector_trig[k]);
+        if k + 1 < n {
+            nodes[k + 1] = frame.column(0).into_owned();
+        }
+    }
+    let (s, c) = fold_trig[0];
+    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
+    frame.set_column(1, &(c * c1 + s * c2));
+    frame.set_column(2, &(c * c2 - s * c1));
+    let r = rotation_vector(&frame);
+    let jl_inv = left_jacobian_inverse(&r);
+    columns[0] = jl_inv * frame.column(0);
+    for k in 1..n {
+        columns[k] = jl_inv * nodes[k];
+    }
+    r
+}
+
 /// Node positions of the rays for the given sector and fold angles, sector 0 fixed in the
 /// xy-plane. `fold_angles[0]` is used only by [`closure_rotation`]; for an open chain
 /// (`sector_angles.len() == n − 1`) the boundary rays' fold angles are ignored.
@@ -247,6 +291,21 @@ mod tests {
     use super::*;
     use crate::geometry::sphere::{fold_angle, geodesic};
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
+
+    #[test]
+    fn the_trigonometric_closure_jacobian_is_the_angle_one() {
+        let sectors = [1.1, 0.9, 1.4, 1.2, TAU - 4.6];
+        let folds = [0.3, -1.2, 2.9, 0.7, -0.4];
+        let (r, jac) = closure_jacobian(&sectors, &folds, &[0, 1, 2, 3, 4]);
+        let sector_trig: Vec<(f64, f64)> = sectors.iter().map(|a| a.sin_cos()).collect();
+        let fold_trig: Vec<(f64, f64)> = folds.iter().map(|a| a.sin_cos()).collect();
+        let (mut nodes, mut columns) = (vec![Vec3::zeros(); 5], vec![Vec3::zeros(); 5]);
+        let r_trig = closure_jacobian_trig(&sector_trig, &fold_trig, &mut nodes, &mut columns);
+        assert!(r.norm() > 0.1 && (r - r_trig).norm() < 1e-14);
+        for (k, column) in columns.iter().enumerate() {
+            assert!((jac.column(k) - column).norm() < 1e-14, "ray {k}");
+        }
+    }
 
     #[test]
     fn flat_state_puts_nodes_at_cumulative_angles() {
