@@ -11,6 +11,7 @@ pub mod path;
 pub mod poses;
 pub mod rank;
 pub mod reduction;
+pub mod second_order;
 pub mod simd_state;
 pub mod verdict;
 

@@ -9,6 +9,7 @@ use super::model::{FoldingModel, Star};
 use super::path::{fold_path, Drive, FoldPath, FoldSettings, StopReason};
 use super::poses::{panel_poses, tree_mismatch};
 use super::rank::{jacobian_rank, RankReport};
+use super::second_order::{second_order, SecondOrder, CERTIFICATE};
 use crate::error::Result;
 use crate::pattern::crease_pattern::EdgeKind;
 use crate::pattern::Assignment;
@@ -319,6 +320,9 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
     let exact = model.exact_angle_tolerance();
     let mut local_checked = 0;
     let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
+    // Vertices of other degrees: the second-order test, once per shape and signs.
+    let mut second_order_seen = std::collections::HashMap::new();
+    let mut second_order_checked = 0;
     for star in &model.stars {
         // A locked crease stays flat: the vertex's modes from flat do not apply as computed.
         if star.columns.iter().any(|&c| model.locked_columns[c]) {
@@ -327,6 +331,49 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
         }
         let Some(modes) = degree4_modes_within(star, exact) else {
             chosen.push(None);
+            let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+            let key = (
+                star.sector_angles
+                    .iter()
+                    .map(|a| (a * 1e12).round() as i64)
+                    .collect::<Vec<_>>(),
+                assigned.iter().map(|&a| a as i8).collect::<Vec<_>>(),
+            );
+            let found = match second_order_seen.get(&key) {
+                Some(found) => *found,
+                None => {
+                    let found = second_order(star, &assigned);
+                    second_order_seen.insert(key, found);
+                    found
+                }
+            };
+            let Some(found) = found else { continue };
+            second_order_checked += 1;
+            if found.excludes_motion(CERTIFICATE) {
+                let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
+                report.verdict = PatternVerdict::NotRigidlyFoldable;
+                report.evidence = match found {
+                    SecondOrder::OneSign => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) has one sign: such a vertex folds only along a straight line through it (its image on the unit sphere, a locally convex polygon of length 2π, must be a great circle or a lune), so its other creases stay flat",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                    SecondOrder::NoFirstOrder => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat: no velocities with these signs close it in the plane",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                    SecondOrder::Range { min, max } => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat at second order: on the velocities with these signs that close it in the plane (scaled to Σ|ρ̇| = 1) the out-of-plane second-order closure Q ranges over [{min:.3e}, {max:.3e}], which excludes 0",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                };
+                return Ok(report);
+            }
             continue;
         };
         local_checked += 1;
@@ -365,6 +412,11 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
     if local_checked > 0 {
         report.tried.push(format!(
             "{local_checked} degree-4 vertices: each assignment matches a folding mode"
+        ));
+    }
+    if second_order_checked > 0 {
+        report.tried.push(format!(
+            "{second_order_checked} vertices of other degrees: each assignment passes the second-order test at flat"
         ));
     }
     if let Some(conflict) = mode_conflict(model, &chosen, exact) {
