@@ -3,7 +3,7 @@
 //! back onto every vertex closure; panel contact checked at every step.
 
 use super::closure::closure_jacobian;
-use super::contact::{panel_contacts, ContactSettings};
+use super::contact::{panel_contacts, ContactReport, ContactSettings};
 use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
 use super::poses::{panel_poses, Pose};
@@ -387,108 +387,180 @@ fn against_assignment(rho: &[f64], signs: &[f64], slack: f64) -> Vec<usize> {
 /// Folds from `start` (a rigid state, or the flat one) as `settings.drive` asks.
 pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -> Result<FoldPath> {
     settings.validate(model)?;
-    let n = model.crease_count();
-    if start.len() != n {
-        return Err(NanofoldError::invalid(
-            "start",
-            format!("{} fold angles", start.len()),
-            format!("one per crease ({n})"),
-        ));
+    let mut walk = Walk::new(model, start, settings)?;
+    if let Some(stop) = walk.check_start() {
+        return Ok(walk.finish(stop));
     }
-    let signs = assigned_signs(model);
-    let mut solver = NormalSolver::new(PATH_REGULARISATION);
-    let mut poses: Vec<Pose> = Vec::new();
-    let mut rho = start.to_vec();
-    let mut newton_iterations = 0;
-    let start_residual = closure_jacobian(model, &rho).worst_residual();
-    if start_residual > settings.closure_tol {
-        match restore_closure(model, &mut rho, settings.closure_tol, &mut solver)? {
-            Some(k) if start_residual <= 1e-6 => newton_iterations += k,
-            _ => {
-                return Err(NanofoldError::invalid(
-                    "start",
-                    format!("closure residual {start_residual:.3e} rad"),
-                    "the start is not a rigid state (above 1e-6 rad at some vertex)",
-                ))
-            }
+    if inf_norm(&walk.rho) <= 1e-12 {
+        if let Some(stop) = walk.leave_flat()? {
+            return Ok(walk.finish(stop));
         }
     }
-    let contact_at = |rho: &[f64], poses: &mut Vec<Pose>| {
-        panel_poses(model, rho, poses);
-        panel_contacts(model, poses, &settings.contact)
-    };
-    let first = contact_at(&rho, &mut poses);
-    let mut steps = vec![PathStep {
-        progress: progress(&settings.drive, start, &rho, &signs),
-        fold_angles: rho.clone(),
-        max_residual: closure_jacobian(model, &rho).worst_residual(),
-        min_clearance: first.min_clearance,
-    }];
-    let finish = |steps: Vec<PathStep>, stop: StopReason, evidence: String, branch: Option<String>, newton| {
-        let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
-        let min_panel_clearance = steps.iter().filter_map(|s| s.min_clearance).reduce(f64::min);
-        Ok(FoldPath {
-            steps,
-            stop,
-            evidence,
-            branch,
-            max_closure_residual,
-            min_panel_clearance,
-            newton_iterations: newton,
-            drive: settings.drive.clone(),
-        })
-    };
-    if let Some(found) = first.overflow {
-        return finish(
-            steps,
-            StopReason::ContactBudget { pairs: found - 1 },
-            over_budget(found, "at the start"),
-            None,
-            newton_iterations,
-        );
+    for _ in 0..settings.max_steps {
+        if let Some(stop) = walk.step()? {
+            return Ok(walk.finish(stop));
+        }
     }
-    if let Some(pair) = first.crossing().next() {
-        let panels = pair.panels;
-        return finish(
-            steps,
-            StopReason::Blocked { panels },
-            format!("panels {} and {} cross at the start", panels[0], panels[1]),
-            None,
-            newton_iterations,
+    let stop = Stop::new(StopReason::StepLimit, format!("{} steps", settings.max_steps));
+    Ok(walk.finish(stop))
+}
+
+/// Why a path ends, and the evidence.
+struct Stop {
+    reason: StopReason,
+    evidence: String,
+}
+
+impl Stop {
+    fn new(reason: StopReason, evidence: impl Into<String>) -> Self {
+        Stop {
+            reason,
+            evidence: evidence.into(),
+        }
+    }
+}
+
+/// A path under way: the state, the steps so far and the scratch the steps reuse.
+struct Walk<'a> {
+    model: &'a FoldingModel,
+    settings: &'a FoldSettings,
+    start: &'a [f64],
+    signs: Vec<f64>,
+    solver: NormalSolver,
+    poses: Vec<Pose>,
+    rho: Vec<f64>,
+    steps: Vec<PathStep>,
+    newton_iterations: usize,
+    branch: Option<String>,
+    /// The next step's length (the largest fold-angle change), rad.
+    h: f64,
+    /// The corrector's last factorisation, made within its last (tiny) correction of `rho`.
+    carried: Option<NormalFactor>,
+    /// The contacts of the first state.
+    first_contacts: Option<ContactReport>,
+}
+
+/// How one step's trials ended.
+enum Trial {
+    /// The next state, its smallest clearance and its corrector's record.
+    Accepted(Vec<f64>, Option<f64>, Correction),
+    /// An event located to within [`LOCATE`].
+    Event(Stop),
+    /// Newton found no rigid state, even with the shortest step.
+    Lost,
+}
+
+impl<'a> Walk<'a> {
+    /// The start, closed onto every vertex where it is within 1e-6 rad of rigid.
+    fn new(model: &'a FoldingModel, start: &'a [f64], settings: &'a FoldSettings) -> Result<Self> {
+        let n = model.crease_count();
+        if start.len() != n {
+            return Err(NanofoldError::invalid(
+                "start",
+                format!("{} fold angles", start.len()),
+                format!("one per crease ({n})"),
+            ));
+        }
+        let mut walk = Walk {
+            model,
+            settings,
+            start,
+            signs: assigned_signs(model),
+            solver: NormalSolver::new(PATH_REGULARISATION),
+            poses: Vec::new(),
+            rho: start.to_vec(),
+            steps: Vec::new(),
+            newton_iterations: 0,
+            branch: None,
+            h: settings.max_step.min(INITIAL_STEP),
+            carried: None,
+            first_contacts: None,
+        };
+        let start_residual = closure_jacobian(model, &walk.rho).worst_residual();
+        if start_residual > settings.closure_tol {
+            match restore_closure(model, &mut walk.rho, settings.closure_tol, &mut walk.solver)? {
+                Some(k) if start_residual <= 1e-6 => walk.newton_iterations += k,
+                _ => {
+                    return Err(NanofoldError::invalid(
+                        "start",
+                        format!("closure residual {start_residual:.3e} rad"),
+                        "the start is not a rigid state (above 1e-6 rad at some vertex)",
+                    ))
+                }
+            }
+        }
+        let first = walk.contacts(&walk.rho.clone());
+        walk.record(
+            walk.rho.clone(),
+            closure_jacobian(model, &walk.rho).worst_residual(),
+            first.min_clearance,
         );
+        walk.first_contacts = Some(first);
+        Ok(walk)
     }
 
-    // Leaving the flat state: a kick along the projected direction, Newton onto the nearest
-    // branch, and every crease's sign checked against its assignment.
-    let mut branch = None;
-    if inf_norm(&rho) <= 1e-12 {
+    fn progress_of(&self, rho: &[f64]) -> f64 {
+        progress(&self.settings.drive, self.start, rho, &self.signs)
+    }
+
+    fn contacts(&mut self, rho: &[f64]) -> ContactReport {
+        panel_poses(self.model, rho, &mut self.poses);
+        panel_contacts(self.model, &self.poses, &self.settings.contact)
+    }
+
+    fn record(&mut self, fold_angles: Vec<f64>, max_residual: f64, min_clearance: Option<f64>) {
+        self.steps.push(PathStep {
+            progress: self.progress_of(&fold_angles),
+            fold_angles,
+            max_residual,
+            min_clearance,
+        });
+    }
+
+    /// The contact budget passed, or panels crossing, at the start.
+    fn check_start(&mut self) -> Option<Stop> {
+        let first = self.first_contacts.take()?;
+        if let Some(found) = first.overflow {
+            return Some(Stop::new(
+                StopReason::ContactBudget { pairs: found - 1 },
+                over_budget(found, "at the start"),
+            ));
+        }
+        let panels = first.crossing().next()?.panels;
+        Some(Stop::new(
+            StopReason::Blocked { panels },
+            format!("panels {} and {} cross at the start", panels[0], panels[1]),
+        ))
+    }
+
+    /// Leaving the flat state: a kick along the projected direction, Newton onto the nearest
+    /// branch, and every crease's sign checked against its assignment.
+    fn leave_flat(&mut self) -> Result<Option<Stop>> {
+        let (model, settings) = (self.model, self.settings);
         // The branch is the assignment's, whatever drives the motion afterwards (a driven
         // crease alone would pick any branch, e.g. a straight line folded on its own).
-        let mut d = if signs.iter().any(|&s| s != 0.0) {
-            signs.clone()
+        let mut d = if self.signs.iter().any(|&s| s != 0.0) {
+            self.signs.clone()
         } else {
-            desired_velocity(&settings.drive, &rho, &signs)
+            desired_velocity(&settings.drive, &self.rho, &self.signs)
         };
         model.hold_locked(&mut d);
-        let factor = solver.factor(&closure_jacobian(model, &rho))?;
+        let factor = self.solver.factor(&closure_jacobian(model, &self.rho))?;
         let v = factor.project(&d);
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d).max(f64::MIN_POSITIVE) {
-            return finish(
-                steps,
+            return Ok(Some(Stop::new(
                 StopReason::Locked,
-                "no first-order motion from flat in the driven direction".into(),
-                None,
-                newton_iterations,
-            );
+                "no first-order motion from flat in the driven direction",
+            )));
         }
         // The noise's kick first; where Newton finds nothing from it, the plain one.
         let raised = noise_kick(model, settings.kick);
         let mut landed = None;
         for kick in [raised, settings.kick] {
-            let mut trial: Vec<f64> = rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
-            if let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut solver)? {
-                newton_iterations += k;
+            let mut trial: Vec<f64> = self.rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
+            if let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut self.solver)? {
+                self.newton_iterations += k;
                 landed = Some((kick, trial));
                 break;
             }
@@ -497,32 +569,23 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
             }
         }
         let Some((kick, trial)) = landed else {
-            return finish(
-                steps,
+            return Ok(Some(Stop::new(
                 StopReason::BranchPoint { creases: vec![] },
                 format!(
                     "Newton found no rigid state {:.0e} rad from flat along the projected direction",
                     settings.kick
                 ),
-                None,
-                newton_iterations,
-            );
+            )));
         };
-        let wrong = against_assignment(&trial, &signs, 1e-3 * kick);
+        let wrong = against_assignment(&trial, &self.signs, 1e-3 * kick);
         if !wrong.is_empty() {
             let evidence = format!(
                 "the branch reached from flat folds creases {:?} against their assignment",
                 &wrong[..wrong.len().min(8)]
             );
-            return finish(
-                steps,
-                StopReason::BranchPoint { creases: wrong },
-                evidence,
-                None,
-                newton_iterations,
-            );
+            return Ok(Some(Stop::new(StopReason::BranchPoint { creases: wrong }, evidence)));
         }
-        branch = Some(format!(
+        self.branch = Some(format!(
             "left flat by a kick of {kick:.0e} rad along the projected direction, Newton onto the closure, every crease's sign checked against its assignment{}",
             if kick > settings.kick {
                 format!(" (the kick raised from {:.0e}: the sheet's vertices are flat-foldable only to its noise, and noise of size ε splits the branches within about √ε of flat)", settings.kick)
@@ -530,207 +593,215 @@ pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -
                 String::new()
             }
         ));
-        rho = trial;
-        let contacts = contact_at(&rho, &mut poses);
-        steps.push(PathStep {
-            progress: progress(&settings.drive, start, &rho, &signs),
-            fold_angles: rho.clone(),
-            max_residual: closure_jacobian(model, &rho).worst_residual(),
-            min_clearance: contacts.min_clearance,
-        });
+        self.rho = trial;
+        let contacts = self.contacts(&self.rho.clone());
+        self.record(
+            self.rho.clone(),
+            closure_jacobian(model, &self.rho).worst_residual(),
+            contacts.min_clearance,
+        );
+        Ok(None)
     }
 
-    let mut h = settings.max_step.min(INITIAL_STEP);
-    let mut carried: Option<NormalFactor> = None;
-    for _ in 0..settings.max_steps {
-        let here = progress(&settings.drive, start, &rho, &signs);
+    /// One step: predictor, corrector, events, step control. Some(stop) where the path ends.
+    fn step(&mut self) -> Result<Option<Stop>> {
+        let here = self.progress_of(&self.rho);
         if here >= 1.0 - 1e-9 {
-            return finish(
-                steps,
-                StopReason::Reached,
-                format!("progress {here:.9}"),
-                branch,
-                newton_iterations,
-            );
+            return Ok(Some(Stop::new(StopReason::Reached, format!("progress {here:.9}"))));
         }
-        // Predictor: the desired velocity projected onto the tangent space, scaled to a
-        // largest component of 1 (h is then the largest fold-angle change, rad).
-        // The corrector's last factorisation, made within its last (tiny) correction of
-        // here, serves the projection; else a fresh one.
-        let factor = match carried.take() {
-            Some(factor) => factor,
-            None => solver.factor(&closure_jacobian(model, &rho))?,
+        let tangent = match self.tangent()? {
+            Ok(tangent) => tangent,
+            Err(size) => {
+                return Ok(Some(Stop::new(
+                    StopReason::Locked,
+                    format!("the projected velocity vanishes (|P d| = {size:.1e}): no rigid motion this way"),
+                )))
+            }
         };
-        let mut d = desired_velocity(&settings.drive, &rho, &signs);
-        model.hold_locked(&mut d);
-        let v = factor.project(&d);
-        let size = inf_norm(&v);
-        if size <= 1e-9 * inf_norm(&d) {
-            return finish(
-                steps,
-                StopReason::Locked,
-                format!("the projected velocity vanishes (|P d| = {size:.1e}): no rigid motion this way"),
-                branch,
-                newton_iterations,
-            );
-        }
-        let tangent: Vec<f64> = v.iter().map(|x| x / size).collect();
-        h = h.min(settings.max_step);
-        if let Drive::Creases(list) = &settings.drive {
+        self.h = self.h.min(self.settings.max_step);
+        if let Drive::Creases(list) = &self.settings.drive {
             // Do not step past a driven crease's target (to first order).
             for &(c, t) in list {
-                if tangent[c] * (t - rho[c]) > 0.0 {
-                    h = h.min((t - rho[c]) / tangent[c]);
+                if tangent[c] * (t - self.rho[c]) > 0.0 {
+                    self.h = self.h.min((t - self.rho[c]) / tangent[c]);
                 }
             }
         }
-        // Corrector: Newton onto every closure. A trial that fails, overshoots the goal, or
-        // meets an event (a crease against its assignment, panels crossing, the contact
-        // budget) is retried shorter; an event is located to within LOCATE rad.
-        let mut accepted = None;
-        let mut event: Option<(StopReason, String)> = None;
+        let (next, min_clearance, correction) = match self.trials(&tangent, here)? {
+            Trial::Accepted(next, min_clearance, correction) => (next, min_clearance, correction),
+            Trial::Event(stop) => {
+                return Ok(Some(Stop::new(
+                    stop.reason,
+                    format!("{} (located to {LOCATE:.0e} rad)", stop.evidence),
+                )))
+            }
+            Trial::Lost => {
+                let mut creases: Vec<usize> = (0..tangent.len()).collect();
+                creases.sort_by(|&a, &b| tangent[b].abs().total_cmp(&tangent[a].abs()));
+                creases.truncate(6);
+                return Ok(Some(Stop::new(
+                    StopReason::BranchPoint { creases },
+                    "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad",
+                )));
+            }
+        };
+        // Step control: the corrector's first move over the step is the angle between the
+        // chord and the tangent, ∝ h (curvature); aim it at TARGET_ANGLE, and shrink where
+        // Newton needed many iterations.
+        let angle = correction.first / self.h;
+        let mut grow = if angle > 0.0 { TARGET_ANGLE / angle } else { MAX_GROWTH };
+        if correction.iterations > SLOW_CORRECTOR {
+            grow = grow.min(0.7);
+        }
+        self.h *= grow.clamp(0.25, MAX_GROWTH);
+        self.carried = correction.factor;
+        self.rho = next;
+        let now = self.progress_of(&self.rho);
+        let steps = &self.steps;
+        if steps.len() > STALL_STEPS && now - steps[steps.len() - STALL_STEPS].progress < 1e-9 {
+            return Ok(Some(Stop::new(
+                StopReason::Locked,
+                format!("progress {now:.9} grew by less than 1e-9 over the last {STALL_STEPS} steps: the drive has no rigid motion left"),
+            )));
+        }
+        self.record(self.rho.clone(), correction.residual, min_clearance);
+        Ok(None)
+    }
+
+    /// Predictor: the desired velocity projected onto the tangent space, scaled to a largest
+    /// component of 1 (h is then the largest fold-angle change, rad). Err(its size) where it
+    /// vanishes.
+    fn tangent(&mut self) -> Result<std::result::Result<Vec<f64>, f64>> {
+        // The corrector's last factorisation serves the projection; else a fresh one.
+        let factor = match self.carried.take() {
+            Some(factor) => factor,
+            None => self.solver.factor(&closure_jacobian(self.model, &self.rho))?,
+        };
+        let mut d = desired_velocity(&self.settings.drive, &self.rho, &self.signs);
+        self.model.hold_locked(&mut d);
+        let v = factor.project(&d);
+        let size = inf_norm(&v);
+        if size <= 1e-9 * inf_norm(&d) {
+            return Ok(Err(size));
+        }
+        Ok(Ok(v.iter().map(|x| x / size).collect()))
+    }
+
+    /// Corrector: Newton onto every closure. A trial that fails, overshoots the goal, or
+    /// meets an event (a crease against its assignment, panels crossing, the contact budget)
+    /// is retried shorter; an event is located to within LOCATE rad.
+    fn trials(&mut self, tangent: &[f64], here: f64) -> Result<Trial> {
+        let (model, settings) = (self.model, self.settings);
         // Landing on the goal is tried until a landed state meets an event: at a singular
         // goal (a flat-folded state) holding one crease there can push another past it.
         let mut may_land = true;
         for _ in 0..80 {
-            let mut trial: Vec<f64> = rho.iter().zip(&tangent).map(|(r, x)| r + h * x).collect();
-            let corrected = correct(model, &mut trial, settings.closure_tol, &mut solver, None)?;
-            let Some(correction) = corrected else {
-                h /= 2.0;
-                if h < settings.max_step.min(MIN_STEP) * 1e-3 {
-                    break;
+            let h = self.h;
+            let mut trial: Vec<f64> = self.rho.iter().zip(tangent).map(|(r, x)| r + h * x).collect();
+            let Some(mut correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None)? else {
+                self.h /= 2.0;
+                if self.h < settings.max_step.min(MIN_STEP) * 1e-3 {
+                    return Ok(Trial::Lost);
                 }
                 continue;
             };
-            newton_iterations += correction.iterations;
+            self.newton_iterations += correction.iterations;
             if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) {
-                h /= 2.0;
+                self.h /= 2.0;
                 continue;
             }
-            let reached = progress(&settings.drive, start, &trial, &signs);
+            let reached = self.progress_of(&trial);
             let mut ahead = reached;
-            let mut correction = correction;
             let mut landed = false;
             if ahead > 1.0 + 1e-10 && may_land {
                 // Past the goal: onto it directly, the crease that sets progress held there.
-                if let Some(landing) = land_on_goal(
+                let goal = land_on_goal(
                     model,
                     &settings.drive,
                     &mut trial,
-                    &signs,
+                    &self.signs,
                     settings.closure_tol,
-                    &mut solver,
-                )? {
-                    newton_iterations += landing.iterations;
+                    &mut self.solver,
+                )?;
+                if let Some(landing) = goal {
+                    self.newton_iterations += landing.iterations;
                     correction.residual = landing.residual;
                     correction.factor = None;
-                    ahead = progress(&settings.drive, start, &trial, &signs);
+                    ahead = self.progress_of(&trial);
                     landed = true;
                 }
             }
             // Overshoot: aim at the goal by the secant on progress.
             let secant = ((1.0 - here) / (reached - here)).clamp(0.05, 0.999_999);
             if ahead > 1.0 + 1e-10 {
-                h *= secant;
+                self.h *= secant;
                 continue;
             }
-            // A crease that passes through flat against its assignment has left the branch.
-            let wrong = against_assignment(&trial, &signs, 1e-9);
-            let found = if !wrong.is_empty() {
-                let evidence = format!(
-                    "creases {:?} would fold against their assignment after progress {here:.6}",
-                    &wrong[..wrong.len().min(8)]
-                );
-                (StopReason::BranchPoint { creases: wrong }, evidence)
-            } else {
-                let contacts = contact_at(&trial, &mut poses);
-                if let Some(found) = contacts.overflow {
-                    (
-                        StopReason::ContactBudget { pairs: found - 1 },
-                        over_budget(found, &format!("after progress {here:.6}")),
-                    )
-                } else if let Some(pair) = contacts.crossing().next() {
-                    let panels = pair.panels;
-                    (
-                        StopReason::Blocked { panels },
-                        format!(
-                            "panels {} and {} would pass through each other after progress {here:.6}",
-                            panels[0], panels[1]
-                        ),
-                    )
-                } else {
-                    accepted = Some((trial, contacts.min_clearance, correction));
-                    break;
-                }
+            let found = match self.event(&trial, here) {
+                Ok(min_clearance) => return Ok(Trial::Accepted(trial, min_clearance, correction)),
+                Err(found) => found,
             };
             if landed {
                 // The event is the landing's: approach the goal from before it instead.
                 may_land = false;
-                h *= secant;
+                self.h *= secant;
                 continue;
             }
-            if h <= LOCATE {
-                event = Some(found);
-                break;
+            if self.h <= LOCATE {
+                return Ok(Trial::Event(found));
             }
-            h /= 2.0;
+            self.h /= 2.0;
         }
-        if let Some((stop, evidence)) = event {
-            return finish(
-                steps,
-                stop,
-                format!("{evidence} (located to {LOCATE:.0e} rad)"),
-                branch,
-                newton_iterations,
-            );
-        }
-        let Some((next, min_clearance, correction)) = accepted else {
-            let mut creases: Vec<usize> = (0..n).collect();
-            creases.sort_by(|&a, &b| tangent[b].abs().total_cmp(&tangent[a].abs()));
-            creases.truncate(6);
-            return finish(
-                steps,
-                StopReason::BranchPoint { creases },
-                "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad".into(),
-                branch,
-                newton_iterations,
-            );
-        };
-        // Step control: the corrector's first move over the step is the angle between the
-        // chord and the tangent, ∝ h (curvature); aim it at TARGET_ANGLE, and shrink where
-        // Newton needed many iterations.
-        let angle = correction.first / h;
-        let mut grow = if angle > 0.0 { TARGET_ANGLE / angle } else { MAX_GROWTH };
-        if correction.iterations > SLOW_CORRECTOR {
-            grow = grow.min(0.7);
-        }
-        h *= grow.clamp(0.25, MAX_GROWTH);
-        carried = correction.factor;
-        rho = next;
-        let now = progress(&settings.drive, start, &rho, &signs);
-        if steps.len() > STALL_STEPS && now - steps[steps.len() - STALL_STEPS].progress < 1e-9 {
-            return finish(
-                steps,
-                StopReason::Locked,
-                format!("progress {now:.9} grew by less than 1e-9 over the last {STALL_STEPS} steps: the drive has no rigid motion left"),
-                branch,
-                newton_iterations,
-            );
-        }
-        steps.push(PathStep {
-            progress: now,
-            fold_angles: rho.clone(),
-            max_residual: correction.residual,
-            min_clearance,
-        });
+        Ok(Trial::Lost)
     }
-    finish(
-        steps,
-        StopReason::StepLimit,
-        format!("{} steps", settings.max_steps),
-        branch,
-        newton_iterations,
-    )
+
+    /// A trial state's event (a crease folded against its assignment, the contact budget
+    /// passed, panels crossing), or its smallest panel clearance where there is none.
+    fn event(&mut self, trial: &[f64], here: f64) -> std::result::Result<Option<f64>, Stop> {
+        // A crease that passes through flat against its assignment has left the branch.
+        let wrong = against_assignment(trial, &self.signs, 1e-9);
+        if !wrong.is_empty() {
+            let evidence = format!(
+                "creases {:?} would fold against their assignment after progress {here:.6}",
+                &wrong[..wrong.len().min(8)]
+            );
+            return Err(Stop::new(StopReason::BranchPoint { creases: wrong }, evidence));
+        }
+        let contacts = self.contacts(trial);
+        if let Some(found) = contacts.overflow {
+            return Err(Stop::new(
+                StopReason::ContactBudget { pairs: found - 1 },
+                over_budget(found, &format!("after progress {here:.6}")),
+            ));
+        }
+        if let Some(pair) = contacts.crossing().next() {
+            let panels = pair.panels;
+            return Err(Stop::new(
+                StopReason::Blocked { panels },
+                format!(
+                    "panels {} and {} would pass through each other after progress {here:.6}",
+                    panels[0], panels[1]
+                ),
+            ));
+        }
+        Ok(contacts.min_clearance)
+    }
+
+    /// The path as it ends.
+    fn finish(self, stop: Stop) -> FoldPath {
+        let max_closure_residual = self.steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
+        let min_panel_clearance = self.steps.iter().filter_map(|s| s.min_clearance).reduce(f64::min);
+        FoldPath {
+            steps: self.steps,
+            stop: stop.reason,
+            evidence: stop.evidence,
+            branch: self.branch,
+            max_closure_residual,
+            min_panel_clearance,
+            newton_iterations: self.newton_iterations,
+            drive: self.settings.drive.clone(),
+        }
+    }
 }
 
 /// Moves a state just past the drive's goal onto it: the crease that sets progress is put

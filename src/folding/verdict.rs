@@ -260,165 +260,24 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
         return Ok(report);
     }
     if has_state || bent.is_some() {
-        (report.verdict, report.evidence) = if let Some(bent) = bent {
-            (
-                PatternVerdict::NotRigid,
-                format!("the folded form is not rigid: {bent}; worst vertex closure {max_residual:.3e} rad"),
-            )
-        } else if max_residual > settings.closure_tol {
-            let list: Vec<String> = worst
-                .iter()
-                .filter(|w| w.1 > settings.closure_tol)
-                .map(|(v, r)| format!("vertex {v}: {r:.3e} rad"))
-                .collect();
-            (
-                PatternVerdict::NotRigid,
-                format!(
-                    "closure fails above {:.0e} rad at {}",
-                    settings.closure_tol,
-                    list.join(", ")
-                ),
-            )
-        } else if let Some(found) = contacts.overflow {
-            (
-                PatternVerdict::Unknown,
-                format!(
-                    "every vertex closes within {max_residual:.1e} rad, but more than {} pairs of panels overlap (layers stacked deep), the contact test's budget: whether panels cross is not decided ({} DOF at this state)",
-                    found - 1,
-                    report.rank.dof
-                ),
-            )
-        } else if !report.intersecting_pairs.is_empty() {
-            let list: Vec<String> = report
-                .intersecting_pairs
-                .iter()
-                .take(8)
-                .map(|p| format!("{p:?}"))
-                .collect();
-            (
-                PatternVerdict::SelfIntersecting,
-                format!(
-                    "{} panel pairs pass through each other: {}",
-                    report.intersecting_pairs.len(),
-                    list.join(", ")
-                ),
-            )
-        } else {
-            (
-                PatternVerdict::Rigid,
-                format!(
-                    "every vertex closes within {max_residual:.1e} rad, no panels cross ({} DOF at this state)",
-                    report.rank.dof
-                ),
-            )
-        };
+        (report.verdict, report.evidence) = state_verdict(&report, bent, &worst, contacts.overflow, settings);
         return Ok(report);
     }
 
     // An assignment alone: first the local test at each degree-4 vertex, then the modes'
     // agreement across shared creases, then a witness.
     let exact = model.exact_angle_tolerance();
-    let mut local_checked = 0;
-    let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
-    // Vertices of other degrees: the second-order test, once per shape and signs.
-    let mut second_order_seen = std::collections::HashMap::new();
-    let mut second_order_checked = 0;
-    for star in &model.stars {
-        // A locked crease stays flat: the vertex's modes from flat do not apply as computed.
-        if star.columns.iter().any(|&c| model.locked_columns[c]) {
-            chosen.push(None);
-            continue;
+    let chosen = match local_tests(model, exact) {
+        Ok(local) => {
+            report.tried.extend(local.tried);
+            local.chosen
         }
-        let Some(modes) = degree4_modes_within(star, exact) else {
-            chosen.push(None);
-            let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
-            let key = (
-                star.sector_angles
-                    .iter()
-                    .map(|a| (a * 1e12).round() as i64)
-                    .collect::<Vec<_>>(),
-                assigned.iter().map(|&a| a as i8).collect::<Vec<_>>(),
-            );
-            let found = match second_order_seen.get(&key) {
-                Some(found) => *found,
-                None => {
-                    let found = second_order(star, &assigned);
-                    second_order_seen.insert(key, found);
-                    found
-                }
-            };
-            let Some(found) = found else { continue };
-            second_order_checked += 1;
-            if found.excludes_motion(CERTIFICATE) {
-                let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
-                report.verdict = PatternVerdict::NotRigidlyFoldable;
-                report.evidence = match found {
-                    SecondOrder::OneSign => format!(
-                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) has one sign: such a vertex folds only along a straight line through it (its image on the unit sphere, a locally convex polygon of length 2π, must be a great circle or a lune), so its other creases stay flat",
-                        star.vertex,
-                        assigned.len(),
-                        names.concat()
-                    ),
-                    SecondOrder::NoFirstOrder => format!(
-                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat: no velocities with these signs close it in the plane",
-                        star.vertex,
-                        assigned.len(),
-                        names.concat()
-                    ),
-                    SecondOrder::Range { min, max } => format!(
-                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat at second order: on the velocities with these signs that close it in the plane (scaled to Σ|ρ̇| = 1) the out-of-plane second-order closure Q ranges over [{min:.3e}, {max:.3e}], which excludes 0",
-                        star.vertex,
-                        assigned.len(),
-                        names.concat()
-                    ),
-                };
-                return Ok(report);
-            }
-            continue;
-        };
-        local_checked += 1;
-        let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
-        // A mode's zero entry: at a flat-foldable vertex the branches keep exact ratios of
-        // tan(ρ/2), so that crease stays flat and cannot be a mountain or valley; elsewhere
-        // its sign is decided at higher order and matches anything.
-        let alternating = star
-            .sector_angles
-            .iter()
-            .enumerate()
-            .map(|(k, a)| if k % 2 == 0 { *a } else { -a })
-            .sum::<f64>();
-        let flat_foldable = alternating.abs() < exact;
-        let fits = |mode: &&[f64; 4]| {
-            mode.iter()
-                .zip(&assigned)
-                .all(|(p, a)| *a == 0.0 || (*p == 0.0 && !flat_foldable) || p * a > 0.0)
-        };
-        let matching: Vec<&[f64; 4]> = modes.iter().filter(fits).collect();
-        if matching.is_empty() {
-            let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
-            let options: Vec<String> = modes.iter().map(|m| m.iter().map(|&a| letter(a)).collect()).collect();
+        Err(evidence) => {
             report.verdict = PatternVerdict::NotRigidlyFoldable;
-            report.evidence = format!(
-                "vertex {}: its assignment {} (creases counter-clockwise; 0 unassigned) matches none of the sign patterns of its folding modes from flat ({}; 0: the crease stays flat); a degree-4 vertex leaves flat only along these",
-                star.vertex,
-                names.concat(),
-                if options.is_empty() { "none: the vertex cannot leave flat".to_string() } else { options.join(", ") }
-            );
+            report.evidence = evidence;
             return Ok(report);
         }
-        let decided = matching.len() == 1 && matching[0].iter().all(|&m| m != 0.0);
-        chosen.push(if decided { Some(*matching[0]) } else { None });
-    }
-    if local_checked > 0 {
-        report.tried.push(format!(
-            "{local_checked} degree-4 vertices: each assignment matches a folding mode"
-        ));
-    }
-    if second_order_checked > 0 {
-        report.tried.push(format!(
-            "{second_order_checked} vertices of other degrees: each assignment passes the second-order test at flat"
-        ));
-    }
+    };
     if let Some(conflict) = mode_conflict(model, &chosen, exact) {
         report.verdict = PatternVerdict::NotRigidlyFoldable;
         report.evidence = conflict;
@@ -466,6 +325,182 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
     }
     report.witness = Some(path);
     Ok(report)
+}
+
+/// The verdict of a folded state (or a folded form whose facets bend, `bent`): not rigid,
+/// undecided where the contact budget overflows, self-intersecting, or rigid.
+fn state_verdict(
+    report: &CheckReport,
+    bent: Option<String>,
+    worst: &[(usize, f64)],
+    overflow: Option<usize>,
+    settings: &CheckSettings,
+) -> (PatternVerdict, String) {
+    let max_residual = report.max_vertex_residual_rad;
+    if let Some(bent) = bent {
+        (
+            PatternVerdict::NotRigid,
+            format!("the folded form is not rigid: {bent}; worst vertex closure {max_residual:.3e} rad"),
+        )
+    } else if max_residual > settings.closure_tol {
+        let list: Vec<String> = worst
+            .iter()
+            .filter(|w| w.1 > settings.closure_tol)
+            .map(|(v, r)| format!("vertex {v}: {r:.3e} rad"))
+            .collect();
+        (
+            PatternVerdict::NotRigid,
+            format!(
+                "closure fails above {:.0e} rad at {}",
+                settings.closure_tol,
+                list.join(", ")
+            ),
+        )
+    } else if let Some(found) = overflow {
+        (
+            PatternVerdict::Unknown,
+            format!(
+                "every vertex closes within {max_residual:.1e} rad, but more than {} pairs of panels overlap (layers stacked deep), the contact test's budget: whether panels cross is not decided ({} DOF at this state)",
+                found - 1,
+                report.rank.dof
+            ),
+        )
+    } else if !report.intersecting_pairs.is_empty() {
+        let list: Vec<String> = report
+            .intersecting_pairs
+            .iter()
+            .take(8)
+            .map(|p| format!("{p:?}"))
+            .collect();
+        (
+            PatternVerdict::SelfIntersecting,
+            format!(
+                "{} panel pairs pass through each other: {}",
+                report.intersecting_pairs.len(),
+                list.join(", ")
+            ),
+        )
+    } else {
+        (
+            PatternVerdict::Rigid,
+            format!(
+                "every vertex closes within {max_residual:.1e} rad, no panels cross ({} DOF at this state)",
+                report.rank.dof
+            ),
+        )
+    }
+}
+
+/// What the local tests at the flat vertices leave: each star's decided degree-4 mode (for
+/// the cycle test) and what was tried.
+struct LocalTests {
+    chosen: Vec<Option<[f64; 4]>>,
+    tried: Vec<String>,
+}
+
+/// The local tests of an assignment at each flat vertex: a degree-4 vertex against its
+/// folding modes, another degree by the second-order test. Err(evidence) where a vertex
+/// excludes the assignment.
+fn local_tests(model: &FoldingModel, exact: f64) -> std::result::Result<LocalTests, String> {
+    let mut tried = Vec::new();
+    let mut local_checked = 0;
+    let mut chosen: Vec<Option<[f64; 4]>> = Vec::with_capacity(model.stars.len());
+    // Vertices of other degrees: the second-order test, once per shape and signs.
+    let mut second_order_seen = std::collections::HashMap::new();
+    let mut second_order_checked = 0;
+    for star in &model.stars {
+        // A locked crease stays flat: the vertex's modes from flat do not apply as computed.
+        if star.columns.iter().any(|&c| model.locked_columns[c]) {
+            chosen.push(None);
+            continue;
+        }
+        let Some(modes) = degree4_modes_within(star, exact) else {
+            chosen.push(None);
+            let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+            let key = (
+                star.sector_angles
+                    .iter()
+                    .map(|a| (a * 1e12).round() as i64)
+                    .collect::<Vec<_>>(),
+                assigned.iter().map(|&a| a as i8).collect::<Vec<_>>(),
+            );
+            let found = match second_order_seen.get(&key) {
+                Some(found) => *found,
+                None => {
+                    let found = second_order(star, &assigned);
+                    second_order_seen.insert(key, found);
+                    found
+                }
+            };
+            let Some(found) = found else { continue };
+            second_order_checked += 1;
+            if found.excludes_motion(CERTIFICATE) {
+                let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
+                return Err(match found {
+                    SecondOrder::OneSign => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) has one sign: such a vertex folds only along a straight line through it (its image on the unit sphere, a locally convex polygon of length 2π, must be a great circle or a lune), so its other creases stay flat",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                    SecondOrder::NoFirstOrder => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat: no velocities with these signs close it in the plane",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                    SecondOrder::Range { min, max } => format!(
+                        "vertex {} (degree {}): its assignment {} (creases counter-clockwise) admits no motion from flat at second order: on the velocities with these signs that close it in the plane (scaled to Σ|ρ̇| = 1) the out-of-plane second-order closure Q ranges over [{min:.3e}, {max:.3e}], which excludes 0",
+                        star.vertex,
+                        assigned.len(),
+                        names.concat()
+                    ),
+                });
+            }
+            continue;
+        };
+        local_checked += 1;
+        let assigned: Vec<f64> = star.columns.iter().map(|&c| sign_of(model, c)).collect();
+        // A mode's zero entry: at a flat-foldable vertex the branches keep exact ratios of
+        // tan(ρ/2), so that crease stays flat and cannot be a mountain or valley; elsewhere
+        // its sign is decided at higher order and matches anything.
+        let alternating = star
+            .sector_angles
+            .iter()
+            .enumerate()
+            .map(|(k, a)| if k % 2 == 0 { *a } else { -a })
+            .sum::<f64>();
+        let flat_foldable = alternating.abs() < exact;
+        let fits = |mode: &&[f64; 4]| {
+            mode.iter()
+                .zip(&assigned)
+                .all(|(p, a)| *a == 0.0 || (*p == 0.0 && !flat_foldable) || p * a > 0.0)
+        };
+        let matching: Vec<&[f64; 4]> = modes.iter().filter(fits).collect();
+        if matching.is_empty() {
+            let names: Vec<&str> = assigned.iter().map(|&a| letter(a)).collect();
+            let options: Vec<String> = modes.iter().map(|m| m.iter().map(|&a| letter(a)).collect()).collect();
+            return Err(format!(
+                "vertex {}: its assignment {} (creases counter-clockwise; 0 unassigned) matches none of the sign patterns of its folding modes from flat ({}; 0: the crease stays flat); a degree-4 vertex leaves flat only along these",
+                star.vertex,
+                names.concat(),
+                if options.is_empty() { "none: the vertex cannot leave flat".to_string() } else { options.join(", ") }
+            ));
+        }
+        let decided = matching.len() == 1 && matching[0].iter().all(|&m| m != 0.0);
+        chosen.push(if decided { Some(*matching[0]) } else { None });
+    }
+    if local_checked > 0 {
+        tried.push(format!(
+            "{local_checked} degree-4 vertices: each assignment matches a folding mode"
+        ));
+    }
+    if second_order_checked > 0 {
+        tried.push(format!(
+            "{second_order_checked} vertices of other degrees: each assignment passes the second-order test at flat"
+        ));
+    }
+    Ok(LocalTests { chosen, tried })
 }
 
 /// When every star is a degree-4 vertex whose assignment picks exactly one mode (all four
