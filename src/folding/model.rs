@@ -216,6 +216,19 @@ impl FoldingModel {
         })
     }
 
+    /// Refuses, naming `field`, a vector that is not one fold angle per crease.
+    pub fn expect_fold_angles(&self, field: &str, fold_angles: &[f64]) -> Result<()> {
+        let n = self.crease_count();
+        if fold_angles.len() != n {
+            return Err(NanofoldError::invalid(
+                field,
+                format!("{} fold angles", fold_angles.len()),
+                format!("one per crease ({n})"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Number of fold-angle coordinates (creases).
     pub fn crease_count(&self) -> usize {
         self.pattern.creases.len()

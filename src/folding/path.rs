@@ -453,14 +453,7 @@ enum Trial {
 impl<'a> Walk<'a> {
     /// The start, closed onto every vertex where it is within 1e-6 rad of rigid.
     fn new(model: &'a FoldingModel, start: &'a [f64], settings: &'a FoldSettings) -> Result<Self> {
-        let n = model.crease_count();
-        if start.len() != n {
-            return Err(NanofoldError::invalid(
-                "start",
-                format!("{} fold angles", start.len()),
-                format!("one per crease ({n})"),
-            ));
-        }
+        model.expect_fold_angles("start", start)?;
         let mut walk = Walk {
             model,
             settings,

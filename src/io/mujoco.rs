@@ -510,6 +510,55 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
 
 /// The MJCF text of `scene`.
 pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
+    let parts = scene_parts(scene, settings)?;
+    let dt = settings.timestep / TIME_UNIT;
+    let mut x = String::new();
+    let w = &mut x;
+    write_header(w, &scene.name, &parts.description, dt);
+    write_assets(w, scene, &parts);
+    write_custom(w, scene, &parts);
+    let joint_order = write_worldbody(w, scene, &parts);
+    let quartics = match (&scene.system, settings.closure) {
+        (System::Closed(chain), LoopClosure::Polycoef) => Some(quartic_curves(chain)?),
+        _ => None,
+    };
+    write_equalities(w, scene, &parts, quartics.as_ref(), dt);
+    // A network that starts flat starts in MuJoCo where nanofold leaves the branch point: its
+    // angles, rates and time (MuJoCo's constraint forces would hold the panels still there).
+    let branch = match &scene.system {
+        System::Network(model) => leave_flat(model)?,
+        _ => None,
+    };
+    let key_time = branch.as_ref().map_or(0.0, |b| b.time);
+    let actuators = write_actuators(w, &parts.bodies, key_time);
+    write_keyframe(
+        w,
+        scene,
+        &joint_order,
+        quartics.as_ref(),
+        branch.as_ref(),
+        key_time,
+        &actuators,
+    )?;
+    writeln!(w, "</mujoco>").unwrap();
+    Ok(x)
+}
+
+/// What a scene puts into its MJCF: its bodies (a tree), a closed chain's connect targets and
+/// anchors, a strip's substrate edge, the drag, the description for the header, and a
+/// network's anchored panel and connect equalities.
+struct MjcfParts {
+    bodies: Vec<BodySpec>,
+    connect_targets: Vec<String>,
+    connect_anchors: Vec<Point3<f64>>,
+    substrate_edge: Option<f64>,
+    drag: Option<crate::dynamics::model::Drag>,
+    description: String,
+    network_parts: Option<(Vec<Point3<f64>>, Vec<ConnectSpec>)>,
+}
+
+/// The scene's bodies and what closes its loops (a network refuses fitted curves).
+fn scene_parts(scene: &Scene, settings: &MujocoSettings) -> Result<MjcfParts> {
     let mut network_parts = None;
     let (bodies, connect_targets, connect_anchors, substrate_edge, drag, description) = match &scene.system {
         System::Network(model) => {
@@ -565,14 +614,20 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
             )
         }
     };
-    let l = 1.0 / LENGTH_UNIT;
-    let m = 1.0 / MASS_UNIT;
-    let inertia_scale = 1.0 / (MASS_UNIT * LENGTH_UNIT * LENGTH_UNIT);
-    let torque_scale = 1.0 / TORQUE_UNIT;
-    let dt = settings.timestep / TIME_UNIT;
-    let mut x = String::new();
-    let w = &mut x;
-    writeln!(w, "<mujoco model=\"{}\">", xml_escape(&scene.name)).unwrap();
+    Ok(MjcfParts {
+        bodies,
+        connect_targets,
+        connect_anchors,
+        substrate_edge,
+        drag,
+        description,
+        network_parts,
+    })
+}
+
+/// The model line, the units and conventions as comments, the compiler and the options.
+fn write_header(w: &mut String, name: &str, description: &str, dt: f64) {
+    writeln!(w, "<mujoco model=\"{}\">", xml_escape(name)).unwrap();
     writeln!(
         w,
         "  <!-- Written by nanofold export mujoco. Units: length µm, mass pg (1e-12 kg), time µs;"
@@ -583,7 +638,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         "       so force µN, torque and hinge stiffness 1e-12 N·m (per rad), density 1e6 kg/m³."
     )
     .unwrap();
-    writeln!(w, "       {} -->", xml_escape(&description)).unwrap();
+    writeln!(w, "       {} -->", xml_escape(description)).unwrap();
     writeln!(
         w,
         "  <!-- Hinges: a positive angle folds valley, right-handed about the joint axis; springref 0 is flat."
@@ -615,7 +670,13 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         fmt(dt)
     )
     .unwrap();
-    // Meshes: each plate a thin prism of its structural thickness.
+}
+
+/// Meshes: each plate a thin prism of its structural thickness, and the anchored sector or
+/// panel.
+fn write_assets(w: &mut String, scene: &Scene, parts: &MjcfParts) {
+    let l = 1.0 / LENGTH_UNIT;
+    let bodies = &parts.bodies;
     writeln!(w, "  <asset>").unwrap();
     // A prism of half-thickness `half` over an outline, µm.
     let prism = |w: &mut String, name: &str, outline: &[Point3<f64>], half: f64| {
@@ -627,7 +688,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
         writeln!(w, "    <mesh name=\"{name}\" vertex=\"{}\"/>", vertex.join("  ")).unwrap();
     };
-    for body in &bodies {
+    for body in bodies.iter() {
         if let Some(outline) = &body.outline {
             prism(w, &body.name, outline, 0.5 * body.thickness.max(1e-3 * LENGTH_UNIT));
         }
@@ -642,17 +703,24 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     if let System::Closed(chain) = &scene.system {
         prism(w, "ground", &chain.ground, ground_half);
     }
-    if let Some((ground, _)) = &network_parts {
+    if let Some((ground, _)) = &parts.network_parts {
         prism(w, "ground", ground, ground_half);
     }
     writeln!(w, "  </asset>").unwrap();
+}
+
+/// The custom numerics a client needs: units, drag, the substrate edge, etch-front release
+/// times and rates.
+fn write_custom(w: &mut String, scene: &Scene, parts: &MjcfParts) {
+    let l = 1.0 / LENGTH_UNIT;
+    let bodies = &parts.bodies;
     writeln!(w, "  <custom>").unwrap();
     writeln!(
         w,
         "    <text name=\"nanofold:units\" data=\"length um, mass pg, time us\"/>"
     )
     .unwrap();
-    if let Some(drag) = drag {
+    if let Some(drag) = parts.drag {
         writeln!(
             w,
             "    <numeric name=\"nanofold:drag_coefficient\" data=\"{}\"/>",
@@ -675,7 +743,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
             .unwrap();
         }
     }
-    if let Some(edge) = substrate_edge {
+    if let Some(edge) = parts.substrate_edge {
         writeln!(
             w,
             "    <numeric name=\"nanofold:substrate_edge_y\" data=\"{}\"/>",
@@ -705,6 +773,16 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
     }
     writeln!(w, "  </custom>").unwrap();
+}
+
+/// The world: the substrate or the anchored geom and the tree of bodies; a strip's first
+/// plate excluded from contact with the world. Returns the joints in MJCF order.
+fn write_worldbody(w: &mut String, scene: &Scene, parts: &MjcfParts) -> Vec<String> {
+    let l = 1.0 / LENGTH_UNIT;
+    let m = 1.0 / MASS_UNIT;
+    let inertia_scale = 1.0 / (MASS_UNIT * LENGTH_UNIT * LENGTH_UNIT);
+    let torque_scale = 1.0 / TORQUE_UNIT;
+    let (bodies, substrate_edge) = (&parts.bodies, parts.substrate_edge);
     writeln!(w, "  <worldbody>").unwrap();
     // The substrate (strip) or the anchored sector (closed).
     let extent = bodies
@@ -731,7 +809,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let mut joint_order = Vec::new();
     write_children(
         w,
-        &bodies,
+        bodies,
         None,
         &Isometry3::identity(),
         2,
@@ -748,10 +826,14 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         writeln!(w, "    <exclude body1=\"world\" body2=\"{}\"/>", bodies[0].name).unwrap();
         writeln!(w, "  </contact>").unwrap();
     }
-    let quartics = match (&scene.system, settings.closure) {
-        (System::Closed(chain), LoopClosure::Polycoef) => Some(quartic_curves(chain)?),
-        _ => None,
-    };
+    joint_order
+}
+
+/// Equalities: a closed chain's loop (connects or fitted quartics) and locks, a network's
+/// connects and locks.
+fn write_equalities(w: &mut String, scene: &Scene, parts: &MjcfParts, quartics: Option<&QuarticCurves>, dt: f64) {
+    let l = 1.0 / LENGTH_UNIT;
+    let (bodies, connect_targets, connect_anchors) = (&parts.bodies, &parts.connect_targets, &parts.connect_anchors);
     if let System::Closed(chain) = &scene.system {
         writeln!(w, "  <equality>").unwrap();
         // Two points of the cut body: one off its hinge axis, one on it away from the vertex
@@ -784,7 +866,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
                 .unwrap();
             }
         }
-        if let Some(quartics) = &quartics {
+        if let Some(quartics) = quartics {
             let driver = chain.crease_user_indices[chain.driver];
             writeln!(
                 w,
@@ -806,7 +888,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
         writeln!(w, "  </equality>").unwrap();
     }
-    if let (Some((_, connects)), System::Network(model)) = (&network_parts, &scene.system) {
+    if let (Some((_, connects)), System::Network(model)) = (&parts.network_parts, &scene.system) {
         let any_lock = (0..model.columns()).any(|c| model.locked(c));
         if !connects.is_empty() || any_lock {
             writeln!(w, "  <equality>").unwrap();
@@ -839,13 +921,20 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
             writeln!(w, "  </equality>").unwrap();
         }
     }
-    // A network that starts flat starts in MuJoCo where nanofold leaves the branch point: its
-    // angles, rates and time (MuJoCo's constraint forces would hold the panels still there).
-    let branch = match &scene.system {
-        System::Network(model) => leave_flat(model)?,
-        _ => None,
-    };
-    let key_time = branch.as_ref().map_or(0.0, |b| b.time);
+}
+
+/// The actuators' keyframe values: ctrl per actuator, act per integrator actuator (None for
+/// a step's), and how many an etch front still holds off.
+struct ActuatorKeys {
+    controls: Vec<f64>,
+    activations: Vec<Option<f64>>,
+    held_back: usize,
+}
+
+/// The stress actuators (a step's affine bias, a ramp's integrator) and their keyframe
+/// values at `key_time`.
+fn write_actuators(w: &mut String, bodies: &[BodySpec], key_time: f64) -> ActuatorKeys {
+    let torque_scale = 1.0 / TORQUE_UNIT;
     writeln!(w, "  <actuator>").unwrap();
     // The keyframe's ctrl: a ramp actuator's rate, 0 for a step's (its ctrl adds torque); an
     // actuator not yet released by an etch front is held off (ctrl 0 for a ramp, minus its
@@ -853,7 +942,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let mut controls = Vec::new();
     let mut activations = Vec::new();
     let mut held_back = 0;
-    for body in &bodies {
+    for body in bodies.iter() {
         let Some(joint) = body.joint.as_ref() else { continue };
         match joint.drive {
             Some(StressDrive::Step { torque, release_time }) => {
@@ -897,6 +986,25 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         }
     }
     writeln!(w, "  </actuator>").unwrap();
+    ActuatorKeys {
+        controls,
+        activations,
+        held_back,
+    }
+}
+
+/// The keyframe: every joint's start (a closed chain's on its closure, a network's where it
+/// leaves flat), its rates and time where it moves, the actuators' ctrl and act.
+fn write_keyframe(
+    w: &mut String,
+    scene: &Scene,
+    joint_order: &[String],
+    quartics: Option<&QuarticCurves>,
+    branch: Option<&crate::dynamics::network::start::BranchStart>,
+    key_time: f64,
+    actuators: &ActuatorKeys,
+) -> Result<()> {
+    let (controls, activations, held_back) = (&actuators.controls, &actuators.activations, actuators.held_back);
     // The state at t = 0: flat for a strip; for a closed chain the driver's start with the
     // locks and the dependents (the cut crease included) on the closure.
     let mut start = vec![0.0; joint_order.len()];
@@ -907,12 +1015,12 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
         chain.update_creases(q, &mut ws)?;
         // With polycoef equalities the keyframe lies on the fitted curves, so MuJoCo starts
         // with every equality satisfied.
-        if let Some(quartics) = &quartics {
+        if let Some(quartics) = quartics {
             for (c, a) in &quartics.curves {
                 ws.crease_angles[*c] = a.iter().rev().fold(0.0, |acc, x| acc * q + x);
             }
         }
-        for (slot, name) in qpos.iter_mut().zip(&joint_order) {
+        for (slot, name) in qpos.iter_mut().zip(joint_order) {
             if let Some(c) =
                 (0..chain.crease_labels.len()).find(|&c| *name == format!("crease_{}", chain.crease_user_indices[c]))
             {
@@ -923,7 +1031,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     let mut velocities = vec![0.0; joint_order.len()];
     let mut network_note = None;
     if let System::Network(model) = &scene.system {
-        let (angles, rates) = match &branch {
+        let (angles, rates) = match branch {
             Some(branch) => {
                 network_note = Some(format!(
                     "The scene starts flat, a branch point where MuJoCo's constraint forces would hold the panels still: the keyframe is nanofold's state where it leaves the branch point, {:e} rad along, {:e} µs after the release.",
@@ -934,7 +1042,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
             }
             None => (model.start.clone(), vec![0.0; model.columns()]),
         };
-        for ((slot, rate), name) in qpos.iter_mut().zip(velocities.iter_mut()).zip(&joint_order) {
+        for ((slot, rate), name) in qpos.iter_mut().zip(velocities.iter_mut()).zip(joint_order) {
             if let Some(c) =
                 (0..model.columns()).find(|&c| *name == format!("crease_{}", model.folding.pattern.creases[c]))
             {
@@ -1002,8 +1110,7 @@ pub fn scene_mjcf(scene: &Scene, settings: &MujocoSettings) -> Result<String> {
     )
     .unwrap();
     writeln!(w, "  </keyframe>").unwrap();
-    writeln!(w, "</mujoco>").unwrap();
-    Ok(x)
+    Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -484,14 +484,8 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             "must lie in (0, 1] rad",
         ));
     }
+    model.expect_fold_angles("start", start)?;
     let n = model.crease_count();
-    if start.len() != n {
-        return Err(NanofoldError::invalid(
-            "start",
-            format!("{} fold angles", start.len()),
-            format!("one per crease ({n})"),
-        ));
-    }
     let residuals = vertex_residuals(model, start);
     let residual = residuals.iter().copied().fold(0.0, f64::max);
     if residual > 1e-6 {
