@@ -5,7 +5,7 @@
 //! closure Jacobian; each step is restored by Newton and refused if panels cross.
 
 use crate::error::{NanofoldError, NumericalError, Result};
-use crate::folding::normal::NormalSolver;
+use crate::folding::normal::{NormalFactor, NormalSolver};
 use crate::folding::{
     closure_jacobian, jacobian_rank, panel_contacts, panel_poses, restore_closure, vertex_residuals, ContactSettings,
     FoldingModel, Pose,
@@ -466,6 +466,64 @@ fn try_state(
     Ok(Trial::Accepted((trial, value, gradient)))
 }
 
+/// Adds the curvature pair (the step, the change of the projected gradient) to `history`
+/// where it has positive curvature, keeping the last `memory`.
+fn remember_pair(
+    history: &mut Vec<(Vec<f64>, Vec<f64>, f64)>,
+    rho: &[f64],
+    previous_rho: &[f64],
+    steepest: &[f64],
+    previous_steepest: &[f64],
+    memory: usize,
+) {
+    let s_pair: Vec<f64> = rho.iter().zip(previous_rho).map(|(a, b)| a - b).collect();
+    let y_pair: Vec<f64> = previous_steepest.iter().zip(steepest).map(|(a, b)| a - b).collect();
+    let sy = dot(&s_pair, &y_pair);
+    if sy > 1e-12 * norm(&s_pair) * norm(&y_pair) && sy > 0.0 {
+        history.push((s_pair, y_pair, 1.0 / sy));
+        if history.len() > memory {
+            history.remove(0);
+        }
+    }
+}
+
+/// L-BFGS's two-loop recursion on the projected gradient, projected onto the tangent space
+/// again; the steepest direction where there is no history or the result is not downhill
+/// (the history is then dropped).
+fn lbfgs_direction(
+    model: &FoldingModel,
+    factor: &NormalFactor,
+    history: &mut Vec<(Vec<f64>, Vec<f64>, f64)>,
+    steepest: &[f64],
+    gradient: &[f64],
+) -> Vec<f64> {
+    if history.is_empty() {
+        return steepest.to_vec();
+    }
+    let mut q: Vec<f64> = steepest.iter().map(|d| -d).collect();
+    let mut alphas = vec![0.0; history.len()];
+    for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate().rev() {
+        alphas[k] = rho_pair * dot(s_pair, &q);
+        q.iter_mut().zip(y_pair).for_each(|(q, y)| *q -= alphas[k] * y);
+    }
+    let (s_last, y_last, _) = history.last().expect("not empty");
+    let gamma = dot(s_last, y_last) / dot(y_last, y_last);
+    q.iter_mut().for_each(|q| *q *= gamma);
+    for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate() {
+        let beta = rho_pair * dot(y_pair, &q);
+        q.iter_mut().zip(s_pair).for_each(|(q, s)| *q += (alphas[k] - beta) * s);
+    }
+    let mut candidate: Vec<f64> = q.iter().map(|q| -q).collect();
+    model.hold_locked(&mut candidate);
+    let candidate = factor.project(&candidate);
+    if dot(gradient, &candidate) < 0.0 {
+        candidate
+    } else {
+        history.clear();
+        steepest.to_vec()
+    }
+}
+
 /// Unfolds a rigid state of `model` by projected gradient descent on the summed vertex
 /// energies.
 pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> Result<NetworkReport> {
@@ -668,40 +726,16 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // The L-BFGS direction on the manifold: curvature pairs of steps and changes of the
         // projected gradient, the result projected onto the tangent space again.
         if let Some((previous_rho, previous_steepest)) = pending.take() {
-            let s_pair: Vec<f64> = rho.iter().zip(&previous_rho).map(|(a, b)| a - b).collect();
-            let y_pair: Vec<f64> = previous_steepest.iter().zip(&steepest).map(|(a, b)| a - b).collect();
-            let sy = dot(&s_pair, &y_pair);
-            if sy > 1e-12 * norm(&s_pair) * norm(&y_pair) && sy > 0.0 {
-                history.push((s_pair, y_pair, 1.0 / sy));
-                if history.len() > settings.memory {
-                    history.remove(0);
-                }
-            }
+            remember_pair(
+                &mut history,
+                &rho,
+                &previous_rho,
+                &steepest,
+                &previous_steepest,
+                settings.memory,
+            );
         }
-        let mut descent = steepest.clone();
-        if settings.memory > 0 && !history.is_empty() {
-            let mut q: Vec<f64> = steepest.iter().map(|d| -d).collect();
-            let mut alphas = vec![0.0; history.len()];
-            for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate().rev() {
-                alphas[k] = rho_pair * dot(s_pair, &q);
-                q.iter_mut().zip(y_pair).for_each(|(q, y)| *q -= alphas[k] * y);
-            }
-            let (s_last, y_last, _) = history.last().expect("not empty");
-            let gamma = dot(s_last, y_last) / dot(y_last, y_last);
-            q.iter_mut().for_each(|q| *q *= gamma);
-            for (k, (s_pair, y_pair, rho_pair)) in history.iter().enumerate() {
-                let beta = rho_pair * dot(y_pair, &q);
-                q.iter_mut().zip(s_pair).for_each(|(q, s)| *q += (alphas[k] - beta) * s);
-            }
-            let mut candidate: Vec<f64> = q.iter().map(|q| -q).collect();
-            model.hold_locked(&mut candidate);
-            let candidate = factor.project(&candidate);
-            if dot(&gradient, &candidate) < 0.0 {
-                descent = candidate;
-            } else {
-                history.clear();
-            }
-        }
+        let descent = lbfgs_direction(model, &factor, &mut history, &steepest, &gradient);
         pending = Some((rho.clone(), steepest));
         let size = descent.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         let slope: f64 = gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
