@@ -543,7 +543,6 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         ));
     }
     model.expect_fold_angles("start", start)?;
-    let n = model.crease_count();
     let residuals = vertex_residuals(model, start);
     let residual = residuals.iter().copied().fold(0.0, f64::max);
     if residual > 1e-6 {
@@ -590,7 +589,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         barrier,
     };
     let mut solver = NormalSolver::new(1e-10);
-    let mut ws = EnergyWorkspace::default();
+    let ws = EnergyWorkspace::default();
     let mut rho = start.to_vec();
     if restore_closure(model, &mut rho, settings.closure_tol, &mut solver)?.is_none() {
         // At a singular state (folded flat, say) Newton's steps need not converge, but the
@@ -598,172 +597,249 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // after it is closed to `closure_tol`.
         rho = start.to_vec();
     }
-    let worst = |rho: &[f64]| vertex_residuals(model, rho).into_iter().fold(0.0, f64::max);
-    let mut gradient = vec![0.0; n];
-    let mut poses = Vec::new();
-    let mut u = objective.evaluate(&rho, &mut ws, &mut poses, &mut gradient);
-    let mut steps = vec![NetworkStep {
-        energy: u,
-        fold_angles: rho.clone(),
-        max_residual: worst(&rho),
-    }];
-    let mut crossings_refused = 0;
-    let mut major = vec![true; n];
-    let mut radial_steps = 0usize;
-    let mut history: Vec<(Vec<f64>, Vec<f64>, f64)> = Vec::new();
-    let mut pending: Option<(Vec<f64>, Vec<f64>)> = None;
-    let mut quasi_newton_scale = 1.0;
-    let mut kick = SplitMix64(0x5EED_F00D);
-    let mut scale = 1.0;
-    // Restarts taken, read by `finish` (a Cell, as the loop counts while `finish` is held).
-    let restarts = std::cell::Cell::new(0usize);
-    let mut restart_failed = false;
-    let finish = |verdict, evidence: String, iterations, steps: Vec<NetworkStep>, crossings_refused, radial_steps| {
-        let max_closure_residual = steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
-        Ok(NetworkReport {
+    let mut descent = Descent::new(objective, settings, solver, ws, rho);
+    // An already flat start is `flat` (the loop says so at step 0), even with no motion.
+    let already_flat = descent.rho.iter().all(|r| r.abs() <= settings.flat_tol);
+    if !already_flat && jacobian_rank(&closure_jacobian(model, &descent.rho))?.dof == 0 {
+        let stop = (
+            NetworkVerdict::Locked,
+            "0 degrees of freedom at the start: no rigid motion".to_string(),
+        );
+        return Ok(descent.finish(stop, 0));
+    }
+    for iteration in 0..settings.max_iterations {
+        if let Some(stop) = descent.iterate(iteration)? {
+            return Ok(descent.finish(stop, iteration));
+        }
+    }
+    let stop = (
+        NetworkVerdict::IterationLimit,
+        format!("{} steps", settings.max_iterations),
+    );
+    Ok(descent.finish(stop, settings.max_iterations))
+}
+
+/// Why a descent ends, and the evidence.
+type DescentStop = (NetworkVerdict, String);
+
+/// A descent under way: the state, its energy and gradient, the steps so far, L-BFGS's
+/// memory, the line search's and the restarts' state, and the scratch they reuse.
+struct Descent<'a> {
+    objective: Objective<'a>,
+    settings: &'a NetworkUnfoldSettings,
+    solver: NormalSolver,
+    ws: EnergyWorkspace,
+    poses: Vec<Pose>,
+    rho: Vec<f64>,
+    u: f64,
+    gradient: Vec<f64>,
+    steps: Vec<NetworkStep>,
+    crossings_refused: usize,
+    major: Vec<bool>,
+    radial_steps: usize,
+    history: Vec<(Vec<f64>, Vec<f64>, f64)>,
+    pending: Option<(Vec<f64>, Vec<f64>)>,
+    quasi_newton_scale: f64,
+    kick: SplitMix64,
+    scale: f64,
+    restarts: usize,
+    restart_failed: bool,
+}
+
+impl<'a> Descent<'a> {
+    fn new(
+        objective: Objective<'a>,
+        settings: &'a NetworkUnfoldSettings,
+        solver: NormalSolver,
+        mut ws: EnergyWorkspace,
+        rho: Vec<f64>,
+    ) -> Self {
+        let n = rho.len();
+        let mut gradient = vec![0.0; n];
+        let mut poses = Vec::new();
+        let u = objective.evaluate(&rho, &mut ws, &mut poses, &mut gradient);
+        let mut descent = Descent {
+            objective,
+            settings,
+            solver,
+            ws,
+            poses,
+            rho,
+            u,
+            gradient,
+            steps: Vec::new(),
+            crossings_refused: 0,
+            major: vec![true; n],
+            radial_steps: 0,
+            history: Vec::new(),
+            pending: None,
+            quasi_newton_scale: 1.0,
+            kick: SplitMix64(0x5EED_F00D),
+            scale: 1.0,
+            restarts: 0,
+            restart_failed: false,
+        };
+        descent.record();
+        descent
+    }
+
+    /// Records the current state as a step.
+    fn record(&mut self) {
+        let max_residual = vertex_residuals(self.objective.model, &self.rho)
+            .into_iter()
+            .fold(0.0, f64::max);
+        self.steps.push(NetworkStep {
+            energy: self.u,
+            fold_angles: self.rho.clone(),
+            max_residual,
+        });
+    }
+
+    /// Puts the flat state in as the last step.
+    fn record_flat(&mut self) {
+        let n = self.rho.len();
+        let flat = flat_step(&self.objective, n, &mut self.ws);
+        self.steps.push(flat);
+    }
+
+    /// The report, with the iteration count at the stop.
+    fn finish(self, (verdict, evidence): DescentStop, iterations: usize) -> NetworkReport {
+        let max_closure_residual = self.steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
+        NetworkReport {
             verdict,
             evidence,
             iterations,
-            steps,
+            steps: self.steps,
             max_closure_residual,
-            crossings_refused,
-            radial_steps,
-            restarts_used: restarts.get(),
-        })
-    };
-    // An already flat start is `flat` (the loop says so at step 0), even with no motion.
-    let already_flat = rho.iter().all(|r| r.abs() <= settings.flat_tol);
-    if !already_flat && jacobian_rank(&closure_jacobian(model, &rho))?.dof == 0 {
-        return finish(
-            NetworkVerdict::Locked,
-            "0 degrees of freedom at the start: no rigid motion".into(),
-            0,
-            steps,
-            0,
-            0,
-        );
+            crossings_refused: self.crossings_refused,
+            radial_steps: self.radial_steps,
+            restarts_used: self.restarts,
+        }
     }
-    // A stop away from flat with no panels in the way: a restart if one is left and found
-    // (the descent goes on from it), else `local_minimum` saying what the restarts did.
-    macro_rules! restart_or_stop {
-        ($factor:expr, $iteration:expr, $why:expr) => {
-            if restarts.get() < settings.restarts {
-                if let Some(state) = restart(
-                    &objective,
-                    settings,
-                    &$factor,
-                    &mut kick,
-                    &rho,
-                    &mut ws,
-                    &mut poses,
-                    &mut solver,
-                )? {
-                    restarts.set(restarts.get() + 1);
-                    (rho, u, gradient) = state;
-                    history.clear();
-                    pending = None;
-                    steps.push(NetworkStep {
-                        energy: u,
-                        fold_angles: rho.clone(),
-                        max_residual: worst(&rho),
-                    });
-                    continue;
-                }
-                restart_failed = true;
+
+    /// A stop away from flat with no panels in the way: a restart if one is left and found
+    /// (None: the descent goes on from it), else `local_minimum` saying what the restarts did.
+    fn restart_or_stop(&mut self, factor: &NormalFactor, why: String) -> Result<Option<DescentStop>> {
+        if self.restarts < self.settings.restarts {
+            let restarted = restart(
+                &self.objective,
+                self.settings,
+                factor,
+                &mut self.kick,
+                &self.rho,
+                &mut self.ws,
+                &mut self.poses,
+                &mut self.solver,
+            )?;
+            if let Some(state) = restarted {
+                self.restarts += 1;
+                (self.rho, self.u, self.gradient) = state;
+                self.history.clear();
+                self.pending = None;
+                self.record();
+                return Ok(None);
             }
-            return finish(
-                NetworkVerdict::LocalMinimum,
-                format!("{}; {}", $why, restart_note(restarts.get(), restart_failed)),
-                $iteration,
-                steps,
-                crossings_refused,
-                radial_steps,
-            );
-        };
+            self.restart_failed = true;
+        }
+        Ok(Some((
+            NetworkVerdict::LocalMinimum,
+            format!("{why}; {}", restart_note(self.restarts, self.restart_failed)),
+        )))
     }
-    for iteration in 0..settings.max_iterations {
-        let largest = rho.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+
+    /// A step along the ray to flat, counted when taken.
+    fn try_radial(&mut self, refused_for_crossing: &mut Option<[usize; 2]>) -> Result<Option<Accepted>> {
+        let state = radial_step(
+            self.objective.model,
+            &self.objective,
+            self.settings,
+            &mut self.solver,
+            &mut self.ws,
+            &mut self.poses,
+            &self.rho,
+            self.u,
+            &mut self.crossings_refused,
+            refused_for_crossing,
+        )?;
+        self.radial_steps += usize::from(state.is_some());
+        Ok(state)
+    }
+
+    /// One iteration: the flat finishes, the direction, the line search, the step. Some(stop)
+    /// where the descent ends.
+    fn iterate(&mut self, iteration: usize) -> Result<Option<DescentStop>> {
+        let (model, settings) = (self.objective.model, self.settings);
+        let u = self.u;
+        let largest = self.rho.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
         if largest <= STALL_TOL && largest > settings.flat_tol {
             // The flat finish: this close, the energy's changes are at its rounding and
             // descent crawls. The flat state is rigid; it is taken if its energy is no higher.
-            let flat = flat_step(&objective, n, &mut ws);
+            let n = self.rho.len();
+            let flat = flat_step(&self.objective, n, &mut self.ws);
             let u_flat = flat.energy;
             if u_flat <= u * (1.0 + 1e-12) {
-                steps.push(flat);
-                return finish(
+                self.steps.push(flat);
+                return Ok(Some((
                     NetworkVerdict::Flat,
                     format!("descended to max |ρ| = {largest:.1e} rad after {iteration} steps, then finished onto the flat state (within {STALL_TOL:.0e}; energy {u:.9e} → {u_flat:.9e})"),
-                    iteration,
-                    steps,
-                    crossings_refused,
-                    radial_steps,
-                );
+                )));
             }
         }
         if largest <= settings.flat_tol {
-            steps.push(flat_step(&objective, n, &mut ws));
-            return finish(
+            self.record_flat();
+            return Ok(Some((
                 NetworkVerdict::Flat,
                 format!("every fold angle within {:.0e} rad after {iteration} steps (max |ρ| = {largest:.1e}), then set to 0", settings.flat_tol),
-                iteration,
-                steps,
-                crossings_refused,
-                radial_steps,
-            );
+            )));
         }
-        let factor = solver.factor(&closure_jacobian(model, &rho))?;
-        let mut downhill: Vec<f64> = gradient.iter().map(|g| -g).collect();
+        let factor = self.solver.factor(&closure_jacobian(model, &self.rho))?;
+        let mut downhill: Vec<f64> = self.gradient.iter().map(|g| -g).collect();
         model.hold_locked(&mut downhill);
         let steepest: Vec<f64> = factor.project(&downhill);
         let steepest_size = steepest.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         if steepest_size <= 1e-14 {
-            restart_or_stop!(
-                factor,
-                iteration,
-                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad")
+            return self.restart_or_stop(
+                &factor,
+                format!("the projected gradient vanishes (|d| = {steepest_size:.1e}) with max |ρ| = {largest:.3e} rad"),
             );
         }
         // The L-BFGS direction on the manifold: curvature pairs of steps and changes of the
         // projected gradient, the result projected onto the tangent space again.
-        if let Some((previous_rho, previous_steepest)) = pending.take() {
+        if let Some((previous_rho, previous_steepest)) = self.pending.take() {
             remember_pair(
-                &mut history,
-                &rho,
+                &mut self.history,
+                &self.rho,
                 &previous_rho,
                 &steepest,
                 &previous_steepest,
                 settings.memory,
             );
         }
-        let descent = lbfgs_direction(model, &factor, &mut history, &steepest, &gradient);
-        pending = Some((rho.clone(), steepest));
+        let descent = lbfgs_direction(model, &factor, &mut self.history, &steepest, &self.gradient);
+        self.pending = Some((self.rho.clone(), steepest));
         let size = descent.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-        let slope: f64 = gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
+        let slope: f64 = self.gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
         if size <= 1e-14 || slope >= 0.0 {
-            return finish(
+            return Ok(Some((
                 NetworkVerdict::LocalMinimum,
                 format!("the projected gradient vanishes (|d| = {size:.1e}) with max |ρ| = {largest:.3e} rad"),
-                iteration,
-                steps,
-                crossings_refused,
-                radial_steps,
-            );
+            )));
         }
         // A quasi-Newton step is tried whole first (within max_step); the gradient's length
         // says nothing of the step, so there the line search remembers its last share.
-        let quasi_newton = settings.memory > 0 && !history.is_empty();
+        let quasi_newton = settings.memory > 0 && !self.history.is_empty();
         let mut t = if quasi_newton {
-            (settings.max_step / size).min(quasi_newton_scale)
+            (settings.max_step / size).min(self.quasi_newton_scale)
         } else {
-            (settings.max_step / size) * scale
+            (settings.max_step / size) * self.scale
         };
         let t_planned = t;
         // No vertex may pass through its flat state in one step: there the branches of its
         // folding motion cross, and beyond lies the mirrored state, not progress. A vertex
         // heads there when one of its major creases (|ρ| within MAJOR_SHARE of its largest)
         // heads to 0; a minor crease of a vertex that stays folded may change sign.
-        major_crease(model, &rho, &mut major);
-        for ((r, d), &is_major) in rho.iter().zip(&descent).zip(&major) {
+        major_crease(model, &self.rho, &mut self.major);
+        for ((r, d), &is_major) in self.rho.iter().zip(&descent).zip(&self.major) {
             if is_major && r * d < 0.0 && r.abs() > settings.flat_tol {
                 t = t.min(FLAT_APPROACH * (r / d).abs());
             }
@@ -771,42 +847,23 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         let t_before_search = t;
         let mut refused_for_crossing = None;
         let mut halvings = 0;
-        // A step along the ray to flat, counted when taken.
-        macro_rules! try_radial {
-            () => {{
-                let state = radial_step(
-                    model,
-                    &objective,
-                    settings,
-                    &mut solver,
-                    &mut ws,
-                    &mut poses,
-                    &rho,
-                    u,
-                    &mut crossings_refused,
-                    &mut refused_for_crossing,
-                )?;
-                radial_steps += usize::from(state.is_some());
-                state
-            }};
-        }
         // Near flat the ray to flat is tried first: the cheapest step that keeps the branch.
         let radial_first = largest <= NEAR_FLAT;
         let mut accepted = None;
         if radial_first {
-            accepted = try_radial!();
+            accepted = self.try_radial(&mut refused_for_crossing)?;
         }
         // Steps shorter than this are lost in the closure tolerance.
         while accepted.is_none() && t * size > 1e-13 {
-            let trial: Vec<f64> = rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
+            let trial: Vec<f64> = self.rho.iter().zip(&descent).map(|(r, d)| r + t * d).collect();
             let armijo = u + 1e-4 * t * slope;
             match try_state(
                 model,
-                &objective,
+                &self.objective,
                 settings,
-                &mut solver,
-                &mut ws,
-                &mut poses,
+                &mut self.solver,
+                &mut self.ws,
+                &mut self.poses,
                 trial,
                 |v| v <= armijo,
             )? {
@@ -815,7 +872,7 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
                     break;
                 }
                 Trial::Crossing(pair) => {
-                    crossings_refused += 1;
+                    self.crossings_refused += 1;
                     refused_for_crossing = Some(pair);
                 }
                 Trial::Refused => {}
@@ -827,36 +884,27 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
         // its rounding: count it as the line search stalling.
         let mut accepted = accepted.filter(|(_, u_next, _)| largest > STALL_TOL || *u_next < u);
         if accepted.is_none() && !radial_first {
-            accepted = try_radial!();
+            accepted = self.try_radial(&mut refused_for_crossing)?;
         }
         let Some((next, u_next, g_next)) = accepted else {
             if largest <= STALL_TOL && refused_for_crossing.is_none() {
                 // The energy's changes are below its rounding this close to flat; the flat
                 // state is rigid and the descent was heading there.
-                steps.push(flat_step(&objective, n, &mut ws));
-                return finish(
+                self.record_flat();
+                return Ok(Some((
                     NetworkVerdict::Flat,
                     format!("the line search stalled {largest:.1e} rad from flat (within {STALL_TOL:.0e}, where the energy's changes are at its rounding), then set to 0"),
-                    iteration,
-                    steps,
-                    crossings_refused,
-                    radial_steps,
-                );
+                )));
             }
             if let Some([a, b]) = refused_for_crossing {
-                return finish(
+                return Ok(Some((
                     NetworkVerdict::Blocked,
                     format!("every shorter step still puts panels through each other: panels {a} and {b} would meet (max |ρ| = {largest:.3e} rad)"),
-                    iteration,
-                    steps,
-                    crossings_refused,
-                    radial_steps,
-                );
+                )));
             }
-            restart_or_stop!(
-                factor,
-                iteration,
-                format!("the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e})")
+            return self.restart_or_stop(
+                &factor,
+                format!("the line search found no decrease (max |ρ| = {largest:.3e} rad, energy {u:.6e})"),
             );
         };
         // The line search's memory: twice the largest step if this one needed no halving,
@@ -866,26 +914,15 @@ pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnf
             // The step multiple to try next: doubled after a step taken whole, the one taken
             // otherwise; a step cut by the flat approach leaves it alone.
             if t_before_search >= t_planned {
-                quasi_newton_scale = if halvings == 0 { 2.0 * t } else { t }.max(1e-6);
+                self.quasi_newton_scale = if halvings == 0 { 2.0 * t } else { t }.max(1e-6);
             }
         } else {
-            scale = (scale * 2f64.powi(1 - halvings)).clamp(1e-6, 1.0);
+            self.scale = (self.scale * 2f64.powi(1 - halvings)).clamp(1e-6, 1.0);
         }
-        rho = next;
-        u = u_next;
-        gradient = g_next;
-        steps.push(NetworkStep {
-            energy: u,
-            fold_angles: rho.clone(),
-            max_residual: worst(&rho),
-        });
+        self.rho = next;
+        self.u = u_next;
+        self.gradient = g_next;
+        self.record();
+        Ok(None)
     }
-    finish(
-        NetworkVerdict::IterationLimit,
-        format!("{} steps", settings.max_iterations),
-        settings.max_iterations,
-        steps,
-        crossings_refused,
-        radial_steps,
-    )
 }
