@@ -28,6 +28,14 @@ pub struct ClosureJacobian {
 }
 
 impl ClosureJacobian {
+    /// Holds crease `column` where it is: its column zeroed, not removed, so the sparsity
+    /// pattern (and the factorisation's symbolic analysis) stays.
+    pub fn hold(&mut self, column: usize) {
+        for entry in self.entries.iter_mut().filter(|e| e.1 == column) {
+            entry.2 = 0.0;
+        }
+    }
+
     /// The Jacobian over the columns where `keep` is true, in their order (none held).
     pub fn columns(&self, keep: &[bool]) -> ClosureJacobian {
         let mut position = vec![usize::MAX; self.cols];

@@ -853,10 +853,7 @@ fn correct(
     for iteration in 0..30 {
         let mut jac = closure_jacobian(model, fold_angles);
         if let Some(c) = held {
-            // Zeroed, not removed: the sparsity pattern (and its symbolic analysis) stays.
-            for entry in jac.entries.iter_mut().filter(|e| e.1 == c) {
-                entry.2 = 0.0;
-            }
+            jac.hold(c);
         }
         let worst = jac.worst_residual();
         if !worst.is_finite() {

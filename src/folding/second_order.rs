@@ -49,13 +49,19 @@ impl SecondOrder {
     }
 }
 
+/// Each ray's direction φ in the plane, ray 0 at 0, counter-clockwise.
+fn ray_directions(sector_angles: &[f64]) -> Vec<f64> {
+    let mut directions = vec![0.0; sector_angles.len()];
+    for k in 1..sector_angles.len() {
+        directions[k] = directions[k - 1] + sector_angles[k - 1];
+    }
+    directions
+}
+
 /// The quadratic form's matrix M (Q(a) = aᵀ M a) of a star with these sector angles.
 pub fn quadratic_form(sector_angles: &[f64]) -> DMatrix<f64> {
     let n = sector_angles.len();
-    let mut directions = vec![0.0; n];
-    for k in 1..n {
-        directions[k] = directions[k - 1] + sector_angles[k - 1];
-    }
+    let directions = ray_directions(sector_angles);
     DMatrix::from_fn(n, n, |i, j| {
         let (a, b) = (i.min(j), i.max(j));
         if a == b {
@@ -89,10 +95,7 @@ pub fn cone_range(star: &Star, signs: &[f64]) -> Option<SecondOrder> {
     if !(5..=MAX_DEGREE).contains(&n) || signs.len() != n || signs.contains(&0.0) {
         return None;
     }
-    let mut directions = vec![0.0; n];
-    for k in 1..n {
-        directions[k] = directions[k - 1] + star.sector_angles[k - 1];
-    }
+    let directions = ray_directions(&star.sector_angles);
     let m = quadratic_form(&star.sector_angles);
     let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
     // Every face of the section: the creases in `zero` held at 0. Q's stationary point on
