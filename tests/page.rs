@@ -82,6 +82,10 @@ fn bad_scenes_are_refused_by_name() {
     let mut scene = square(1);
     scene.frames[0].highlight = vec![4];
     assert!(message(scene).contains("highlight"));
+    let mut scene = square(1);
+    scene.fixed = vec![7];
+    let refused = message(scene);
+    assert!(refused.contains("fixed") && refused.contains('7'), "{refused}");
     let frames = MAX_PAGE_POINTS / 4 + 1;
     assert!(message(square(frames)).contains("at most"));
 }
