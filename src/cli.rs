@@ -478,7 +478,7 @@ fn unfold_one(
     let pattern = match nanofold::io::load_pattern(pattern_path, &solver.load_options()) {
         Ok(pattern) => pattern,
         Err(e) if nanofold::commands::takes_many_vertices(&e, pattern_path) => {
-            return folding::unfold_network_one(pattern_path, solver, dir)
+            return folding::unfold_network_one(pattern_path, solver, dir, progress)
         }
         Err(e) => return Err(reading(pattern_path, e)),
     };

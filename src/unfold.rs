@@ -201,13 +201,7 @@ pub fn unfold_observed(
     if let Some(progress) = progress {
         executor = executor.add_observer(progress, ObserverMode::Always);
     }
-    let result = executor.run().map_err(|e| match e.downcast::<NanofoldError>() {
-        Ok(error) => error,
-        Err(other) => NumericalError::Executor {
-            detail: other.to_string(),
-        }
-        .into(),
-    })?;
+    let result = executor.run().map_err(from_executor)?;
     let solver = result.solver;
     let (verdict, evidence) = verdict(&solver, settings);
     let final_nodes = solver.nodes.clone();
@@ -231,6 +225,17 @@ pub fn unfold_observed(
         trajectory: recorder.take(),
         final_nodes,
     })
+}
+
+/// An error out of argmin's executor: the solver's own error where it raised one.
+pub(crate) fn from_executor(error: argmin::core::Error) -> NanofoldError {
+    match error.downcast::<NanofoldError>() {
+        Ok(error) => error,
+        Err(other) => NumericalError::Executor {
+            detail: other.to_string(),
+        }
+        .into(),
+    }
 }
 
 /// The verdict and its evidence from the solver's termination.

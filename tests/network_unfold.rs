@@ -599,3 +599,58 @@ fn new_inputs_are_refused_by_name() {
     let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
     assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
 }
+
+/// The descent is an argmin solver: the progress observer the single vertex takes is told of
+/// every iteration, with the state each step left; driven by a bare loop over
+/// `NetworkDescent::iterate` it takes the same steps as under argmin's executor.
+#[test]
+fn the_descent_under_argmin_reports_every_step_to_the_shared_observer() {
+    use nanofold::folding::{fold_path, Drive, FoldSettings};
+    use nanofold::unfold::network::{start_descent, unfold_network_observed, NetworkStart};
+    use nanofold::unfold::UnfoldProgress;
+    use std::sync::{Arc, Mutex};
+    let model = miura(4, 60.0);
+    let fold = FoldSettings {
+        drive: Drive::Assignment { to: 0.8 },
+        ..FoldSettings::default()
+    };
+    let start = fold_path(&model, &model.given_fold_angles(), &fold)
+        .unwrap()
+        .steps
+        .last()
+        .unwrap()
+        .fold_angles
+        .clone();
+    let settings = NetworkUnfoldSettings::default();
+    let told = Arc::new(Mutex::new(Vec::new()));
+    let seen = told.clone();
+    let progress = UnfoldProgress(Arc::new(move |step, largest, energy| {
+        seen.lock().unwrap().push((step, largest, energy));
+    }));
+    let report = unfold_network_observed(&model, &start, &settings, Some(progress)).unwrap();
+    assert_eq!(report.verdict, NetworkVerdict::Flat, "{}", report.evidence);
+    assert_eq!(report.restarts_used, 0);
+    let told = told.lock().unwrap().clone();
+    // One call per iteration, the stopping one included.
+    assert_eq!(told.len(), report.iterations + 1);
+    for (k, &(step, largest, energy)) in told.iter().enumerate() {
+        assert_eq!(step, k + 1);
+        if k < report.iterations {
+            let after = &report.steps[k + 1];
+            let expected = after.fold_angles.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+            assert_eq!((largest, energy), (expected, after.energy), "iteration {k}");
+        }
+    }
+    // The same descent, driven by hand.
+    let NetworkStart::Descent(mut descent) = start_descent(&model, &start, &settings).unwrap() else {
+        panic!("a folded Miura-ori is not decided at its start");
+    };
+    let mut iteration = 0;
+    let by_hand = loop {
+        if let Some(stop) = descent.iterate(iteration).unwrap() {
+            break descent.finish(stop, iteration);
+        }
+        iteration += 1;
+    };
+    assert_eq!(by_hand, report);
+}

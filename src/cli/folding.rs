@@ -564,10 +564,11 @@ pub fn unfold_network_one(
     pattern_path: &Path,
     solver: &super::SolverArgs,
     dir: Option<&Path>,
+    progress: Option<nanofold::unfold::UnfoldProgress>,
 ) -> Result<(Value, String)> {
     use nanofold::io::folding_output::states_fold;
     use nanofold::plot::folding::angles_svg;
-    use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
+    use nanofold::unfold::network::{unfold_network_observed, NetworkUnfoldSettings};
     use std::fmt::Write as _;
     let (model, projection) = load_projected(pattern_path, solver.project)?;
     let frames_note = nanofold::io::file_frames_note(pattern_path);
@@ -580,7 +581,7 @@ pub fn unfold_network_one(
     };
     let start_state = model.given_fold_angles();
     let clock = Instant::now();
-    let report = unfold_network(&model, &start_state, &settings)
+    let report = unfold_network_observed(&model, &start_state, &settings, progress)
         .map_err(|e| flags(e, &[("flat_tol", "--flat-tol"), ("start", "edges_foldAngle")]))?;
     let seconds = clock.elapsed().as_secs_f64();
     let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);

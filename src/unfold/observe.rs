@@ -1,5 +1,5 @@
 //! Observers of an unfolding run (argmin's `Observe`): the trajectory recorder, bounded or
-//! thinned as [`Recording`] says, and a progress callback.
+//! thinned as [`Recording`] says, and a progress callback that either engine's run takes.
 
 use super::settings::Recording;
 use super::state::{StepKind, UnfoldState};
@@ -139,10 +139,23 @@ impl std::fmt::Debug for UnfoldProgress {
     }
 }
 
-impl Observe<UnfoldState> for UnfoldProgress {
-    fn observe_iter(&mut self, state: &UnfoldState, _kv: &KV) -> Result<(), argmin::core::Error> {
-        if state.recorded.is_some() {
-            (self.0)(state.steps, state.max_fold_angle, state.energy);
+/// What [`UnfoldProgress`] reads of a run's state, whichever engine runs: (steps so far,
+/// max |ρ| in rad, energy) after a step that recorded one.
+pub trait ProgressOf {
+    /// None after a call that recorded no step (a decision, a restart).
+    fn progress(&self) -> Option<(usize, f64, f64)>;
+}
+
+impl ProgressOf for UnfoldState {
+    fn progress(&self) -> Option<(usize, f64, f64)> {
+        self.recorded.map(|_| (self.steps, self.max_fold_angle, self.energy))
+    }
+}
+
+impl<S: ProgressOf> Observe<S> for UnfoldProgress {
+    fn observe_iter(&mut self, state: &S, _kv: &KV) -> Result<(), argmin::core::Error> {
+        if let Some((steps, largest, energy)) = state.progress() {
+            (self.0)(steps, largest, energy);
         }
         Ok(())
     }
