@@ -30,8 +30,10 @@ use crate::error::{NanofoldError, Result};
 use crate::folding::{check_pattern, fold_path, CheckReport, CheckSettings, FoldPath, FoldSettings, FoldingModel};
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
 use crate::pattern::{Assignment, Chain, LoadOptions, RayRole};
-use crate::unfold::network::{unfold_network, NetworkReport, NetworkUnfoldSettings, NetworkVerdict};
-use crate::unfold::{UnfoldReport, UnfoldSettings};
+use crate::unfold::network::{
+    unfold_network, unfold_network_observed, NetworkReport, NetworkUnfoldSettings, NetworkVerdict,
+};
+use crate::unfold::{UnfoldProgress, UnfoldReport, UnfoldSettings};
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -551,13 +553,34 @@ fn sheet_of<'p>(pattern: &'p Pattern, command: &str) -> Result<&'p FoldingModel>
 /// Unfolds a folded pattern to flat: the single vertex by the sphere's energy descent, a
 /// crease pattern of many vertices by descent on its closures.
 pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+    unfold_observed(pattern, settings, None)
+}
+
+/// [`unfold`], with `progress` told of every step (recorded steps so far, max |ρ|, energy)
+/// by whichever engine runs: both are argmin solvers under its executor.
+///
+/// ```
+/// use nanofold::prelude::*;
+/// use std::sync::{Arc, Mutex};
+/// # fn main() -> nanofold::prelude::Result<()> {
+/// let pattern = Pattern::open(std::path::Path::new("patterns/corner_cube.fold"), &LoadOptions::default())?;
+/// let steps = Arc::new(Mutex::new(0));
+/// let counter = steps.clone();
+/// let progress = UnfoldProgress(Arc::new(move |_, _, _| *counter.lock().unwrap() += 1));
+/// let report = unfold_observed(&pattern, &Settings::default(), Some(progress))?;
+/// assert_eq!(report.verdict, Verdict::Flat);
+/// assert!(*steps.lock().unwrap() > 0);
+/// # Ok(())
+/// # }
+/// ```
+pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<UnfoldProgress>) -> Result<Report> {
     match pattern.vertex() {
-        Some(vertex) => vertex_report(pattern, vertex, Command::Unfold, settings),
+        Some(vertex) => vertex_report(pattern, vertex, Command::Unfold, settings, progress),
         None => {
             let model = sheet_of(pattern, "unfold")?;
             let start = model.given_fold_angles();
             let clock = Instant::now();
-            let report = unfold_network(model, &start, &settings.network_unfold())?;
+            let report = unfold_network_observed(model, &start, &settings.network_unfold(), progress)?;
             let last = report
                 .steps
                 .last()
@@ -585,7 +608,7 @@ pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
 /// flat, by its assignment (rigidly foldable or not, with a witness path).
 pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
     match pattern.vertex() {
-        Some(vertex) => vertex_report(pattern, vertex, Command::Check, settings),
+        Some(vertex) => vertex_report(pattern, vertex, Command::Check, settings, None),
         None => {
             let model = sheet_of(pattern, "check")?;
             let clock = Instant::now();
@@ -658,8 +681,14 @@ pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
     })
 }
 
-fn vertex_report(pattern: &Pattern, vertex: &VertexPattern, command: Command, settings: &Settings) -> Result<Report> {
-    let report = crate::unfold::unfold(vertex, &settings.unfold)?;
+fn vertex_report(
+    pattern: &Pattern,
+    vertex: &VertexPattern,
+    command: Command,
+    settings: &Settings,
+    progress: Option<UnfoldProgress>,
+) -> Result<Report> {
+    let report = crate::unfold::unfold_observed(vertex, &settings.unfold, progress)?;
     Ok(Report {
         pattern: pattern.name().to_string(),
         command,

@@ -4,7 +4,7 @@
 //! (under `VertexPattern`, `unfold_vertex`, `VertexReport`, `VertexVerdict`).
 
 pub use crate::commands::{
-    check, fold, unfold, Command, Detail, Engine, Pattern, Report, Settings, Verdict, VertexPattern,
+    check, fold, unfold, unfold_observed, Command, Detail, Engine, Pattern, Report, Settings, Verdict, VertexPattern,
 };
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::Method;
@@ -18,5 +18,5 @@ pub use crate::pattern::{Assignment, Chain, LoadOptions, VertexBuilder};
 pub use crate::unfold::energy::EnergyKind;
 pub use crate::unfold::qp::QpMethod;
 pub use crate::unfold::{
-    unfold as unfold_vertex, UnfoldReport as VertexReport, UnfoldSettings, Verdict as VertexVerdict,
+    unfold as unfold_vertex, UnfoldProgress, UnfoldReport as VertexReport, UnfoldSettings, Verdict as VertexVerdict,
 };
