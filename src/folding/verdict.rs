@@ -497,7 +497,7 @@ fn local_tests(model: &FoldingModel, exact: f64) -> std::result::Result<LocalTes
     }
     if second_order_checked > 0 {
         tried.push(format!(
-            "{second_order_checked} vertices of other degrees: each assignment passes the second-order test at flat"
+            "{second_order_checked} vertices of other degrees: each one's signs pass the second-order test at flat on their own (some velocity with those signs closes the vertex to second order); their conditions are not combined"
         ));
     }
     Ok(LocalTests { chosen, tried })

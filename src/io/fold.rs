@@ -335,7 +335,9 @@ pub(crate) fn parse_graph(value: &Value, limits: GraphLimits) -> Result<FoldGrap
     })
 }
 
-/// Reads the key frame of a FOLD object into a raw vertex.
+/// Reads the key frame of a FOLD object into a raw vertex: the edges classified, the one
+/// vertex where the creases meet, its edges ordered by direction, the paper's span, and the
+/// rays and sectors in that order.
 pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
     let FoldGraph {
         coords,
@@ -357,26 +359,60 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             "a single vertex is read from its flat crease pattern (z = 0) with edges_foldAngle; 3D folded forms are read as crease patterns of many vertices (`check`, `fold`)",
         ));
     }
-    let (nv, ne) = (coords.len(), edges.len());
     let angles_json =
         angles_json.ok_or_else(|| NanofoldError::missing_with("edges_foldAngle", "the folded state, degrees"))?;
+    let is_crease = crease_edges(&letters)?;
+    let center = the_vertex(&edges, &is_crease, coords.len())?;
+    let spokes = spokes_at(center, &coords, &edges)?;
+    let (chain, start, ray_count) = paper_span(&spokes, &is_crease, center)?;
+    let edge_table = EdgeTable {
+        letters: &letters,
+        is_crease: &is_crease,
+        angle_key,
+        angles_json,
+        locked: &locked,
+    };
+    let (rays, sector_angles, sector_fields) = rays_and_sectors(&spokes, &edge_table, chain, start, ray_count)?;
+    Ok(VertexBuilder {
+        name: name.to_string(),
+        chain,
+        rays,
+        sector_angles,
+        sector_fields,
+        mesh: Some(FlatMesh {
+            vertices_coords: coords,
+            edges_vertices: edges,
+            edges_assignment: letters,
+            faces_vertices,
+            center,
+            ray0_direction: spokes[start].direction,
+            unit,
+        }),
+    })
+}
 
-    // Classify edges; B edges are boundary, the rest creases (C/J refused).
-    let mut is_crease = vec![false; ne];
+/// Which edges are creases: every edge but the boundary (B) ones; C and J are refused.
+fn crease_edges(letters: &[String]) -> Result<Vec<bool>> {
+    let mut is_crease = vec![false; letters.len()];
     for (i, letter) in letters.iter().enumerate() {
         if letter != "B" && letter != "b" {
             Assignment::from_letter(letter, &format!("edges_assignment[{i}]"))?;
             is_crease[i] = true;
         }
     }
-    let mut crease_degree = vec![0usize; nv];
+    Ok(is_crease)
+}
+
+/// The one vertex where two or more creases meet, every crease meeting it.
+fn the_vertex(edges: &[[usize; 2]], is_crease: &[bool], vertex_count: usize) -> Result<usize> {
+    let mut crease_degree = vec![0usize; vertex_count];
     for (i, e) in edges.iter().enumerate() {
         if is_crease[i] {
             crease_degree[e[0]] += 1;
             crease_degree[e[1]] += 1;
         }
     }
-    let centers: Vec<usize> = (0..nv).filter(|&v| crease_degree[v] >= 2).collect();
+    let centers: Vec<usize> = (0..vertex_count).filter(|&v| crease_degree[v] >= 2).collect();
     let center = match centers.len() {
         0 => {
             return Err(NanofoldError::invalid(
@@ -397,13 +433,19 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             ));
         }
     }
+    Ok(center)
+}
 
-    // Rays: every edge at the centre, by polar angle.
+/// An edge at the vertex and the direction it leaves in, rad in [0, 2π).
+struct Spoke {
+    edge: usize,
+    direction: f64,
+}
+
+/// Every edge at `center`, by direction; refused where one has zero length or two leave in
+/// the same direction.
+fn spokes_at(center: usize, coords: &[[f64; 2]], edges: &[[usize; 2]]) -> Result<Vec<Spoke>> {
     let c = coords[center];
-    struct Spoke {
-        edge: usize,
-        direction: f64,
-    }
     let mut spokes = Vec::new();
     for (i, e) in edges.iter().enumerate() {
         if e[0] != center && e[1] != center {
@@ -436,7 +478,65 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             ));
         }
     }
-    let boundary_spokes: Vec<usize> = (0..spokes.len()).filter(|&k| !is_crease[spokes[k].edge]).collect();
+    Ok(spokes)
+}
+
+/// The paper around the vertex: all the way round (no boundary edge: a closed chain), or the
+/// angular gap between its two boundary edges that holds the creases (an open chain). Returns
+/// the chain, the spoke it starts at, and how many rays it has.
+fn paper_span(spokes: &[Spoke], is_crease: &[bool], center: usize) -> Result<(Chain, usize, usize)> {
+    let m = spokes.len();
+    let boundary_spokes: Vec<usize> = (0..m).filter(|&k| !is_crease[spokes[k].edge]).collect();
+    match boundary_spokes.len() {
+        0 => Ok((Chain::Closed, 0, m)),
+        2 => {
+            let (b0, b1) = (boundary_spokes[0], boundary_spokes[1]);
+            let creases_between = (b0 + 1..b1).count();
+            let creases_outside = m - 2 - creases_between;
+            if creases_between > 0 && creases_outside > 0 {
+                return Err(NanofoldError::invalid(
+                    "vertices_coords",
+                    format!(
+                        "boundary edges {} and {} at vertex {center}",
+                        spokes[b0].edge, spokes[b1].edge
+                    ),
+                    "creases leave the vertex on both sides of its two boundary edges: the paper must lie between them",
+                ));
+            }
+            if creases_between > 0 {
+                Ok((Chain::Open, b0, b1 - b0 + 1))
+            } else {
+                Ok((Chain::Open, b1, m - b1 + b0 + 1))
+            }
+        }
+        k => Err(NanofoldError::invalid(
+            "edges_assignment",
+            format!("{k} boundary (B) edges at vertex {center}"),
+            "a vertex has 0 (interior) or 2 (on the sheet's edge) boundary edges",
+        )),
+    }
+}
+
+/// What a ray reads of its edge: the assignment, whether it is a crease, its fold angle
+/// (under `angle_key`), whether it is locked.
+struct EdgeTable<'a> {
+    letters: &'a [String],
+    is_crease: &'a [bool],
+    angle_key: &'a str,
+    angles_json: &'a [Value],
+    locked: &'a [bool],
+}
+
+/// The rays from the span's first spoke on (creases with their assignment and fold angle,
+/// boundary edges as boundary rays), and the sector after each but an open chain's last,
+/// with the field each sector is read from.
+fn rays_and_sectors(
+    spokes: &[Spoke],
+    table: &EdgeTable,
+    chain: Chain,
+    start: usize,
+    ray_count: usize,
+) -> Result<(Vec<RaySpec>, Vec<f64>, Vec<String>)> {
     let m = spokes.len();
     let gap = |k: usize| -> f64 {
         let next = spokes[(k + 1) % m].direction;
@@ -447,56 +547,27 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             next - here
         }
     };
-    let (chain, start, ray_count) =
-        match boundary_spokes.len() {
-            0 => (Chain::Closed, 0, m),
-            2 => {
-                // The paper is the angular gap between the two boundary rays that holds creases.
-                let (b0, b1) = (boundary_spokes[0], boundary_spokes[1]);
-                let creases_between = (b0 + 1..b1).count();
-                let creases_outside = m - 2 - creases_between;
-                if creases_between > 0 && creases_outside > 0 {
-                    return Err(NanofoldError::invalid(
-                    "vertices_coords",
-                    format!("boundary edges {} and {} at vertex {center}", spokes[b0].edge, spokes[b1].edge),
-                    "creases leave the vertex on both sides of its two boundary edges: the paper must lie between them",
-                ));
-                }
-                if creases_between > 0 {
-                    (Chain::Open, b0, b1 - b0 + 1)
-                } else {
-                    (Chain::Open, b1, m - b1 + b0 + 1)
-                }
-            }
-            k => {
-                return Err(NanofoldError::invalid(
-                    "edges_assignment",
-                    format!("{k} boundary (B) edges at vertex {center}"),
-                    "a vertex has 0 (interior) or 2 (on the sheet's edge) boundary edges",
-                ))
-            }
-        };
-
-    let mut rays = Vec::with_capacity(ray_count);
-    let mut sector_angles = Vec::new();
-    let mut sector_fields = Vec::new();
-    let mut order_of_edge = vec![usize::MAX; ne];
-    let mut crease_edges: Vec<usize> = spokes.iter().map(|s| s.edge).filter(|&e| is_crease[e]).collect();
+    // Creases are numbered by their edge index.
+    let mut order_of_edge = vec![usize::MAX; table.letters.len()];
+    let mut crease_edges: Vec<usize> = spokes.iter().map(|s| s.edge).filter(|&e| table.is_crease[e]).collect();
     crease_edges.sort_unstable();
     for (order, &e) in crease_edges.iter().enumerate() {
         order_of_edge[e] = order;
     }
+    let mut rays = Vec::with_capacity(ray_count);
+    let mut sector_angles = Vec::new();
+    let mut sector_fields = Vec::new();
     for j in 0..ray_count {
         let k = (start + j) % m;
         let edge = spokes[k].edge;
-        if is_crease[edge] {
-            let field = format!("{angle_key}[{edge}]");
-            let degrees = number(&angles_json[edge], &field)?;
+        if table.is_crease[edge] {
+            let field = format!("{}[{edge}]", table.angle_key);
+            let degrees = number(&table.angles_json[edge], &field)?;
             rays.push(RaySpec::Crease(CreaseSpec {
                 label: format!("edges[{edge}]"),
-                assignment: Assignment::from_letter(&letters[edge], &format!("edges_assignment[{edge}]"))?,
+                assignment: Assignment::from_letter(&table.letters[edge], &format!("edges_assignment[{edge}]"))?,
                 fold_angle: degrees.to_radians(),
-                locked: locked[edge],
+                locked: table.locked[edge],
                 fold_edge: Some(edge),
                 order: order_of_edge[edge],
                 angle_field: field,
@@ -517,23 +588,7 @@ pub(crate) fn read_fold(value: &Value, name: &str) -> Result<VertexBuilder> {
             ));
         }
     }
-
-    Ok(VertexBuilder {
-        name: name.to_string(),
-        chain,
-        rays,
-        sector_angles,
-        sector_fields,
-        mesh: Some(FlatMesh {
-            vertices_coords: coords,
-            edges_vertices: edges,
-            edges_assignment: letters,
-            faces_vertices,
-            center,
-            ray0_direction: spokes[start].direction,
-            unit,
-        }),
-    })
+    Ok((rays, sector_angles, sector_fields))
 }
 
 /// Reads the key frame of a FOLD object into a crease pattern of any number of vertices
