@@ -15,7 +15,7 @@ pub mod second_order;
 pub mod simd_state;
 pub mod verdict;
 
-pub use closure::{closure_jacobian, vertex_residuals, ClosureJacobian};
+pub use closure::{closure_jacobian, closure_residual, vertex_residuals, worst_of, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
 pub use frames::{path_frames, PathFrame, FRAME_CLOSURE};
 pub use model::{FoldingModel, Star, TreeStep};

@@ -67,10 +67,7 @@ impl ClosureJacobian {
 
     /// The largest vertex residual |r_v|, rad.
     pub fn worst_residual(&self) -> f64 {
-        self.residual
-            .chunks(3)
-            .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
-            .fold(0.0, f64::max)
+        worst_of(&self.residual)
     }
 
     /// y = J x.
@@ -107,6 +104,27 @@ pub fn vertex_residuals(model: &FoldingModel, fold_angles: &[f64]) -> Vec<f64> {
             kinematics::closure_residual(&star.sector_angles, &by_ray)
         })
         .collect()
+}
+
+/// The stacked residual alone (3 entries per star, as [`ClosureJacobian::residual`], equal
+/// to it bit for bit) into `residual`: what a chord step needs.
+pub fn closure_residual(model: &FoldingModel, fold_angles: &[f64], residual: &mut Vec<f64>) {
+    residual.clear();
+    let mut by_ray = Vec::new();
+    for (s, star) in model.stars.iter().enumerate() {
+        by_ray.clear();
+        by_ray.extend(star.columns.iter().map(|&c| fold_angles[c].sin_cos()));
+        let r = kinematics::closure_residual_trig(&model.sector_trig[s], &by_ray);
+        residual.extend(r.iter());
+    }
+}
+
+/// The largest vertex residual |r_v| of a stacked residual, rad.
+pub fn worst_of(residual: &[f64]) -> f64 {
+    residual
+        .chunks(3)
+        .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
+        .fold(0.0, f64::max)
 }
 
 /// The stacked residual and the sparse Jacobian ∂r/∂ρ at `fold_angles` (one per crease).

@@ -3,19 +3,23 @@
 //! path's chord length) and polished by Newton onto every closure, so a frame costs a
 //! Newton solve, not a path step.
 
-use super::closure::{closure_jacobian, ClosureJacobian};
+use super::closure::{closure_jacobian, closure_residual, worst_of, ClosureJacobian};
 use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
 use super::path::{assigned_signs, progress, progress_by_crease, progress_crease, FoldPath};
 use crate::error::{NanofoldError, Result};
 
-/// The closure a frame is polished to, rad: tight enough that the spanning tree's
-/// coordinates hold every edge length to about 1e-12 (a residual r at each vertex moves
-/// the last panels of a tree of depth d by about d·r of the pattern's size).
-pub const FRAME_CLOSURE: f64 = 1e-14;
+/// The closure a frame is polished towards, rad: below rounding, so the polish goes on
+/// while chord steps still halve the residual. A residual r at each vertex moves the last
+/// panels of a tree of depth d by about d·r of the pattern's size, and at depth 100 the
+/// edge lengths hold to 1e-12 only from about 1e-15.
+pub const FRAME_CLOSURE: f64 = 1e-16;
 
 /// The residual's fall per chord step below which a frame's polish refactorises.
 const CHORD_CONTRACTION: f64 = 0.1;
+
+/// Below this residual, rad, a frame's polish takes only chord steps.
+const CHORD_ONLY: f64 = 1e-13;
 
 /// Most frames one call places.
 pub const MAX_FRAMES: usize = 100_000;
@@ -200,14 +204,15 @@ fn polish(
     solver: &mut NormalSolver,
 ) -> Result<f64> {
     let mut best = (f64::INFINITY, fold_angles.to_vec());
-    let mut factored: Option<(ClosureJacobian, NormalFactor, bool)> = None;
+    let mut factored: Option<(ClosureJacobian, NormalFactor)> = None;
+    let mut fresh = false;
     let mut previous = f64::INFINITY;
+    let mut residual = Vec::with_capacity(3 * model.stars.len());
+    let mut step = vec![0.0; fold_angles.len()];
     for _ in 0..20 {
-        let mut jac = closure_jacobian(model, fold_angles);
-        if let Some(c) = held {
-            jac.hold(c);
-        }
-        let worst = jac.worst_residual();
+        // The residual alone: a chord step reuses the factorised Jacobian.
+        closure_residual(model, fold_angles, &mut residual);
+        let worst = worst_of(&residual);
         if !worst.is_finite() {
             break;
         }
@@ -217,21 +222,28 @@ fn polish(
         if worst <= FRAME_CLOSURE {
             break;
         }
-        let fresh_before = factored.as_ref().is_some_and(|f| f.2);
-        if factored.is_none() || worst > CHORD_CONTRACTION * previous {
+        // Near rounding the residual cannot fall tenfold: chord steps go on while it halves.
+        if worst <= CHORD_ONLY && factored.is_some() && worst > 0.5 * previous {
+            break;
+        }
+        if factored.is_none() || (worst > CHORD_CONTRACTION * previous && worst > CHORD_ONLY) {
             // A fresh matrix that could not halve the residual: as close as rounding allows.
-            if fresh_before && worst > 0.5 * previous {
+            if fresh && worst > 0.5 * previous {
                 break;
             }
+            let mut jac = closure_jacobian(model, fold_angles);
+            if let Some(c) = held {
+                jac.hold(c);
+            }
             let factor = solver.factor(&jac)?;
-            factored = Some((jac.clone(), factor, true));
-        } else if let Some(entry) = factored.as_mut() {
-            entry.2 = false;
+            factored = Some((jac, factor));
+            fresh = true;
+        } else {
+            fresh = false;
         }
         previous = worst;
-        let (matrix, factor, _) = factored.as_ref().expect("set above");
-        let mut step = vec![0.0; jac.cols];
-        matrix.apply_transpose(&jac.residual, &mut step);
+        let (matrix, factor) = factored.as_ref().expect("set above");
+        matrix.apply_transpose(&residual, &mut step);
         factor.solve(&mut step);
         for (rho, d) in fold_angles.iter_mut().zip(&step) {
             *rho -= d;

@@ -63,6 +63,22 @@ fn turn_trig(frame: &mut Matrix3<f64>, (s, c): (f64, f64), (sa, ca): (f64, f64))
     frame.set_column(1, &(ca * c1 - sa * c0));
 }
 
+/// The holonomy's rotation vector alone, from the (sin, cos) of the sector angles and of
+/// the fold angles (ray order): the same products as [`closure_jacobian_trig`], so the same
+/// r to the last bit, without the Jacobian's columns.
+pub fn closure_residual_trig(sector_trig: &[(f64, f64)], fold_trig: &[(f64, f64)]) -> Vector3<f64> {
+    let (s0, c0) = sector_trig[0];
+    let mut frame = Matrix3::new(c0, -s0, 0.0, s0, c0, 0.0, 0.0, 0.0, 1.0);
+    for k in 1..fold_trig.len() {
+        turn_trig(&mut frame, fold_trig[k], sector_trig[k]);
+    }
+    let (s, c) = fold_trig[0];
+    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
+    frame.set_column(1, &(c * c1 + s * c2));
+    frame.set_column(2, &(c * c2 - s * c1));
+    rotation_vector(&frame)
+}
+
 /// [`closure_jacobian`] of every ray, from the (sin, cos) of the sector angles and of the
 /// fold angles (ray order), without allocating: returns r and writes ∂r/∂ρ_k into
 /// `columns[k]` (`nodes` is scratch; both as long as the fold angles).
