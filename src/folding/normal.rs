@@ -4,10 +4,19 @@
 
 use super::closure::ClosureJacobian;
 use crate::error::{NumericalError, Result};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::Side;
+use faer::{Conj, Par, Side};
+use std::sync::Arc;
+
+/// Creases from which the supernodal Cholesky is used: faer's own choice keeps the
+/// simplicial one for these matrices, which is faster only below about this size (a
+/// Miura-ori's JᵀJ: 1.4× slower at 1 984 creases, 1.1× faster at 3 120, 1.9× at 19 800).
+const SUPERNODAL_FROM: usize = 2_500;
 
 /// Factorises JᵀJ + μI (structure and symbolic analysis kept between states) for the
 /// null-space projection and the least-norm Newton step.
@@ -27,7 +36,9 @@ struct Assembly {
     /// The value slot of each diagonal entry.
     diagonal: Vec<usize>,
     structure: faer::sparse::SymbolicSparseColMat<usize>,
-    symbolic: SymbolicLlt<usize>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// The numeric factorisation's workspace, kept between states.
+    scratch: MemBuffer,
 }
 
 impl Assembly {
@@ -72,10 +83,20 @@ impl Assembly {
                 detail: format!("{e:?}"),
             }
         })?;
-        let symbolic = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).map_err(|e| NumericalError::Singular {
-            what: "JᵀJ + μI (symbolic)",
-            detail: format!("{e:?}"),
-        })?;
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: if jac.cols >= SUPERNODAL_FROM {
+                SupernodalThreshold::FORCE_SUPERNODAL
+            } else {
+                SupernodalThreshold::AUTO
+            },
+            ..Default::default()
+        };
+        let symbolic = factorize_symbolic_cholesky(matrix.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+            .map_err(|e| NumericalError::Singular {
+                what: "JᵀJ + μI (symbolic)",
+                detail: format!("{e:?}"),
+            })?;
+        let scratch = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
         Ok(Assembly {
             pattern: jac.entries.iter().map(|&(r, c, _)| (r, c)).collect(),
             products,
@@ -84,7 +105,8 @@ impl Assembly {
                 what: "JᵀJ + μI (structure)",
                 detail: format!("{e:?}"),
             })?,
-            symbolic,
+            symbolic: Arc::new(symbolic),
+            scratch,
         })
     }
 
@@ -100,7 +122,9 @@ impl Assembly {
 
 /// One factorisation and its regularisation.
 pub struct NormalFactor {
-    llt: Llt<usize, f64>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// The factor L's values, in the symbolic structure's order.
+    l_values: Vec<f64>,
     /// μ.
     pub mu: f64,
     /// The largest diagonal entry of JᵀJ (the largest squared column norm of J, at least 1).
@@ -121,7 +145,7 @@ impl NormalSolver {
         if !self.assembly.as_ref().is_some_and(|a| a.fits(jac)) {
             self.assembly = Some(Assembly::new(jac)?);
         }
-        let assembly = self.assembly.as_ref().expect("set above");
+        let assembly = self.assembly.as_mut().expect("set above");
         let mut values = vec![0.0; assembly.structure.compute_nnz()];
         for &(a, b, slot) in &assembly.products {
             values[slot] += jac.entries[a].2 * jac.entries[b].2;
@@ -132,25 +156,46 @@ impl NormalSolver {
             values[k] += mu;
         }
         let matrix = SparseColMat::new(assembly.structure.clone(), values);
-        let llt = Llt::try_new_with_symbolic(assembly.symbolic.clone(), matrix.as_ref(), Side::Lower).map_err(|e| {
-            NumericalError::NotPositiveDefinite {
+        let mut l_values = vec![0.0; assembly.symbolic.len_val()];
+        assembly
+            .symbolic
+            .factorize_numeric_llt(
+                &mut l_values,
+                matrix.as_ref(),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut assembly.scratch),
+                Default::default(),
+            )
+            .map_err(|e| NumericalError::NotPositiveDefinite {
                 matrix: "JᵀJ + μI",
                 at: format!("{e:?}"),
-            }
-        })?;
-        Ok(NormalFactor { llt, mu, max_diagonal })
+            })?;
+        Ok(NormalFactor {
+            symbolic: assembly.symbolic.clone(),
+            l_values,
+            mu,
+            max_diagonal,
+        })
     }
 }
 
 impl NormalFactor {
     /// Solves (JᵀJ + μI) x = b in place.
     pub fn solve(&self, b: &mut [f64]) {
-        self.llt.solve_in_place(faer::ColMut::from_slice_mut(b).as_mat_mut());
+        self.solve_many(faer::ColMut::from_slice_mut(b).as_mat_mut());
     }
 
     /// Solves (JᵀJ + μI) X = B in place, one column per right-hand side.
     pub fn solve_many(&self, b: faer::MatMut<'_, f64>) {
-        self.llt.solve_in_place(b);
+        let mut scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq));
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            b,
+            Par::Seq,
+            MemStack::new(&mut scratch),
+        );
     }
 
     /// The desired velocity's component in the null space of J: d − Jᵀ(JJᵀ + μI)⁻¹J d,
