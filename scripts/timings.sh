@@ -40,6 +40,7 @@ section "unfold_timing (single vertices)" target/release/examples/unfold_timing
 section "crease_pattern_speed (patterns of many vertices)" target/release/examples/crease_pattern_speed
 section "work_precision (every engine; its report.json)" target/release/examples/work_precision
 section "closed_chain_timing (fitted against exact closure)" target/release/examples/closed_chain_timing
+section "executor_overhead (argmin's executor against a bare loop, both engines)" target/release/examples/executor_overhead
 if [ "${1:-}" != "--quick" ]; then
   section "cargo bench (criterion)" cargo bench --quiet
 fi
