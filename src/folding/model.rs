@@ -61,6 +61,9 @@ pub struct FoldingModel {
     /// (sin, cos) of each star's sector angles, computed when built (closures use them at
     /// every Newton step).
     pub(crate) sector_trig: Vec<Vec<(f64, f64)>>,
+    /// The medians over panels of their flat bounding boxes' smaller and larger sides: the
+    /// contact test's length scales, computed when built.
+    pub(crate) median_panel_sides: [f64; 2],
 }
 
 impl FoldingModel {
@@ -200,9 +203,14 @@ impl FoldingModel {
             .iter()
             .map(|star: &Star| star.sector_angles.iter().map(|a| a.sin_cos()).collect())
             .collect();
+        let median_panel_sides = [
+            median_panel_side(&pattern.vertices, &panel_vertices, f64::min),
+            median_panel_side(&pattern.vertices, &panel_vertices, f64::max),
+        ];
         Ok(FoldingModel {
             locked_columns,
             sector_trig,
+            median_panel_sides,
             pattern,
             stars,
             column_of_edge,
@@ -262,6 +270,28 @@ impl FoldingModel {
         model.pattern.folded_form = None;
         model
     }
+}
+
+/// The median over panels of one side of their flat bounding boxes (`pick` of the two).
+fn median_panel_side(vertices: &[[f64; 2]], panel_vertices: &[Vec<usize>], pick: fn(f64, f64) -> f64) -> f64 {
+    let mut sizes: Vec<f64> = panel_vertices
+        .iter()
+        .map(|list| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for &v in list {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(vertices[v][k]);
+                    hi[k] = hi[k].max(vertices[v][k]);
+                }
+            }
+            pick(hi[0] - lo[0], hi[1] - lo[1])
+        })
+        .collect();
+    if sizes.is_empty() {
+        return 0.0;
+    }
+    sizes.sort_by(f64::total_cmp);
+    sizes[sizes.len() / 2]
 }
 
 fn bounds(vertices: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
