@@ -110,10 +110,11 @@ pub fn vertex_residuals(model: &FoldingModel, fold_angles: &[f64]) -> Vec<f64> {
 /// to it bit for bit) into `residual`: what a chord step needs.
 pub fn closure_residual(model: &FoldingModel, fold_angles: &[f64], residual: &mut Vec<f64>) {
     residual.clear();
+    let fold_trig: Vec<(f64, f64)> = fold_angles.iter().map(|a| a.sin_cos()).collect();
     let mut by_ray = Vec::new();
     for (s, star) in model.stars.iter().enumerate() {
         by_ray.clear();
-        by_ray.extend(star.columns.iter().map(|&c| fold_angles[c].sin_cos()));
+        by_ray.extend(star.columns.iter().map(|&c| fold_trig[c]));
         let r = kinematics::closure_residual_trig(&model.sector_trig[s], &by_ray);
         residual.extend(r.iter());
     }
