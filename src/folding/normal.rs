@@ -155,13 +155,13 @@ impl NormalSolver {
         for &k in &assembly.diagonal {
             values[k] += mu;
         }
-        let matrix = SparseColMat::new(assembly.structure.clone(), values);
+        let matrix = faer::sparse::SparseColMatRef::new(assembly.structure.as_ref(), &values);
         let mut l_values = vec![0.0; assembly.symbolic.len_val()];
         assembly
             .symbolic
             .factorize_numeric_llt(
                 &mut l_values,
-                matrix.as_ref(),
+                matrix,
                 Side::Lower,
                 Default::default(),
                 Par::Seq,
