@@ -164,7 +164,8 @@ def test_long_calls_release_the_gil():
     counter.start()
     clock = time.perf_counter()
     before = ticks[0]
-    nanofold.fold(nanofold.generate.miura(10, 10), max_step=0.004)
+    # Long enough (about 0.3 s) for the counter's share of the time to show.
+    nanofold.fold(nanofold.generate.miura(14, 14), max_step=0.004)
     during = ticks[0] - before
     seconds = time.perf_counter() - clock
     stop.set()
