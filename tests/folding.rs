@@ -1571,3 +1571,24 @@ fn the_normal_equations_are_solved_at_either_factorisation() {
         );
     }
 }
+
+/// Frames are independent: placed on several threads (runs of consecutive frames, each with
+/// its own factorisation workspace) they are the frames placed one at a time, bit for bit.
+#[test]
+fn frames_on_several_threads_are_the_frames_placed_one_at_a_time() {
+    use nanofold::folding::{fold_path, path_frames_on, Drive, FoldSettings};
+    let model = miura(12, 12, 60.0, 0.0);
+    let settings = FoldSettings {
+        drive: Drive::Assignment { to: 0.9 },
+        ..Default::default()
+    };
+    let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+    let alone = path_frames_on(&model, &path, 23, 1).unwrap();
+    for threads in [2, 3, 23, 40] {
+        assert_eq!(
+            path_frames_on(&model, &path, 23, threads).unwrap(),
+            alone,
+            "{threads} threads"
+        );
+    }
+}

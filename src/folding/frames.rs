@@ -42,8 +42,29 @@ pub struct PathFrame {
 /// nearest steps (in cumulative chord length), placed where its progress is the target,
 /// and Newton moves it onto every closure (to [`FRAME_CLOSURE`], or as close as rounding
 /// allows) with the crease that sets progress held, so the frame keeps its progress. Where
-/// Newton finds no rigid state near it the nearer step is the frame.
+/// Newton finds no rigid state near it the nearer step is the frame. Frames are independent:
+/// on a large pattern they are placed on the machine's cores (at most [`MAX_FRAME_THREADS`]),
+/// with the same result as one at a time.
 pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Result<Vec<PathFrame>> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = if model.crease_count() >= PARALLEL_FROM_CREASES {
+        cores.min(MAX_FRAME_THREADS).min(count / 2).max(1)
+    } else {
+        1
+    };
+    path_frames_on(model, path, count, threads)
+}
+
+/// Most threads [`path_frames`] uses.
+pub const MAX_FRAME_THREADS: usize = 8;
+
+/// Creases from which [`path_frames`] spreads frames over threads (below, a frame takes a
+/// millisecond or less and one thread is as quick).
+const PARALLEL_FROM_CREASES: usize = 500;
+
+/// [`path_frames`] on `threads` threads (at least 1), each taking a run of consecutive
+/// frames with its own factorisation workspace.
+pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threads: usize) -> Result<Vec<PathFrame>> {
     if !(2..=MAX_FRAMES).contains(&count) {
         return Err(NanofoldError::invalid(
             "frames",
@@ -51,26 +72,74 @@ pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Resul
             format!("must lie in [2, {MAX_FRAMES}]"),
         ));
     }
-    let steps = &path.steps;
-    let signs = assigned_signs(model);
-    let start = &steps[0].fold_angles;
-    let progress_of = |rho: &[f64]| progress(&path.drive, start, rho, &signs);
-    // Cumulative chord length: the cubic's parameter.
-    let mut chord = vec![0.0];
-    for pair in steps.windows(2) {
-        let d: f64 = pair[0]
-            .fold_angles
-            .iter()
-            .zip(&pair[1].fold_angles)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>()
-            .sqrt();
-        chord.push(chord.last().copied().unwrap_or(0.0) + d);
+    let placer = FramePlacer::new(model, path, count);
+    let threads = threads.clamp(1, count);
+    if threads == 1 {
+        let mut solver = NormalSolver::new(1e-10);
+        return (0..count).map(|k| placer.frame(k, &mut solver)).collect();
     }
-    let (first, last) = (steps[0].progress, steps[steps.len() - 1].progress);
-    let mut solver = NormalSolver::new(1e-10);
-    let mut frames = Vec::with_capacity(count);
-    for k in 0..count {
+    let runs: Vec<std::ops::Range<usize>> = (0..threads)
+        .map(|t| (t * count / threads)..((t + 1) * count / threads))
+        .collect();
+    std::thread::scope(|scope| {
+        let placer = &placer;
+        let handles: Vec<_> = runs
+            .into_iter()
+            .map(|run| {
+                scope.spawn(move || {
+                    let mut solver = NormalSolver::new(1e-10);
+                    run.map(|k| placer.frame(k, &mut solver)).collect::<Result<Vec<_>>>()
+                })
+            })
+            .collect();
+        let mut frames = Vec::with_capacity(count);
+        for handle in handles {
+            let run = handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+            frames.extend(run);
+        }
+        Ok(frames)
+    })
+}
+
+/// What every frame of one call shares: the path, its chord lengths and progress range.
+struct FramePlacer<'a> {
+    model: &'a FoldingModel,
+    path: &'a FoldPath,
+    signs: Vec<f64>,
+    /// Cumulative chord length at each step: the cubic's parameter.
+    chord: Vec<f64>,
+    count: usize,
+}
+
+impl<'a> FramePlacer<'a> {
+    fn new(model: &'a FoldingModel, path: &'a FoldPath, count: usize) -> Self {
+        let mut chord = vec![0.0];
+        for pair in path.steps.windows(2) {
+            let d: f64 = pair[0]
+                .fold_angles
+                .iter()
+                .zip(&pair[1].fold_angles)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt();
+            chord.push(chord.last().copied().unwrap_or(0.0) + d);
+        }
+        FramePlacer {
+            model,
+            path,
+            signs: assigned_signs(model),
+            chord,
+            count,
+        }
+    }
+
+    /// Frame `k` of `count`.
+    fn frame(&self, k: usize, solver: &mut NormalSolver) -> Result<PathFrame> {
+        let (path, steps, count) = (self.path, &self.path.steps, self.count);
+        let signs = &self.signs;
+        let start = &steps[0].fold_angles;
+        let progress_of = |rho: &[f64]| progress(&path.drive, start, rho, signs);
+        let (first, last) = (steps[0].progress, steps[steps.len() - 1].progress);
         let target = first + (last - first) * k as f64 / (count - 1) as f64;
         // The segment whose steps bracket the target (the last one where progress is flat).
         let segment = (0..steps.len().saturating_sub(1))
@@ -84,22 +153,22 @@ pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Resul
             // Bisection on the crease that sets progress at the segment's end, checked on the
             // whole state (and redone on it where another crease sets progress).
             let end = &steps[(segment + 1).min(steps.len() - 1)].fold_angles;
-            let setter = progress_crease(&path.drive, end, &signs)
+            let setter = progress_crease(&path.drive, end, signs)
                 .map(|c| (c, move |value: f64| progress_by_crease(&path.drive, start, c, value)));
             let by_setter = setter
                 .as_ref()
-                .map(|(c, f)| place(steps, &chord, segment, target, &Placement::Crease(*c, f)))
+                .map(|(c, f)| place(steps, &self.chord, segment, target, &Placement::Crease(*c, f)))
                 .filter(|guess| (progress_of(guess) - target).abs() <= 1e-12);
-            by_setter.unwrap_or_else(|| place(steps, &chord, segment, target, &Placement::State(&progress_of)))
+            by_setter.unwrap_or_else(|| place(steps, &self.chord, segment, target, &Placement::State(&progress_of)))
         };
         let mut rho = guess;
         // The crease that sets progress keeps its angle, so the frame stays at its target.
         let held = if k == 0 || k == count - 1 {
             None
         } else {
-            progress_crease(&path.drive, &rho, &signs)
+            progress_crease(&path.drive, &rho, signs)
         };
-        let residual = polish(model, &mut rho, held, &mut solver)?;
+        let residual = polish(self.model, &mut rho, held, solver)?;
         let (fold_angles, max_residual) = if residual <= path_tolerance(path) {
             (rho, residual)
         } else {
@@ -113,14 +182,13 @@ pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Resul
             };
             (steps[nearer].fold_angles.clone(), steps[nearer].max_residual)
         };
-        frames.push(PathFrame {
+        Ok(PathFrame {
             progress: progress_of(&fold_angles),
             fold_angles,
             max_residual,
             after_step: segment,
-        });
+        })
     }
-    Ok(frames)
 }
 
 /// The closure a frame must reach to be used: the path's own worst, or 1e-10 rad.
