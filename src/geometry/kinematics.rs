@@ -63,20 +63,37 @@ fn turn_trig(frame: &mut Matrix3<f64>, (s, c): (f64, f64), (sa, ca): (f64, f64))
     frame.set_column(1, &(ca * c1 - sa * c0));
 }
 
-/// The holonomy's rotation vector alone, from the (sin, cos) of the sector angles and of
-/// the fold angles (ray order): the same products as [`closure_jacobian_trig`], so the same
-/// r to the last bit, without the Jacobian's columns.
-pub fn closure_residual_trig(sector_trig: &[(f64, f64)], fold_trig: &[(f64, f64)]) -> Vector3<f64> {
+/// The holonomy's frame, as [`chain`] but from the (sin, cos) of the sector angles and of
+/// the fold angles (ray order), with node k (k ≥ 1) in `nodes[k]` when asked.
+fn chain_trig(sector_trig: &[(f64, f64)], fold_trig: &[(f64, f64)], mut nodes: Option<&mut [Vec3]>) -> Matrix3<f64> {
+    let n = fold_trig.len();
     let (s0, c0) = sector_trig[0];
     let mut frame = Matrix3::new(c0, -s0, 0.0, s0, c0, 0.0, 0.0, 0.0, 1.0);
-    for k in 1..fold_trig.len() {
+    if let Some(nodes) = nodes.as_deref_mut() {
+        if n > 1 {
+            nodes[1] = frame.column(0).into_owned();
+        }
+    }
+    for k in 1..n {
         turn_trig(&mut frame, fold_trig[k], sector_trig[k]);
+        if let Some(nodes) = nodes.as_deref_mut() {
+            if k + 1 < n {
+                nodes[k + 1] = frame.column(0).into_owned();
+            }
+        }
     }
     let (s, c) = fold_trig[0];
     let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
     frame.set_column(1, &(c * c1 + s * c2));
     frame.set_column(2, &(c * c2 - s * c1));
-    rotation_vector(&frame)
+    frame
+}
+
+/// The holonomy's rotation vector alone, from the (sin, cos) of the sector angles and of
+/// the fold angles (ray order): the same products as [`closure_jacobian_trig`], so the same
+/// r to the last bit, without the Jacobian's columns.
+pub fn closure_residual_trig(sector_trig: &[(f64, f64)], fold_trig: &[(f64, f64)]) -> Vector3<f64> {
+    rotation_vector(&chain_trig(sector_trig, fold_trig, None))
 }
 
 /// [`closure_jacobian`] of every ray, from the (sin, cos) of the sector angles and of the
@@ -88,26 +105,11 @@ pub fn closure_jacobian_trig(
     nodes: &mut [Vec3],
     columns: &mut [Vector3<f64>],
 ) -> Vector3<f64> {
-    let n = fold_trig.len();
-    let (s0, c0) = sector_trig[0];
-    let mut frame = Matrix3::new(c0, -s0, 0.0, s0, c0, 0.0, 0.0, 0.0, 1.0);
-    if n > 1 {
-        nodes[1] = frame.column(0).into_owned();
-    }
-    for k in 1..n {
-        turn_trig(&mut frame, fold_trig[k], sector_trig[k]);
-        if k + 1 < n {
-            nodes[k + 1] = frame.column(0).into_owned();
-        }
-    }
-    let (s, c) = fold_trig[0];
-    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
-    frame.set_column(1, &(c * c1 + s * c2));
-    frame.set_column(2, &(c * c2 - s * c1));
+    let frame = chain_trig(sector_trig, fold_trig, Some(nodes));
     let r = rotation_vector(&frame);
     let jl_inv = left_jacobian_inverse(&r);
     columns[0] = jl_inv * frame.column(0);
-    for k in 1..n {
+    for k in 1..fold_trig.len() {
         columns[k] = jl_inv * nodes[k];
     }
     r
