@@ -13,6 +13,16 @@ use nanofold::pattern::generate::MiuraSpec;
 use nanofold::pattern::{Assignment, LoadOptions};
 use std::path::Path;
 
+/// The folding path from flat along the assignment to 90%, at the default settings.
+fn path_to_90_percent(model: &FoldingModel) -> nanofold::folding::FoldPath {
+    use nanofold::folding::{fold_path, Drive, FoldSettings};
+    let settings = FoldSettings {
+        drive: Drive::Assignment { to: 0.9 },
+        ..Default::default()
+    };
+    fold_path(model, &model.given_fold_angles(), &settings).unwrap()
+}
+
 fn miura(rows: usize, cols: usize, gamma_deg: f64, zigzag_deg: f64) -> FoldingModel {
     let spec = MiuraSpec {
         rows,
@@ -1413,14 +1423,10 @@ fn flat_sheets_with_hundreds_of_dof_are_counted_by_the_reductions() {
 /// the spanning tree's coordinates within 1e-12 of the crease pattern's.
 #[test]
 fn frames_between_steps_lie_on_the_miura_oris_closed_form_motion() {
-    use nanofold::folding::{fold_path, path_frames, Drive, FoldSettings};
+    use nanofold::folding::path_frames;
     let (n, gamma) = (8, 60.0);
     let model = miura(n, n, gamma, 0.0);
-    let settings = FoldSettings {
-        drive: Drive::Assignment { to: 0.9 },
-        ..Default::default()
-    };
-    let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+    let path = path_to_90_percent(&model);
     // The last step lands on the goal (the crease that sets progress held there), and a
     // smooth one-DOF path takes few steps.
     let end = path.steps.last().unwrap().progress;
@@ -1485,13 +1491,9 @@ fn frames_between_steps_lie_on_the_miura_oris_closed_form_motion() {
 /// of every frame holds to 1e-12 relative.
 #[test]
 fn frames_of_a_100_by_100_miura_ori_hold_every_edge_to_1e_12() {
-    use nanofold::folding::{fold_path, path_frames, Drive, FoldSettings};
+    use nanofold::folding::path_frames;
     let model = miura(100, 100, 60.0, 0.0);
-    let settings = FoldSettings {
-        drive: Drive::Assignment { to: 0.9 },
-        ..Default::default()
-    };
-    let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+    let path = path_to_90_percent(&model);
     let frames = path_frames(&model, &path, 101).unwrap();
     let pattern = &model.pattern;
     let mut poses = Vec::new();
@@ -1576,13 +1578,9 @@ fn the_normal_equations_are_solved_at_either_factorisation() {
 /// its own factorisation workspace) they are the frames placed one at a time, bit for bit.
 #[test]
 fn frames_on_several_threads_are_the_frames_placed_one_at_a_time() {
-    use nanofold::folding::{fold_path, path_frames_on, Drive, FoldSettings};
+    use nanofold::folding::path_frames_on;
     let model = miura(12, 12, 60.0, 0.0);
-    let settings = FoldSettings {
-        drive: Drive::Assignment { to: 0.9 },
-        ..Default::default()
-    };
-    let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
+    let path = path_to_90_percent(&model);
     let alone = path_frames_on(&model, &path, 23, 1).unwrap();
     for threads in [2, 3, 23, 40] {
         assert_eq!(
