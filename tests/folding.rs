@@ -1589,4 +1589,6 @@ fn frames_on_several_threads_are_the_frames_placed_one_at_a_time() {
             "{threads} threads"
         );
     }
+    let refused = path_frames_on(&model, &path, 23, 0).unwrap_err().to_string();
+    assert!(refused.contains("threads") && refused.contains('0'), "{refused}");
 }

@@ -653,4 +653,16 @@ fn the_descent_under_argmin_reports_every_step_to_the_shared_observer() {
         iteration += 1;
     };
     assert_eq!(by_hand, report);
+    // A start that is not one fold angle per crease is refused by name, by either way in.
+    let short = &start[1..];
+    for refused in [
+        unfold_network_observed(&model, short, &settings, None).err(),
+        start_descent(&model, short, &settings).err(),
+    ] {
+        let message = refused.expect("a short start is refused").to_string();
+        assert!(
+            message.contains("start") && message.contains("one per crease"),
+            "{message}"
+        );
+    }
 }

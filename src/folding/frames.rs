@@ -62,8 +62,8 @@ pub const MAX_FRAME_THREADS: usize = 8;
 /// millisecond or less and one thread is as quick).
 const PARALLEL_FROM_CREASES: usize = 500;
 
-/// [`path_frames`] on `threads` threads (at least 1), each taking a run of consecutive
-/// frames with its own factorisation workspace.
+/// [`path_frames`] on `threads` threads (at least 1; more than `count` are not used), each
+/// taking a run of consecutive frames with its own factorisation workspace.
 pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threads: usize) -> Result<Vec<PathFrame>> {
     if !(2..=MAX_FRAMES).contains(&count) {
         return Err(NanofoldError::invalid(
@@ -72,8 +72,11 @@ pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threa
             format!("must lie in [2, {MAX_FRAMES}]"),
         ));
     }
+    if threads == 0 {
+        return Err(NanofoldError::invalid("threads", threads, "must be at least 1"));
+    }
     let placer = FramePlacer::new(model, path, count);
-    let threads = threads.clamp(1, count);
+    let threads = threads.min(count);
     if threads == 1 {
         let mut solver = NormalSolver::new(1e-10);
         return (0..count).map(|k| placer.frame(k, &mut solver)).collect();
