@@ -185,7 +185,8 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
                     distance = distance.min(bound);
                     continue;
                 }
-                let (d, c) = triangle_distance(&triangles[i], &triangles[j], depth);
+                let normal = |k: usize| planes[k].map(|(n, _)| n);
+                let (d, c) = triangle_distance_with(&triangles[i], &triangles[j], normal(i), normal(j), depth);
                 distance = distance.min(d);
                 crossing |= c;
             }
@@ -246,9 +247,16 @@ pub(crate) fn share_vertex(a: &[usize], b: &[usize]) -> bool {
 /// along the planes' common line by more than `tolerance`. The test does not depend on how
 /// a panel was cut into triangles: two panels crossing where their diagonals meet are
 /// found as well as an edge through an interior. Touching (coplanar overlap, an edge lying
-/// on the other) gives distance 0 without a crossing.
-pub(crate) fn triangle_distance(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> (f64, bool) {
-    if triangles_cross(s, t, tolerance) {
+/// on the other) gives distance 0 without a crossing. `ns` and `nt` are the triangles'
+/// unit normals (None: no area), computed once per contact test.
+fn triangle_distance_with(
+    s: &[Point; 3],
+    t: &[Point; 3],
+    ns: Option<Point>,
+    nt: Option<Point>,
+    tolerance: f64,
+) -> (f64, bool) {
+    if triangles_cross(s, t, ns, nt, tolerance) {
         return (0.0, true);
     }
     let mut best = f64::INFINITY;
@@ -295,9 +303,9 @@ fn unit_normal(triangle: &[Point; 3]) -> Option<Point> {
     unit(u.cross(&v))
 }
 
-/// Whether two triangles pass through each other (see [`triangle_distance`]).
-fn triangles_cross(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> bool {
-    let (Some(ns), Some(nt)) = (unit_normal(s), unit_normal(t)) else {
+/// Whether two triangles pass through each other (see [`triangle_distance_with`]).
+fn triangles_cross(s: &[Point; 3], t: &[Point; 3], ns: Option<Point>, nt: Option<Point>, tolerance: f64) -> bool {
+    let (Some(ns), Some(nt)) = (ns, nt) else {
         return false;
     };
     let side = |triangle: &[Point; 3], normal: &Point, origin: &Point| triangle.map(|x| normal.dot(&(x - origin)));
@@ -447,6 +455,10 @@ pub(crate) fn closest_point_on_triangle(p: &Point, triangle: &[Point; 3]) -> Poi
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn triangle_distance(s: &[Point; 3], t: &[Point; 3], tolerance: f64) -> (f64, bool) {
+        triangle_distance_with(s, t, unit_normal(s), unit_normal(t), tolerance)
+    }
 
     fn p(x: f64, y: f64, z: f64) -> Point {
         Point::new(x, y, z)
