@@ -16,14 +16,7 @@ fn rot_z(angle: f64) -> Matrix3<f64> {
 
 /// `frame ← frame · R_x(ρ) · R_z(α)`, column by column (a third of a full product's work).
 fn turn(frame: &mut Matrix3<f64>, fold_angle: f64, sector_angle: f64) {
-    let (s, c) = fold_angle.sin_cos();
-    let (c1, c2) = (frame.column(1).into_owned(), frame.column(2).into_owned());
-    frame.set_column(1, &(c * c1 + s * c2));
-    frame.set_column(2, &(c * c2 - s * c1));
-    let (s, c) = sector_angle.sin_cos();
-    let (c0, c1) = (frame.column(0).into_owned(), frame.column(1).into_owned());
-    frame.set_column(0, &(c * c0 + s * c1));
-    frame.set_column(1, &(c * c1 - s * c0));
+    turn_trig(frame, fold_angle.sin_cos(), sector_angle.sin_cos());
 }
 
 /// The frames' chain once round the vertex: returns the holonomy and, when asked, puts
