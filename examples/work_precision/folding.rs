@@ -73,6 +73,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
         "seconds": seconds,
         "steps": path.steps.len() - 1,
         "newton_iterations": path.newton_iterations,
+        "factorisations": path.factorisations,
         "max_closure_residual": path.max_closure_residual,
         "stop": path.stop.as_str(),
         "progress": path.steps.last().map(|s| s.progress),
@@ -82,13 +83,14 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
         "frame_edge_error": frame_edges.max(edges_101),
     });
     println!(
-        "{:<22} {:>6} {:>7.0e} {:>8.3} {:>5} {:>6} {:>9.1e} {:>9.3} {:>9.3} {:>9.1e} {:>9.1e}  {}",
+        "{:<22} {:>6} {:>7.0e} {:>8.3} {:>5} {:>6} {:>6} {:>9.1e} {:>9.3} {:>9.3} {:>9.1e} {:>9.1e}  {}",
         name,
         model.crease_count(),
         closure_tol,
         seconds,
         path.steps.len() - 1,
         path.newton_iterations,
+        path.factorisations,
         path.max_closure_residual,
         frames_11,
         frames_101,
@@ -103,13 +105,14 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
 pub fn folding_part() -> Value {
     println!("\nFolding paths by continuation to 90% (median of 3 runs; 1 above 5 000 creases)");
     println!(
-        "{:<22} {:>6} {:>7} {:>8} {:>5} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}  stop",
+        "{:<22} {:>6} {:>7} {:>8} {:>5} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}  stop",
         "pattern",
         "creases",
         "tol",
         "path s",
         "steps",
         "newton",
+        "factor",
         "closure",
         "11 fr. s",
         "101 fr. s",

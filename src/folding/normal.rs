@@ -24,6 +24,8 @@ pub struct NormalSolver {
     assembly: Option<Assembly>,
     /// μ relative to the largest diagonal entry of JᵀJ.
     regularisation: f64,
+    /// Numeric factorisations made.
+    factorisations: usize,
 }
 
 /// Where each product of two Jacobian entries lands in the lower triangle of JᵀJ (its CSC
@@ -137,7 +139,13 @@ impl NormalSolver {
         NormalSolver {
             assembly: None,
             regularisation,
+            factorisations: 0,
         }
+    }
+
+    /// Numeric factorisations made so far.
+    pub fn factorisations(&self) -> usize {
+        self.factorisations
     }
 
     /// Factorises JᵀJ + μI.
@@ -146,6 +154,7 @@ impl NormalSolver {
             self.assembly = Some(Assembly::new(jac)?);
         }
         let assembly = self.assembly.as_mut().expect("set above");
+        self.factorisations += 1;
         let mut values = vec![0.0; assembly.structure.compute_nnz()];
         for &(a, b, slot) in &assembly.products {
             values[slot] += jac.entries[a].2 * jac.entries[b].2;

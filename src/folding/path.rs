@@ -2,7 +2,7 @@
 //! fold angles projected onto the null space of the closure Jacobian, a step, and Newton
 //! back onto every vertex closure; panel contact checked at every step.
 
-use super::closure::closure_jacobian;
+use super::closure::{closure_jacobian, closure_residual, worst_of, ClosureJacobian};
 use super::contact::{panel_contacts, ContactReport, ContactSettings};
 use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
@@ -225,8 +225,11 @@ pub struct FoldPath {
     pub max_closure_residual: f64,
     /// Smallest panel clearance over every step (None: no pair came within the search range).
     pub min_panel_clearance: Option<f64>,
-    /// Newton iterations over the whole path.
+    /// Newton iterations over the whole path (chord steps included).
     pub newton_iterations: usize,
+    /// Numeric factorisations of JᵀJ + μI over the whole path: Newton's fresh steps and the
+    /// tangents not served by the corrector's last one.
+    pub factorisations: usize,
     /// What drove it (frames placed on the path measure their progress by it).
     pub drive: Drive,
 }
@@ -274,7 +277,7 @@ pub fn restore_closure(
     tol: f64,
     solver: &mut NormalSolver,
 ) -> Result<Option<usize>> {
-    Ok(correct(model, fold_angles, tol, solver, None)?.map(|c| c.iterations))
+    Ok(correct(model, fold_angles, tol, solver, None, false)?.map(|c| c.iterations))
 }
 
 /// The first step after leaving flat, rad (the step control takes it from there).
@@ -293,6 +296,9 @@ const SLOW_CORRECTOR: usize = 6;
 /// How closely an event (a crease reaching flat against its assignment, panels crossing,
 /// the contact budget) is located: the last step before it is at most this long, rad.
 pub const LOCATE: f64 = 1e-6;
+
+/// The residual cut per corrector step for which the factorisation is reused (chord steps).
+const CHORD_CONTRACTION: f64 = 0.1;
 
 /// Steps over which progress must grow by 1e-9, or the path counts as stalled.
 const STALL_STEPS: usize = 200;
@@ -434,10 +440,17 @@ struct Walk<'a> {
     branch: Option<String>,
     /// The next step's length (the largest fold-angle change), rad.
     h: f64,
-    /// The corrector's last factorisation, made within its last (tiny) correction of `rho`.
-    carried: Option<NormalFactor>,
+    /// The corrector's last factorisation (near `rho`: at the start of its last fresh step).
+    carried: Option<Factored>,
     /// The contacts of the first state.
     first_contacts: Option<ContactReport>,
+    /// Whether the next step may use the curved predictor ([`Walk::bend`]).
+    curved: bool,
+    /// Whether the motion has one degree of freedom (tested once, on the path's third
+    /// state): its path is then one curve whatever the drive, and the curved predictor
+    /// serves. With more, the path follows the projected drive, which the tangent
+    /// predictor and least-norm corrector define; they are kept as they are.
+    one_dof: Option<bool>,
 }
 
 /// How one step's trials ended.
@@ -468,6 +481,8 @@ impl<'a> Walk<'a> {
             h: settings.max_step.min(INITIAL_STEP),
             carried: None,
             first_contacts: None,
+            curved: true,
+            one_dof: None,
         };
         let start_residual = closure_jacobian(model, &walk.rho).worst_residual();
         if start_residual > settings.closure_tol {
@@ -620,7 +635,12 @@ impl<'a> Walk<'a> {
                 }
             }
         }
-        let (next, min_clearance, correction) = match self.trials(&tangent, here)? {
+        let bend = if self.curved && self.one_dof == Some(true) {
+            self.bend(&tangent)
+        } else {
+            None
+        };
+        let (next, min_clearance, correction) = match self.trials(&tangent, bend.as_ref(), here)? {
             Trial::Accepted(next, min_clearance, correction) => (next, min_clearance, correction),
             Trial::Event(stop) => {
                 return Ok(Some(Stop::new(
@@ -638,10 +658,23 @@ impl<'a> Walk<'a> {
                 )));
             }
         };
-        // Step control: the corrector's first move over the step is the angle between the
-        // chord and the tangent, ∝ h (curvature); aim it at TARGET_ANGLE, and shrink where
-        // Newton needed many iterations.
-        let angle = correction.first / self.h;
+        // Step control: the corrector's first move from the tangent's prediction ρ + h t is
+        // the angle between the chord and the tangent, ∝ h (curvature); aim it at
+        // TARGET_ANGLE, and shrink where Newton needed many iterations. With the curved
+        // predictor that move is not made; it is measured by the last factorisation.
+        let first = match (&bend, &correction.factor) {
+            (Some(_), Some(factored)) => {
+                let linear: Vec<f64> = self.rho.iter().zip(&tangent).map(|(r, t)| r + self.h * t).collect();
+                factored.least_norm_move(self.model, &linear)
+            }
+            _ => correction.first,
+        };
+        // The curved predictor serves while it predicts better than the tangent alone (it
+        // does not near a singular end, where the path's higher derivatives grow); the
+        // step is sized by the larger of the two moves, so the corrector's own move stays
+        // what the step control aims at.
+        self.curved = bend.is_none() || correction.first <= first;
+        let angle = first.max(correction.first) / self.h;
         let mut grow = if angle > 0.0 { TARGET_ANGLE / angle } else { MAX_GROWTH };
         if correction.iterations > SLOW_CORRECTOR {
             grow = grow.min(0.7);
@@ -666,13 +699,24 @@ impl<'a> Walk<'a> {
     /// vanishes.
     fn tangent(&mut self) -> Result<std::result::Result<Vec<f64>, f64>> {
         // The corrector's last factorisation serves the projection; else a fresh one.
-        let factor = match self.carried.take() {
-            Some(factor) => factor,
-            None => self.solver.factor(&closure_jacobian(self.model, &self.rho))?,
-        };
         let mut d = desired_velocity(&self.settings.drive, &self.rho, &self.signs);
         self.model.hold_locked(&mut d);
-        let v = factor.project(&d);
+        let factored = match self.carried.take() {
+            Some(factored) => factored,
+            None => {
+                let jacobian = closure_jacobian(self.model, &self.rho);
+                let factor = self.solver.factor(&jacobian)?;
+                Factored {
+                    jacobian,
+                    factor,
+                    stale: false,
+                }
+            }
+        };
+        let v = factored.project_at(self.model, &self.rho, &d);
+        if self.one_dof.is_none() && self.steps.len() >= 3 {
+            self.one_dof = Some(factored.one_direction(self.model, &self.rho, &v));
+        }
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d) {
             return Ok(Err(size));
@@ -680,10 +724,64 @@ impl<'a> Walk<'a> {
         Ok(Ok(v.iter().map(|x| x / size).collect()))
     }
 
+    /// The predictor's curvature terms: near the last accepted state ρ_k the path is the
+    /// graph ρ_k + s t + s² q + s³ r over its tangent line (s = ⟨ρ − ρ_k, t⟩ / ⟨t, t⟩),
+    /// with q and r fitted to the two states before it (q alone, r = 0, where there is one).
+    /// A state that left flat is not used: flat is a branch point, where the path's tangent
+    /// is not the projected one. None where no earlier state serves.
+    fn bend(&self, tangent: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let from = usize::from(self.branch.is_some());
+        let usable = self.steps.get(from..)?;
+        let [.., last] = usable else {
+            return None;
+        };
+        let tt: f64 = tangent.iter().map(|t| t * t).sum();
+        // Each earlier state's parameter and its offset from the tangent line.
+        let offset = |state: &PathStep| -> (f64, Vec<f64>) {
+            let delta: Vec<f64> = state
+                .fold_angles
+                .iter()
+                .zip(&last.fold_angles)
+                .map(|(a, b)| a - b)
+                .collect();
+            let s = delta.iter().zip(tangent).map(|(d, t)| d * t).sum::<f64>() / tt;
+            (s, delta.iter().zip(tangent).map(|(d, t)| d - s * t).collect())
+        };
+        match usable {
+            [.., before2, before, _] => {
+                let ((s1, g1), (s2, g2)) = (offset(before), offset(before2));
+                if !(s1 < 0.0 && s2 < s1) {
+                    return None;
+                }
+                // g = s² q + s³ r at s1 and s2.
+                let det = s1 * s1 * s2 * s2 * (s2 - s1);
+                let q = g1
+                    .iter()
+                    .zip(&g2)
+                    .map(|(a, b)| (a * s2.powi(3) - b * s1.powi(3)) / det)
+                    .collect();
+                let r = g1
+                    .iter()
+                    .zip(&g2)
+                    .map(|(a, b)| (b * s1 * s1 - a * s2 * s2) / det)
+                    .collect();
+                Some((q, r))
+            }
+            [.., before, _] => {
+                let (s1, g1) = offset(before);
+                if s1.is_nan() || s1 >= 0.0 {
+                    return None;
+                }
+                Some((g1.iter().map(|g| g / (s1 * s1)).collect(), vec![0.0; g1.len()]))
+            }
+            _ => None,
+        }
+    }
+
     /// Corrector: Newton onto every closure. A trial that fails, overshoots the goal, or
     /// meets an event (a crease against its assignment, panels crossing, the contact budget)
     /// is retried shorter; an event is located to within LOCATE rad.
-    fn trials(&mut self, tangent: &[f64], here: f64) -> Result<Trial> {
+    fn trials(&mut self, tangent: &[f64], bend: Option<&(Vec<f64>, Vec<f64>)>, here: f64) -> Result<Trial> {
         let (model, settings) = (self.model, self.settings);
         // Landing on the goal is tried until a landed state meets an event: at a singular
         // goal (a flat-folded state) holding one crease there can push another past it.
@@ -691,7 +789,14 @@ impl<'a> Walk<'a> {
         for _ in 0..80 {
             let h = self.h;
             let mut trial: Vec<f64> = self.rho.iter().zip(tangent).map(|(r, x)| r + h * x).collect();
-            let Some(mut correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None)? else {
+            if let Some((q, r)) = bend {
+                trial
+                    .iter_mut()
+                    .zip(q.iter().zip(r))
+                    .for_each(|(x, (q, r))| *x += h * h * (q + h * r));
+            }
+            let Some(mut correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None, true)?
+            else {
                 self.h /= 2.0;
                 if self.h < settings.max_step.min(MIN_STEP) * 1e-3 {
                     return Ok(Trial::Lost);
@@ -792,6 +897,7 @@ impl<'a> Walk<'a> {
             max_closure_residual,
             min_panel_clearance,
             newton_iterations: self.newton_iterations,
+            factorisations: self.solver.factorisations(),
             drive: self.settings.drive.clone(),
         }
     }
@@ -819,7 +925,10 @@ fn land_on_goal(
     };
     let mut state = trial.to_vec();
     state[crease] = value;
-    let landed = correct(model, &mut state, tol, solver, Some(crease))?;
+    // Fresh steps only: their last one leaves the residual far below `tol`, so the creases
+    // that fold alike with the held one (a Miura-ori's zigzags) end at its angle to
+    // rounding, and the goal is the state's progress to rounding too.
+    let landed = correct(model, &mut state, tol, solver, Some(crease), false)?;
     if landed.is_some() {
         trial.copy_from_slice(&state);
     }
@@ -834,28 +943,102 @@ struct Correction {
     first: f64,
     /// Worst vertex residual at the end, rad.
     residual: f64,
-    /// The last factorisation (at the state before the last correction).
-    factor: Option<NormalFactor>,
+    /// The last factorisation.
+    factor: Option<Factored>,
+}
+
+/// A factorised Jacobian and how far the state has moved since it was made.
+struct Factored {
+    jacobian: ClosureJacobian,
+    factor: NormalFactor,
+    /// Chord steps were taken with it: the state is as far from it as the corrections since
+    /// its fresh step, not just that step's own (tiny) last correction.
+    stale: bool,
+}
+
+impl Factored {
+    /// Whether the tangent space at `fold_angles` is the one direction `tangent`: a fixed
+    /// spread of every crease, projected, keeps less than 1e-3 of its size off `tangent`.
+    fn one_direction(&self, model: &FoldingModel, fold_angles: &[f64], tangent: &[f64]) -> bool {
+        // Fractional parts of multiples of the golden ratio: every crease moved, unevenly.
+        let mut spread: Vec<f64> = (1..=tangent.len())
+            .map(|k| (k as f64 * 0.618_033_988_749_894_9).fract() - 0.5)
+            .collect();
+        model.hold_locked(&mut spread);
+        let w = self.project_at(model, fold_angles, &spread);
+        let along = w.iter().zip(tangent).map(|(a, b)| a * b).sum::<f64>() / tangent.iter().map(|t| t * t).sum::<f64>();
+        let off = w
+            .iter()
+            .zip(tangent)
+            .map(|(a, t)| (a - along * t).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let size = w.iter().map(|a| a * a).sum::<f64>().sqrt();
+        off <= 1e-3 * size
+    }
+
+    /// The size (largest component) of the least-norm Newton step from `fold_angles`,
+    /// J⁺ r, with this factorisation's J.
+    fn least_norm_move(&self, model: &FoldingModel, fold_angles: &[f64]) -> f64 {
+        let mut residual = Vec::with_capacity(self.jacobian.rows);
+        closure_residual(model, fold_angles, &mut residual);
+        let mut step = vec![0.0; self.jacobian.cols];
+        self.jacobian.apply_transpose(&residual, &mut step);
+        self.factor.solve(&mut step);
+        inf_norm(&step)
+    }
+
+    /// The desired velocity projected onto the tangent space at `fold_angles`. A stale
+    /// factorisation's projection v₀ is in the null space of the Jacobian J₀ where it was
+    /// made, off by O(δ) from the current J's (δ: the distance moved since); one least-norm
+    /// correction v = v₀ − J₀⁺ (J v₀) puts it in J's null space to O(δ²).
+    fn project_at(&self, model: &FoldingModel, fold_angles: &[f64], desired: &[f64]) -> Vec<f64> {
+        let mut v = self.factor.project(desired);
+        if self.stale {
+            let here = closure_jacobian(model, fold_angles);
+            let mut moved = vec![0.0; here.rows];
+            here.apply(&v, &mut moved);
+            let mut correction = vec![0.0; v.len()];
+            self.jacobian.apply_transpose(&moved, &mut correction);
+            self.factor.solve(&mut correction);
+            v.iter_mut().zip(&correction).for_each(|(x, c)| *x -= c);
+        }
+        v
+    }
 }
 
 /// Newton's least-norm steps back onto every closure ([`restore_closure`]), reporting the
-/// first correction's size for step control.
+/// first correction's size for step control. With `chord_steps`, once a fresh step has cut
+/// the residual tenfold, the factorised Jacobian is reused (chord steps on the new residual)
+/// for as long as each step cuts it tenfold again; a chord step costs the residual and a
+/// solve, a fresh one the Jacobian and a numeric factorisation as well. Without, every step
+/// is fresh: the residual then falls quadratically far below `tol` in its last step, which
+/// matters near a singular state (flat), where a residual r leaves the angles some r/σ²
+/// off along J's nearly null directions.
 fn correct(
     model: &FoldingModel,
     fold_angles: &mut [f64],
     tol: f64,
     solver: &mut NormalSolver,
     held: Option<usize>,
+    chord_steps: bool,
 ) -> Result<Option<Correction>> {
     let mut previous = f64::INFINITY;
     let mut first = 0.0;
-    let mut last = None;
+    let mut factored: Option<Factored> = None;
+    let mut residual = Vec::with_capacity(3 * model.stars.len());
+    let mut step = vec![0.0; fold_angles.len()];
     for iteration in 0..30 {
-        let mut jac = closure_jacobian(model, fold_angles);
-        if let Some(c) = held {
-            jac.hold(c);
-        }
-        let worst = jac.worst_residual();
+        // The first iteration always factorises, so its residual comes with the Jacobian.
+        let fresh_jacobian = if iteration == 0 {
+            let jac = closure_jacobian(model, fold_angles);
+            residual.clone_from(&jac.residual);
+            Some(jac)
+        } else {
+            closure_residual(model, fold_angles, &mut residual);
+            None
+        };
+        let worst = worst_of(&residual);
         if !worst.is_finite() {
             return Ok(None);
         }
@@ -864,24 +1047,36 @@ fn correct(
                 iterations: iteration,
                 first,
                 residual: worst,
-                factor: last,
+                factor: factored,
             }));
         }
         if iteration > 3 && worst > 0.5 * previous {
             return Ok(None);
         }
+        let chord = chord_steps && factored.is_some() && worst <= CHORD_CONTRACTION * previous;
+        if !chord {
+            let mut jac = fresh_jacobian.unwrap_or_else(|| closure_jacobian(model, fold_angles));
+            if let Some(c) = held {
+                jac.hold(c);
+            }
+            let factor = solver.factor(&jac)?;
+            factored = Some(Factored {
+                jacobian: jac,
+                factor,
+                stale: false,
+            });
+        }
         previous = worst;
-        let factor = solver.factor(&jac)?;
-        let mut step = vec![0.0; jac.cols];
-        jac.apply_transpose(&jac.residual, &mut step);
-        factor.solve(&mut step);
+        let last = factored.as_mut().expect("set above");
+        last.stale |= chord;
+        last.jacobian.apply_transpose(&residual, &mut step);
+        last.factor.solve(&mut step);
         if iteration == 0 {
             first = inf_norm(&step);
         }
         for (rho, d) in fold_angles.iter_mut().zip(&step) {
             *rho -= d;
         }
-        last = Some(factor);
         if fold_angles.iter().any(|r| r.abs() > PI + 0.5) {
             return Ok(None);
         }
@@ -936,18 +1131,131 @@ pub fn project_to_rigid(model: &FoldingModel, fold_angles: &[f64], tol: f64) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pattern::generate::MiuraSpec;
+    use crate::pattern::generate::{BirdBaseSpec, MiuraSpec};
 
-    /// A state just past the goal lands on it: progress 1 to rounding, every vertex closed,
-    /// and the move is small (the state was within a step of the goal).
-    #[test]
-    fn a_state_past_the_goal_lands_on_it() {
+    fn miura_4x4() -> FoldingModel {
         let spec = MiuraSpec {
             rows: 4,
             cols: 4,
             ..MiuraSpec::default()
         };
-        let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
+        FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap()
+    }
+
+    /// A state a few steps along the default path to `to`.
+    fn along(model: &FoldingModel, to: f64) -> Vec<f64> {
+        let settings = FoldSettings {
+            drive: Drive::Assignment { to },
+            ..FoldSettings::default()
+        };
+        let path = fold_path(model, &model.given_fold_angles(), &settings).unwrap();
+        assert_eq!(path.stop, StopReason::Reached, "{}", path.evidence);
+        path.steps.last().unwrap().fold_angles.clone()
+    }
+
+    fn factored_at(model: &FoldingModel, rho: &[f64], stale: bool) -> Factored {
+        let jacobian = closure_jacobian(model, rho);
+        let factor = NormalSolver::new(PATH_REGULARISATION).factor(&jacobian).unwrap();
+        Factored {
+            jacobian,
+            factor,
+            stale,
+        }
+    }
+
+    /// |J v| / |v| at `rho`: how far v is from the tangent space there.
+    fn off_tangent(model: &FoldingModel, rho: &[f64], v: &[f64]) -> f64 {
+        let jac = closure_jacobian(model, rho);
+        let mut jv = vec![0.0; jac.rows];
+        jac.apply(v, &mut jv);
+        let norm = |x: &[f64]| x.iter().map(|a| a * a).sum::<f64>().sqrt();
+        norm(&jv) / norm(v)
+    }
+
+    /// A factorisation made δ away projects the drive off the tangent space by O(δ); the
+    /// stale correction leaves O(δ²): tenfold nearer, the error falls about tenfold without
+    /// it and about a hundredfold with it.
+    #[test]
+    fn a_stale_projection_is_corrected_to_second_order() {
+        let model = miura_4x4();
+        let rho = along(&model, 0.5);
+        let signs = assigned_signs(&model);
+        let offset: Vec<f64> = (0..rho.len()).map(|k| ((k * 7 % 11) as f64 - 5.0) / 5.0).collect();
+        let errors = |delta: f64, stale: bool| {
+            let made_at: Vec<f64> = rho.iter().zip(&offset).map(|(r, o)| r + delta * o).collect();
+            let v = factored_at(&model, &made_at, stale).project_at(&model, &rho, &signs);
+            off_tangent(&model, &rho, &v)
+        };
+        let (plain, plain_nearer) = (errors(1e-3, false), errors(1e-4, false));
+        let (corrected, corrected_nearer) = (errors(1e-3, true), errors(1e-4, true));
+        assert!(
+            plain / plain_nearer > 7.0 && plain / plain_nearer < 14.0,
+            "{plain:e} {plain_nearer:e}"
+        );
+        assert!(
+            corrected / corrected_nearer > 70.0,
+            "{corrected:e} {corrected_nearer:e}"
+        );
+        assert!(corrected < 1e-2 * plain, "{corrected:e} {plain:e}");
+    }
+
+    /// The one-direction test: a Miura-ori moves one way; the bird base, off flat, three.
+    #[test]
+    fn one_degree_of_freedom_is_told_from_several() {
+        let miura = miura_4x4();
+        let bird = FoldingModel::new(BirdBaseSpec::default().build().unwrap().build().unwrap()).unwrap();
+        for (model, one) in [(&miura, true), (&bird, false)] {
+            let rho = along(model, 0.3);
+            let factored = factored_at(model, &rho, false);
+            let signs = assigned_signs(model);
+            let tangent = factored.project_at(model, &rho, &signs);
+            assert_eq!(factored.one_direction(model, &rho, &tangent), one);
+        }
+    }
+
+    /// Chord steps end within the tolerance asked for, in fewer factorisations than fresh
+    /// steps, at nearly the same rigid state.
+    #[test]
+    fn chord_steps_reach_the_tolerance_with_fewer_factorisations() {
+        let model = miura_4x4();
+        let rho = along(&model, 0.5);
+        let signs = assigned_signs(&model);
+        let start: Vec<f64> = rho.iter().zip(&signs).map(|(r, s)| r + 0.02 * s).collect();
+        let mut ends = Vec::new();
+        for chord_steps in [false, true] {
+            let mut state = start.clone();
+            let mut solver = NormalSolver::new(PATH_REGULARISATION);
+            let correction = correct(&model, &mut state, 1e-12, &mut solver, None, chord_steps)
+                .unwrap()
+                .expect("Newton converges from 0.02 rad off");
+            assert!(correction.residual <= 1e-12);
+            assert_eq!(
+                super::super::closure::vertex_residuals(&model, &state)
+                    .into_iter()
+                    .fold(0.0, f64::max),
+                correction.residual
+            );
+            ends.push((state, solver.factorisations(), correction.iterations));
+        }
+        let (fresh, chord) = (&ends[0], &ends[1]);
+        assert!(chord.1 < fresh.1, "{} against {} factorisations", chord.1, fresh.1);
+        assert!(chord.2 > chord.1, "chord steps were taken");
+        let apart = fresh
+            .0
+            .iter()
+            .zip(&chord.0)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        // Both are least-norm corrections from one start: their feet differ by second-order
+        // terms of the 0.02 rad correction, far below the correction itself.
+        assert!(apart < 1e-6, "{apart:e}");
+    }
+
+    /// A state just past the goal lands on it: progress 1 to rounding, every vertex closed,
+    /// and the move is small (the state was within a step of the goal).
+    #[test]
+    fn a_state_past_the_goal_lands_on_it() {
+        let model = miura_4x4();
         let settings = FoldSettings {
             drive: Drive::Assignment { to: 0.5 },
             ..FoldSettings::default()

@@ -420,6 +420,7 @@ pub fn fold_summary(model: &FoldingModel, file: &str, path: &FoldPath, dof: usiz
         "max_closure_residual_rad": path.max_closure_residual,
         "min_panel_clearance": path.min_panel_clearance.map_or(Value::Null, number),
         "newton_iterations": path.newton_iterations,
+        "factorisations": path.factorisations,
         "reading": model.pattern.reading,
         "target_angles_rad": target_angles(model),
         "seconds": seconds,
