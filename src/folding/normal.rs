@@ -9,7 +9,6 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMat, Triplet};
 use faer::{Conj, Par, Side};
 use std::sync::Arc;
 
@@ -43,48 +42,80 @@ struct Assembly {
     scratch: MemBuffer,
 }
 
+/// Lists of entry indices grouped by a key (a row or a column of J), in entry order.
+struct Grouped {
+    start: Vec<usize>,
+    items: Vec<usize>,
+}
+
+impl Grouped {
+    fn new(groups: usize, keys: impl Iterator<Item = usize> + Clone) -> Grouped {
+        let mut start = vec![0; groups + 1];
+        for key in keys.clone() {
+            start[key + 1] += 1;
+        }
+        for g in 0..groups {
+            start[g + 1] += start[g];
+        }
+        let mut next = start.clone();
+        let mut items = vec![0; start[groups]];
+        for (k, key) in keys.enumerate() {
+            items[next[key]] = k;
+            next[key] += 1;
+        }
+        Grouped { start, items }
+    }
+
+    fn of(&self, group: usize) -> &[usize] {
+        &self.items[self.start[group]..self.start[group + 1]]
+    }
+}
+
 impl Assembly {
     fn new(jac: &ClosureJacobian) -> Result<Assembly> {
-        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); jac.rows];
-        for (k, &(r, _, _)) in jac.entries.iter().enumerate() {
-            rows[r].push(k);
-        }
-        let mut keys: Vec<(usize, usize)> = (0..jac.cols).map(|c| (c, c)).collect();
-        for row in &rows {
-            for &a in row {
-                for &b in row {
-                    let (ca, cb) = (jac.entries[a].1, jac.entries[b].1);
-                    if ca >= cb {
-                        keys.push((cb, ca));
-                    }
-                }
-            }
-        }
-        // Column-major, rows ascending within a column: faer's CSC order.
-        keys.sort_unstable();
-        keys.dedup();
-        let slot: std::collections::HashMap<(usize, usize), usize> =
-            keys.iter().enumerate().map(|(k, &key)| (key, k)).collect();
+        let n = jac.cols;
+        let by_row = Grouped::new(jac.rows, jac.entries.iter().map(|e| e.0));
+        let by_column = Grouped::new(n, jac.entries.iter().map(|e| e.1));
+        // Column b of JᵀJ's lower triangle holds the columns a ≥ b that share a row of J
+        // with b; each product J_ra·J_rb lands in its slot. Faer's CSC order: rows ascending
+        // within a column, so the diagonal comes first.
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut row_idx: Vec<usize> = Vec::new();
         let mut products = Vec::new();
-        for row in &rows {
-            for &a in row {
-                for &b in row {
-                    let (ca, cb) = (jac.entries[a].1, jac.entries[b].1);
-                    if ca >= cb {
-                        products.push((a, b, slot[&(cb, ca)]));
-                    }
+        let mut marked = vec![usize::MAX; n];
+        let mut slot = vec![0; n];
+        for column in 0..n {
+            let first = row_idx.len();
+            marked[column] = column;
+            row_idx.push(column);
+            let partners = || {
+                by_column
+                    .of(column)
+                    .iter()
+                    .flat_map(|&b| by_row.of(jac.entries[b].0).iter().map(move |&a| (a, b)))
+            };
+            for (a, _) in partners() {
+                let other = jac.entries[a].1;
+                if other > column && marked[other] != column {
+                    marked[other] = column;
+                    row_idx.push(other);
                 }
             }
-        }
-        let diagonal = (0..jac.cols).map(|c| slot[&(c, c)]).collect();
-        let triplets: Vec<Triplet<usize, usize, f64>> =
-            keys.iter().map(|&(col, row)| Triplet::new(row, col, 0.0)).collect();
-        let matrix = SparseColMat::try_new_from_triplets(jac.cols, jac.cols, &triplets).map_err(|e| {
-            NumericalError::Singular {
-                what: "JᵀJ + μI",
-                detail: format!("{e:?}"),
+            row_idx[first..].sort_unstable();
+            for (k, &row) in row_idx[first..].iter().enumerate() {
+                slot[row] = first + k;
             }
-        })?;
+            for (a, b) in partners() {
+                let other = jac.entries[a].1;
+                if other >= column {
+                    products.push((a, b, slot[other]));
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let diagonal = col_ptr[..n].to_vec();
+        let structure = faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: if jac.cols >= SUPERNODAL_FROM {
                 SupernodalThreshold::FORCE_SUPERNODAL
@@ -93,7 +124,7 @@ impl Assembly {
             },
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(matrix.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+        let symbolic = factorize_symbolic_cholesky(structure.as_ref(), Side::Lower, SymmetricOrdering::Amd, params)
             .map_err(|e| NumericalError::Singular {
                 what: "JᵀJ + μI (symbolic)",
                 detail: format!("{e:?}"),
@@ -103,10 +134,7 @@ impl Assembly {
             pattern: jac.entries.iter().map(|&(r, c, _)| (r, c)).collect(),
             products,
             diagonal,
-            structure: matrix.symbolic().to_owned().map_err(|e| NumericalError::Singular {
-                what: "JᵀJ + μI (structure)",
-                detail: format!("{e:?}"),
-            })?,
+            structure,
             symbolic: Arc::new(symbolic),
             scratch,
         })
