@@ -1592,3 +1592,45 @@ fn frames_on_several_threads_are_the_frames_placed_one_at_a_time() {
     let refused = path_frames_on(&model, &path, 23, 0).unwrap_err().to_string();
     assert!(refused.contains("threads") && refused.contains('0'), "{refused}");
 }
+
+/// Frames placed while the path goes on are the frames placed on the finished path, bit
+/// for bit: on a path that reaches its goal (frames placed early, then shared), on one cut
+/// short by its step budget (the early ones dropped, all placed on its own end), and on a
+/// small pattern (one thread, path first).
+#[test]
+fn frames_placed_during_the_path_are_the_frames_placed_after_it() {
+    use nanofold::folding::{fold_path, fold_path_and_frames, path_frames, Drive, FoldSettings, StopReason};
+    let large = miura(18, 18, 60.0, 0.0);
+    assert!(
+        large.crease_count() >= 500,
+        "{} creases: not the threaded case",
+        large.crease_count()
+    );
+    let small = miura(4, 4, 60.0, 0.0);
+    let reach = FoldSettings {
+        drive: Drive::Assignment { to: 0.9 },
+        ..Default::default()
+    };
+    let cut = FoldSettings {
+        max_steps: 6,
+        ..reach.clone()
+    };
+    for (model, settings, stop) in [
+        (&large, &reach, StopReason::Reached),
+        (&large, &cut, StopReason::StepLimit),
+        (&small, &reach, StopReason::Reached),
+    ] {
+        let start = model.given_fold_angles();
+        for count in [2, 11, 40] {
+            let (path, frames) = fold_path_and_frames(model, &start, settings, count).unwrap();
+            assert_eq!(path.stop, stop);
+            let alone = fold_path(model, &start, settings).unwrap();
+            assert_eq!(path, alone);
+            assert_eq!(frames, path_frames(model, &alone, count).unwrap(), "{count} frames");
+        }
+    }
+    let refused = fold_path_and_frames(&small, &small.given_fold_angles(), &reach, 1)
+        .unwrap_err()
+        .to_string();
+    assert!(refused.contains("frames") && refused.contains('1'), "{refused}");
+}

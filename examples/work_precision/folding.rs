@@ -5,8 +5,8 @@
 
 use super::common::timed;
 use nanofold::folding::{
-    fold_path, panel_poses, path_frames, vertex_positions, vertex_residuals, Drive, FoldSettings, FoldingModel,
-    PathFrame,
+    fold_path, fold_path_and_frames, panel_poses, path_frames, vertex_positions, vertex_residuals, Drive, FoldSettings,
+    FoldingModel, PathFrame,
 };
 use nanofold::pattern::generate::MiuraSpec;
 use serde_json::{json, Value};
@@ -62,6 +62,12 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
     let start = model.given_fold_angles();
     let (seconds, path) = timed(runs, || fold_path(model, &start, &settings).unwrap());
     let (frames_11, frames) = timed(runs, || path_frames(model, &path, 11).unwrap());
+    // The path with 11 frames placed while it goes on, as `fold --frames 11` does it.
+    let (together_11, (_, together)) = timed(runs, || fold_path_and_frames(model, &start, &settings, 11).unwrap());
+    assert_eq!(
+        together, frames,
+        "frames placed during the path are those placed after it"
+    );
     let (frame_closure, frame_edges) = frame_errors(model, &frames);
     let (frames_101, frames) = timed(1, || path_frames(model, &path, 101).unwrap());
     let (closure_101, edges_101) = frame_errors(model, &frames);
@@ -78,12 +84,13 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
         "stop": path.stop.as_str(),
         "progress": path.steps.last().map(|s| s.progress),
         "frames_11_seconds": frames_11,
+        "path_and_11_frames_seconds": together_11,
         "frames_101_seconds": frames_101,
         "frame_closure": frame_closure.max(closure_101),
         "frame_edge_error": frame_edges.max(edges_101),
     });
     println!(
-        "{:<22} {:>6} {:>7.0e} {:>8.3} {:>5} {:>6} {:>6} {:>9.1e} {:>9.3} {:>9.3} {:>9.1e} {:>9.1e}  {}",
+        "{:<22} {:>6} {:>7.0e} {:>8.3} {:>5} {:>6} {:>6} {:>9.1e} {:>9.3} {:>9.3} {:>9.3} {:>9.1e} {:>9.1e}  {}",
         name,
         model.crease_count(),
         closure_tol,
@@ -93,6 +100,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
         path.factorisations,
         path.max_closure_residual,
         frames_11,
+        together_11,
         frames_101,
         frame_closure.max(closure_101),
         frame_edges.max(edges_101),
@@ -105,7 +113,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
 pub fn folding_part() -> Value {
     println!("\nFolding paths by continuation to 90% (median of 3 runs; 1 above 5 000 creases)");
     println!(
-        "{:<22} {:>6} {:>7} {:>8} {:>5} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}  stop",
+        "{:<22} {:>6} {:>7} {:>8} {:>5} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  stop",
         "pattern",
         "creases",
         "tol",
@@ -115,6 +123,7 @@ pub fn folding_part() -> Value {
         "factor",
         "closure",
         "11 fr. s",
+        "both s",
         "101 fr. s",
         "fr. closure",
         "fr. edges"

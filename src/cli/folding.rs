@@ -4,7 +4,7 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use nanofold::folding::{fold_path, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
+use nanofold::folding::{fold_path_and_frames, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
 use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
 use nanofold::io::output::{number, write_atomic};
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
@@ -335,11 +335,11 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         )
     })?;
     let start = Instant::now();
-    let path = fold_path(&model, &model.given_fold_angles(), &settings)?;
+    // The frames are placed while the path goes on (on a large pattern).
+    let (path, frames) = fold_path_and_frames(&model, &model.given_fold_angles(), &settings, args.frames)?;
     let seconds = start.elapsed().as_secs_f64();
     let end = &path.steps.last().expect("a path has its start").fold_angles;
     let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end))?.dof;
-    let frames = nanofold::folding::path_frames(&model, &path, args.frames)?;
     let dir = args
         .out
         .clone()

@@ -6,8 +6,12 @@
 use super::closure::{closure_jacobian, closure_residual, worst_of, ClosureJacobian};
 use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
-use super::path::{assigned_signs, progress, progress_by_crease, progress_crease, FoldPath};
+use super::path::{
+    assigned_signs, fold_path, fold_path_observed, progress, progress_by_crease, progress_crease, Drive, FoldPath,
+    FoldSettings, PathStep, StopReason,
+};
 use crate::error::{NanofoldError, Result};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The closure a frame is polished towards, rad: below rounding, so the polish goes on
 /// while chord steps still halve the residual. A residual r at each vertex moves the last
@@ -38,21 +42,26 @@ pub struct PathFrame {
 }
 
 /// `count` frames (at least 2) at evenly spaced progress from the path's first state to its
-/// last, both included. Between steps a frame starts from the cubic through the four
-/// nearest steps (in cumulative chord length), placed where its progress is the target,
-/// and Newton moves it onto every closure (to [`FRAME_CLOSURE`], or as close as rounding
-/// allows) with the crease that sets progress held, so the frame keeps its progress. Where
-/// Newton finds no rigid state near it the nearer step is the frame. Frames are independent:
-/// on a large pattern they are placed on the machine's cores (at most [`MAX_FRAME_THREADS`]),
-/// with the same result as one at a time.
+/// last (to the goal, progress 1, where the path reached it), both included. Between steps a
+/// frame starts from the cubic through the four nearest steps (in cumulative chord length),
+/// placed where its progress is the target, and Newton moves it onto every closure (to
+/// [`FRAME_CLOSURE`], or as close as rounding allows) with the crease that sets progress
+/// held, so the frame keeps its progress. Where Newton finds no rigid state near it the
+/// nearer step is the frame. Frames are independent: on a large pattern they are placed on
+/// the machine's cores (at most [`MAX_FRAME_THREADS`]), with the same result as one at a
+/// time.
 pub fn path_frames(model: &FoldingModel, path: &FoldPath, count: usize) -> Result<Vec<PathFrame>> {
+    path_frames_on(model, path, count, frame_threads(model, count))
+}
+
+/// The threads [`path_frames`] uses: the machine's cores from [`PARALLEL_FROM_CREASES`].
+fn frame_threads(model: &FoldingModel, count: usize) -> usize {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads = if model.crease_count() >= PARALLEL_FROM_CREASES {
+    if model.crease_count() >= PARALLEL_FROM_CREASES {
         cores.min(MAX_FRAME_THREADS).min(count / 2).max(1)
     } else {
         1
-    };
-    path_frames_on(model, path, count, threads)
+    }
 }
 
 /// Most threads [`path_frames`] uses.
@@ -62,9 +71,7 @@ pub const MAX_FRAME_THREADS: usize = 8;
 /// millisecond or less and one thread is as quick).
 const PARALLEL_FROM_CREASES: usize = 500;
 
-/// [`path_frames`] on `threads` threads (at least 1; more than `count` are not used), each
-/// taking a run of consecutive frames with its own factorisation workspace.
-pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threads: usize) -> Result<Vec<PathFrame>> {
+fn check_frame_count(count: usize) -> Result<()> {
     if !(2..=MAX_FRAMES).contains(&count) {
         return Err(NanofoldError::invalid(
             "frames",
@@ -72,30 +79,57 @@ pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threa
             format!("must lie in [2, {MAX_FRAMES}]"),
         ));
     }
+    Ok(())
+}
+
+/// [`path_frames`] on `threads` threads (at least 1; more than `count` are not used), each
+/// taking a run of consecutive frames with its own factorisation workspace.
+pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threads: usize) -> Result<Vec<PathFrame>> {
+    check_frame_count(count)?;
     if threads == 0 {
         return Err(NanofoldError::invalid("threads", threads, "must be at least 1"));
     }
-    let placer = FramePlacer::new(model, path, count);
-    let threads = threads.min(count);
+    let placer = FramePlacer::new(model, &path.drive, count);
+    let chord = chord_lengths(&path.steps);
+    let last = end_progress(path);
+    let polished = polish_frames(&placer, &path.steps, &chord, last, 0..count, threads)?;
+    Ok(polished
+        .into_iter()
+        .map(|p| placer.judged(p, &path.steps, path_tolerance(path)))
+        .collect())
+}
+
+/// Frames `ks`, polished on `threads` threads (runs of consecutive frames).
+fn polish_frames(
+    placer: &FramePlacer,
+    steps: &[PathStep],
+    chord: &[f64],
+    last: f64,
+    ks: std::ops::Range<usize>,
+    threads: usize,
+) -> Result<Vec<Polished>> {
+    let threads = threads.min(ks.len()).max(1);
     if threads == 1 {
         let mut solver = NormalSolver::new(1e-10);
-        return (0..count).map(|k| placer.frame(k, &mut solver)).collect();
+        return ks
+            .map(|k| placer.polished(steps, chord, last, k, &mut solver))
+            .collect();
     }
     let runs: Vec<std::ops::Range<usize>> = (0..threads)
-        .map(|t| (t * count / threads)..((t + 1) * count / threads))
+        .map(|t| (ks.start + t * ks.len() / threads)..(ks.start + (t + 1) * ks.len() / threads))
         .collect();
     std::thread::scope(|scope| {
-        let placer = &placer;
         let handles: Vec<_> = runs
             .into_iter()
             .map(|run| {
                 scope.spawn(move || {
                     let mut solver = NormalSolver::new(1e-10);
-                    run.map(|k| placer.frame(k, &mut solver)).collect::<Result<Vec<_>>>()
+                    run.map(|k| placer.polished(steps, chord, last, k, &mut solver))
+                        .collect::<Result<Vec<_>>>()
                 })
             })
             .collect();
-        let mut frames = Vec::with_capacity(count);
+        let mut frames = Vec::with_capacity(ks.len());
         for handle in handles {
             let run = handle.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
             frames.extend(run);
@@ -104,50 +138,267 @@ pub fn path_frames_on(model: &FoldingModel, path: &FoldPath, count: usize, threa
     })
 }
 
-/// What every frame of one call shares: the path, its chord lengths and progress range.
-struct FramePlacer<'a> {
-    model: &'a FoldingModel,
-    path: &'a FoldPath,
-    signs: Vec<f64>,
-    /// Cumulative chord length at each step: the cubic's parameter.
-    chord: Vec<f64>,
+/// A folding path and `count` frames on it, as [`fold_path`] and [`path_frames`] give them,
+/// with the frames placed while the path goes on: on a large pattern a second thread places
+/// each frame as soon as the steps its cubic needs are accepted (a path that reaches its
+/// goal ends at progress 1, so the frames' targets are known from the start), and what is
+/// left when the path ends is shared by both threads (and more cores, where there are
+/// more). A path that stops short of its goal has its frames placed afterwards, on its own
+/// end. The frames are those of [`path_frames`], bit for bit, either way.
+pub fn fold_path_and_frames(
+    model: &FoldingModel,
+    start: &[f64],
+    settings: &FoldSettings,
+    count: usize,
+) -> Result<(FoldPath, Vec<PathFrame>)> {
+    check_frame_count(count)?;
+    let threads = frame_threads(model, count);
+    if threads == 1 {
+        let path = fold_path(model, start, settings)?;
+        let frames = path_frames_on(model, &path, count, 1)?;
+        return Ok((path, frames));
+    }
+    let placer = FramePlacer::new(model, &settings.drive, count);
+    let claims = Claims {
+        next: AtomicUsize::new(0),
+        count,
+    };
+    let (sender, receiver) = std::sync::mpsc::channel::<Accepted>();
+    let (path, mut polished) = std::thread::scope(|scope| -> Result<(FoldPath, Vec<(usize, Polished)>)> {
+        let (placer, claims) = (&placer, &claims);
+        let worker = scope.spawn(move || early_frames(placer, claims, &receiver));
+        let walked = fold_path_observed(model, start, settings, &mut |step| {
+            // A worker that stopped (on an error) has no use for more steps.
+            let _ = sender.send(Accepted::Step(step.clone()));
+        });
+        let reached = walked.as_ref().is_ok_and(|(path, _)| path.stop == StopReason::Reached);
+        let _ = sender.send(Accepted::End { reached });
+        drop(sender);
+        let (path, mut solver) = match walked {
+            Ok(walked) => walked,
+            Err(e) => {
+                let _ = worker.join();
+                return Err(e);
+            }
+        };
+        let mut polished = Vec::new();
+        if reached {
+            // The rest is shared: this thread (with the path's solver), the worker, and
+            // the other cores.
+            let chord = chord_lengths(&path.steps);
+            let (steps, chord) = (&path.steps, &chord);
+            std::thread::scope(|helping| -> Result<()> {
+                let helpers: Vec<_> = (2..threads)
+                    .map(|_| {
+                        helping
+                            .spawn(move || claimed_frames(placer, claims, steps, chord, &mut NormalSolver::new(1e-10)))
+                    })
+                    .collect();
+                polished.extend(claimed_frames(placer, claims, steps, chord, &mut solver)?);
+                for helper in helpers {
+                    polished.extend(helper.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))?);
+                }
+                Ok(())
+            })?;
+        }
+        let early = worker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        if reached {
+            polished.extend(early?);
+        }
+        Ok((path, polished))
+    })?;
+    if path.stop != StopReason::Reached {
+        let chord = chord_lengths(&path.steps);
+        let all = polish_frames(&placer, &path.steps, &chord, end_progress(&path), 0..count, threads)?;
+        polished = all.into_iter().enumerate().collect();
+    }
+    polished.sort_by_key(|(k, _)| *k);
+    let frames = polished
+        .into_iter()
+        .map(|(_, p)| placer.judged(p, &path.steps, path_tolerance(&path)))
+        .collect();
+    Ok((path, frames))
+}
+
+/// What the path tells the frame worker.
+enum Accepted {
+    Step(PathStep),
+    End { reached: bool },
+}
+
+/// The frames not yet placed, claimed one at a time by whichever thread is free.
+struct Claims {
+    next: AtomicUsize,
     count: usize,
 }
 
-impl<'a> FramePlacer<'a> {
-    fn new(model: &'a FoldingModel, path: &'a FoldPath, count: usize) -> Self {
-        let mut chord = vec![0.0];
-        for pair in path.steps.windows(2) {
-            let d: f64 = pair[0]
-                .fold_angles
-                .iter()
-                .zip(&pair[1].fold_angles)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum::<f64>()
-                .sqrt();
-            chord.push(chord.last().copied().unwrap_or(0.0) + d);
+impl Claims {
+    /// The next frame, if any is left and `ready` says it can be placed.
+    fn claim(&self, ready: impl Fn(usize) -> bool) -> Option<usize> {
+        self.next
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |k| {
+                (k < self.count && ready(k)).then_some(k + 1)
+            })
+            .ok()
+    }
+}
+
+/// Frames claimed on a whole path that reached its goal, until none is left.
+fn claimed_frames(
+    placer: &FramePlacer,
+    claims: &Claims,
+    steps: &[PathStep],
+    chord: &[f64],
+    solver: &mut NormalSolver,
+) -> Result<Vec<(usize, Polished)>> {
+    let mut polished = Vec::new();
+    while let Some(k) = claims.claim(|_| true) {
+        polished.push((k, placer.polished(steps, chord, GOAL, k, solver)?));
+    }
+    Ok(polished)
+}
+
+/// The frames placed while the path goes on: frame k once the steps its cubic uses are all
+/// accepted; once the path has reached its goal, the frames left are claimed with the other
+/// threads. A path that ends short of its goal ends the worker.
+fn early_frames(
+    placer: &FramePlacer,
+    claims: &Claims,
+    receiver: &std::sync::mpsc::Receiver<Accepted>,
+) -> Result<Vec<(usize, Polished)>> {
+    let mut steps: Vec<PathStep> = Vec::new();
+    let mut chord: Vec<f64> = Vec::new();
+    let mut polished = Vec::new();
+    let mut solver = NormalSolver::new(1e-10);
+    // Some(reached) once the path has ended.
+    let mut ended = None;
+    let take =
+        |message: Accepted, steps: &mut Vec<PathStep>, chord: &mut Vec<f64>, ended: &mut Option<bool>| match message {
+            Accepted::Step(step) => {
+                let length = steps.last().map_or(0.0, |before| {
+                    chord.last().copied().unwrap_or(0.0) + distance(&before.fold_angles, &step.fold_angles)
+                });
+                chord.push(length);
+                steps.push(step);
+            }
+            Accepted::End { reached } => *ended = Some(reached),
+        };
+    loop {
+        while let Ok(message) = receiver.try_recv() {
+            take(message, &mut steps, &mut chord, &mut ended);
         }
+        match ended {
+            Some(false) => return Ok(Vec::new()),
+            Some(true) => {
+                polished.extend(claimed_frames(placer, claims, &steps, &chord, &mut solver)?);
+                return Ok(polished);
+            }
+            None => {}
+        }
+        if let Some(k) = claims.claim(|k| placer.ready(&steps, GOAL, k)) {
+            polished.push((k, placer.polished(&steps, &chord, GOAL, k, &mut solver)?));
+            continue;
+        }
+        match receiver.recv() {
+            Ok(message) => take(message, &mut steps, &mut chord, &mut ended),
+            Err(_) => return Ok(polished),
+        }
+    }
+}
+
+/// The progress of a path that reached its goal.
+const GOAL: f64 = 1.0;
+
+/// The progress the frames span to: the goal where the path reached it (its last step is
+/// there to within the landing's rounding), else its last step's.
+fn end_progress(path: &FoldPath) -> f64 {
+    if path.stop == StopReason::Reached {
+        GOAL
+    } else {
+        path.steps.last().map_or(0.0, |s| s.progress)
+    }
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
+}
+
+/// Cumulative chord length at each step: the cubic's parameter.
+fn chord_lengths(steps: &[PathStep]) -> Vec<f64> {
+    let mut chord = vec![0.0];
+    for pair in steps.windows(2) {
+        chord.push(chord.last().copied().unwrap_or(0.0) + distance(&pair[0].fold_angles, &pair[1].fold_angles));
+    }
+    chord.truncate(steps.len());
+    chord
+}
+
+/// What every frame of one call shares.
+struct FramePlacer<'a> {
+    model: &'a FoldingModel,
+    drive: &'a Drive,
+    signs: Vec<f64>,
+    count: usize,
+}
+
+/// A frame polished, not yet judged against the path's closure.
+struct Polished {
+    target: f64,
+    segment: usize,
+    fold_angles: Vec<f64>,
+    residual: f64,
+}
+
+impl<'a> FramePlacer<'a> {
+    fn new(model: &'a FoldingModel, drive: &'a Drive, count: usize) -> Self {
         FramePlacer {
             model,
-            path,
+            drive,
             signs: assigned_signs(model),
-            chord,
             count,
         }
     }
 
-    /// Frame `k` of `count`.
-    fn frame(&self, k: usize, solver: &mut NormalSolver) -> Result<PathFrame> {
-        let (path, steps, count) = (self.path, &self.path.steps, self.count);
+    fn target(&self, first: f64, last: f64, k: usize) -> f64 {
+        first + (last - first) * k as f64 / (self.count - 1) as f64
+    }
+
+    /// The segment whose steps bracket the target (the last one where progress is flat).
+    fn segment(steps: &[PathStep], target: f64) -> Option<usize> {
+        (0..steps.len().saturating_sub(1)).find(|&i| steps[i + 1].progress >= target)
+    }
+
+    /// Whether frame k, of a path ending at progress `last`, is placed on `steps` (the
+    /// accepted ones so far) as on the whole path: its segment found, with the two steps
+    /// after it that its cubic uses. The last frame waits for the path's end.
+    fn ready(&self, steps: &[PathStep], last: f64, k: usize) -> bool {
+        let Some(first) = steps.first() else {
+            return false;
+        };
+        if k == 0 {
+            return true;
+        }
+        if k + 1 >= self.count {
+            return false;
+        }
+        Self::segment(steps, self.target(first.progress, last, k)).is_some_and(|i| i + 2 < steps.len())
+    }
+
+    /// Frame `k` of `count` on a path ending at progress `last`, polished.
+    fn polished(
+        &self,
+        steps: &[PathStep],
+        chord: &[f64],
+        last: f64,
+        k: usize,
+        solver: &mut NormalSolver,
+    ) -> Result<Polished> {
+        let (drive, count) = (self.drive, self.count);
         let signs = &self.signs;
         let start = &steps[0].fold_angles;
-        let progress_of = |rho: &[f64]| progress(&path.drive, start, rho, signs);
-        let (first, last) = (steps[0].progress, steps[steps.len() - 1].progress);
-        let target = first + (last - first) * k as f64 / (count - 1) as f64;
-        // The segment whose steps bracket the target (the last one where progress is flat).
-        let segment = (0..steps.len().saturating_sub(1))
-            .find(|&i| steps[i + 1].progress >= target)
-            .unwrap_or(steps.len().saturating_sub(2).min(steps.len() - 1));
+        let progress_of = |rho: &[f64]| progress(drive, start, rho, signs);
+        let target = self.target(steps[0].progress, last, k);
+        let segment = Self::segment(steps, target).unwrap_or(steps.len().saturating_sub(2).min(steps.len() - 1));
         let guess = if k == 0 || steps.len() == 1 {
             steps[0].fold_angles.clone()
         } else if k == count - 1 {
@@ -156,41 +407,56 @@ impl<'a> FramePlacer<'a> {
             // Bisection on the crease that sets progress at the segment's end, checked on the
             // whole state (and redone on it where another crease sets progress).
             let end = &steps[(segment + 1).min(steps.len() - 1)].fold_angles;
-            let setter = progress_crease(&path.drive, end, signs)
-                .map(|c| (c, move |value: f64| progress_by_crease(&path.drive, start, c, value)));
+            let setter = progress_crease(drive, end, signs)
+                .map(|c| (c, move |value: f64| progress_by_crease(drive, start, c, value)));
             let by_setter = setter
                 .as_ref()
-                .map(|(c, f)| place(steps, &self.chord, segment, target, &Placement::Crease(*c, f)))
+                .map(|(c, f)| place(steps, chord, segment, target, &Placement::Crease(*c, f)))
                 .filter(|guess| (progress_of(guess) - target).abs() <= 1e-12);
-            by_setter.unwrap_or_else(|| place(steps, &self.chord, segment, target, &Placement::State(&progress_of)))
+            by_setter.unwrap_or_else(|| place(steps, chord, segment, target, &Placement::State(&progress_of)))
         };
         let mut rho = guess;
         // The crease that sets progress keeps its angle, so the frame stays at its target.
         let held = if k == 0 || k == count - 1 {
             None
         } else {
-            progress_crease(&path.drive, &rho, signs)
+            progress_crease(drive, &rho, signs)
         };
         let residual = polish(self.model, &mut rho, held, solver)?;
-        let (fold_angles, max_residual) = if residual <= path_tolerance(path) {
-            (rho, residual)
+        Ok(Polished {
+            target,
+            segment,
+            fold_angles: rho,
+            residual,
+        })
+    }
+
+    /// The frame: the polished state where it closes within `tolerance`, else the nearer
+    /// step, as the path accepted it (no rigid state near the cubic).
+    fn judged(&self, polished: Polished, steps: &[PathStep], tolerance: f64) -> PathFrame {
+        let Polished {
+            target,
+            segment,
+            fold_angles,
+            residual,
+        } = polished;
+        let (fold_angles, max_residual) = if residual <= tolerance {
+            (fold_angles, residual)
         } else {
-            // No rigid state near the cubic: the nearer step, as the path accepted it.
-            let nearer = if (target - steps[segment].progress).abs()
-                <= (steps[(segment + 1).min(steps.len() - 1)].progress - target).abs()
-            {
+            let next = (segment + 1).min(steps.len() - 1);
+            let nearer = if (target - steps[segment].progress).abs() <= (steps[next].progress - target).abs() {
                 segment
             } else {
-                (segment + 1).min(steps.len() - 1)
+                next
             };
             (steps[nearer].fold_angles.clone(), steps[nearer].max_residual)
         };
-        Ok(PathFrame {
-            progress: progress_of(&fold_angles),
+        PathFrame {
+            progress: progress(self.drive, &steps[0].fold_angles, &fold_angles, &self.signs),
             fold_angles,
             max_residual,
             after_step: segment,
-        })
+        }
     }
 }
 
@@ -209,7 +475,7 @@ enum Placement<'a> {
 
 /// The cubic (Lagrange, through up to four steps around `segment`, in chord length) at the
 /// point of the segment where progress is `target` (bisection on the chord length).
-fn place(steps: &[super::path::PathStep], chord: &[f64], segment: usize, target: f64, by: &Placement) -> Vec<f64> {
+fn place(steps: &[PathStep], chord: &[f64], segment: usize, target: f64, by: &Placement) -> Vec<f64> {
     let m = steps.len();
     let lo = segment.saturating_sub(1);
     let hi = (segment + 2).min(m - 1);

@@ -392,18 +392,42 @@ fn against_assignment(rho: &[f64], signs: &[f64], slack: f64) -> Vec<usize> {
 
 /// Folds from `start` (a rigid state, or the flat one) as `settings.drive` asks.
 pub fn fold_path(model: &FoldingModel, start: &[f64], settings: &FoldSettings) -> Result<FoldPath> {
+    Ok(fold_path_observed(model, start, settings, &mut |_| {})?.0)
+}
+
+/// [`fold_path`], telling `on_step` of every accepted state as it is accepted (the start
+/// first): accepted states are final, so frames can be placed on them while the path goes
+/// on. The path's solver comes back with it, its symbolic analysis done.
+pub(crate) fn fold_path_observed(
+    model: &FoldingModel,
+    start: &[f64],
+    settings: &FoldSettings,
+    on_step: &mut dyn FnMut(&PathStep),
+) -> Result<(FoldPath, NormalSolver)> {
     settings.validate(model)?;
     let mut walk = Walk::new(model, start, settings)?;
+    let mut told = 0;
+    let mut tell = |walk: &Walk| {
+        for step in &walk.steps[told..] {
+            on_step(step);
+        }
+        told = walk.steps.len();
+    };
+    tell(&walk);
     if let Some(stop) = walk.check_start() {
         return Ok(walk.finish(stop));
     }
     if inf_norm(&walk.rho) <= 1e-12 {
-        if let Some(stop) = walk.leave_flat()? {
+        let left = walk.leave_flat()?;
+        tell(&walk);
+        if let Some(stop) = left {
             return Ok(walk.finish(stop));
         }
     }
     for _ in 0..settings.max_steps {
-        if let Some(stop) = walk.step()? {
+        let stepped = walk.step()?;
+        tell(&walk);
+        if let Some(stop) = stepped {
             return Ok(walk.finish(stop));
         }
     }
@@ -446,6 +470,8 @@ struct Walk<'a> {
     first_contacts: Option<ContactReport>,
     /// Whether the next step may use the curved predictor ([`Walk::bend`]).
     curved: bool,
+    /// The tangent at `rho`, projected beside its contact test ([`Walk::event_and_tangent`]).
+    next_tangent: Option<(Tangent, Option<bool>)>,
     /// Whether the motion has one degree of freedom (tested once, on the path's third
     /// state): its path is then one curve whatever the drive, and the curved predictor
     /// serves. With more, the path follows the projected drive, which the tangent
@@ -453,10 +479,22 @@ struct Walk<'a> {
     one_dof: Option<bool>,
 }
 
+/// A tangent scaled to a largest component of 1, or the size of the projected velocity
+/// where it vanishes.
+type Tangent = std::result::Result<Vec<f64>, f64>;
+
+/// A trial state's smallest clearance, or the event that stops it.
+type Judged = std::result::Result<Option<f64>, Stop>;
+
+/// Creases from which a trial's contact test runs on a second thread beside the next
+/// tangent's projection (below, both take well under a millisecond).
+const PARALLEL_EVENT_FROM: usize = 500;
+
 /// How one step's trials ended.
 enum Trial {
-    /// The next state, its smallest clearance and its corrector's record.
-    Accepted(Vec<f64>, Option<f64>, Correction),
+    /// The next state, its smallest clearance, its corrector's record and (where it was
+    /// projected beside the contact test) the tangent there.
+    Accepted(Vec<f64>, Option<f64>, Correction, Option<(Tangent, Option<bool>)>),
     /// An event located to within [`LOCATE`].
     Event(Stop),
     /// Newton found no rigid state, even with the shortest step.
@@ -482,6 +520,7 @@ impl<'a> Walk<'a> {
             carried: None,
             first_contacts: None,
             curved: true,
+            next_tangent: None,
             one_dof: None,
         };
         let start_residual = closure_jacobian(model, &walk.rho).worst_residual();
@@ -641,7 +680,10 @@ impl<'a> Walk<'a> {
             None
         };
         let (next, min_clearance, correction) = match self.trials(&tangent, bend.as_ref(), here)? {
-            Trial::Accepted(next, min_clearance, correction) => (next, min_clearance, correction),
+            Trial::Accepted(next, min_clearance, correction, tangent) => {
+                self.next_tangent = tangent;
+                (next, min_clearance, correction)
+            }
             Trial::Event(stop) => {
                 return Ok(Some(Stop::new(
                     stop.reason,
@@ -661,13 +703,16 @@ impl<'a> Walk<'a> {
         // Step control: the corrector's first move from the tangent's prediction ρ + h t is
         // the angle between the chord and the tangent, ∝ h (curvature); aim it at
         // TARGET_ANGLE, and shrink where Newton needed many iterations. With the curved
-        // predictor that move is not made; it is measured by the last factorisation.
-        let first = match (&bend, &correction.factor) {
-            (Some(_), Some(factored)) => {
-                let linear: Vec<f64> = self.rho.iter().zip(&tangent).map(|(r, t)| r + self.h * t).collect();
-                factored.least_norm_move(self.model, &linear)
-            }
-            _ => correction.first,
+        // predictor that move is not made: on a one-DOF path (the only kind it serves) the
+        // accepted state is the curve's point nearest the tangent's prediction, to leading
+        // order, so their distance stands in for it.
+        let first = if bend.is_some() {
+            next.iter()
+                .zip(&self.rho)
+                .zip(&tangent)
+                .fold(0.0_f64, |m, ((n, r), t)| m.max((n - r - self.h * t).abs()))
+        } else {
+            correction.first
         };
         // The curved predictor serves while it predicts better than the tangent alone (it
         // does not near a singular end, where the path's higher derivatives grow); the
@@ -680,7 +725,11 @@ impl<'a> Walk<'a> {
             grow = grow.min(0.7);
         }
         self.h *= grow.clamp(0.25, MAX_GROWTH);
-        self.carried = correction.factor;
+        self.carried = if self.next_tangent.is_some() {
+            None
+        } else {
+            correction.factor
+        };
         self.rho = next;
         let now = self.progress_of(&self.rho);
         let steps = &self.steps;
@@ -698,9 +747,11 @@ impl<'a> Walk<'a> {
     /// component of 1 (h is then the largest fold-angle change, rad). Err(its size) where it
     /// vanishes.
     fn tangent(&mut self) -> Result<std::result::Result<Vec<f64>, f64>> {
+        if let Some((tangent, one_dof)) = self.next_tangent.take() {
+            self.one_dof = self.one_dof.or(one_dof);
+            return Ok(tangent);
+        }
         // The corrector's last factorisation serves the projection; else a fresh one.
-        let mut d = desired_velocity(&self.settings.drive, &self.rho, &self.signs);
-        self.model.hold_locked(&mut d);
         let factored = match self.carried.take() {
             Some(factored) => factored,
             None => {
@@ -713,15 +764,24 @@ impl<'a> Walk<'a> {
                 }
             }
         };
-        let v = factored.project_at(self.model, &self.rho, &d);
-        if self.one_dof.is_none() && self.steps.len() >= 3 {
-            self.one_dof = Some(factored.one_direction(self.model, &self.rho, &v));
-        }
+        let (tangent, one_dof) = self.tangent_with(&self.rho, &factored, self.steps.len());
+        self.one_dof = self.one_dof.or(one_dof);
+        Ok(tangent)
+    }
+
+    /// The tangent at `rho` (a state that will be the path's `states`-th) by a factorisation
+    /// near it, and, where not yet known and the state is the third or later, whether the
+    /// motion has one degree of freedom.
+    fn tangent_with(&self, rho: &[f64], factored: &Factored, states: usize) -> (Tangent, Option<bool>) {
+        let mut d = desired_velocity(&self.settings.drive, rho, &self.signs);
+        self.model.hold_locked(&mut d);
+        let v = factored.project_at(self.model, rho, &d);
+        let one_dof = (self.one_dof.is_none() && states >= 3).then(|| factored.one_direction(self.model, rho, &v));
         let size = inf_norm(&v);
         if size <= 1e-9 * inf_norm(&d) {
-            return Ok(Err(size));
+            return (Err(size), one_dof);
         }
-        Ok(Ok(v.iter().map(|x| x / size).collect()))
+        (Ok(v.iter().map(|x| x / size).collect()), one_dof)
     }
 
     /// The predictor's curvature terms: near the last accepted state ρ_k the path is the
@@ -835,8 +895,14 @@ impl<'a> Walk<'a> {
                 self.h *= secant;
                 continue;
             }
-            let found = match self.event(&trial, here) {
-                Ok(min_clearance) => return Ok(Trial::Accepted(trial, min_clearance, correction)),
+            let (judged, tangent) = match &correction.factor {
+                Some(factored) if model.crease_count() >= PARALLEL_EVENT_FROM => {
+                    self.event_and_tangent(&trial, here, factored)
+                }
+                _ => (self.event(&trial, here), None),
+            };
+            let found = match judged {
+                Ok(min_clearance) => return Ok(Trial::Accepted(trial, min_clearance, correction, tangent)),
                 Err(found) => found,
             };
             if landed {
@@ -856,40 +922,41 @@ impl<'a> Walk<'a> {
     /// A trial state's event (a crease folded against its assignment, the contact budget
     /// passed, panels crossing), or its smallest panel clearance where there is none.
     fn event(&mut self, trial: &[f64], here: f64) -> std::result::Result<Option<f64>, Stop> {
-        // A crease that passes through flat against its assignment has left the branch.
-        let wrong = against_assignment(trial, &self.signs, 1e-9);
-        if !wrong.is_empty() {
-            let evidence = format!(
-                "creases {:?} would fold against their assignment after progress {here:.6}",
-                &wrong[..wrong.len().min(8)]
-            );
-            return Err(Stop::new(StopReason::BranchPoint { creases: wrong }, evidence));
-        }
+        against_assignment_event(trial, &self.signs, here)?;
         let contacts = self.contacts(trial);
-        if let Some(found) = contacts.overflow {
-            return Err(Stop::new(
-                StopReason::ContactBudget { pairs: found - 1 },
-                over_budget(found, &format!("after progress {here:.6}")),
-            ));
-        }
-        if let Some(pair) = contacts.crossing().next() {
-            let panels = pair.panels;
-            return Err(Stop::new(
-                StopReason::Blocked { panels },
-                format!(
-                    "panels {} and {} would pass through each other after progress {here:.6}",
-                    panels[0], panels[1]
-                ),
-            ));
-        }
-        Ok(contacts.min_clearance)
+        contact_event(&contacts, here)
     }
 
-    /// The path as it ends.
-    fn finish(self, stop: Stop) -> FoldPath {
+    /// [`Walk::event`], with the contact test on a second thread while this one projects the
+    /// tangent at the trial state (the next step's first work, kept where the state is
+    /// accepted): on a large pattern the contact test costs about what the projection does.
+    fn event_and_tangent(
+        &self,
+        trial: &[f64],
+        here: f64,
+        factored: &Factored,
+    ) -> (Judged, Option<(Tangent, Option<bool>)>) {
+        if let Err(stop) = against_assignment_event(trial, &self.signs, here) {
+            return (Err(stop), None);
+        }
+        let (model, contact) = (self.model, &self.settings.contact);
+        std::thread::scope(|scope| {
+            let test = scope.spawn(move || {
+                let mut poses = Vec::new();
+                panel_poses(model, trial, &mut poses);
+                panel_contacts(model, &poses, contact)
+            });
+            let tangent = self.tangent_with(trial, factored, self.steps.len() + 1);
+            let contacts = test.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (contact_event(&contacts, here), Some(tangent))
+        })
+    }
+
+    /// The path as it ends, and the solver whose symbolic analysis fits its Jacobian.
+    fn finish(self, stop: Stop) -> (FoldPath, NormalSolver) {
         let max_closure_residual = self.steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
         let min_panel_clearance = self.steps.iter().filter_map(|s| s.min_clearance).reduce(f64::min);
-        FoldPath {
+        let path = FoldPath {
             steps: self.steps,
             stop: stop.reason,
             evidence: stop.evidence,
@@ -899,8 +966,44 @@ impl<'a> Walk<'a> {
             newton_iterations: self.newton_iterations,
             factorisations: self.solver.factorisations(),
             drive: self.settings.drive.clone(),
-        }
+        };
+        (path, self.solver)
     }
+}
+
+/// A crease that passes through flat against its assignment has left the branch.
+fn against_assignment_event(trial: &[f64], signs: &[f64], here: f64) -> std::result::Result<(), Stop> {
+    let wrong = against_assignment(trial, signs, 1e-9);
+    if wrong.is_empty() {
+        return Ok(());
+    }
+    let evidence = format!(
+        "creases {:?} would fold against their assignment after progress {here:.6}",
+        &wrong[..wrong.len().min(8)]
+    );
+    Err(Stop::new(StopReason::BranchPoint { creases: wrong }, evidence))
+}
+
+/// The contact budget passed or panels crossing in a trial state's contact test, or its
+/// smallest clearance.
+fn contact_event(contacts: &ContactReport, here: f64) -> std::result::Result<Option<f64>, Stop> {
+    if let Some(found) = contacts.overflow {
+        return Err(Stop::new(
+            StopReason::ContactBudget { pairs: found - 1 },
+            over_budget(found, &format!("after progress {here:.6}")),
+        ));
+    }
+    if let Some(pair) = contacts.crossing().next() {
+        let panels = pair.panels;
+        return Err(Stop::new(
+            StopReason::Blocked { panels },
+            format!(
+                "panels {} and {} would pass through each other after progress {here:.6}",
+                panels[0], panels[1]
+            ),
+        ));
+    }
+    Ok(contacts.min_clearance)
 }
 
 /// Moves a state just past the drive's goal onto it: the crease that sets progress is put
@@ -975,17 +1078,6 @@ impl Factored {
             .sqrt();
         let size = w.iter().map(|a| a * a).sum::<f64>().sqrt();
         off <= 1e-3 * size
-    }
-
-    /// The size (largest component) of the least-norm Newton step from `fold_angles`,
-    /// J⁺ r, with this factorisation's J.
-    fn least_norm_move(&self, model: &FoldingModel, fold_angles: &[f64]) -> f64 {
-        let mut residual = Vec::with_capacity(self.jacobian.rows);
-        closure_residual(model, fold_angles, &mut residual);
-        let mut step = vec![0.0; self.jacobian.cols];
-        self.jacobian.apply_transpose(&residual, &mut step);
-        self.factor.solve(&mut step);
-        inf_norm(&step)
     }
 
     /// The desired velocity projected onto the tangent space at `fold_angles`. A stale
