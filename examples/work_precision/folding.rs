@@ -58,7 +58,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
         closure_tol,
         ..FoldSettings::default()
     };
-    let runs = if model.crease_count() > 5000 { 1 } else { 3 };
+    let runs = if model.crease_count() > 10_000 { 1 } else { 5 };
     let start = model.given_fold_angles();
     let (seconds, path) = timed(runs, || fold_path(model, &start, &settings).unwrap());
     let (frames_11, frames) = timed(runs, || path_frames(model, &path, 11).unwrap());
@@ -111,7 +111,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
 
 /// The folding part of the report.
 pub fn folding_part() -> Value {
-    println!("\nFolding paths by continuation to 90% (median of 3 runs; 1 above 5 000 creases)");
+    println!("\nFolding paths by continuation to 90% (median of 5 runs; 1 above 10 000 creases)");
     println!(
         "{:<22} {:>6} {:>7} {:>8} {:>5} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  stop",
         "pattern",
