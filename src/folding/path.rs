@@ -523,7 +523,9 @@ impl<'a> Walk<'a> {
             next_tangent: None,
             one_dof: None,
         };
-        let start_residual = closure_jacobian(model, &walk.rho).worst_residual();
+        let mut residual = Vec::with_capacity(3 * model.stars.len());
+        closure_residual(model, &walk.rho, &mut residual);
+        let start_residual = worst_of(&residual);
         if start_residual > settings.closure_tol {
             match restore_closure(model, &mut walk.rho, settings.closure_tol, &mut walk.solver)? {
                 Some(k) if start_residual <= 1e-6 => walk.newton_iterations += k,
@@ -537,11 +539,8 @@ impl<'a> Walk<'a> {
             }
         }
         let first = walk.contacts(&walk.rho.clone());
-        walk.record(
-            walk.rho.clone(),
-            closure_jacobian(model, &walk.rho).worst_residual(),
-            first.min_clearance,
-        );
+        closure_residual(model, &walk.rho, &mut residual);
+        walk.record(walk.rho.clone(), worst_of(&residual), first.min_clearance);
         walk.first_contacts = Some(first);
         Ok(walk)
     }
@@ -606,16 +605,16 @@ impl<'a> Walk<'a> {
         let mut landed = None;
         for kick in [raised, settings.kick] {
             let mut trial: Vec<f64> = self.rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
-            if let Some(k) = restore_closure(model, &mut trial, settings.closure_tol, &mut self.solver)? {
-                self.newton_iterations += k;
-                landed = Some((kick, trial));
+            if let Some(correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None, false)? {
+                self.newton_iterations += correction.iterations;
+                landed = Some((kick, trial, correction));
                 break;
             }
             if raised == settings.kick {
                 break;
             }
         }
-        let Some((kick, trial)) = landed else {
+        let Some((kick, trial, correction)) = landed else {
             return Ok(Some(Stop::new(
                 StopReason::BranchPoint { creases: vec![] },
                 format!(
@@ -640,13 +639,21 @@ impl<'a> Walk<'a> {
                 String::new()
             }
         ));
+        // The kicked state's clearance is recorded, not judged; on a large pattern its
+        // contact test runs beside the first tangent's projection.
+        let min_clearance = match &correction.factor {
+            Some(factored) if model.crease_count() >= PARALLEL_EVENT_FROM => {
+                let (contacts, tangent) = self.contacts_and_tangent(&trial, factored);
+                self.next_tangent = Some(tangent);
+                contacts.min_clearance
+            }
+            _ => {
+                self.carried = correction.factor;
+                self.contacts(&trial).min_clearance
+            }
+        };
         self.rho = trial;
-        let contacts = self.contacts(&self.rho.clone());
-        self.record(
-            self.rho.clone(),
-            closure_jacobian(model, &self.rho).worst_residual(),
-            contacts.min_clearance,
-        );
+        self.record(self.rho.clone(), correction.residual, min_clearance);
         Ok(None)
     }
 
@@ -855,23 +862,54 @@ impl<'a> Walk<'a> {
                     .zip(q.iter().zip(r))
                     .for_each(|(x, (q, r))| *x += h * h * (q + h * r));
             }
-            let Some(mut correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None, true)?
-            else {
-                self.h /= 2.0;
-                if self.h < settings.max_step.min(MIN_STEP) * 1e-3 {
-                    return Ok(Trial::Lost);
+            // A prediction past the goal lands on it from there, the crease that sets progress
+            // held at its goal: the state past it, which the path would not keep, is not
+            // corrected first.
+            let predicted = self.progress_of(&trial);
+            let mut early = None;
+            if may_land && predicted > 1.0 + 1e-10 {
+                let mut state = trial.clone();
+                let goal = land_on_goal(
+                    model,
+                    &settings.drive,
+                    &mut state,
+                    &self.signs,
+                    settings.closure_tol,
+                    &mut self.solver,
+                )?;
+                early = goal.map(|landing| (state, landing));
+            }
+            let landed_early = early.is_some();
+            let mut correction = match early {
+                Some((state, mut landing)) => {
+                    trial = state;
+                    landing.factor = None;
+                    landing
                 }
-                continue;
+                None => match correct(model, &mut trial, settings.closure_tol, &mut self.solver, None, true)? {
+                    Some(correction) => correction,
+                    None => {
+                        self.h /= 2.0;
+                        if self.h < settings.max_step.min(MIN_STEP) * 1e-3 {
+                            return Ok(Trial::Lost);
+                        }
+                        continue;
+                    }
+                },
             };
             self.newton_iterations += correction.iterations;
             if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) {
                 self.h /= 2.0;
                 continue;
             }
-            let reached = self.progress_of(&trial);
-            let mut ahead = reached;
-            let mut landed = false;
-            if ahead > 1.0 + 1e-10 && may_land {
+            let reached = if landed_early {
+                predicted
+            } else {
+                self.progress_of(&trial)
+            };
+            let mut ahead = self.progress_of(&trial);
+            let mut landed = landed_early;
+            if !landed && ahead > 1.0 + 1e-10 && may_land {
                 // Past the goal: onto it directly, the crease that sets progress held there.
                 let goal = land_on_goal(
                     model,
@@ -939,6 +977,12 @@ impl<'a> Walk<'a> {
         if let Err(stop) = against_assignment_event(trial, &self.signs, here) {
             return (Err(stop), None);
         }
+        let (contacts, tangent) = self.contacts_and_tangent(trial, factored);
+        (contact_event(&contacts, here), Some(tangent))
+    }
+
+    /// The contact test of `trial` on a second thread, and the tangent there on this one.
+    fn contacts_and_tangent(&self, trial: &[f64], factored: &Factored) -> (ContactReport, (Tangent, Option<bool>)) {
         let (model, contact) = (self.model, &self.settings.contact);
         std::thread::scope(|scope| {
             let test = scope.spawn(move || {
@@ -948,7 +992,7 @@ impl<'a> Walk<'a> {
             });
             let tangent = self.tangent_with(trial, factored, self.steps.len() + 1);
             let contacts = test.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            (contact_event(&contacts, here), Some(tangent))
+            (contacts, tangent)
         })
     }
 
