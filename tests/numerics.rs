@@ -183,7 +183,20 @@ proptest! {
             let direct = solve_direct(&problem).unwrap();
             let clarabel = solve_clarabel(&problem).unwrap();
             let scale = 1.0 + problem.q.amax();
-            prop_assert!((&direct.y - &clarabel.y).amax() <= 1e-10 * scale, "differ by {:e} (scale {scale:e})", (&direct.y - &clarabel.y).amax());
+            // Along A's null space (where the objective decides) the two agree to 1e-10.
+            // Across it they differ by what their constraint residuals allow through A's
+            // smallest singular value: near flat the closure rows are nearly dependent
+            // (σ_min 4.4e-4 for a vertex driven 0.04° from flat), and Clarabel's residual of
+            // 4e-14 there moved y by 1.7e-10, the bound itself, while both were stationary
+            // to 1e-16.
+            let difference = &direct.y - &clarabel.y;
+            let mut row_space = RowSpace::dense(&problem.a).unwrap();
+            let along = row_space.project_to_null(&difference);
+            prop_assert!(along.amax() <= 1e-10 * scale, "differ by {:e} along the null space (scale {scale:e})", along.amax());
+            let sigma_min = problem.a.to_dense().singular_values().min();
+            let allowed = (problem.a.mul(&direct.y).norm() + problem.a.mul(&clarabel.y).norm()) / sigma_min;
+            let across = (&difference - &along).norm();
+            prop_assert!(across <= 1e-10 * scale + 2.0 * allowed, "differ by {across:e} across it, {allowed:e} allowed");
             prop_assert!((problem.a.mul(&direct.y)).amax() <= 1e-12 * scale);
             // Optimality: M y + q lies in the row space of A.
             let stationarity = RowSpace::dense(&problem.a).unwrap().project_to_null(&(problem.metric_times(&direct.y) + &problem.q));
