@@ -8,7 +8,7 @@ use super::model::FoldingModel;
 use super::normal::{NormalFactor, NormalSolver};
 use super::path::{
     assigned_signs, fold_path, fold_path_observed, progress, progress_by_crease, progress_crease, Drive, FoldPath,
-    FoldSettings, PathStep, StopReason,
+    FoldSettings, PathStep, StopReason, CHORD_CONTRACTION,
 };
 use crate::error::{NanofoldError, Result};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -18,9 +18,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// panels of a tree of depth d by about d·r of the pattern's size, and at depth 100 the
 /// edge lengths hold to 1e-12 only from about 1e-15.
 pub const FRAME_CLOSURE: f64 = 1e-16;
-
-/// The residual's fall per chord step below which a frame's polish refactorises.
-const CHORD_CONTRACTION: f64 = 0.1;
 
 /// Below this residual, rad, a frame's polish takes only chord steps.
 const CHORD_ONLY: f64 = 1e-13;

@@ -297,8 +297,9 @@ const SLOW_CORRECTOR: usize = 6;
 /// the contact budget) is located: the last step before it is at most this long, rad.
 pub const LOCATE: f64 = 1e-6;
 
-/// The residual cut per corrector step for which the factorisation is reused (chord steps).
-const CHORD_CONTRACTION: f64 = 0.1;
+/// The residual cut per step for which a corrector (a path's, a frame's polish) reuses its
+/// factorisation (chord steps); a step that cuts less is followed by a fresh one.
+pub(crate) const CHORD_CONTRACTION: f64 = 0.1;
 
 /// Steps over which progress must grow by 1e-9, or the path counts as stalled.
 const STALL_STEPS: usize = 200;
