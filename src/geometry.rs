@@ -5,3 +5,16 @@
 pub mod broad_phase;
 pub mod kinematics;
 pub mod sphere;
+
+/// Uniform draws in [0, 1) from a fixed seed (xorshift): the deterministic random inputs of
+/// the geometry tests and of the tests built on them.
+#[cfg(test)]
+pub(crate) fn test_draws(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

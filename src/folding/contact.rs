@@ -510,13 +510,7 @@ mod tests {
     /// draw, many of them near each other).
     #[test]
     fn the_plane_bound_is_a_lower_bound_of_the_distance() {
-        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::geometry::test_draws(0x9E37_79B9_7F4A_7C15_u64);
         let mut separated = 0;
         for _ in 0..20_000 {
             let mut corner = || p(next(), next(), next());

@@ -276,13 +276,7 @@ mod tests {
     #[test]
     fn the_pairs_are_those_of_testing_every_pair() {
         // A pseudo-random mix of small boxes, long thin ones, points and one far away.
-        let mut state = 0x2545_F491_4F6C_DD1D_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::geometry::test_draws(0x2545_F491_4F6C_DD1D_u64);
         for round in 0..20 {
             let mut boxes2: Vec<Aabb<2>> = Vec::new();
             let mut boxes3: Vec<Aabb<3>> = Vec::new();
