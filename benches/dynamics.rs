@@ -16,7 +16,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn bridge() -> Scene {
-    nanofold::io::load_scene(Path::new("patterns/bridge_step.scene.json"))
+    nanofold::read::load_scene(Path::new("patterns/bridge_step.scene.json"))
         .and_then(|spec| spec.build())
         .unwrap()
 }

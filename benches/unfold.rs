@@ -15,7 +15,7 @@ fn library() -> Vec<Pattern> {
     paths.sort();
     paths
         .iter()
-        .map(|p| nanofold::io::load_pattern(p, &LoadOptions::default()).unwrap())
+        .map(|p| nanofold::read::load_pattern(p, &LoadOptions::default()).unwrap())
         .collect()
 }
 
@@ -30,7 +30,7 @@ fn bench_unfold(c: &mut Criterion) {
 }
 
 fn bench_energy(c: &mut Criterion) {
-    let pattern = nanofold::io::load_pattern(
+    let pattern = nanofold::read::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
         &LoadOptions::default(),
     )

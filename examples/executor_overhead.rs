@@ -53,7 +53,7 @@ fn median(mut values: Vec<f64>) -> f64 {
 fn main() {
     let settings = UnfoldSettings::default();
     for name in ["corner_cube.fold", "symmetric16.fold"] {
-        let pattern = nanofold::io::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let runs = 2000;
         let (mut executor, mut bare) = (Vec::with_capacity(runs), Vec::with_capacity(runs));
@@ -77,7 +77,7 @@ fn main() {
     }
     let settings = NetworkUnfoldSettings::default();
     for name in ["huffman_waterbomb_6x4.fold", "miura_4x4.fold"] {
-        let pattern = nanofold::io::load_crease_pattern(&Path::new("patterns/many").join(name)).unwrap();
+        let pattern = nanofold::read::load_crease_pattern(&Path::new("patterns/many").join(name)).unwrap();
         let model = FoldingModel::new(pattern).unwrap();
         let fold = FoldSettings {
             drive: Drive::Assignment { to: 0.9 },

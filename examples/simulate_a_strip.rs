@@ -3,8 +3,8 @@
 //! to an etch ramp. Run: `cargo run --release --example simulate_a_strip`
 
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::spec::{HingeSpec, LayerSpec, MaterialSpec, StripSpec};
 use nanofold::prelude::*;
+use nanofold::read::scene_spec::{HingeSpec, LayerSpec, MaterialSpec, StripSpec};
 
 fn strip(ramp: bool) -> StripSpec {
     let bilayer = || vec![LayerSpec::new("SiN", 0.2), LayerSpec::new("Cr", 0.1)];

@@ -1,7 +1,7 @@
 //! Unfolds the corner cube 200 times (a fixed workload for instruction counting with
 //! `valgrind --tool=callgrind`).
 fn main() {
-    let pattern = nanofold::io::load_pattern(
+    let pattern = nanofold::read::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
         &nanofold::pattern::LoadOptions::default(),
     )

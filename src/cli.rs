@@ -13,16 +13,16 @@ use nanofold::dynamics::integrate::{Method, ProgressObserver};
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::{Scene, System};
 use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, SimulationSettings};
-use nanofold::io::folder::{folder_name, write_folder_of};
-use nanofold::io::output::{
-    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
-};
 use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::unfold::energy::EnergyKind;
 use nanofold::unfold::qp::QpMethod;
 use nanofold::unfold::{unfold, unfold_observed, UnfoldModel, UnfoldProgress, UnfoldReport, UnfoldSettings};
+use nanofold::write::folder::{folder_name, write_folder_of};
+use nanofold::write::output::{
+    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
+};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -422,7 +422,7 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         for path in entries {
             if path.is_dir() {
                 walk(&path, seen_dirs, found)?;
-            } else if nanofold::io::is_pattern_file(&path) {
+            } else if nanofold::read::is_pattern_file(&path) {
                 found.push(path);
             }
             anyhow::ensure!(
@@ -463,7 +463,7 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 const MAX_BATCH_FILES: usize = 10_000;
 
 fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json::Value {
-    nanofold::io::output::vertex_unfold_summary(pattern, &path.display().to_string(), report)
+    nanofold::write::output::vertex_unfold_summary(pattern, &path.display().to_string(), report)
 }
 
 /// Unfolds one pattern into `dir`; returns its JSON summary and its human-readable lines.
@@ -475,7 +475,7 @@ fn unfold_one(
 ) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
-    let pattern = match nanofold::io::load_pattern(pattern_path, &solver.load_options()) {
+    let pattern = match nanofold::read::load_pattern(pattern_path, &solver.load_options()) {
         Ok(pattern) => pattern,
         Err(e) if nanofold::commands::takes_many_vertices(&e, pattern_path) => {
             return folding::unfold_network_one(pattern_path, solver, dir, progress)
@@ -596,7 +596,7 @@ fn run_unfold(
     let mut jobs: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
     let mut writer_of: std::collections::HashMap<PathBuf, PathBuf> = std::collections::HashMap::new();
     for path in files {
-        let file_name = nanofold::io::pattern_name(&path);
+        let file_name = nanofold::read::pattern_name(&path);
         let dir = parent.join(folder_name(&file_name, &file_name));
         if let Some(other) = writer_of.insert(dir.clone(), path.clone()) {
             anyhow::bail!(
@@ -643,7 +643,7 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
     let settings = solver.settings()?;
     let files = expand_patterns(patterns)?;
     parallel.all(&files, |path| {
-        let outcome = nanofold::io::load_pattern(path, &solver.load_options());
+        let outcome = nanofold::read::load_pattern(path, &solver.load_options());
         if let Err(e) = &outcome {
             if nanofold::commands::takes_many_vertices(e, path) {
                 return match folding::check_json(path, solver.closure_tol, solver.project) {
@@ -767,7 +767,7 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
         ..LoadOptions::default()
     };
     options.validate().map_err(constraints_flags)?;
-    let pattern = match nanofold::io::load_pattern(&args.pattern, &options) {
+    let pattern = match nanofold::read::load_pattern(&args.pattern, &options) {
         Ok(pattern) => pattern,
         Err(e) if nanofold::commands::takes_many_vertices(&e, &args.pattern) => {
             return folding::run_network_constraints(args, degree)
@@ -981,7 +981,7 @@ fn print_constraints(
 /// `output/<name>`, where a name that is not one plain folder name (`..`, `/abs`, empty)
 /// gives way to the file's own name.
 fn default_folder(name: &str, file: &Path) -> PathBuf {
-    PathBuf::from("output").join(folder_name(name, &nanofold::io::pattern_name(file)))
+    PathBuf::from("output").join(folder_name(name, &nanofold::read::pattern_name(file)))
 }
 
 /// Writes the (file name, contents) set into `dir` as one (see `io::folder`); everything is
@@ -1087,7 +1087,7 @@ pub(crate) fn reading(path: &Path, error: nanofold::NanofoldError) -> anyhow::Er
 
 /// Loads a scene file and builds it (the closed chain's sweep and fit run here).
 fn load_scene(path: &Path) -> Result<Scene> {
-    let spec = nanofold::io::load_scene(path).map_err(|e| reading(path, e))?;
+    let spec = nanofold::read::load_scene(path).map_err(|e| reading(path, e))?;
     spec.build()
         .with_context(|| format!("building the scene of {}", path.display()))
 }
@@ -1118,7 +1118,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     let response = &simulation.response;
     // Render everything before writing anything.
     let dir = args.out.clone().unwrap_or_else(|| {
-        let file_name = nanofold::io::scene::scene_name(&args.scene);
+        let file_name = nanofold::read::scene::scene_name(&args.scene);
         PathBuf::from("output").join(folder_name(&scene.name, &file_name))
     });
     let mut files = vec![
@@ -1130,7 +1130,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         ("snapshots.svg", snapshots_svg(&scene, response)?),
     ];
     if let System::Network(model) = &scene.system {
-        let motion = nanofold::io::folding_output::network_motion_fold(model, response);
+        let motion = nanofold::write::folding_output::network_motion_fold(model, response);
         let page = nanofold::plot::scene_page::network_response_page(
             &scene.name,
             model,
@@ -1311,17 +1311,17 @@ fn run_export(format: &ExportKind) -> Result<()> {
             nanofold::dynamics::network::NetworkPlant::new(model, false)?.time_scales()?
         }
     };
-    let settings = nanofold::io::mujoco::MujocoSettings {
+    let settings = nanofold::write::mujoco::MujocoSettings {
         timestep: *timestep,
         closure: match closure {
-            ClosureArg::Connect => nanofold::io::mujoco::LoopClosure::Connect,
-            ClosureArg::Poly => nanofold::io::mujoco::LoopClosure::Polycoef,
+            ClosureArg::Connect => nanofold::write::mujoco::LoopClosure::Connect,
+            ClosureArg::Poly => nanofold::write::mujoco::LoopClosure::Polycoef,
         },
     };
     settings
         .validate(scales.fastest_period_s)
         .map_err(|e| with_flags(e, &[("timestep", "--timestep")]))?;
-    let text = nanofold::io::mujoco::scene_mjcf(&built, &settings)?;
+    let text = nanofold::write::mujoco::scene_mjcf(&built, &settings)?;
     let out = out.clone().unwrap_or_else(|| {
         PathBuf::from("output")
             .join(&built.name)
@@ -1330,7 +1330,8 @@ fn run_export(format: &ExportKind) -> Result<()> {
     if out.extension().and_then(|e| e.to_str()) != Some("xml") {
         anyhow::bail!("--out {}: the file name must end in .xml", out.display());
     }
-    nanofold::io::output::write_atomic(&out, text.as_bytes()).with_context(|| format!("writing {}", out.display()))?;
+    nanofold::write::output::write_atomic(&out, text.as_bytes())
+        .with_context(|| format!("writing {}", out.display()))?;
     println!(
         "{}: wrote {} (MJCF, units µm, pg, µs; RK4 step {:e} s, a {:.0}th of the fastest period {:.3e} s)",
         built.name,
@@ -1345,7 +1346,7 @@ fn run_export(format: &ExportKind) -> Result<()> {
 fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     let scene = load_scene(path)?;
     let dir = out.map(Path::to_path_buf).unwrap_or_else(|| {
-        let file_name = nanofold::io::scene::scene_name(path);
+        let file_name = nanofold::read::scene::scene_name(path);
         PathBuf::from("output").join(folder_name(&scene.name, &file_name))
     });
     let chain = match &scene.system {
@@ -1414,12 +1415,12 @@ fn run_modes_network(
     dir: &Path,
 ) -> Result<()> {
     let result = nanofold::dynamics::network::modes::folded_modes(model)?;
-    let fold = nanofold::io::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
+    let fold = nanofold::write::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
     let files = [
         (
             "modes.html",
             nanofold::plot::page::page_of_fold(
-                &nanofold::io::folding_output::network_modes_oscillation_fold(model, &result, MODE_AMPLITUDE, 12)?,
+                &nanofold::write::folding_output::network_modes_oscillation_fold(model, &result, MODE_AMPLITUDE, 12)?,
                 name,
                 &[],
                 Some((model.unit * 1e6, "µm")),
@@ -1429,7 +1430,7 @@ fn run_modes_network(
     ];
     write_outputs(dir, input, &files)?;
     if json {
-        let mut value = nanofold::io::output::network_modes_json(name, model, &result);
+        let mut value = nanofold::write::output::network_modes_json(name, model, &result);
         value["out"] = serde_json::json!(dir.display().to_string());
         println!("{value}");
         return Ok(());

@@ -85,9 +85,9 @@ impl Pattern {
     /// Reads a FOLD file or a native vertex file: the single-vertex engine takes it when it
     /// reads it, the many-vertex reader otherwise (its errors are then the ones returned).
     pub fn open(path: &Path, options: &LoadOptions) -> Result<Pattern> {
-        let text = crate::io::input::read_text(path, crate::io::input::MAX_PATTERN_BYTES)?;
+        let text = crate::read::input::read_text(path, crate::read::input::MAX_PATTERN_BYTES)?;
         let origin = path.display().to_string();
-        let mut pattern = Pattern::parse(&text, &crate::io::pattern_name(path), &origin, options)?;
+        let mut pattern = Pattern::parse(&text, &crate::read::pattern_name(path), &origin, options)?;
         pattern.source = Some(origin);
         Ok(pattern)
     }
@@ -95,11 +95,11 @@ impl Pattern {
     /// Reads pattern text (FOLD or a native vertex) as [`Pattern::open`] reads a file;
     /// `name` names the pattern when the text has no title, `origin` names it in errors.
     pub fn parse(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
-        let frames_note = crate::io::input::parse_json(text, origin)
+        let frames_note = crate::read::input::parse_json(text, origin)
             .ok()
-            .and_then(|v| crate::io::frames_note(&v));
-        let sheet_of_text = || crate::io::parse_crease_pattern(text, name, origin);
-        match crate::io::parse_pattern(text, name, origin, options) {
+            .and_then(|v| crate::read::frames_note(&v));
+        let sheet_of_text = || crate::read::parse_crease_pattern(text, name, origin);
+        match crate::read::parse_pattern(text, name, origin, options) {
             Ok(vertex) => {
                 let sheet = sheet_of_text()
                     .ok()
@@ -274,7 +274,7 @@ fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
 /// 3D folded form, no fold angles, a mesh larger than a vertex's); otherwise (a vertex whose
 /// folded state does not close, say) only if it reads as a crease pattern.
 pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
-    refused_as_vertex(error, || crate::io::load_crease_pattern(path).is_ok())
+    refused_as_vertex(error, || crate::read::load_crease_pattern(path).is_ok())
 }
 
 /// [`takes_many_vertices`] with the crease-pattern reading as a closure.
@@ -471,11 +471,11 @@ impl Report {
     /// The report as `nanofold <command> --json` prints it for `pattern` (the one it
     /// answers), less the command line's own keys (`out`, `frames`).
     pub fn to_json(&self, pattern: &Pattern) -> serde_json::Value {
-        use crate::io::folding_output::{check_summary, fold_summary, network_unfold_summary};
+        use crate::write::folding_output::{check_summary, fold_summary, network_unfold_summary};
         let file = pattern.source().unwrap_or(pattern.name());
         match (&self.detail, pattern.vertex(), pattern.sheet()) {
             (Detail::VertexUnfold(report), Some(vertex), _) => {
-                crate::io::output::vertex_unfold_summary(vertex, file, report)
+                crate::write::output::vertex_unfold_summary(vertex, file, report)
             }
             (Detail::NetworkUnfold(report), _, Some(model)) => {
                 let adjustments: Vec<String> = pattern

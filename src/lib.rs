@@ -59,8 +59,9 @@
 //! ## Layers
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
-//! [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`] → [`io`] → [`commands`] (the
-//! front door) → `plot` (feature `plot`) → the `nanofold` binary (feature `cli`). [`error`]
+//! [`read`] (the file readers) → [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`]
+//! → [`write`] (the file writers) → [`commands`] (the front door) → `plot` (feature `plot`)
+//! → the `nanofold` binary (feature `cli`). [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.
 
 pub mod commands;
@@ -69,12 +70,13 @@ pub mod dynamics;
 pub mod error;
 pub mod folding;
 pub mod geometry;
-pub mod io;
 pub mod pattern;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod prelude;
+pub mod read;
 pub mod unfold;
+pub mod write;
 
 pub use error::{NanofoldError, Result};
 

@@ -1,6 +1,6 @@
 //! The crease-pattern model (`docs/model.md#the-vertex`): a validated single vertex — its rays, sectors and
 //! creases — that every algorithm reads. Built from numbers with [`VertexBuilder`], or from
-//! files by the io layer ([`crate::io`]). Patterns of many vertices are [`crease_pattern`].
+//! files by the readers ([`crate::read`]). Patterns of many vertices are [`crease_pattern`].
 
 pub mod crease_pattern;
 pub mod generate;

@@ -10,9 +10,9 @@ pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
-use crate::io::output::{snapshot_indices, write_atomic};
 use crate::pattern::Pattern;
 use crate::unfold::UnfoldReport;
+use crate::write::output::{snapshot_indices, write_atomic};
 use canvas::{canvas, px, pxi, shown_at};
 use plotters::prelude::*;
 use std::path::Path;

@@ -8,13 +8,13 @@ pub use crate::commands::{
 };
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::Method;
-pub use crate::dynamics::scene::{Scene, SceneSpec, System};
+pub use crate::dynamics::scene::{Scene, System};
 pub use crate::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
-pub use crate::dynamics::spec::{ClosedSpec, StripSpec};
 pub use crate::error::{NanofoldError, NumericalError, Result};
 pub use crate::folding::{CheckSettings, FoldSettings};
-pub use crate::io::{load_pattern, load_scene};
 pub use crate::pattern::{Assignment, Chain, LoadOptions, VertexBuilder};
+pub use crate::read::scene_spec::{ClosedSpec, SceneSpec, StripSpec};
+pub use crate::read::{load_pattern, load_scene};
 pub use crate::unfold::energy::EnergyKind;
 pub use crate::unfold::qp::QpMethod;
 pub use crate::unfold::{

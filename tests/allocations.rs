@@ -102,7 +102,7 @@ fn an_unfold_step_allocates_nothing_after_the_first() {
     let _serial = SERIAL.lock().unwrap();
     // The counter sees what it should.
     assert_eq!(count(|| drop(std::hint::black_box(vec![1u8; 3]))), 1);
-    let corner = nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
+    let corner = nanofold::read::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
     let per_step = allocations_per_step(&corner, 10);
     assert!(per_step.iter().all(|&a| a == 0), "corner cube: {per_step:?}");
     let per_step = allocations_per_step(&random_vertex(64), 20);
@@ -115,7 +115,7 @@ fn an_unfold_step_allocates_nothing_after_the_first() {
 fn a_whole_unfolding_allocates_about_once_per_recorded_step() {
     let _serial = SERIAL.lock().unwrap();
     for pattern in [
-        nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap(),
+        nanofold::read::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap(),
         random_vertex(64),
     ] {
         let mut report = None;

@@ -3,7 +3,7 @@
 use nanofold::pattern::LoadOptions;
 
 fn error_of(text: &str) -> String {
-    match nanofold::io::parse_pattern(text, "test", "test.json", &LoadOptions::default()) {
+    match nanofold::read::parse_pattern(text, "test", "test.json", &LoadOptions::default()) {
         Ok(_) => panic!("accepted bad input: {text}"),
         Err(e) => e.to_string(),
     }
@@ -108,7 +108,7 @@ fn flat_folded_input_is_backed_off_by_the_documented_rule() {
     let text = r#"{"vertices_coords":[[0,0],[1,0],[-1,0],[1,1],[-1,1],[-1,-1],[1,-1]],
         "edges_vertices":[[0,1],[0,2],[1,3],[3,4],[4,2],[2,5],[5,6],[6,1]],
         "edges_assignment":["V","V","B","B","B","B","B","B"],"edges_foldAngle":[180,180,0,0,0,0,0,0]}"#;
-    let pattern = nanofold::io::parse_pattern(text, "flat_folded", "t", &LoadOptions::default()).unwrap();
+    let pattern = nanofold::read::parse_pattern(text, "flat_folded", "t", &LoadOptions::default()).unwrap();
     let report = nanofold::unfold::unfold(&pattern, &Default::default()).unwrap();
     assert_eq!(report.verdict, nanofold::unfold::Verdict::Flat);
     assert!(report.adjustments.iter().any(|a| a.contains("flat-folded")));

@@ -718,8 +718,9 @@ fn unfold_fold_reads_back_as_its_input_and_its_frames_follow_the_sign_rule() {
             .unwrap();
         assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
         let original =
-            nanofold::io::load_pattern(&std::path::Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
-        let again = nanofold::io::load_pattern(&dir.join("unfold.fold"), &LoadOptions::default()).unwrap();
+            nanofold::read::load_pattern(&std::path::Path::new("patterns").join(name), &LoadOptions::default())
+                .unwrap();
+        let again = nanofold::read::load_pattern(&dir.join("unfold.fold"), &LoadOptions::default()).unwrap();
         assert_eq!(original.sector_angles.len(), again.sector_angles.len(), "{name}");
         for (a, b) in original.sector_angles.iter().zip(&again.sector_angles) {
             assert!((a - b).abs() < 1e-12, "{name}: sector {a} vs {b}");

@@ -18,7 +18,7 @@ use nanofold::pattern::{LoadOptions, Pattern};
 use std::path::Path;
 
 fn degree4() -> Pattern {
-    nanofold::io::load_pattern(Path::new("patterns/degree4_generic.fold"), &LoadOptions::default()).unwrap()
+    nanofold::read::load_pattern(Path::new("patterns/degree4_generic.fold"), &LoadOptions::default()).unwrap()
 }
 
 /// A 4R spherical linkage (degree-4 vertex): the diagonal between the driver's neighbours
@@ -500,7 +500,7 @@ fn bad_closed_scene_geometry_names_the_field() {
         std::fs::write(dir.join("edited.fold"), pattern.to_string()).unwrap();
         let mut scene: serde_json::Value = serde_json::from_str(&scene_text).unwrap();
         scene["pattern"] = serde_json::json!("edited.fold");
-        nanofold::io::parse_scene(&scene.to_string(), "test", "test", &dir)
+        nanofold::read::parse_scene(&scene.to_string(), "test", "test", &dir)
             .and_then(|spec| spec.build())
             .unwrap_err()
             .to_string()

@@ -11,7 +11,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
 fn load(name: &str) -> Pattern {
-    nanofold::io::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap()
+    nanofold::read::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap()
 }
 
 fn ray_angles(pattern: &Pattern, crease_angles: &[f64]) -> Vec<f64> {
@@ -39,7 +39,7 @@ fn flat_foldable_vertex(alpha_deg: f64, beta_deg: f64, rho0_deg: f64) -> (Patter
         PI - beta,
         -rho0
     );
-    let pattern = nanofold::io::parse_pattern(&text, "flat_foldable", "test", &LoadOptions::default()).unwrap();
+    let pattern = nanofold::read::parse_pattern(&text, "flat_foldable", "test", &LoadOptions::default()).unwrap();
     (pattern, k)
 }
 

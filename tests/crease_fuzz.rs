@@ -104,7 +104,7 @@ fn mutated_crease_patterns_are_refused_or_run_without_panicking() {
             }
         }
         let text = value.to_string();
-        let Ok(pattern) = nanofold::io::parse_crease_pattern(&text, "fuzz", "fuzz") else {
+        let Ok(pattern) = nanofold::read::parse_crease_pattern(&text, "fuzz", "fuzz") else {
             continue;
         };
         let Ok(model) = FoldingModel::new(pattern) else {
@@ -136,7 +136,7 @@ fn mutated_crease_patterns_are_refused_or_run_without_panicking() {
 
 /// `check`'s verdict and DOF of a FOLD object (None when refused).
 fn verdict_of(value: &Value, max_steps: usize) -> Option<(String, usize)> {
-    let pattern = nanofold::io::parse_crease_pattern(&value.to_string(), "fuzz", "fuzz").ok()?;
+    let pattern = nanofold::read::parse_crease_pattern(&value.to_string(), "fuzz", "fuzz").ok()?;
     let model = FoldingModel::new(pattern).ok()?;
     let mut settings = CheckSettings::default();
     settings.path.max_steps = max_steps;

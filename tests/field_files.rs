@@ -5,7 +5,7 @@
 //! plane, ±180 targets), so the clean pattern is the independent answer.
 
 use nanofold::folding::{check_pattern, fold_path, CheckSettings, FoldSettings, FoldingModel, PatternVerdict};
-use nanofold::io::parse_crease_pattern;
+use nanofold::read::parse_crease_pattern;
 use serde_json::{json, Value};
 
 /// A small deterministic generator (no dependency for a few thousand numbers).
@@ -104,7 +104,7 @@ fn a_noisy_flat_sheet_in_3d_is_its_crease_pattern() {
     // the coordinates leaves them some 1e-3 rad apart there.
     assert!(gap(&angles, &clean_angles) < 0.05, "{:e}", gap(&angles, &clean_angles));
     // Folded, the same sheet is a folded form again: the threshold is the noise's, not a fold's.
-    let folded = nanofold::io::load_crease_pattern("patterns/many/miura_4x4_folded.fold".as_ref()).unwrap();
+    let folded = nanofold::read::load_crease_pattern("patterns/many/miura_4x4_folded.fold".as_ref()).unwrap();
     assert!(folded.reading.is_empty());
 }
 
@@ -142,7 +142,7 @@ fn flat_coordinates_with_targets_are_an_assignment() {
         "patterns/many/miura_4x4_folded.fold",
         "patterns/many/miura_4x4_bent.fold",
     ] {
-        let pattern = nanofold::io::load_crease_pattern(kept.as_ref()).unwrap();
+        let pattern = nanofold::read::load_crease_pattern(kept.as_ref()).unwrap();
         assert!(pattern.reading.is_empty() && pattern.target_angles.is_none(), "{kept}");
         assert!(pattern.fold_angles.iter().any(|a| *a != 0.0), "{kept}");
     }

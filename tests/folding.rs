@@ -57,9 +57,9 @@ fn single_vertex_library_patterns_agree_with_the_vertex_engine() {
         if path.extension().and_then(|e| e.to_str()) != Some("fold") {
             continue;
         }
-        let cp = nanofold::io::load_crease_pattern(&path).unwrap();
+        let cp = nanofold::read::load_crease_pattern(&path).unwrap();
         // The files the single-vertex engine reads (the others have many vertices or no state).
-        let Ok(vertex) = nanofold::io::load_pattern(&path, &LoadOptions::default()) else {
+        let Ok(vertex) = nanofold::read::load_pattern(&path, &LoadOptions::default()) else {
             assert!(
                 cp.stars.len() != 1 || cp.fold_angles.iter().all(|&r| r == 0.0),
                 "{}",
@@ -519,7 +519,7 @@ fn every_crease_pattern_in_the_library_gets_its_expected_verdict() {
     let mut seen = 0;
     for (name, verdict) in expected {
         let path = Path::new("patterns/many").join(format!("{name}.fold"));
-        let model = FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap();
+        let model = FoldingModel::new(nanofold::read::load_crease_pattern(&path).unwrap()).unwrap();
         let report = check_pattern(&model, &CheckSettings::default()).unwrap();
         assert_eq!(report.verdict, verdict, "{name}: {}", report.evidence);
         if let Some(witness) = report.witness.as_ref().filter(|_| verdict == RigidlyFoldable) {
@@ -543,7 +543,7 @@ fn every_crease_pattern_in_the_library_gets_its_expected_verdict() {
     assert_eq!(seen, files, "every file in patterns/many has its expected verdict here");
     // The bent Miura-ori names the bent crease's two vertices as its worst.
     let path = Path::new("patterns/many/miura_4x4_bent.fold");
-    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let report = check_pattern(&model, &CheckSettings::default()).unwrap();
     let bent = model
         .pattern
@@ -563,7 +563,7 @@ fn every_crease_pattern_in_the_library_gets_its_expected_verdict() {
     assert!(report.worst_vertices[2].1 < 1e-12);
     // The crossing strips: the two outer panels.
     let path = Path::new("patterns/many/strips_crossing.fold");
-    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let report = check_pattern(&model, &CheckSettings::default()).unwrap();
     assert_eq!(report.intersecting_pairs.len(), 1);
     let outer: Vec<usize> = report.intersecting_pairs[0]
@@ -595,13 +595,13 @@ fn the_sparse_dof_count_agrees_with_the_pivoted_qr() {
     }
     for name in ["square_twist", "waterbomb_4x3", "strips_crossing"] {
         let path = Path::new("patterns/many").join(format!("{name}.fold"));
-        let model = FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap();
+        let model = FoldingModel::new(nanofold::read::load_crease_pattern(&path).unwrap()).unwrap();
         let rho = model.given_fold_angles();
         cases.push((name.into(), model, rho));
     }
     // A folded waterbomb state from a folding path.
     let path = Path::new("patterns/many/waterbomb_4x3.fold");
-    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let settings = nanofold::folding::FoldSettings {
         drive: nanofold::folding::Drive::Assignment { to: 0.3 },
         ..Default::default()
@@ -729,7 +729,7 @@ fn patterns_without_interior_vertices_fold_crease_by_crease() {
     let diagonal = r#"{"file_spec": 1.1, "vertices_coords": [[0,0],[1,0],[1,1],[0,1]],
         "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[0,2]],
         "edges_assignment": ["B","B","B","B","V"]}"#;
-    let cp = nanofold::io::parse_crease_pattern(diagonal, "diagonal", "test").unwrap();
+    let cp = nanofold::read::parse_crease_pattern(diagonal, "diagonal", "test").unwrap();
     assert_eq!((cp.stars.len(), cp.creases.len(), cp.panel_count), (0, 1, 2));
     let model = FoldingModel::new(cp).unwrap();
     let report = check_pattern(&model, &CheckSettings::default()).unwrap();
@@ -748,7 +748,7 @@ fn patterns_without_interior_vertices_fold_crease_by_crease() {
         "edges_vertices": [[0,1],[1,2],[2,3],[3,4],[4,5],[5,6],[6,7],[7,0],[1,6],[2,5]],
         "edges_assignment": ["B","B","B","B","B","B","B","B","M","V"],
         "edges_foldAngle": [0,0,0,0,0,0,0,0,-90,90]}"#;
-    let model = FoldingModel::new(nanofold::io::parse_crease_pattern(pleats, "pleats", "test").unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::parse_crease_pattern(pleats, "pleats", "test").unwrap()).unwrap();
     let report = check_pattern(&model, &CheckSettings::default()).unwrap();
     assert_eq!(
         (report.verdict, report.rank.dof),
@@ -830,7 +830,8 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
     let model = miura(3, 4, 65.0, 110.0);
     let rho = model.given_fold_angles();
     let text = simulator_export(&model, &rho, 0.0, false);
-    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "exported", "test").unwrap()).unwrap();
+    let developed =
+        FoldingModel::new(nanofold::read::parse_crease_pattern(&text, "exported", "test").unwrap()).unwrap();
     let fit = developed.pattern.folded_form.unwrap();
     assert!(fit.development_error < 1e-12 && fit.max_facet_angle < 1e-12, "{fit:?}");
     // The same creases (file order kept) with the same angles, and every edge its length.
@@ -854,7 +855,7 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
     );
     // Faces listed clockwise: the development is mirrored, and the assignments turn it back.
     let text = simulator_export(&model, &rho, 0.0, true);
-    let mirrored = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "cw", "test").unwrap()).unwrap();
+    let mirrored = FoldingModel::new(nanofold::read::parse_crease_pattern(&text, "cw", "test").unwrap()).unwrap();
     assert!(mirrored.pattern.folded_form.unwrap().mirrored);
     let worst = mirrored
         .given_fold_angles()
@@ -865,7 +866,7 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
     assert!(worst < 1e-12, "mirrored: fold angles differ by {worst:e}");
     // A compliant simulator's state: one interior vertex lifted by 1e-3.
     let text = simulator_export(&model, &rho, 1e-3, false);
-    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
+    let developed = FoldingModel::new(nanofold::read::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
     let report = check_pattern(&developed, &CheckSettings::default()).unwrap();
     assert_eq!(report.verdict, PatternVerdict::NotRigid, "{}", report.evidence);
     assert!(
@@ -888,7 +889,7 @@ fn a_folded_form_in_the_simulator_layout_develops_into_its_crease_pattern() {
 fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
     use nanofold::folding::{check_pattern, fold_path, CheckSettings, Drive, FoldSettings, PatternVerdict};
     let model =
-        FoldingModel::new(nanofold::io::load_crease_pattern(Path::new("patterns/many/bird_base.fold")).unwrap())
+        FoldingModel::new(nanofold::read::load_crease_pattern(Path::new("patterns/many/bird_base.fold")).unwrap())
             .unwrap();
     let settings = FoldSettings {
         drive: Drive::Assignment { to: 0.3 },
@@ -902,7 +903,7 @@ fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
         .fold_angles
         .clone();
     let text = simulator_export(&model, &rho, 1e-3, false);
-    let developed = FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
+    let developed = FoldingModel::new(nanofold::read::parse_crease_pattern(&text, "bent", "test").unwrap()).unwrap();
     let report = check_pattern(&developed, &CheckSettings::default()).unwrap();
     assert_eq!(report.verdict, PatternVerdict::NotRigid, "{}", report.evidence);
     let projection = nanofold::folding::project_to_rigid(&developed, &developed.given_fold_angles(), 1e-11).unwrap();
@@ -956,7 +957,7 @@ fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
 /// The Origami Simulator export folded "to 50%": every crease near ±90°, with its sign.
 #[test]
 fn the_simulator_fixture_is_half_folded() {
-    let cp = nanofold::io::load_crease_pattern(Path::new("tests/fixtures/origami-simulator/simple_50.fold")).unwrap();
+    let cp = nanofold::read::load_crease_pattern(Path::new("tests/fixtures/origami-simulator/simple_50.fold")).unwrap();
     for &e in &cp.creases {
         let degrees = cp.fold_angles[e].to_degrees();
         let sign = match cp.kinds[e] {
@@ -1008,9 +1009,9 @@ fn a_locked_sweep_agrees_with_the_single_vertex_sweep() {
     use nanofold::constraints::network::network_sweep;
     use nanofold::constraints::{sweep_samples, Setup};
     let path = Path::new("patterns/corner_cube.fold");
-    let vertex = nanofold::io::load_pattern(path, &LoadOptions::default()).unwrap();
+    let vertex = nanofold::read::load_pattern(path, &LoadOptions::default()).unwrap();
     let setup = Setup::new(&vertex, 0, &[(1, 0.0)]).unwrap();
-    let mut model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let mut model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     assert_eq!(model.crease_count(), vertex.creases.len());
     // Hold crease 1; start from one state of the single-vertex sweep (crease 1 at 0) and
     // sweep the whole range independently from there.
@@ -1040,7 +1041,7 @@ fn a_locked_sweep_agrees_with_the_single_vertex_sweep() {
 fn the_bird_base_folds_with_the_flat_foldable_vertex_closed_form() {
     use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
     let path = Path::new("patterns/many/bird_base.fold");
-    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let report = check_pattern(&model, &CheckSettings::default()).unwrap();
     assert_eq!(report.verdict, PatternVerdict::RigidlyFoldable, "{}", report.evidence);
     let witness = report.witness.unwrap();
@@ -1128,7 +1129,7 @@ fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
     ] {
         let path = dir.join(format!("{name}-flat.fold"));
         let value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        let model = FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap();
+        let model = FoldingModel::new(nanofold::read::load_crease_pattern(&path).unwrap()).unwrap();
         // The crease pattern is the unfolded coordinates, not the folded ones.
         let unfolded = value["vertices_flatUnfoldCoords"].as_array().unwrap();
         for (v, p) in model.pattern.file_vertices().iter().enumerate() {
@@ -1171,7 +1172,7 @@ fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
     let mut value: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bird_base-flat.fold")).unwrap()).unwrap();
     value.as_object_mut().unwrap().remove("vertices_flatUnfoldCoords");
-    let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
+    let error = nanofold::read::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
     assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
 }
 
@@ -1243,7 +1244,7 @@ fn the_smallest_panel_clearance_matches_a_brute_force_search() {
         (
             "waterbomb 4x3",
             FoldingModel::new(
-                nanofold::io::load_crease_pattern(Path::new("patterns/many/waterbomb_4x3.fold")).unwrap(),
+                nanofold::read::load_crease_pattern(Path::new("patterns/many/waterbomb_4x3.fold")).unwrap(),
             )
             .unwrap(),
         ),
@@ -1320,7 +1321,7 @@ fn the_smallest_panel_clearance_matches_a_brute_force_search() {
 /// The grid of `common::grid_fold` as a folding model.
 fn grid_model(n: usize, jitter: f64) -> FoldingModel {
     let text = common::grid_fold(n, jitter, None).to_string();
-    FoldingModel::new(nanofold::io::parse_crease_pattern(&text, "grid", "grid").unwrap()).unwrap()
+    FoldingModel::new(nanofold::read::parse_crease_pattern(&text, "grid", "grid").unwrap()).unwrap()
 }
 
 /// The exact reductions before the rank count (ties merged, rows held by one crease
@@ -1343,7 +1344,7 @@ fn the_reduced_rank_count_is_the_svds_count() {
     }
     for name in ["square_twist", "waterbomb_4x3", "strips_crossing", "bird_base"] {
         let path = Path::new("patterns/many").join(format!("{name}.fold"));
-        let Ok(pattern) = nanofold::io::load_crease_pattern(&path) else {
+        let Ok(pattern) = nanofold::read::load_crease_pattern(&path) else {
             continue;
         };
         let model = FoldingModel::new(pattern).unwrap();

@@ -61,7 +61,7 @@ fn all_finite(values: &[f64]) -> bool {
 /// A pattern that loads must be usable (finite angles) and unfold, within a small budget,
 /// to a verdict with finite numbers, or fail with a message.
 fn run_pattern(text: &str) -> Outcome {
-    let Ok(pattern) = nanofold::io::parse_pattern(text, "fuzz", "fuzz", &LoadOptions::default()) else {
+    let Ok(pattern) = nanofold::read::parse_pattern(text, "fuzz", "fuzz", &LoadOptions::default()) else {
         return Outcome::Refused;
     };
     assert!(pattern.sector_angles.iter().all(|a| a.is_finite() && *a > 0.0));
@@ -90,7 +90,7 @@ fn run_pattern(text: &str) -> Outcome {
 /// small step budget, to finite samples and a contact inside the run, or fail with a message.
 fn run_scene(text: &str) -> Outcome {
     let built =
-        nanofold::io::parse_scene(text, "fuzz", "fuzz", std::path::Path::new("patterns")).and_then(|s| s.build());
+        nanofold::read::parse_scene(text, "fuzz", "fuzz", std::path::Path::new("patterns")).and_then(|s| s.build());
     let Ok(scene) = built else {
         return Outcome::Refused;
     };

@@ -21,7 +21,7 @@ fn vertex(sectors: &[f64], fold: f64) -> String {
 }
 
 fn load(text: &str) -> nanofold::Result<Pattern> {
-    nanofold::io::parse_pattern(text, "hard", "hard", &LoadOptions::default())
+    nanofold::read::parse_pattern(text, "hard", "hard", &LoadOptions::default())
 }
 
 #[test]
@@ -95,7 +95,7 @@ fn a_degree_twelve_fit_exported_in_degrees_on_0_to_180_stays_accurate() {
     // (measured: the same as the radian form to 3e-16 rad; fit error 6e-8 rad).
     use nanofold::constraints::chebyshev::eval_monomial;
     use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
-    let pattern = nanofold::io::load_pattern(
+    let pattern = nanofold::read::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
         &LoadOptions::default(),
     )
@@ -320,7 +320,7 @@ fn a_step_through_a_barrier_is_detected_even_where_the_energy_cannot_see_it() {
         if !(name.ends_with(".fold") || name.ends_with(".json")) || name.ends_with(".scene.json") {
             continue;
         }
-        let pattern = nanofold::io::load_pattern(&path, &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::load_pattern(&path, &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let report = unfold(&pattern, &settings).unwrap();
         for pair in report.trajectory.windows(2) {

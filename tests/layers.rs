@@ -1,5 +1,6 @@
 //! The library's layers depend one way (README, "How it works"): geometry → pattern →
-//! folding → unfold and constraints → dynamics → io → commands → plot, with `error` beneath them all and the
+//! read (the file readers) → folding → unfold and constraints → dynamics → write (the file
+//! writers) → commands → plot, with `error` beneath them all and the
 //! crate root and prelude above. This reads every library source file, collects the
 //! `crate::…` and `super::…` paths it uses (unit tests aside), and fails on an import of a
 //! higher layer, on unfold and constraints importing each other, and on any cycle between
@@ -14,12 +15,13 @@ fn rank(module: &str) -> Option<usize> {
         "error" => 0,
         "geometry" => 1,
         "pattern" => 2,
-        "folding" => 3,
-        "unfold" | "constraints" => 4,
-        "dynamics" => 5,
-        "io" => 6,
-        "commands" => 7,
-        "plot" => 8,
+        "read" => 3,
+        "folding" => 4,
+        "unfold" | "constraints" => 5,
+        "dynamics" => 6,
+        "write" => 7,
+        "commands" => 8,
+        "plot" => 9,
         _ => return None,
     })
 }

@@ -5,7 +5,7 @@ use nanofold::unfold::{unfold, UnfoldSettings, Verdict};
 use std::path::Path;
 
 fn run(name: &str) -> (Pattern, nanofold::unfold::UnfoldReport) {
-    let pattern = nanofold::io::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
+    let pattern = nanofold::read::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
     let report = unfold(&pattern, &UnfoldSettings::default()).unwrap();
     (pattern, report)
 }

@@ -95,7 +95,7 @@ fn the_exported_bridge_carries_the_scenes_masses_stiffnesses_and_torques() {
     let dir = temp_dir("bridge-units");
     let file = dir.join("bridge.xml");
     let mjcf = export(Path::new("patterns/bridge_step.scene.json"), 1e-8, &file);
-    let scene = nanofold::io::load_scene(Path::new("patterns/bridge_step.scene.json"))
+    let scene = nanofold::read::load_scene(Path::new("patterns/bridge_step.scene.json"))
         .unwrap()
         .build()
         .unwrap();
@@ -154,7 +154,7 @@ fn the_exported_network_carries_its_front_and_its_panels_mass() {
         "patterns/devices/miura_sheet.scene.json",
     ] {
         let mjcf = export(Path::new(scene_path), 1e-8, &dir.join("network.xml"));
-        let scene = nanofold::io::load_scene(Path::new(scene_path))
+        let scene = nanofold::read::load_scene(Path::new(scene_path))
             .unwrap()
             .build()
             .unwrap();
@@ -374,7 +374,7 @@ fn mujoco_ramps_the_exported_stress_torques_as_nanofold_drives_them() {
     let dir = temp_dir("ramp");
     let model = dir.join("bridge_ramp.xml");
     export(Path::new("patterns/bridge_ramp.scene.json"), 1e-8, &model);
-    let scene = nanofold::io::load_scene(Path::new("patterns/bridge_ramp.scene.json"))
+    let scene = nanofold::read::load_scene(Path::new("patterns/bridge_ramp.scene.json"))
         .unwrap()
         .build()
         .unwrap();

@@ -228,7 +228,7 @@ fn a_miura_sheet_keeps_its_energy_balance_and_its_closures() {
         .unwrap()
         .replace("miura_4x4.fold", "miura_4x4_folded.fold")
         .replace(r#""drag": true"#, r#""drag": false"#);
-    let still_air = nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices"))
+    let still_air = nanofold::read::parse_scene(&text, "test", "test", Path::new("patterns/devices"))
         .and_then(|s| s.build())
         .unwrap();
     let ringing = run(&still_air, 1e-10, 6e-5);
@@ -273,7 +273,7 @@ fn the_corner_cube_through_the_network_keeps_its_step_times() {
         let mut times = Vec::new();
         for source in ["exact", "network"] {
             value["constraint"] = serde_json::json!({"source": source, "range_deg": range});
-            let scene = nanofold::io::parse_scene(&value.to_string(), "test", "test", Path::new("patterns"))
+            let scene = nanofold::read::parse_scene(&value.to_string(), "test", "test", Path::new("patterns"))
                 .and_then(|s| s.build())
                 .unwrap();
             assert_eq!(scene.network().is_some(), source == "network");
@@ -357,7 +357,7 @@ fn network_error(edit: impl Fn(&mut serde_json::Value)) -> String {
         serde_json::from_str(&std::fs::read_to_string("patterns/devices/cube_closes.scene.json").unwrap()).unwrap();
     edit(&mut value);
     let text = value.to_string();
-    match nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build()) {
+    match nanofold::read::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build()) {
         Ok(_) => panic!("accepted a bad scene: {text}"),
         Err(e) => full_message(&e),
     }
@@ -438,11 +438,12 @@ fn bad_network_scenes_get_errors_that_name_the_field() {
 fn a_network_scene_must_start_rigid() {
     let text = std::fs::read_to_string("patterns/devices/miura_sheet.scene.json").unwrap();
     let text = text.replace("../many/miura_4x4.fold", "../many/miura_4x4_bent.fold");
-    let message =
-        match nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build()) {
-            Ok(_) => panic!("a bent start was accepted"),
-            Err(e) => full_message(&e),
-        };
+    let message = match nanofold::read::parse_scene(&text, "test", "test", Path::new("patterns/devices"))
+        .and_then(|s| s.build())
+    {
+        Ok(_) => panic!("a bent start was accepted"),
+        Err(e) => full_message(&e),
+    };
     assert!(
         message.contains("invalid `pattern`") && message.contains("not a rigid state"),
         "{message}"
@@ -458,7 +459,7 @@ fn network_fold_animations_hold_rigid_sheets() {
     let scene = scene_file("patterns/devices/cube_jams.scene.json");
     let model = network(&scene);
     let run = simulate(&scene, &SimulationSettings::default()).unwrap();
-    let motion = nanofold::io::folding_output::network_motion_fold(model, &run.response);
+    let motion = nanofold::write::folding_output::network_motion_fold(model, &run.response);
     let check_frames = |model: &NetworkModel, fold: &serde_json::Value| {
         let (flat, edges) = (&model.folding.pattern.vertices, &model.folding.pattern.edges);
         let frames = fold["file_frames"].as_array().unwrap();
@@ -478,7 +479,7 @@ fn network_fold_animations_hold_rigid_sheets() {
         frames.len()
     };
     let count = check_frames(model, &motion);
-    assert_eq!(count, nanofold::io::folding_output::MOTION_FRAMES);
+    assert_eq!(count, nanofold::write::folding_output::MOTION_FRAMES);
     let times: Vec<f64> = motion["file_frames"]
         .as_array()
         .unwrap()
@@ -503,7 +504,7 @@ fn network_fold_animations_hold_rigid_sheets() {
         );
     }
     let text = motion.to_string();
-    let reread = nanofold::io::parse_crease_pattern(&text, "motion", "motion.fold").unwrap();
+    let reread = nanofold::read::parse_crease_pattern(&text, "motion", "motion.fold").unwrap();
     assert!(
         reread.fold_angles.iter().all(|&a| a == 0.0),
         "the key frame is the flat start"
@@ -512,7 +513,7 @@ fn network_fold_animations_hold_rigid_sheets() {
     let miura = scene_file("patterns/devices/miura_sheet.scene.json");
     let model = network(&miura);
     let modes = folded_modes(model).unwrap();
-    let fold = nanofold::io::folding_output::network_modes_fold(model, &modes, 0.1).unwrap();
+    let fold = nanofold::write::folding_output::network_modes_fold(model, &modes, 0.1).unwrap();
     assert_eq!(check_frames(model, &fold), 1 + 2 * modes.modes.basis.ncols());
     let frames = fold["file_frames"].as_array().unwrap();
     let angles = |f: &serde_json::Value| -> Vec<f64> {
@@ -553,7 +554,7 @@ fn strip_scene(path: &str, equations: &str, edit: impl Fn(&mut serde_json::Value
     let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     value["equations"] = equations.into();
     edit(&mut value);
-    nanofold::io::parse_scene(&value.to_string(), "test", "test", Path::new("patterns"))?.build()
+    nanofold::read::parse_scene(&value.to_string(), "test", "test", Path::new("patterns"))?.build()
 }
 
 /// The strip is a chain of panels: the bridge run through the panel network (the substrate
@@ -657,7 +658,7 @@ fn miura_scene(file: &str, drag: bool, constraint: Option<&str>) -> nanofold::Re
     if let Some(constraint) = constraint {
         text = text.replacen(r#""time""#, &format!(r#""constraint": {constraint}, "time""#), 1);
     }
-    nanofold::io::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build())
+    nanofold::read::parse_scene(&text, "test", "test", Path::new("patterns/devices")).and_then(|s| s.build())
 }
 
 /// Largest |Δρ| between two runs at the output times both recorded.
@@ -805,7 +806,7 @@ fn layers_stacked_past_the_contact_budget_stop_the_run() {
     let text = std::fs::read_to_string("patterns/devices/miura_sheet.scene.json")
         .unwrap()
         .replace("../many/miura_4x4.fold", "accordion.fold");
-    let scene = nanofold::io::parse_scene(&text, "accordion", "accordion", &dir)
+    let scene = nanofold::read::parse_scene(&text, "accordion", "accordion", &dir)
         .and_then(|s| s.build())
         .unwrap();
     let simulation = run(&scene, 1e-8, 1e-6);
@@ -830,7 +831,8 @@ fn the_modes_oscillate_about_the_equilibrium() {
     let gap = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     // For each amplitude, each mode's (move at phase 3, leftover of phases 3 + 9).
     let measure = |amplitude: f64| -> Vec<(f64, f64)> {
-        let fold = nanofold::io::folding_output::network_modes_oscillation_fold(model, &modes, amplitude, 12).unwrap();
+        let fold =
+            nanofold::write::folding_output::network_modes_oscillation_fold(model, &modes, amplitude, 12).unwrap();
         let frames = fold["file_frames"].as_array().unwrap();
         assert_eq!(frames.len(), 1 + 12 * count);
         let coords = |k: usize| -> Vec<f64> {

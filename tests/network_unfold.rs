@@ -59,10 +59,10 @@ fn single_vertices_get_the_single_vertex_engines_energy_and_verdict() {
         if path.extension().and_then(|e| e.to_str()) != Some("fold") {
             continue;
         }
-        let Ok(vertex) = nanofold::io::load_pattern(&path, &LoadOptions::default()) else {
+        let Ok(vertex) = nanofold::read::load_pattern(&path, &LoadOptions::default()) else {
             continue;
         };
-        let model = FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap();
+        let model = FoldingModel::new(nanofold::read::load_crease_pattern(&path).unwrap()).unwrap();
         if model.stars.len() != 1 {
             continue;
         }
@@ -214,7 +214,7 @@ fn hard_starts_get_their_verdicts() {
     assert!(report.max_closure_residual <= 1e-10);
     // No degree of freedom: the library's locked single vertex.
     let path = Path::new("patterns/degree4_locked.fold");
-    let model = FoldingModel::new(nanofold::io::load_crease_pattern(path).unwrap()).unwrap();
+    let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let report = unfold_network(&model, &model.given_fold_angles(), &NetworkUnfoldSettings::default()).unwrap();
     assert_eq!(report.verdict, NetworkVerdict::Locked, "{}", report.evidence);
 }
@@ -596,7 +596,7 @@ fn new_inputs_are_refused_by_name() {
         serde_json::from_str(&std::fs::read_to_string("tests/fixtures/fold-convert/bird_base-flat.fold").unwrap())
             .unwrap();
     value["vertices_flatUnfoldCoords"].as_array_mut().unwrap().pop();
-    let error = nanofold::io::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
+    let error = nanofold::read::parse_crease_pattern(&value.to_string(), "x", "test").unwrap_err();
     assert!(error.to_string().contains("vertices_flatUnfoldCoords"), "{error}");
 }
 

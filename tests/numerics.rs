@@ -141,7 +141,7 @@ proptest! {
         let vertex = random_vertex(n, &weights, &drive);
         prop_assume!(vertex.is_some(), "the continuation lost its branch");
         let (sectors, rho) = vertex.unwrap();
-        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let nodes = model.folded_nodes();
         let kind = if separable { EnergyKind::Separable } else { EnergyKind::NonSeparable };
@@ -173,7 +173,7 @@ proptest! {
         let vertex = random_vertex(n, &weights, &drive);
         prop_assume!(vertex.is_some(), "the continuation lost its branch");
         let (sectors, rho) = vertex.unwrap();
-        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let mut solver = ProjectedGradient::new(&model, &UnfoldSettings::default(), model.folded_nodes()).unwrap();
         let bending = solver.direction_problem().unwrap();
@@ -226,7 +226,7 @@ proptest! {
         let sectors: Vec<f64> = weights[..n].iter().map(|w| w / total * TAU).collect();
         let scale = [0.1, 1e-3, 1e-6, 0.0][scale_index];
         let rho: Vec<f64> = rho_seed[..n].iter().map(|r| r * scale).collect();
-        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &vec![0.0; n]), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::parse_pattern(&native_json(&sectors, &vec![0.0; n]), "r", "r", &LoadOptions::default()).unwrap();
         let model = UnfoldModel::new(&pattern);
         let nodes = nanofold::geometry::kinematics::forward(&model.sector_angles, &rho);
         // Restoration can fail from a random fold (the loop gap is ~ρ²/ρ away along a
@@ -268,7 +268,7 @@ proptest! {
         prop_assume!(vertex.is_some(), "the continuation lost its branch");
         let (sectors, rho) = vertex.unwrap();
         prop_assert!(closure_residual(&sectors, &rho) < 1e-12);
-        let pattern = nanofold::io::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
+        let pattern = nanofold::read::parse_pattern(&native_json(&sectors, &rho), "r", "r", &LoadOptions::default()).unwrap();
         let settings = UnfoldSettings { max_iterations: 5000, ..Default::default() };
         let report = unfold(&pattern, &settings).unwrap();
         for step in &report.trajectory {

@@ -22,7 +22,7 @@ fn scratch(label: &str) -> PathBuf {
 }
 
 fn parse(text: &str) -> nanofold::Result<VertexPattern> {
-    nanofold::io::parse_pattern(text, "test", "test.json", &LoadOptions::default())
+    nanofold::read::parse_pattern(text, "test", "test.json", &LoadOptions::default())
 }
 
 fn error_of(text: &str) -> String {
@@ -103,14 +103,14 @@ fn a_key_given_twice_in_a_pattern_is_refused() {
 #[test]
 fn devices_and_oversized_files_are_not_read() {
     // Was: `check /dev/zero` read until memory ran out.
-    let e = nanofold::io::load_pattern(Path::new("/dev/zero"), &LoadOptions::default()).unwrap_err();
+    let e = nanofold::read::load_pattern(Path::new("/dev/zero"), &LoadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("not a regular file"), "{e}");
     let dir = scratch("size");
     let big = dir.join("big.fold");
     let file = std::fs::File::create(&big).unwrap();
     // Sparse: no disk is used.
-    file.set_len(nanofold::io::input::MAX_PATTERN_BYTES + 1).unwrap();
-    let e = nanofold::io::load_pattern(&big, &LoadOptions::default()).unwrap_err();
+    file.set_len(nanofold::read::input::MAX_PATTERN_BYTES + 1).unwrap();
+    let e = nanofold::read::load_pattern(&big, &LoadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("byte limit"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -377,7 +377,7 @@ fn corner_cube_with_faces(
         .unwrap()
         .replace("corner_cube_plates.fold", "plates.fold");
     std::fs::write(dir.join("step.scene.json"), scene).unwrap();
-    nanofold::io::load_scene(&dir.join("step.scene.json"))?.build()
+    nanofold::read::load_scene(&dir.join("step.scene.json"))?.build()
 }
 
 #[test]
@@ -480,7 +480,8 @@ fn a_narrow_sweep_far_from_the_fold_finishes() {
 fn a_dense_sweep_through_the_flat_state_is_not_refused() {
     // Was: "no solution beyond 0.2°" at 5001 samples and more.
     use nanofold::constraints::{sweep_samples, Setup};
-    let pattern = nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
+    let pattern =
+        nanofold::read::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).unwrap();
     let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).unwrap();
     for samples in [5001, 20001] {
         let curve = sweep_samples(&pattern, &setup, [0.0, std::f64::consts::PI], samples).unwrap();

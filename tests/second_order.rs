@@ -8,7 +8,7 @@
 use nanofold::folding::second_order::{cone_range, quadratic_form, second_order, SecondOrder};
 use nanofold::folding::{check_pattern, CheckSettings, FoldingModel, PatternVerdict, Star};
 use nanofold::geometry::kinematics::solve_closure;
-use nanofold::io::parse_crease_pattern;
+use nanofold::read::parse_crease_pattern;
 use serde_json::json;
 use std::f64::consts::TAU;
 

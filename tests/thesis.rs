@@ -7,8 +7,8 @@
 mod tables;
 
 use nanofold::constraints::{check_curve, sweep_samples, ConstraintPoly, ConstraintReport, Setup};
-use nanofold::io::load_pattern;
 use nanofold::pattern::LoadOptions;
+use nanofold::read::load_pattern;
 use std::f64::consts::PI;
 use std::path::Path;
 use tables::*;

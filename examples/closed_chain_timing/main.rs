@@ -16,7 +16,7 @@ use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate, ModelChoice, Simulation, SimulationSettings};
-use nanofold::io::output::write_atomic;
+use nanofold::write::output::write_atomic;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -26,7 +26,7 @@ fn scene(name: &str, constraint: serde_json::Value) -> Scene {
     let path = format!("patterns/{name}.scene.json");
     let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     value["constraint"] = constraint;
-    nanofold::io::parse_scene(&value.to_string(), &path, name, Path::new("patterns"))
+    nanofold::read::parse_scene(&value.to_string(), &path, name, Path::new("patterns"))
         .and_then(|spec| spec.build())
         .unwrap()
 }
@@ -110,7 +110,7 @@ fn main() {
         }));
     }
     // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
-    let ramp = nanofold::io::load_scene(Path::new("patterns/corner_cube_step1_ramp.scene.json"))
+    let ramp = nanofold::read::load_scene(Path::new("patterns/corner_cube_step1_ramp.scene.json"))
         .and_then(|spec| spec.build())
         .unwrap();
     let auto = SimulationSettings {

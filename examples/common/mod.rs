@@ -4,8 +4,8 @@
 #![allow(dead_code)]
 
 use nanofold::geometry::kinematics::solve_closure;
-use nanofold::io::is_pattern_file;
 use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::read::is_pattern_file;
 use nanofold::unfold::SplitMix64;
 use serde_json::json;
 
@@ -82,7 +82,7 @@ pub fn many_creases(n: usize) -> Pattern {
         r#"{{"chain":"closed","angle_unit":"rad","sector_angles":{sectors:?},"creases":[{}]}}"#,
         creases.join(",")
     );
-    nanofold::io::parse_pattern(&json, &format!("random{n}"), "generated", &LoadOptions::default())
+    nanofold::read::parse_pattern(&json, &format!("random{n}"), "generated", &LoadOptions::default())
         .expect("a valid vertex")
 }
 
@@ -96,6 +96,6 @@ pub fn library_patterns() -> Vec<Pattern> {
     paths.sort();
     paths
         .iter()
-        .map(|p| nanofold::io::load_pattern(p, &LoadOptions::default()).expect("library pattern"))
+        .map(|p| nanofold::read::load_pattern(p, &LoadOptions::default()).expect("library pattern"))
         .collect()
 }

@@ -8,8 +8,8 @@ use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Set
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::{Scene, System};
 use nanofold::dynamics::simulate::{simulate, SimulationSettings};
-use nanofold::io::{load_pattern, parse_scene};
 use nanofold::pattern::LoadOptions;
+use nanofold::read::{load_pattern, parse_scene};
 use serde_json::Value;
 use std::f64::consts::PI;
 use std::fmt::Write;

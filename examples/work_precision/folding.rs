@@ -23,7 +23,7 @@ fn miura(n: usize) -> FoldingModel {
 
 fn library(name: &str) -> FoldingModel {
     let path = Path::new("patterns/many").join(format!("{name}.fold"));
-    FoldingModel::new(nanofold::io::load_crease_pattern(&path).unwrap()).unwrap()
+    FoldingModel::new(nanofold::read::load_crease_pattern(&path).unwrap()).unwrap()
 }
 
 /// Worst closure (rad) and worst relative edge-length error over the frames.

@@ -29,12 +29,12 @@ use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate, ModelChoice, SimulationSettings};
 use nanofold::dynamics::strip::StripPlant;
 use nanofold::geometry::sphere::Vec3;
-use nanofold::io::output::write_atomic;
 use nanofold::pattern::LoadOptions;
 use nanofold::plot::work_precision::{largest_sizes, power_law_fit};
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::{self, QpMethod};
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
+use nanofold::write::output::write_atomic;
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -176,7 +176,7 @@ fn unfold_part() -> Value {
 /// Degree against error and evaluation time of f and G for the corner cube's step-1 curves.
 fn fits_part() -> Value {
     let pattern =
-        nanofold::io::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
+        nanofold::read::load_pattern(Path::new("patterns/corner_cube.fold"), &LoadOptions::default()).expect("pattern");
     let setup = Setup::new(&pattern, 0, &[(1, 0.0)]).expect("setup");
     let (sweep_seconds, samples) = timed(RUNS, || sweep_samples(&pattern, &setup, [0.0, PI], 201).expect("sweep"));
     println!(
@@ -543,7 +543,7 @@ fn measure_into(path: &str, key: &str, mut part: Value) -> Value {
 
 /// A bundled scene, loaded and built.
 fn load_scene(path: &Path) -> Scene {
-    nanofold::io::load_scene(path)
+    nanofold::read::load_scene(path)
         .and_then(|spec| spec.build())
         .expect("scene")
 }

@@ -15,11 +15,11 @@ use nanofold::dynamics::plant::Plant;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate, Simulation, SimulationSettings};
 use nanofold::folding::FoldingModel;
-use nanofold::io::folding_output::crease_pattern_fold;
-use nanofold::io::load_scene;
-use nanofold::io::mujoco::{scene_mjcf, LoopClosure, MujocoSettings};
-use nanofold::io::output::write_atomic;
 use nanofold::pattern::generate::MiuraSpec;
+use nanofold::read::load_scene;
+use nanofold::write::folding_output::crease_pattern_fold;
+use nanofold::write::mujoco::{scene_mjcf, LoopClosure, MujocoSettings};
+use nanofold::write::output::write_atomic;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -151,7 +151,7 @@ pub fn networks_part(sizes: &[usize], python: Option<&Path>) -> Value {
     );
     println!(
         "ms: the whole run with the scene's {} output samples; 'integrate': with 2 samples, less the set-up; 'samples': the rest",
-        nanofold::dynamics::spec::OutputSpec::default().samples
+        nanofold::read::scene_spec::OutputSpec::default().samples
     );
     println!(
         "{:>3} {:>6} {:>7} {:>7} {:>9} {:>9} {:>9} {:>9} {:>6} {:>6} {:>9} {:>9} {:>9} {:>9}",
@@ -285,7 +285,7 @@ fn strip(plates: usize, equations: &str) -> Scene {
         value["hinges"] = Value::Array(vec![hinge; plates]);
     }
     value["equations"] = equations.into();
-    nanofold::io::parse_scene(&value.to_string(), "strip", "strip", Path::new("patterns"))
+    nanofold::read::parse_scene(&value.to_string(), "strip", "strip", Path::new("patterns"))
         .and_then(|spec| spec.build())
         .expect("the strip builds")
 }

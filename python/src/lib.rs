@@ -216,7 +216,7 @@ fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(
 /// `frames` frames and its end state as FOLD.
 #[pyfunction]
 fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    use nanofold::io::folding_output::{crease_pattern_fold, fold_path_fold};
+    use nanofold::write::folding_output::{crease_pattern_fold, fold_path_fold};
     let mut settings =
         settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Fold).map_err(to_py)?;
     let pattern = pattern.pattern.clone();
@@ -381,7 +381,7 @@ impl SceneHandle {
 #[pyfunction]
 fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base: String) -> PyResult<SceneHandle> {
     let scene = run_detached(py, move || {
-        nanofold::io::scene::parse_scene(&text, &source, &name, Path::new(&base))?.build()
+        nanofold::read::scene::parse_scene(&text, &source, &name, Path::new(&base))?.build()
     })?;
     Ok(SceneHandle {
         scene: Arc::new(Mutex::new(scene)),

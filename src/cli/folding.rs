@@ -5,10 +5,10 @@ use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::folding::{fold_path_and_frames, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
-use nanofold::io::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
-use nanofold::io::output::{number, write_atomic};
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
+use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
+use nanofold::write::output::{number, write_atomic};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -250,7 +250,7 @@ fn load_projected(path: &Path, project: bool) -> Result<(FoldingModel, Option<(S
 }
 
 fn load_model(path: &Path) -> Result<FoldingModel> {
-    let pattern = nanofold::io::load_crease_pattern(path).map_err(|e| reading(path, e))?;
+    let pattern = nanofold::read::load_crease_pattern(path).map_err(|e| reading(path, e))?;
     Ok(FoldingModel::new(pattern)?)
 }
 
@@ -286,7 +286,7 @@ fn parse_edge_angle(text: &str, flag: &str) -> Result<(usize, f64)> {
 }
 
 fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, seconds: f64) -> Value {
-    nanofold::io::folding_output::fold_summary(model, &file.display().to_string(), path, dof, seconds)
+    nanofold::write::folding_output::fold_summary(model, &file.display().to_string(), path, dof, seconds)
 }
 
 /// `nanofold fold PATTERN`.
@@ -439,7 +439,7 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
         seconds * 1e3,
         report.evidence
     );
-    let mut value = nanofold::io::folding_output::check_summary(
+    let mut value = nanofold::write::folding_output::check_summary(
         &model,
         &path.display().to_string(),
         &report,
@@ -566,12 +566,12 @@ pub fn unfold_network_one(
     dir: Option<&Path>,
     progress: Option<nanofold::unfold::UnfoldProgress>,
 ) -> Result<(Value, String)> {
-    use nanofold::io::folding_output::states_fold;
     use nanofold::plot::folding::angles_svg;
     use nanofold::unfold::network::{unfold_network_observed, NetworkUnfoldSettings};
+    use nanofold::write::folding_output::states_fold;
     use std::fmt::Write as _;
     let (model, projection) = load_projected(pattern_path, solver.project)?;
-    let frames_note = nanofold::io::file_frames_note(pattern_path);
+    let frames_note = nanofold::read::file_frames_note(pattern_path);
     let settings = NetworkUnfoldSettings {
         energy: solver.energy.into(),
         p: solver.p,
@@ -642,7 +642,7 @@ pub fn unfold_network_one(
         .chain(frames_note.clone())
         .chain(model.pattern.reading.iter().cloned())
         .collect();
-    let mut summary = nanofold::io::folding_output::network_unfold_summary(
+    let mut summary = nanofold::write::folding_output::network_unfold_summary(
         &model,
         &pattern_path.display().to_string(),
         &report,
@@ -707,9 +707,9 @@ pub struct ViewArgs {
 /// `nanofold view FILE.fold`: a page of the file's frames as written, or, for a crease
 /// pattern (2D, no 3D frame), of its state placed by the spanning tree.
 pub fn run_view(args: &ViewArgs) -> Result<()> {
-    let text = nanofold::io::input::read_text(&args.file, MAX_VIEW_BYTES).map_err(|e| reading(&args.file, e))?;
+    let text = nanofold::read::input::read_text(&args.file, MAX_VIEW_BYTES).map_err(|e| reading(&args.file, e))?;
     let value: Value = serde_json::from_str(&text).with_context(|| format!("{}: not JSON", args.file.display()))?;
-    let name = nanofold::io::pattern_name(&args.file);
+    let name = nanofold::read::pattern_name(&args.file);
     let three_d = |frame: &Value| {
         frame["vertices_coords"].as_array().is_some_and(|v| {
             v.iter()

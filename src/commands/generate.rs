@@ -3,8 +3,8 @@
 
 use crate::error::Result;
 use crate::folding::FoldingModel;
-use crate::io::folding_output::crease_pattern_fold;
 use crate::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
+use crate::write::folding_output::crease_pattern_fold;
 
 /// A pattern family with its parameters (each spec validates its own fields).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,8 +5,8 @@
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{simulate as simulate_scene, Simulation, SimulationSettings};
 use crate::error::Result;
-use crate::io::folding_output::{network_modes_fold, network_motion_fold};
-use crate::io::output::{closed_modes_json, modes_json, network_modes_json, response_json, response_summary};
+use crate::write::folding_output::{network_modes_fold, network_motion_fold};
+use crate::write::output::{closed_modes_json, modes_json, network_modes_json, response_json, response_summary};
 use serde_json::Value;
 
 /// Each mode's frames in modes.fold move its largest crease this far either way, rad.

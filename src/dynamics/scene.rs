@@ -1,33 +1,24 @@
 //! Scenes (`docs/model.md#scenes`): a validated [`Scene`] — a strip or a closed chain, its
 //! time span and outputs — assembled in SI units from a description ([`SceneSpec`], the
-//! types of [`super::spec`]) by its `build`.
+//! types of [`crate::read::scene_spec`]) by its `build`.
 
 use super::closed::{assemble, ClosedChain};
 use super::forcing::{Actuation, Forcing, HingeDrive};
 use super::model::{Joint, Model, Plate};
 use super::network::NetworkModel;
-use super::spec::{
-    actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, time_and_outputs, validate_materials,
-    within, ClosedSpec, NetworkSpec, StripEquations, StripSpec, MICROMETRE, NETWORK_FROM_PLATES,
-};
 use super::strip::StripChain;
+use crate::dynamics::spec::{actuation, drag_law, hinge_stiffness, time_and_outputs};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::CreasePattern;
 use crate::pattern::Pattern;
+use crate::read::scene_spec::{
+    count_within, finite, limits, material, validate_materials, within, ClosedSpec, NetworkSpec, StripEquations,
+    StripSpec, MICROMETRE, NETWORK_FROM_PLATES,
+};
 use nalgebra::{Point3, Vector3};
 
-pub use super::spec::OutputSpec;
-
-/// A scene description: a strip or a closed chain.
-#[derive(Debug, Clone)]
-pub enum SceneSpec {
-    /// Plates in a row on parallel hinges.
-    Strip(StripSpec),
-    /// The sectors of a closed single vertex.
-    Closed(Box<ClosedSpec<Pattern>>),
-    /// The panels of any crease pattern.
-    Network(Box<NetworkSpec<CreasePattern>>),
-}
+pub use crate::read::scene_spec::OutputSpec;
+use crate::read::scene_spec::SceneSpec;
 
 impl SceneSpec {
     /// Validates and assembles the scene. A closed chain is assembled by
@@ -37,15 +28,6 @@ impl SceneSpec {
             SceneSpec::Strip(spec) => spec.build(),
             SceneSpec::Closed(spec) => spec.build(),
             SceneSpec::Network(spec) => spec.build(),
-        }
-    }
-
-    /// The scene's name, if it has one.
-    pub fn name(&self) -> Option<&str> {
-        match self {
-            SceneSpec::Strip(spec) => spec.name.as_deref(),
-            SceneSpec::Closed(spec) => spec.name.as_deref(),
-            SceneSpec::Network(spec) => spec.name.as_deref(),
         }
     }
 }
@@ -293,7 +275,7 @@ impl ClosedSpec<Pattern> {
         // The cheap checks first: the chain's assembly runs a sweep.
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
         let chain = assemble::closed_chain(self)?;
-        let system = if self.constraint.source == super::spec::SourceKind::Network {
+        let system = if self.constraint.source == crate::read::scene_spec::SourceKind::Network {
             System::Network(Box::new(super::network::assemble::from_closed(self, &chain)?))
         } else {
             System::Closed(Box::new(chain))

@@ -153,6 +153,20 @@ impl CreasePattern {
         [p[0] + self.origin[0], p[1] + self.origin[1], p[2]]
     }
 
+    /// The loop-closure residual of every interior vertex at the state the pattern carries,
+    /// rad (`stars` order): what a reader needs to tell a state from targets.
+    pub fn given_closure_residuals(&self) -> Vec<f64> {
+        let mut by_ray = Vec::new();
+        self.stars
+            .iter()
+            .map(|star| {
+                by_ray.clear();
+                by_ray.extend(star.creases.iter().map(|&e| self.fold_angles[e]));
+                crate::geometry::kinematics::closure_residual(&star.sector_angles, &by_ray)
+            })
+            .collect()
+    }
+
     /// The flat positions in the file's coordinates.
     pub fn file_vertices(&self) -> Vec<[f64; 2]> {
         self.vertices.iter().map(|&p| self.file_point(p)).collect()

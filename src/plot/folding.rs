@@ -5,9 +5,9 @@ use super::canvas::{canvas, px, shown_at};
 use super::{axis_range, draw_side_legend, plot_error, LineKind, LEGEND_MARGIN};
 use crate::error::Result;
 use crate::folding::{panel_poses, FoldPath, FoldingModel};
-use crate::io::folding_output::evenly;
 use crate::pattern::crease_pattern::EdgeKind;
 use crate::pattern::Assignment;
+use crate::write::folding_output::evenly;
 use plotters::prelude::*;
 
 /// Renders `fold.svg` to a string.

@@ -27,7 +27,7 @@ pub fn response_page(scene: &Scene, response: &Response) -> Result<String> {
     let collision = response.collision.as_ref();
     match &scene.system {
         System::Network(model) => {
-            let motion = crate::io::folding_output::network_motion_fold(model, response);
+            let motion = crate::write::folding_output::network_motion_fold(model, response);
             network_response_page(&scene.name, model, &motion, collision)
         }
         System::Strip(chain) => {

@@ -18,14 +18,14 @@ pub fn native_json(sectors: &[f64], rho: &[f64]) -> String {
 
 /// A bundled scene file, loaded and built.
 pub fn scene_file(path: &str) -> Scene {
-    nanofold::io::load_scene(Path::new(path))
+    nanofold::read::load_scene(Path::new(path))
         .and_then(|spec| spec.build())
         .unwrap()
 }
 
 /// Scene text (a closed chain's pattern relative to `patterns/`), parsed and built.
 pub fn scene_text(text: &str) -> nanofold::Result<Scene> {
-    nanofold::io::parse_scene(text, "test", "test", Path::new("patterns"))?.build()
+    nanofold::read::parse_scene(text, "test", "test", Path::new("patterns"))?.build()
 }
 
 /// An error and its sources, joined as the CLI prints them.

@@ -7,12 +7,13 @@ use crate::constraints::exact::ExactConstraint;
 use crate::constraints::{sweep_samples, ConstraintPoly, Setup};
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::model::{Joint, Model, Plate};
-use crate::dynamics::spec::{
-    actuation, count_within, drag_law, finite, hinge_stiffness, limits, material, validate_materials, within,
-    ClosedSpec, CreaseHingeSpec, HingeSpec, SourceKind, MICROMETRE,
-};
+use crate::dynamics::spec::{actuation, drag_law, hinge_stiffness};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
+use crate::read::scene_spec::{
+    count_within, finite, limits, material, validate_materials, within, ClosedSpec, CreaseHingeSpec, HingeSpec,
+    SourceKind, MICROMETRE,
+};
 use nalgebra::{Point3, Unit, Vector3};
 use std::f64::consts::TAU;
 

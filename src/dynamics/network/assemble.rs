@@ -9,15 +9,16 @@ use super::model::{NetworkModel, NetworkParts, PanelBody};
 use super::reduced::reduce;
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
-use crate::dynamics::spec::{
-    count_within, drag_law, finite, hinge_stiffness_named, limits, material, network_actuation, validate_materials,
-    within, ClosedSpec, HingeSpec, NetworkSource, NetworkSpec, MICROMETRE,
-};
+use crate::dynamics::spec::{drag_law, hinge_stiffness_named, network_actuation};
 use crate::dynamics::strip::StripChain;
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
 use crate::pattern::{Assignment, Pattern};
+use crate::read::scene_spec::{
+    count_within, finite, limits, material, validate_materials, within, ClosedSpec, HingeSpec, NetworkSource,
+    NetworkSpec, MICROMETRE,
+};
 
 /// A start whose closure residual exceeds this is not a rigid state, rad.
 pub const START_TOLERANCE: f64 = 1e-6;

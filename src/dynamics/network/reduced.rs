@@ -19,8 +19,8 @@ use crate::constraints::{MAX_DEGREE, MAX_SAMPLES};
 use crate::dynamics::contact::{Collision, ContactProbe};
 use crate::dynamics::forcing::{Actuation, Forcing};
 use crate::dynamics::plant::{InitialState, Plant, Sample, TimeScales};
-use crate::dynamics::spec::NetworkConstraintSpec;
 use crate::error::{NanofoldError, NumericalError, Result};
+use crate::read::scene_spec::NetworkConstraintSpec;
 use std::f64::consts::{PI, TAU};
 
 /// The default domain reaches past the start and the overshoot by this fraction of its width.

@@ -9,9 +9,9 @@ use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::simulate::Response;
 use crate::error::Result;
 use crate::folding::{panel_poses, vertex_positions, CheckReport, FoldPath, FoldingModel, PathFrame};
-use crate::io::output::number;
 use crate::pattern::crease_pattern::{CreasePattern, EdgeKind};
 use crate::pattern::Assignment;
+use crate::write::output::number;
 use serde_json::{json, Value};
 
 /// FOLD's letter for an edge, the assignment following the angle's sign (M < 0 < V) when
@@ -70,7 +70,7 @@ pub fn crease_pattern_fold(pattern: &CreasePattern, fold_angles: Option<&[f64]>,
         root["edges_foldAngle"] = json!(angles);
     }
     if pattern.locked.iter().any(|&l| l) {
-        root[crate::io::fold::LOCKED_KEY] = json!(pattern.locked);
+        root[crate::read::fold::LOCKED_KEY] = json!(pattern.locked);
     }
     root
 }

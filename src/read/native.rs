@@ -38,7 +38,7 @@ pub(crate) fn read_native(value: &Value, name: &str) -> Result<VertexBuilder> {
             ));
         }
     }
-    let vertex: NativeVertex = crate::io::input::from_value(value)?;
+    let vertex: NativeVertex = crate::read::input::from_value(value)?;
     let to_rad = match vertex.angle_unit.as_str() {
         "deg" | "degrees" => std::f64::consts::PI / 180.0,
         "rad" | "radians" => 1.0,

@@ -252,7 +252,7 @@ pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldRep
             .iter()
             .map(|c| c.is_some_and(|i| pattern.creases[i].locked))
             .collect();
-        root[crate::io::fold::LOCKED_KEY] = json!(locked);
+        root[crate::read::fold::LOCKED_KEY] = json!(locked);
     }
     if let Some(faces) = mesh.faces_vertices {
         root["faces_vertices"] = json!(faces);

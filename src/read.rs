@@ -1,16 +1,13 @@
-//! The io layer: files other tools write and read (FOLD), nanofold's own inputs (native
-//! vertices, scene files) and every output file (JSON reports, FOLD animations, MuJoCo),
-//! written atomically. Loaders parse and validate; they run no numerics.
+//! The readers: files other tools write (FOLD) and nanofold's own inputs (native vertices,
+//! scene files), parsed and validated into patterns and scene descriptions. They sit just
+//! above `pattern`; loaders parse and validate and run no engine.
 
 pub mod fold;
 pub mod folded_form;
-pub mod folder;
-pub mod folding_output;
 pub mod input;
-pub mod mujoco;
 pub mod native;
-pub mod output;
 pub mod scene;
+pub mod scene_spec;
 
 pub use scene::{load_scene, parse_scene};
 
@@ -110,10 +107,7 @@ fn developed_vertex(value: &serde_json::Value, name: &str, closure_tol: f64) -> 
     if pattern.stars.len() != 1 || pattern.folded_form.is_none() {
         return None;
     }
-    let model = crate::folding::FoldingModel::new(pattern.clone()).ok()?;
-    let residual = crate::folding::vertex_residuals(&model, &model.given_fold_angles())
-        .into_iter()
-        .fold(0.0, f64::max);
+    let residual = pattern.given_closure_residuals().into_iter().fold(0.0, f64::max);
     if residual > closure_tol {
         return None;
     }
@@ -192,7 +186,7 @@ pub fn file_frames_note(path: &Path) -> Option<String> {
 /// (`docs/model.md#crease-patterns`).
 ///
 /// ```
-/// use nanofold::io::load_crease_pattern;
+/// use nanofold::read::load_crease_pattern;
 /// let cp = load_crease_pattern("patterns/waterbomb.fold".as_ref())?;
 /// assert_eq!((cp.stars.len(), cp.creases.len()), (1, 8));
 /// # Ok::<(), nanofold::NanofoldError>(())
@@ -248,14 +242,13 @@ fn angles_as_targets(pattern: &mut CreasePattern) -> Result<()> {
     let why = if full {
         "every crease at ±180° (the targets' convention of Origami Simulator and other solvers)".to_string()
     } else {
-        let model = crate::folding::FoldingModel::new(pattern.clone())?;
-        let residuals = crate::folding::vertex_residuals(&model, &model.given_fold_angles());
+        let residuals = pattern.given_closure_residuals();
         // A vertex of two creases (one crease line through it) closes whenever they are equal:
         // it says nothing of a state.
         let closing = residuals
             .iter()
-            .zip(&model.stars)
-            .filter(|(_, star)| star.columns.len() >= 3)
+            .zip(&pattern.stars)
+            .filter(|(_, star)| star.creases.len() >= 3)
             .map(|(r, _)| *r)
             .fold(f64::INFINITY, f64::min);
         if !closing.is_finite() || closing <= STATE_CLOSURE {

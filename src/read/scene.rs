@@ -3,10 +3,10 @@
 //! its file when it has no `name`, and loads the pattern; building the scene
 //! ([`SceneSpec::build`]) validates it and runs the closed chain's sweep and fit.
 
-use crate::dynamics::scene::SceneSpec;
-use crate::dynamics::spec::{ClosedSpec, NetworkSpec, StripSpec};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::LoadOptions;
+use crate::read::scene_spec::SceneSpec;
+use crate::read::scene_spec::{ClosedSpec, NetworkSpec, StripSpec};
 use std::path::Path;
 
 /// A scene's name from its file name: `bridge_step.scene.json` → `bridge_step`.
@@ -30,7 +30,7 @@ pub fn scene_name(path: &Path) -> String {
 /// # Ok::<(), NanofoldError>(())
 /// ```
 pub fn load_scene(path: &Path) -> Result<SceneSpec> {
-    let text = crate::io::input::read_text(path, crate::io::input::MAX_SCENE_BYTES)?;
+    let text = crate::read::input::read_text(path, crate::read::input::MAX_SCENE_BYTES)?;
     let base = path.parent().unwrap_or(Path::new("."));
     parse_scene(&text, &path.display().to_string(), &scene_name(path), base)
 }
@@ -38,8 +38,8 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec> {
 /// Parses scene text; `source` names it in errors, `fallback_name` names the scene when it
 /// has no `name`, `base` is the folder a closed chain's pattern path is relative to.
 pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -> Result<SceneSpec> {
-    let value = crate::io::input::parse_json(text, source)?;
-    if crate::io::is_fold_object(&value) || value.get("sector_angles").is_some() {
+    let value = crate::read::input::parse_json(text, source)?;
+    if crate::read::is_fold_object(&value) || value.get("sector_angles").is_some() {
         return Err(NanofoldError::invalid(
             source,
             "a pattern file",
@@ -49,10 +49,10 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
     let closed = value.get("pattern").is_some() && value.get("cut_crease").is_some();
     let network = value.get("pattern").is_some() && !closed;
     let mut spec = if network {
-        let file: NetworkSpec<String> = crate::io::input::from_value(&value)?;
+        let file: NetworkSpec<String> = crate::read::input::from_value(&value)?;
         let loaded = file.with_pattern(|path| {
             let resolved = base.join(&path);
-            crate::io::load_crease_pattern(&resolved).map_err(|e| {
+            crate::read::load_crease_pattern(&resolved).map_err(|e| {
                 NanofoldError::invalid(
                     "pattern",
                     format!("\"{path}\" ({})", resolved.display()),
@@ -62,10 +62,10 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         })?;
         SceneSpec::Network(Box::new(loaded))
     } else if closed {
-        let file: ClosedSpec<String> = crate::io::input::from_value(&value)?;
+        let file: ClosedSpec<String> = crate::read::input::from_value(&value)?;
         let loaded = file.with_pattern(|path| {
             let resolved = base.join(&path);
-            crate::io::load_pattern(&resolved, &LoadOptions::default()).map_err(|e| {
+            crate::read::load_pattern(&resolved, &LoadOptions::default()).map_err(|e| {
                 NanofoldError::invalid(
                     "pattern",
                     format!("\"{path}\" ({})", resolved.display()),
@@ -75,7 +75,7 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         })?;
         SceneSpec::Closed(Box::new(loaded))
     } else {
-        let file: StripSpec = crate::io::input::from_value(&value)?;
+        let file: StripSpec = crate::read::input::from_value(&value)?;
         SceneSpec::Strip(file)
     };
     match &mut spec {

@@ -3,9 +3,9 @@
 //! state. Locked creases use the custom key `edges_nanofold:locked` (FOLD's namespace rule).
 
 use crate::error::{NanofoldError, Result};
-use crate::io::input::short_json;
 use crate::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind, FoldedFormFit, ReadBuilder};
 use crate::pattern::{Assignment, Chain, CreaseSpec, FlatMesh, RaySpec, VertexBuilder, MIN_SECTOR_RAD};
+use crate::read::input::short_json;
 use serde_json::Value;
 use std::f64::consts::TAU;
 
@@ -794,7 +794,7 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
             "a 3D folded form is developed into its crease pattern face by face",
         ));
     };
-    let development = crate::io::folded_form::develop(&graph.coords3, &graph.edges, &faces)?;
+    let development = crate::read::folded_form::develop(&graph.coords3, &graph.edges, &faces)?;
     // Faces listed clockwise give a mirrored development with every angle's sign flipped:
     // the assignments say which way round the file is.
     let (mut agree, mut disagree) = (0usize, 0usize);

@@ -1,0 +1,8 @@
+//! The writers: every output file (JSON reports, FOLD animations, MuJoCo models) and the
+//! output folders they go into, written atomically. They sit above the engines whose results
+//! they write.
+
+pub mod folder;
+pub mod folding_output;
+pub mod mujoco;
+pub mod output;
