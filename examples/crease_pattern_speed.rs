@@ -120,7 +120,7 @@ fn main() {
     for n in [8, 16, 32, 64] {
         let model = miura(n, 0.0);
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: 0.95 },
+            drive: Drive::Assignment { to: 95.0 },
             ..FoldSettings::default()
         };
         let runs = if n >= 64 { 1 } else { 3 };
@@ -194,7 +194,7 @@ fn main() {
         let spec = WaterbombSpec { rows, cols, row_height };
         let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: 0.4 },
+            drive: Drive::Assignment { to: 40.0 },
             ..FoldSettings::default()
         };
         let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();

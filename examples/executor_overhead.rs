@@ -80,7 +80,7 @@ fn main() {
         let pattern = nanofold::read::load_crease_pattern(&Path::new("patterns/many").join(name)).unwrap();
         let model = FoldingModel::new(pattern).unwrap();
         let fold = FoldSettings {
-            drive: Drive::Assignment { to: 0.9 },
+            drive: Drive::Assignment { to: 90.0 },
             ..FoldSettings::default()
         };
         let path = fold_path(&model, &model.given_fold_angles(), &fold).unwrap();

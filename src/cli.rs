@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 #[command(
     name = "nanofold",
     version,
-    about = "Rigid origami: check, fold and unfold crease patterns (single vertices and many), extract their constraint curves, simulate folding dynamics of plate chains"
+    about = "Rigid origami: check, fold and unfold crease patterns (single vertices and many), extract their constraint curves, simulate the folding of devices of rigid panels on stress-actuated hinges"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -96,8 +96,9 @@ pub enum Command {
     /// many vertices with one degree of freedom; writes constraints.json, constraints.svg (and
     /// constraints.xml for MuJoCo).
     Constraints(ConstraintsArgs),
-    /// Response of a scene (a chain of plates) to its actuation: writes response.json,
-    /// response.svg and snapshots.svg (`docs/model.md#dynamics`).
+    /// Response of a scene (a strip of plates, a closed vertex or a device of many panels) to
+    /// its actuation: writes response.json, response.svg and snapshots.svg, and a device's 3D
+    /// page (`docs/model.md#dynamics`).
     Simulate(SimulateArgs),
     /// Write a scene in another tool's format: `export mujoco SCENE` writes one complete MJCF
     /// model (`docs/model.md#mujoco-scenes`).

@@ -17,7 +17,7 @@ use std::path::Path;
 fn path_to_90_percent(model: &FoldingModel) -> nanofold::folding::FoldPath {
     use nanofold::folding::{fold_path, Drive, FoldSettings};
     let settings = FoldSettings {
-        drive: Drive::Assignment { to: 0.9 },
+        drive: Drive::Assignment { to: 90.0 },
         ..Default::default()
     };
     fold_path(model, &model.given_fold_angles(), &settings).unwrap()
@@ -291,7 +291,7 @@ fn a_miura_ori_folds_from_flat_along_its_closed_form() {
     for (rows, cols, gamma) in [(3, 3, 60.0), (5, 4, 75.0)] {
         let model = miura(rows, cols, gamma, 0.0);
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: 0.95 },
+            drive: Drive::Assignment { to: 95.0 },
             ..FoldSettings::default()
         };
         let path = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -603,7 +603,7 @@ fn the_sparse_dof_count_agrees_with_the_pivoted_qr() {
     let path = Path::new("patterns/many/waterbomb_4x3.fold");
     let model = FoldingModel::new(nanofold::read::load_crease_pattern(path).unwrap()).unwrap();
     let settings = nanofold::folding::FoldSettings {
-        drive: nanofold::folding::Drive::Assignment { to: 0.3 },
+        drive: nanofold::folding::Drive::Assignment { to: 30.0 },
         ..Default::default()
     };
     let folded = nanofold::folding::fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -892,7 +892,7 @@ fn a_nearly_rigid_export_is_projected_onto_a_rigid_state() {
         FoldingModel::new(nanofold::read::load_crease_pattern(Path::new("patterns/many/bird_base.fold")).unwrap())
             .unwrap();
     let settings = FoldSettings {
-        drive: Drive::Assignment { to: 0.3 },
+        drive: Drive::Assignment { to: 30.0 },
         ..FoldSettings::default()
     };
     let rho = fold_path(&model, &model.given_fold_angles(), &settings)
@@ -1250,7 +1250,7 @@ fn the_smallest_panel_clearance_matches_a_brute_force_search() {
         ),
     ] {
         let settings = nanofold::folding::FoldSettings {
-            drive: nanofold::folding::Drive::Assignment { to: 0.9 },
+            drive: nanofold::folding::Drive::Assignment { to: 90.0 },
             ..Default::default()
         };
         let path = nanofold::folding::fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -1351,7 +1351,7 @@ fn the_reduced_rank_count_is_the_svds_count() {
         let rho = model.given_fold_angles();
         // Flat, and part-way along its assignment's path where there is one.
         let settings = nanofold::folding::FoldSettings {
-            drive: nanofold::folding::Drive::Assignment { to: 0.3 },
+            drive: nanofold::folding::Drive::Assignment { to: 30.0 },
             ..Default::default()
         };
         if let Ok(path) = nanofold::folding::fold_path(&model, &rho, &settings) {
@@ -1609,7 +1609,7 @@ fn frames_placed_during_the_path_are_the_frames_placed_after_it() {
     );
     let small = miura(4, 4, 60.0, 0.0);
     let reach = FoldSettings {
-        drive: Drive::Assignment { to: 0.9 },
+        drive: Drive::Assignment { to: 90.0 },
         ..Default::default()
     };
     let cut = FoldSettings {

@@ -299,7 +299,7 @@ fn fold_ends_in_the_same_state_however_the_file_is_placed() {
     let fold: Value = serde_json::from_str(&text).unwrap();
     let settings = Settings {
         fold: FoldSettings {
-            drive: nanofold::folding::Drive::Assignment { to: 0.5 },
+            drive: nanofold::folding::Drive::Assignment { to: 50.0 },
             ..Settings::default().fold
         },
         ..Settings::default()

@@ -155,7 +155,7 @@ fn random_miura_states_folded_by_fold_unfold_flat() {
         let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
         let depth = 0.1 + 0.85 * uniform(&mut seed);
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: depth },
+            drive: Drive::Assignment { to: 100.0 * depth },
             ..FoldSettings::default()
         };
         let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -255,7 +255,7 @@ fn waterbombs_and_the_bird_base_folded_by_fold_unfold_flat() {
     for (name, builder, depth) in cases {
         let model = FoldingModel::new(builder.build().unwrap()).unwrap();
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: depth },
+            drive: Drive::Assignment { to: 100.0 * depth },
             ..FoldSettings::default()
         };
         let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -412,7 +412,7 @@ fn random_waterbomb_states_folded_by_fold_unfold_flat() {
         let model = FoldingModel::new(spec.build().unwrap().build().unwrap()).unwrap();
         let depth = 0.1 + 0.4 * uniform(&mut seed);
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: depth },
+            drive: Drive::Assignment { to: 100.0 * depth },
             ..FoldSettings::default()
         };
         let folded = fold_path(&model, &model.given_fold_angles(), &settings).unwrap();
@@ -520,7 +520,7 @@ fn random_trapezoidal_miura_quad_meshes_fold_by_the_closed_form_and_unfold_flat(
         // Fold from flat (the crease pattern alone) along the assignment.
         let flat = model.with_fold_angles(&vec![0.0; state.len()]);
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: 0.6 },
+            drive: Drive::Assignment { to: 60.0 },
             ..FoldSettings::default()
         };
         let path = fold_path(&flat, &flat.given_fold_angles(), &settings).unwrap();
@@ -611,7 +611,7 @@ fn the_descent_under_argmin_reports_every_step_to_the_shared_observer() {
     use std::sync::{Arc, Mutex};
     let model = miura(4, 60.0);
     let fold = FoldSettings {
-        drive: Drive::Assignment { to: 0.8 },
+        drive: Drive::Assignment { to: 80.0 },
         ..FoldSettings::default()
     };
     let start = fold_path(&model, &model.given_fold_angles(), &fold)

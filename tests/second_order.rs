@@ -247,7 +247,7 @@ fn exclusions_agree_with_the_witness_search() {
         if report.verdict == PatternVerdict::NotRigidlyFoldable && report.evidence.contains("(degree 6)") {
             excluded += 1;
             let drive = FoldSettings {
-                drive: Drive::Assignment { to: 1.0 },
+                drive: Drive::Assignment { to: 100.0 },
                 ..FoldSettings::default()
             };
             let path = fold_path(&model, &model.given_fold_angles(), &drive).unwrap();

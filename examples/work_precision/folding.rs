@@ -52,9 +52,9 @@ fn frame_errors(model: &FoldingModel, frames: &[PathFrame]) -> (f64, f64) {
     (closure, edges)
 }
 
-fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value {
+fn measure(name: &str, model: &FoldingModel, to_percent: f64, closure_tol: f64) -> Value {
     let settings = FoldSettings {
-        drive: Drive::Assignment { to },
+        drive: Drive::Assignment { to: to_percent },
         closure_tol,
         ..FoldSettings::default()
     };
@@ -74,7 +74,7 @@ fn measure(name: &str, model: &FoldingModel, to: f64, closure_tol: f64) -> Value
     let row = json!({
         "pattern": name,
         "creases": model.crease_count(),
-        "to": to,
+        "to_percent": to_percent,
         "closure_tol": closure_tol,
         "seconds": seconds,
         "steps": path.steps.len() - 1,
@@ -130,13 +130,13 @@ pub fn folding_part() -> Value {
     );
     let mut rows = Vec::new();
     for n in [4, 8, 16, 32, 64, 100] {
-        rows.push(measure(&format!("miura {n}x{n}"), &miura(n), 0.9, 1e-11));
+        rows.push(measure(&format!("miura {n}x{n}"), &miura(n), 90.0, 1e-11));
     }
     for tol in [1e-6, 1e-8, 1e-10, 1e-12] {
-        rows.push(measure("miura 32x32", &miura(32), 0.9, tol));
+        rows.push(measure("miura 32x32", &miura(32), 90.0, tol));
     }
     for name in ["square_twist", "waterbomb_4x3", "huffman_waterbomb_6x4"] {
-        rows.push(measure(name, &library(name), 0.9, 1e-11));
+        rows.push(measure(name, &library(name), 90.0, 1e-11));
     }
     json!({ "rows": rows })
 }

@@ -451,8 +451,12 @@ fn main() {
     // --from REPORT: redraw the figures of a saved report, measuring nothing.
     let args: Vec<String> = std::env::args().collect();
     if let Some(at) = args.iter().position(|a| a == "--from") {
-        let path = args.get(at + 1).expect("--from REPORT.json");
-        let report: Value = serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+        let path = report_flag(&args, at, "--from");
+        if !Path::new(path).exists() {
+            eprintln!("error: the report {path} does not exist");
+            std::process::exit(2)
+        }
+        let report = saved_report(path);
         for (name, svg) in figures::figures(&report) {
             write(out, name, &svg);
         }
@@ -478,8 +482,13 @@ fn main() {
     // --networks-into REPORT: measure the network part only, put it (with its own machine
     // and commit) into that saved report, and redraw the report's figures.
     if let Some(at) = args.iter().position(|a| a == "--networks-into") {
-        let path = args.get(at + 1).expect("--networks-into REPORT.json");
-        let report = measure_into(path, "networks", networks::networks_part(&sizes, python.as_deref()));
+        let path = report_flag(&args, at, "--networks-into");
+        let saved = saved_report(path);
+        let report = measure_into(path, saved, "networks", networks::networks_part(&sizes, python.as_deref()));
+        if report.get("unfolding").is_none() {
+            println!("measured the network part into {path} (a report without the other parts: no figures drawn)");
+            return;
+        }
         for (name, svg) in figures::figures(&report) {
             write(out, name, &svg);
         }
@@ -491,8 +500,9 @@ fn main() {
     }
     // --folding-into REPORT: measure the folding paths alone into that saved report.
     if let Some(at) = args.iter().position(|a| a == "--folding-into") {
-        let path = args.get(at + 1).expect("--folding-into REPORT.json");
-        measure_into(path, "folding", folding::folding_part());
+        let path = report_flag(&args, at, "--folding-into");
+        let saved = saved_report(path);
+        measure_into(path, saved, "folding", folding::folding_part());
         println!("measured the folding paths into {path}");
         return;
     }
@@ -528,9 +538,46 @@ fn main() {
     );
 }
 
+/// The report file a `--…-into` flag names; exits with a message when it names none.
+fn report_flag<'a>(args: &'a [String], at: usize, flag: &str) -> &'a str {
+    match args.get(at + 1) {
+        Some(path) if !path.starts_with("--") => path,
+        _ => {
+            eprintln!("error: {flag} needs a report file, e.g. {flag} docs/work_precision_report.json");
+            std::process::exit(2)
+        }
+    }
+}
+
+/// The saved report a part goes into, read before anything is measured: a report that does
+/// not exist yet starts empty; one that cannot be read or is not a JSON object ends the run.
+fn saved_report(path: &str) -> Value {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            println!("{path} does not exist yet: a new report is started there");
+            return json!({});
+        }
+        Err(e) => {
+            eprintln!("error: reading the report {path}: {e}");
+            std::process::exit(2)
+        }
+    };
+    match serde_json::from_str::<Value>(&text) {
+        Ok(report) if report.is_object() => report,
+        Ok(_) => {
+            eprintln!("error: the report {path} is not a JSON object");
+            std::process::exit(2)
+        }
+        Err(e) => {
+            eprintln!("error: the report {path} is not JSON: {e}");
+            std::process::exit(2)
+        }
+    }
+}
+
 /// Puts one part (with this machine) into a saved report, rewrites it, and returns it.
-fn measure_into(path: &str, key: &str, mut part: Value) -> Value {
-    let mut report: Value = serde_json::from_str(&std::fs::read_to_string(path).expect("the report")).expect("JSON");
+fn measure_into(path: &str, mut report: Value, key: &str, mut part: Value) -> Value {
     part["machine"] = machine();
     report[key] = part;
     write_atomic(

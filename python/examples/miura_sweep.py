@@ -17,8 +17,8 @@ def miura_design(angle_deg: float, rows: int, cols: int) -> dict:
     """One design: its verdict, DOF at flat (first order) and half folded, time to fold."""
     sheet = nanofold.generate.miura(rows, cols, angle_deg=angle_deg)
     verdict = nanofold.check(sheet)
-    half = nanofold.fold(sheet, to=0.5)
-    full = nanofold.fold(sheet, to=0.95)
+    half = nanofold.fold(sheet, to=50)
+    full = nanofold.fold(sheet, to=95)
     return {
         "verdict": verdict.verdict,
         "panels": rows * cols,

@@ -15,7 +15,7 @@ import nanofold
 
 def one_ms_task(angle_deg: float) -> dict:
     """Folds a 4 × 4 Miura-ori to 30% (about 1 ms in the library)."""
-    r = nanofold.fold(_sheet(angle_deg), to=0.3)
+    r = nanofold.fold(_sheet(angle_deg), to=30)
     return {"steps": r.steps, "library_seconds": r.seconds}
 
 
@@ -40,7 +40,7 @@ def main() -> None:
     engine, library, wall = [], [], []
     for _ in range(args.repeat):
         clock = time.perf_counter()
-        results = [nanofold.fold(sheet, to=0.3) for _ in range(calls)]
+        results = [nanofold.fold(sheet, to=30) for _ in range(calls)]
         wall.append((time.perf_counter() - clock) / calls)
         engine.append(statistics.mean(r.seconds for r in results))
         library.append(statistics.mean(r.library_seconds for r in results))
@@ -51,7 +51,7 @@ def main() -> None:
             nanofold._native.noop()
         empty.append((time.perf_counter() - clock) / 1000)
     w, l, e = statistics.median(wall), statistics.median(library), statistics.median(empty)
-    print(f"fold(miura 4x4, to=0.3): {w * 1e3:.3f} ms per call from Python; in the library {l * 1e3:.3f} ms "
+    print(f"fold(miura 4x4, to=30): {w * 1e3:.3f} ms per call from Python; in the library {l * 1e3:.3f} ms "
           f"(the path {statistics.median(engine) * 1e3:.3f} ms, the rest its summary, DOF and FOLD files); "
           f"the Python layer {(w - l) * 1e6:.0f} µs ({(w - l) / l * 100:.1f}% of the library's time); "
           f"an empty call {e * 1e6:.0f} µs")

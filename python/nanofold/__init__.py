@@ -9,7 +9,7 @@ numeric lists as numpy arrays.
 >>> sheet = nanofold.generate.miura(4, 4, angle_deg=60)
 >>> nanofold.check(sheet).verdict
 'rigidly_foldable'
->>> nanofold.fold(sheet, to=0.9).verdict
+>>> nanofold.fold(sheet, to=90).verdict
 'reached'
 """
 

@@ -291,15 +291,35 @@ def _restore_scene(spec: Dict[str, Any], base: str, name: str, source: str) -> S
     return Scene(spec, base=base, name=name, source=source)
 
 
-def _pattern(pattern: Union[Pattern, PathLike]) -> Pattern:
-    return pattern if isinstance(pattern, Pattern) else Pattern.open(pattern)
+#: What the pattern functions take: a path, a :class:`Pattern`, or a FOLD object as a dict.
+PatternLike = Union[Pattern, PathLike, Mapping[str, Any]]
+#: What the scene functions take: a path, a :class:`Scene`, or a scene file's dict.
+SceneLike = Union[Scene, PathLike, Mapping[str, Any]]
 
 
-def _scene(scene: Union[Scene, PathLike]) -> Scene:
-    return scene if isinstance(scene, Scene) else Scene.open(scene)
+def _pattern(pattern: PatternLike) -> Pattern:
+    if isinstance(pattern, Pattern):
+        return pattern
+    if isinstance(pattern, Mapping):
+        return Pattern.from_fold(pattern)
+    if isinstance(pattern, (str, os.PathLike)):
+        return Pattern.open(pattern)
+    raise TypeError(
+        f"pattern: expected a path, a nanofold.Pattern or a FOLD dict, got {type(pattern).__name__}"
+    )
 
 
-def check(pattern: Union[Pattern, PathLike], *, closure_tol: Optional[float] = None) -> PatternResult:
+def _scene(scene: SceneLike) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, Mapping):
+        return Scene(scene)
+    if isinstance(scene, (str, os.PathLike)):
+        return Scene.open(scene)
+    raise TypeError(f"scene: expected a path, a nanofold.Scene or a scene dict, got {type(scene).__name__}")
+
+
+def check(pattern: PatternLike, *, closure_tol: Optional[float] = None) -> PatternResult:
     """The pattern's verdict: a single vertex by unfolding it; a sheet of many vertices by its
     state (``rigid``, ``not_rigid``, ``self_intersecting``) or, flat, its assignment
     (``rigidly_foldable``, ``not_rigidly_foldable``, ``unknown``), with evidence.
@@ -314,7 +334,7 @@ def check(pattern: Union[Pattern, PathLike], *, closure_tol: Optional[float] = N
 
 
 def unfold(
-    pattern: Union[Pattern, PathLike],
+    pattern: PatternLike,
     *,
     energy: Optional[str] = None,
     p: Optional[float] = None,
@@ -342,7 +362,7 @@ def unfold(
 
 
 def fold(
-    pattern: Union[Pattern, PathLike],
+    pattern: PatternLike,
     *,
     to: Optional[float] = None,
     drive: Optional[Mapping[int, float]] = None,
@@ -351,12 +371,13 @@ def fold(
     max_steps: Optional[int] = None,
 ) -> FoldResult:
     """Folds a pattern rigidly: from flat along its assignment until the most folded crease
-    reaches ``to`` × 180° (a fraction, default 1), or ``drive`` = {FOLD edge index: angle in
-    rad}. ``frames`` snapshots go into the FOLD animation (``fold_file()``); ``max_step`` is
-    the largest change of any fold angle in one step, rad.
+    reaches ``to`` % of 180° (a percentage, default 100, as ``fold --to``), or ``drive`` =
+    {FOLD edge index: angle in degrees} (as ``fold --drive EDGE=DEG``). ``frames`` snapshots
+    go into the FOLD animation (``fold_file()``); ``max_step`` is the largest change of any
+    fold angle in one step, degrees (as ``fold --max-step``).
 
     >>> import nanofold
-    >>> r = nanofold.fold("patterns/many/miura_4x4.fold", to=0.5, frames=5)
+    >>> r = nanofold.fold("patterns/many/miura_4x4.fold", to=50, frames=5)
     >>> r.verdict, r.dof, len(r.fold_file()["file_frames"])
     ('reached', 1, 5)
     """
@@ -367,7 +388,7 @@ def fold(
 
 
 def constraints(
-    pattern: Union[Pattern, PathLike],
+    pattern: PatternLike,
     *,
     driver: int,
     locks: Optional[Mapping[int, float]] = None,
@@ -394,7 +415,7 @@ def constraints(
 
 
 def simulate(
-    scene: Union[Scene, PathLike],
+    scene: SceneLike,
     *,
     model: Optional[str] = None,
     method: Optional[str] = None,
@@ -419,7 +440,7 @@ def simulate(
     return SimulationResult("simulate", summary, rest)
 
 
-def modes(scene: Union[Scene, PathLike]) -> Result:
+def modes(scene: SceneLike) -> Result:
     """Natural frequencies (Hz), mode shapes and stability at the scene's folded equilibrium.
 
     >>> import nanofold

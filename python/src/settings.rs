@@ -139,7 +139,7 @@ pub fn command_settings(value: &Value, kind: Kind) -> Result<CommandSettings> {
             "closure_tol" => settings.check.closure_tol = number(key, v)?,
             "to" => settings.fold.drive = nanofold::folding::Drive::Assignment { to: number(key, v)? },
             "drive" => drive_edges = drive(v)?,
-            "max_step" => settings.fold.max_step = number(key, v)?,
+            "max_step" => settings.fold.max_step = number(key, v)?.to_radians(),
             "max_steps" => settings.fold.max_steps = count(key, v)?,
             "frames" => {
                 frames = count(key, v)?;
@@ -158,7 +158,7 @@ pub fn command_settings(value: &Value, kind: Kind) -> Result<CommandSettings> {
     })
 }
 
-/// `drive`: {FOLD edge index: angle in rad}.
+/// `drive`: {FOLD edge index: angle in degrees}, as `fold --drive EDGE=DEG`.
 fn drive(value: &Value) -> Result<Vec<(usize, f64)>> {
     let map = object(value, "drive")?;
     map.iter()
@@ -166,7 +166,7 @@ fn drive(value: &Value) -> Result<Vec<(usize, f64)>> {
             let edge: usize = edge
                 .parse()
                 .map_err(|_| NanofoldError::invalid("drive", edge, "keys are FOLD edge indices"))?;
-            Ok((edge, number("drive", angle)?))
+            Ok((edge, number("drive", angle)?.to_radians()))
         })
         .collect()
 }

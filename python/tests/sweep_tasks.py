@@ -7,7 +7,7 @@ import nanofold
 
 def miura_design(angle_deg, rows, cols):
     sheet = nanofold.generate.miura(rows, cols, angle_deg=angle_deg)
-    folded = nanofold.fold(sheet, to=0.5)
+    folded = nanofold.fold(sheet, to=50)
     return {"verdict": nanofold.check(sheet).verdict, "dof": folded.dof, "steps": folded.steps}
 
 

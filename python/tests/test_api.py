@@ -2,6 +2,7 @@
 field, pickling, the GIL released and Ctrl-C honoured during long calls."""
 
 import json
+import math
 import os
 import pickle
 import signal
@@ -40,7 +41,7 @@ def test_a_cross_of_four_creases_folds_and_its_folded_state_unfolds_as_a_single_
     cross = nanofold.Pattern.from_arrays(**CROSS, name="cross")
     # Flat, with no fold angles, it is a crease pattern (an assignment to fold).
     assert cross.engine == "network" and len(cross.crease_labels) == 4
-    folded = nanofold.fold(cross, to=0.5)
+    folded = nanofold.fold(cross, to=50)
     assert folded.verdict == "reached"
     # The folded state read back through FOLD unfolds flat by the single-vertex engine.
     state = nanofold.Pattern.from_fold(folded.folded_file(), "cross_folded")
@@ -52,7 +53,7 @@ def test_a_cross_of_four_creases_folds_and_its_folded_state_unfolds_as_a_single_
 
 
 def test_results_give_arrays_and_plain_dicts():
-    r = nanofold.fold(nanofold.generate.miura(3, 3), to=0.4, frames=4)
+    r = nanofold.fold(nanofold.generate.miura(3, 3), to=40, frames=4)
     assert isinstance(r.to_dict(), dict) and isinstance(r.to_dict()["progress"], float)
     assert r.trajectory.ndim == 2 and r.trajectory.shape[1] == r.creases
     assert np.all(np.diff(r.progress_per_step) > 0)
@@ -94,7 +95,7 @@ def test_a_folded_miura_from_the_generator_is_rigid_and_unfolds_flat():
         (lambda: nanofold.generate.miura(4, 4, angle_deg=95), nanofold.InvalidFieldError, "sector_angle"),
         (lambda: nanofold.unfold("patterns/miura_vertex.fold", p=-1), nanofold.InvalidFieldError, "p"),
         (lambda: nanofold.unfold("patterns/miura_vertex.fold", energy="quadratic"), nanofold.InvalidFieldError, "energy"),
-        (lambda: nanofold.fold("patterns/many/miura_4x4.fold", to=2.0), nanofold.InvalidFieldError, "drive.to"),
+        (lambda: nanofold.fold("patterns/many/miura_4x4.fold", to=200), nanofold.InvalidFieldError, "drive.to"),
         (lambda: nanofold.fold("patterns/many/miura_4x4.fold", drive={3: 1.0}), nanofold.InvalidFieldError, "drive"),
         (lambda: nanofold.simulate("patterns/bridge_step.scene.json", rtol=-1), nanofold.InvalidFieldError, "rtol"),
         (lambda: nanofold.constraints("patterns/miura_vertex.fold", driver=9), nanofold.InvalidFieldError, "driver"),
@@ -117,12 +118,12 @@ def test_a_drive_key_that_is_a_crease_folds_to_its_angle():
     sheet = nanofold.Pattern.open("patterns/many/miura_4x4.fold")
     edge = int(sheet.crease_labels[0].split("[")[1].rstrip("]"))
     # The target's sign is the crease's assignment's (a mountain folds to negative angles).
-    sign = np.sign(nanofold.fold(sheet, to=0.1).final_fold_angles_rad[0])
-    r = nanofold.fold(sheet, drive={edge: sign * 1.0})
+    sign = np.sign(nanofold.fold(sheet, to=10).final_fold_angles_rad[0])
+    r = nanofold.fold(sheet, drive={edge: sign * math.degrees(1.0)})
     assert r.verdict == "reached"
     assert abs(r.final_fold_angles_rad[0] - sign * 1.0) < 1e-9
     with pytest.raises(nanofold.InvalidFieldError, match="contradicts the crease's assignment"):
-        nanofold.fold(sheet, drive={edge: -sign * 1.0})
+        nanofold.fold(sheet, drive={edge: -sign * math.degrees(1.0)})
 
 
 def test_objects_pickle_and_answer_the_same_after():
@@ -149,7 +150,7 @@ def test_a_scene_changed_by_dotted_paths_changes_its_answer():
 
 
 def _long_call():
-    return nanofold.fold(nanofold.generate.miura(16, 16), max_step=0.002)
+    return nanofold.fold(nanofold.generate.miura(16, 16), max_step=math.degrees(0.002))
 
 
 def test_long_calls_release_the_gil():
@@ -165,7 +166,7 @@ def test_long_calls_release_the_gil():
     clock = time.perf_counter()
     before = ticks[0]
     # Long enough (about 0.3 s) for the counter's share of the time to show.
-    nanofold.fold(nanofold.generate.miura(14, 14), max_step=0.004)
+    nanofold.fold(nanofold.generate.miura(14, 14), max_step=math.degrees(0.004))
     during = ticks[0] - before
     seconds = time.perf_counter() - clock
     stop.set()
@@ -197,3 +198,26 @@ def test_generated_miura_sheets_fold_rigidly_and_their_folded_states_are_rigid(r
     state = nanofold.check(folded)
     assert state.verdict == "rigid" and state.max_vertex_residual_rad < 1e-9
     assert pickle.loads(pickle.dumps(folded)).fold_angles.tolist() == folded.fold_angles.tolist()
+
+
+def test_every_pattern_function_takes_a_path_a_pattern_or_a_fold_dict():
+    path = "patterns/many/miura_4x4.fold"
+    with open(path) as f:
+        fold_dict = json.load(f)
+    by_path = nanofold.check(path)
+    for given in (nanofold.Pattern.open(path), fold_dict):
+        r = nanofold.check(given)
+        assert (r.verdict, r.dof) == (by_path.verdict, by_path.dof)
+    assert nanofold.fold(fold_dict, to=50).verdict == nanofold.fold(path, to=50).verdict == "reached"
+    with pytest.raises(TypeError, match="a path, a nanofold.Pattern or a FOLD dict, got int"):
+        nanofold.check(3)  # type: ignore[arg-type]
+
+
+def test_a_scene_dict_simulates_as_its_file_does():
+    path = "patterns/bridge_step.scene.json"
+    with open(path) as f:
+        spec = json.load(f)
+    spec["time"]["t_end_s"] = 1e-4
+    by_dict = nanofold.simulate(spec)
+    by_scene = nanofold.simulate(nanofold.Scene.open(path).replace({"time.t_end_s": 1e-4}))
+    assert by_dict.final_fold_angles_rad.tolist() == by_scene.final_fold_angles_rad.tolist()

@@ -43,7 +43,7 @@ def test_unfold_equals_the_command_line(path, tmp_path):
 def test_fold_equals_the_command_line(path, tmp_path):
     if not (ROOT / path).exists():
         pytest.skip(f"{path} is not bundled")
-    result = nanofold.fold(path, to=0.6, frames=7)
+    result = nanofold.fold(path, to=60, frames=7)
     expected = cli_json("fold", path, "--to", "60", "--frames", "7", "--out", str(tmp_path / "f"))
     assert comparable(result.to_dict()) == comparable(expected)
     # The square twist stops at its branch point at once: one frame, as on the command line.

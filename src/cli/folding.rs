@@ -293,7 +293,7 @@ fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, 
 pub fn run_fold(args: &FoldArgs) -> Result<()> {
     let model = load_model(&args.pattern)?;
     let drive = if args.drive.is_empty() {
-        Drive::Assignment { to: args.to / 100.0 }
+        Drive::Assignment { to: args.to }
     } else {
         Drive::Creases(
             args.drive
@@ -302,17 +302,8 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
                 .collect::<Result<_>>()?,
         )
     };
-    // The flags in their own units (percent, degrees), before the library's radians.
-    let (lowest_to, lowest_step) = (
-        100.0 * nanofold::folding::MIN_GOAL,
-        nanofold::folding::MIN_STEP.to_degrees(),
-    );
-    if !(args.to >= lowest_to && args.to <= 100.0) {
-        bail!(
-            "--to {:e}: must lie in [{lowest_to}, 100] (percent of a full fold)",
-            args.to
-        );
-    }
+    // The step in the flag's degrees, before the library's radians.
+    let lowest_step = nanofold::folding::MIN_STEP.to_degrees();
     if !(args.max_step >= lowest_step && args.max_step <= 0.5f64.to_degrees()) {
         bail!(
             "--max-step {:e}: must lie in [{lowest_step:.1e}, {:.1}] degrees",
@@ -329,7 +320,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         flags(
             e,
             &[
-                ("drive.to", "--to (as a fraction)"),
+                ("drive.to", "--to"),
                 ("max_step", "--max-step (in rad)"),
             ],
         )

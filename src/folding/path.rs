@@ -16,9 +16,9 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Drive {
     /// Every mountain crease towards −π and every valley towards +π at equal speed, until
-    /// the most folded crease reaches `to` × π.
+    /// the most folded crease reaches `to` % of π.
     Assignment {
-        /// Fraction of full folding at which to stop, in (0, 1].
+        /// Percentage of a full fold at which to stop, in [0.1, 100] (as `fold --to`).
         to: f64,
     },
     /// The listed creases (fold-angle columns) towards their target angles (rad).
@@ -45,7 +45,7 @@ pub struct FoldSettings {
 impl Default for FoldSettings {
     fn default() -> Self {
         FoldSettings {
-            drive: Drive::Assignment { to: 1.0 },
+            drive: Drive::Assignment { to: 100.0 },
             // The command line's default too (`fold --max-step 15`, degrees): a cap, the step
             // control chooses below it.
             max_step: 15.0 * std::f64::consts::PI / 180.0,
@@ -67,11 +67,11 @@ impl FoldSettings {
         match &self.drive {
             Drive::Assignment { to } => {
                 // A goal below the kick that leaves flat would be passed by the first step.
-                if !(*to >= MIN_GOAL && *to <= 1.0) {
+                if !(*to >= MIN_GOAL_PERCENT && *to <= 100.0) {
                     return Err(NanofoldError::invalid(
                         "drive.to",
                         format!("{to:e}"),
-                        format!("must lie in [{MIN_GOAL:e}, 1]"),
+                        format!("must lie in [{MIN_GOAL_PERCENT}, 100] (percent of a full fold)"),
                     ));
                 }
             }
@@ -236,9 +236,9 @@ pub struct FoldPath {
 
 /// The smallest step a path takes, rad.
 pub const MIN_STEP: f64 = 1e-6;
-/// The smallest goal of an assignment drive, as a fraction of a full fold: above the kick
-/// that leaves flat (1e-3 rad), so a path can stop at its goal, not past it.
-pub const MIN_GOAL: f64 = 1e-3;
+/// The smallest goal of an assignment drive, percent of a full fold: above the kick that
+/// leaves flat (1e-3 rad), so a path can stop at its goal, not past it.
+pub const MIN_GOAL_PERCENT: f64 = 0.1;
 
 /// Kawasaki residuals below this, rad, are a flat-foldable design's noise, not its geometry.
 const DESIGN_NOISE: f64 = 1e-4;
@@ -340,7 +340,7 @@ pub(crate) fn progress_crease(drive: &Drive, rho: &[f64], signs: &[f64]) -> Opti
 /// [`progress_crease`]): the same number [`progress`] gives, from one crease.
 pub(crate) fn progress_by_crease(drive: &Drive, start: &[f64], crease: usize, value: f64) -> f64 {
     match drive {
-        Drive::Assignment { to } => value.abs() / PI / to,
+        Drive::Assignment { to } => value.abs() / PI / (to / 100.0),
         Drive::Creases(list) => {
             let span = list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - start[c]).abs()));
             let target = list.iter().find(|&&(c, _)| c == crease).map_or(value, |&(_, t)| t);
@@ -361,7 +361,7 @@ pub(crate) fn progress(drive: &Drive, start: &[f64], rho: &[f64], signs: &[f64])
                 .filter(|(_, s)| **s != 0.0)
                 .fold(0.0_f64, |m, (r, _)| m.max(r.abs()))
                 / PI;
-            amount / to
+            amount / (to / 100.0)
         }
         Drive::Creases(list) => {
             let span = list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - start[c]).abs()));
@@ -1065,7 +1065,7 @@ fn land_on_goal(
 ) -> Result<Option<Correction>> {
     let (crease, value) = match drive {
         Drive::Assignment { to } => match progress_crease(drive, trial, signs) {
-            Some(c) => (c, trial[c].signum() * PI * to),
+            Some(c) => (c, trial[c].signum() * PI * (to / 100.0)),
             None => return Ok(None),
         },
         Drive::Creases(list) if list.len() == 1 => list[0],
@@ -1315,7 +1315,7 @@ mod tests {
     #[test]
     fn a_stale_projection_is_corrected_to_second_order() {
         let model = miura_4x4();
-        let rho = along(&model, 0.5);
+        let rho = along(&model, 50.0);
         let signs = assigned_signs(&model);
         let offset: Vec<f64> = (0..rho.len()).map(|k| ((k * 7 % 11) as f64 - 5.0) / 5.0).collect();
         let errors = |delta: f64, stale: bool| {
@@ -1342,7 +1342,7 @@ mod tests {
         let miura = miura_4x4();
         let bird = FoldingModel::new(BirdBaseSpec::default().build().unwrap().build().unwrap()).unwrap();
         for (model, one) in [(&miura, true), (&bird, false)] {
-            let rho = along(model, 0.3);
+            let rho = along(model, 30.0);
             let factored = factored_at(model, &rho, false);
             let signs = assigned_signs(model);
             let tangent = factored.project_at(model, &rho, &signs);
@@ -1355,7 +1355,7 @@ mod tests {
     #[test]
     fn chord_steps_reach_the_tolerance_with_fewer_factorisations() {
         let model = miura_4x4();
-        let rho = along(&model, 0.5);
+        let rho = along(&model, 50.0);
         let signs = assigned_signs(&model);
         let start: Vec<f64> = rho.iter().zip(&signs).map(|(r, s)| r + 0.02 * s).collect();
         let mut ends = Vec::new();
@@ -1394,14 +1394,14 @@ mod tests {
     fn a_state_past_the_goal_lands_on_it() {
         let model = miura_4x4();
         let settings = FoldSettings {
-            drive: Drive::Assignment { to: 0.5 },
+            drive: Drive::Assignment { to: 50.0 },
             ..FoldSettings::default()
         };
         let start = model.given_fold_angles();
         let path = fold_path(&model, &start, &settings).unwrap();
         let past = path.steps.last().unwrap().fold_angles.clone();
         let signs = assigned_signs(&model);
-        let goal = Drive::Assignment { to: 0.48 };
+        let goal = Drive::Assignment { to: 48.0 };
         assert!(progress(&goal, &start, &past, &signs) > 1.03);
         let mut state = past.clone();
         let mut solver = NormalSolver::new(PATH_REGULARISATION);

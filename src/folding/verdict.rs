@@ -284,7 +284,7 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
         return Ok(report);
     }
     let path_settings = FoldSettings {
-        drive: Drive::Assignment { to: 1.0 },
+        drive: Drive::Assignment { to: 100.0 },
         ..settings.path.clone()
     };
     report.tried.push(format!(

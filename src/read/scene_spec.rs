@@ -277,7 +277,7 @@ impl StripSpec {
     /// drag, 1 ms.
     ///
     /// ```
-    /// use nanofold::dynamics::spec::{HingeSpec, LayerSpec, MaterialSpec, StripSpec};
+    /// use nanofold::read::scene_spec::{HingeSpec, LayerSpec, MaterialSpec, StripSpec};
     /// use nanofold::prelude::*;
     /// // One 100 µm SiN plate on a SiN/Cr bilayer hinge, released by a step towards 100°.
     /// let scene = StripSpec::new("flap")
