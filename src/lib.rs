@@ -84,3 +84,8 @@ pub use error::{NanofoldError, Result};
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeExample;
+
+/// The user guide's library chapter, its examples compiled and run as doc-tests.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/guide/library.md")]
+pub struct GuideLibraryExamples;

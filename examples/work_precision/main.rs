@@ -484,7 +484,12 @@ fn main() {
     if let Some(at) = args.iter().position(|a| a == "--networks-into") {
         let path = report_flag(&args, at, "--networks-into");
         let saved = saved_report(path);
-        let report = measure_into(path, saved, "networks", networks::networks_part(&sizes, python.as_deref()));
+        let report = measure_into(
+            path,
+            saved,
+            "networks",
+            networks::networks_part(&sizes, python.as_deref()),
+        );
         if report.get("unfolding").is_none() {
             println!("measured the network part into {path} (a report without the other parts: no figures drawn)");
             return;

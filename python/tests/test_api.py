@@ -220,4 +220,4 @@ def test_a_scene_dict_simulates_as_its_file_does():
     spec["time"]["t_end_s"] = 1e-4
     by_dict = nanofold.simulate(spec)
     by_scene = nanofold.simulate(nanofold.Scene.open(path).replace({"time.t_end_s": 1e-4}))
-    assert by_dict.final_fold_angles_rad.tolist() == by_scene.final_fold_angles_rad.tolist()
+    assert by_dict.final_angles_rad.tolist() == by_scene.final_angles_rad.tolist()

@@ -37,7 +37,7 @@ def client():
 PATTERN_GRID = {
     "pattern": ["patterns/many/miura_4x4.fold", "patterns/many/square_twist.fold", "patterns/many/bird_base.fold",
                 "patterns/no_such_file.fold"],
-    "to": [0.3, 0.8, 7.0],
+    "to": [30, 80, 700],
 }
 
 
@@ -45,8 +45,8 @@ def test_a_grid_is_its_product_in_order_and_a_bad_case_is_a_row():
     table = nanofold.sweep("fold", PATTERN_GRID, client="serial", progress=False)
     assert list(table["run"]) == list(range(12))
     assert list(table["pattern"][:3]) == ["patterns/many/miura_4x4.fold"] * 3
-    assert list(table["to"][:3]) == [0.3, 0.8, 7.0]
-    bad_goal = table[(table["to"] == 7.0) & (table["pattern"] != "patterns/no_such_file.fold")]
+    assert list(table["to"][:3]) == [30, 80, 700]
+    bad_goal = table[(table["to"] == 700) & (table["pattern"] != "patterns/no_such_file.fold")]
     assert bad_goal["error_kind"].eq("invalid_field").all() and bad_goal["error"].str.contains("drive.to").all()
     missing = table[table["pattern"] == "patterns/no_such_file.fold"]
     assert missing["error_kind"].eq("io").all()

@@ -316,15 +316,9 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         max_step: args.max_step.to_radians(),
         ..FoldSettings::default()
     };
-    settings.validate(&model).map_err(|e| {
-        flags(
-            e,
-            &[
-                ("drive.to", "--to"),
-                ("max_step", "--max-step (in rad)"),
-            ],
-        )
-    })?;
+    settings
+        .validate(&model)
+        .map_err(|e| flags(e, &[("drive.to", "--to"), ("max_step", "--max-step (in rad)")]))?;
     let start = Instant::now();
     // The frames are placed while the path goes on (on a large pattern).
     let (path, frames) = fold_path_and_frames(&model, &model.given_fold_angles(), &settings, args.frames)?;
