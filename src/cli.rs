@@ -1255,9 +1255,9 @@ const UNFOLD_FLAGS: &[(&str, &str)] = &[
     ("closure_tol", "--closure-tol"),
 ];
 const CONSTRAINT_FLAGS: &[(&str, &str)] = &[
-    ("driver", "--drive"),
-    ("locks", "--lock"),
-    ("domain", "--range"),
+    ("drive", "--drive"),
+    ("lock", "--lock"),
+    ("range", "--range"),
     ("samples", "--samples"),
     ("degree", "--degree"),
     ("tolerance", "--tol"),

@@ -40,11 +40,16 @@ use std::time::Instant;
 
 mod constraints;
 mod generate;
+pub mod options;
 mod scene;
 
 pub use constraints::{constraints, ConstraintSettings, Constraints, Degree};
 pub use generate::Generator;
-pub use scene::{modes, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
+pub use options::{
+    options_from_json, CheckOptions, ConstraintOptions, FoldOptions, FromJson, ReadOptions, SimulateOptions,
+    UnfoldOptions,
+};
+pub use scene::{modes, open_scene, parse_scene, scene_kind, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
 
 /// The single-vertex pattern type of the engine behind the door.
 pub use crate::pattern::Pattern as VertexPattern;
@@ -661,11 +666,52 @@ pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
     let start = model.given_fold_angles();
     let clock = Instant::now();
     let path = fold_path(model, &start, &settings.fold)?;
+    Ok(fold_report(pattern, model, start, path, clock))
+}
+
+/// A fold's report with what `fold` writes beside it: the FOLD animation of `frames`
+/// frames (placed while the path goes on, on a large pattern) and the end state as FOLD.
+#[derive(Debug, Clone)]
+pub struct FoldRun {
+    /// The report.
+    pub report: Report,
+    /// The animation's frames, evenly spaced in progress.
+    pub frames: Vec<crate::folding::PathFrame>,
+    /// fold.fold: the crease pattern with one frame per snapshot.
+    pub animation: serde_json::Value,
+    /// folded.fold: the crease pattern carrying the end state.
+    pub end_state: serde_json::Value,
+}
+
+/// Folds `pattern` with the front ends' options (`fold --to`, `--drive`, `--frames`, …).
+pub fn fold_run(pattern: &Pattern, options: &options::FoldOptions) -> Result<FoldRun> {
+    use crate::write::folding_output::{crease_pattern_fold, fold_path_fold};
+    let model = sheet_of(pattern, "fold")?;
+    let settings = options.settings(model)?;
+    let start = model.given_fold_angles();
+    let clock = Instant::now();
+    let (path, frames) = crate::folding::fold_path_and_frames(model, &start, &settings, options.frames)?;
+    let report = fold_report(pattern, model, start, path, clock);
+    let animation = fold_path_fold(model, &frames);
+    let end_state = crease_pattern_fold(
+        &model.pattern,
+        Some(&report.final_fold_angles_rad),
+        "end state of nanofold fold (a crease pattern with its fold angles)",
+    );
+    Ok(FoldRun {
+        report,
+        frames,
+        animation,
+        end_state,
+    })
+}
+
+fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: FoldPath, clock: Instant) -> Report {
     let last = path
         .steps
         .last()
         .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
-    Ok(Report {
+    Report {
         pattern: pattern.name().to_string(),
         command: Command::Fold,
         engine: Engine::Network,
@@ -678,7 +724,7 @@ pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
         final_fold_angles_rad: last,
         max_closure_residual_rad: path.max_closure_residual,
         detail: Detail::Fold(Box::new(path)),
-    })
+    }
 }
 
 fn vertex_report(

@@ -227,3 +227,155 @@ fn the_checker_sees_grouped_nested_and_relative_paths() {
     .collect();
     assert_eq!(paths, expected);
 }
+
+/// Every `nanofold::a::b` path (two segments at most) a front end's sources use, with the
+/// file that uses it; `use nanofold::{x, y::z}` groups expanded.
+fn front_end_paths(files: &[&str]) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    for file in files {
+        let source = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let code: String = source
+            .lines()
+            .map(|line| line.split("//").next().unwrap_or(""))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let text: Vec<char> = code.chars().collect();
+        let prefix: Vec<char> = "nanofold::".chars().collect();
+        let mut at = 0;
+        while at + prefix.len() <= text.len() {
+            let preceded_by_ident = at > 0 && (text[at - 1].is_alphanumeric() || text[at - 1] == '_');
+            if !preceded_by_ident && text[at..].starts_with(&prefix) {
+                let mut paths = Vec::new();
+                at = read_paths(&text, at + prefix.len(), Vec::new(), &mut paths);
+                for path in paths {
+                    let shown: Vec<String> = path.into_iter().take(2).collect();
+                    out.entry(shown.join("::")).or_insert_with(|| file.to_string());
+                }
+            } else {
+                at += 1;
+            }
+        }
+    }
+    out
+}
+
+fn rust_files(dir: &str) -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
+        .map(|p| p.display().to_string())
+        .collect();
+    files.sort();
+    files
+}
+
+/// The front door and the prelude: all a front end may use.
+fn through_the_door(path: &str) -> bool {
+    let top = path.split("::").next().unwrap_or("");
+    top == "commands" || top == "prelude"
+}
+
+#[test]
+fn python_calls_only_the_door_and_the_prelude() {
+    let paths = front_end_paths(&rust_files("python/src").iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(paths.keys().any(|p| p.starts_with("commands")), "{paths:?}");
+    let past: Vec<String> = paths
+        .iter()
+        .filter(|(path, _)| !through_the_door(path))
+        .map(|(path, file)| format!("{file}: nanofold::{path}"))
+        .collect();
+    assert!(
+        past.is_empty(),
+        "the Python binding reaches past the door:\n{}",
+        past.join("\n")
+    );
+}
+
+/// What the command line still reaches past the door for. This list only shrinks: a new
+/// entry fails the test, and so does an entry no longer used (take it off the list).
+const CLI_PAST_THE_DOOR: &[&str] = &[
+    "NanofoldError",
+    "NanofoldError::Io",
+    "NanofoldError::Json",
+    "constraints::ConstraintPoly",
+    "constraints::ConstraintReport",
+    "constraints::MAX_DEGREE",
+    "constraints::Setup",
+    "constraints::check_curve",
+    "constraints::default_domain",
+    "constraints::fit_to_tolerance",
+    "constraints::held_pattern",
+    "constraints::mujoco_snippet",
+    "constraints::network",
+    "constraints::sweep_samples",
+    "constraints::trajectory_samples",
+    "dynamics::closed",
+    "dynamics::integrate",
+    "dynamics::modes",
+    "dynamics::network",
+    "dynamics::plant",
+    "dynamics::scene",
+    "dynamics::simulate",
+    "error::NumericalError",
+    "folding::CheckSettings",
+    "folding::Drive",
+    "folding::FoldPath",
+    "folding::FoldSettings",
+    "folding::FoldingModel",
+    "folding::MIN_STEP",
+    "folding::closure_jacobian",
+    "folding::fold_path_and_frames",
+    "folding::jacobian_rank",
+    "folding::project_to_rigid",
+    "pattern::LoadOptions",
+    "pattern::Pattern",
+    "pattern::generate",
+    "plot::constraints_svg",
+    "plot::folding",
+    "plot::page",
+    "plot::response",
+    "plot::scene_page",
+    "plot::unfold_svg",
+    "read::file_frames_note",
+    "read::input",
+    "read::is_pattern_file",
+    "read::load_crease_pattern",
+    "read::load_pattern",
+    "read::load_scene",
+    "read::pattern_name",
+    "read::scene",
+    "unfold::UnfoldModel",
+    "unfold::UnfoldProgress",
+    "unfold::UnfoldReport",
+    "unfold::UnfoldSettings",
+    "unfold::energy",
+    "unfold::network",
+    "unfold::qp",
+    "unfold::unfold",
+    "unfold::unfold_observed",
+    "write::folder",
+    "write::folding_output",
+    "write::mujoco",
+    "write::output",
+];
+
+#[test]
+fn the_command_line_reaches_past_the_door_no_more_than_it_did() {
+    let mut files = rust_files("src/cli");
+    files.push("src/cli.rs".into());
+    files.push("src/main.rs".into());
+    let paths = front_end_paths(&files.iter().map(String::as_str).collect::<Vec<_>>());
+    let used: BTreeSet<String> = paths.keys().filter(|path| !through_the_door(path)).cloned().collect();
+    let allowed: BTreeSet<String> = CLI_PAST_THE_DOOR.iter().map(|s| s.to_string()).collect();
+    let new: Vec<&String> = used.difference(&allowed).collect();
+    let gone: Vec<&String> = allowed.difference(&used).collect();
+    assert!(
+        new.is_empty(),
+        "the command line reaches past the door anew: {new:?} (call the door)"
+    );
+    assert!(
+        gone.is_empty(),
+        "no longer used past the door: {gone:?} (take them off CLI_PAST_THE_DOOR)"
+    );
+}

@@ -390,26 +390,28 @@ def fold(
 def constraints(
     pattern: PatternLike,
     *,
-    driver: int,
-    locks: Optional[Mapping[int, float]] = None,
+    drive: int,
+    lock: Optional[Mapping[int, float]] = None,
     free: Optional[Sequence[int]] = None,
     degree: Union[int, str, None] = None,
     tol: Optional[float] = None,
-    domain: Optional[Sequence[float]] = None,
+    range: Optional[Sequence[float]] = None,
     samples: Optional[int] = None,
 ) -> Result:
-    """Constraint curves: every free crease as a polynomial of the ``driver`` crease (the
-    file's crease index: a FOLD edge index), swept by exact loop closure over ``domain``
-    (rad), with each curve's error. ``degree`` is 1..20 or ``"auto"`` with ``tol`` (rad).
+    """Constraint curves: every free crease as a polynomial of the ``drive`` crease (the
+    file's crease index: a FOLD edge index), swept by exact loop closure over ``range``
+    (degrees, as ``constraints --range A:B``), with each curve's error. ``lock`` holds
+    creases at angles in degrees (``--lock J=DEG``); ``degree`` is 1..20 or ``"auto"`` with
+    ``tol`` (rad).
 
     >>> import nanofold
-    >>> c = nanofold.constraints("patterns/miura_vertex.fold", driver=0, degree=6)
+    >>> c = nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree=6)
     >>> bool(c.max_closure_residual < 1e-3)
     True
     """
     pat = _pattern(pattern)
-    keywords = dict(driver=driver, locks=locks, free=list(free) if free is not None else None,
-                    degree=degree, tol=tol, domain=list(domain) if domain is not None else None, samples=samples)
+    keywords = dict(drive=drive, lock=lock, free=list(free) if free is not None else None,
+                    degree=degree, tol=tol, range=list(range) if range is not None else None, samples=samples)
     summary, rest = _call(_native.constraints, pat._handle, _settings(keywords))
     return Result("constraints", summary, rest)
 

@@ -4,11 +4,8 @@
 //! run on a worker thread with the GIL released, and Ctrl-C returns at once (the abandoned
 //! run finishes within the library's own bounds and its result is dropped).
 
-mod settings;
-
-use nanofold::commands::{self, Pattern};
-use nanofold::dynamics::scene::Scene;
-use nanofold::NanofoldError;
+use nanofold::commands::{self, FromJson, Pattern};
+use nanofold::prelude::{NanofoldError, Scene};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
@@ -52,7 +49,7 @@ fn to_py(error: NanofoldError) -> PyErr {
 /// signals) every 20 ms.
 fn run_detached<T: Send + 'static>(
     py: Python<'_>,
-    work: impl FnOnce() -> nanofold::Result<T> + Send + 'static,
+    work: impl FnOnce() -> nanofold::prelude::Result<T> + Send + 'static,
 ) -> PyResult<T> {
     let (sender, receiver) = mpsc::channel();
     std::thread::Builder::new()
@@ -146,7 +143,7 @@ impl PatternHandle {
 /// Reads a pattern file (FOLD or a native vertex).
 #[pyfunction]
 fn open_pattern(py: Python<'_>, path: String, options: &str) -> PyResult<PatternHandle> {
-    let options = settings::load_options(&parse_json(options, "options")?).map_err(to_py)?;
+    let options = read_options(options)?;
     let pattern = run_detached(py, move || Pattern::open(Path::new(&path), &options))?;
     Ok(PatternHandle {
         pattern: Arc::new(pattern),
@@ -165,7 +162,7 @@ fn parse_pattern(
     options: &str,
     source: Option<String>,
 ) -> PyResult<PatternHandle> {
-    let options = settings::load_options(&parse_json(options, "options")?).map_err(to_py)?;
+    let options = read_options(options)?;
     let pattern = run_detached(py, move || {
         let pattern = Pattern::parse(&text, &name, &origin, &options)?;
         Ok(match source {
@@ -178,15 +175,29 @@ fn parse_pattern(
     })
 }
 
+/// The keywords of a call as one command's options (the door's names and units; unknown
+/// names refused by name).
+fn options<T: FromJson>(text: &str, what: &'static str) -> PyResult<T> {
+    T::from_json(&parse_json(text, what)?).map_err(to_py)
+}
+
+/// The reading options (`closure_tol`, `angle_sum_tol`), validated.
+fn read_options(text: &str) -> PyResult<nanofold::prelude::LoadOptions> {
+    options::<commands::ReadOptions>(text, "options")?
+        .load_options()
+        .map_err(to_py)
+}
+
 /// `check`: the report's JSON.
 #[pyfunction]
 fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    let settings =
-        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Check).map_err(to_py)?;
+    let check: commands::CheckOptions = options(settings, "settings")?;
+    let mut settings = commands::Settings::default();
+    settings.check.closure_tol = check.closure_tol;
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
         let clock = Instant::now();
-        let report = commands::check(&pattern, &settings.settings)?;
+        let report = commands::check(&pattern, &settings)?;
         Ok(payload(
             report.to_json(&pattern),
             json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
@@ -198,12 +209,15 @@ fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(S
 /// `unfold`: the report's JSON and the fold angles of every recorded step.
 #[pyfunction]
 fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    let settings =
-        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Unfold).map_err(to_py)?;
+    let unfold: commands::UnfoldOptions = options(settings, "settings")?;
+    let settings = commands::Settings {
+        unfold: unfold.settings().map_err(to_py)?,
+        ..commands::Settings::default()
+    };
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
         let clock = Instant::now();
-        let report = commands::unfold(&pattern, &settings.settings)?;
+        let report = commands::unfold(&pattern, &settings)?;
         Ok(payload(
             report.to_json(&pattern),
             json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
@@ -212,62 +226,28 @@ fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(
     })
 }
 
-/// `fold`: the report's JSON, the path's fold angles and progress, its FOLD animation with
-/// `frames` frames and its end state as FOLD.
+/// `fold`: the report's JSON, the path's fold angles and progress, its FOLD animation and
+/// its end state as FOLD.
 #[pyfunction]
 fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    use nanofold::write::folding_output::{crease_pattern_fold, fold_path_fold};
-    let mut settings =
-        settings::command_settings(&parse_json(settings, "settings")?, settings::Kind::Fold).map_err(to_py)?;
+    let fold: commands::FoldOptions = options(settings, "settings")?;
     let pattern = pattern.pattern.clone();
-    if !settings.drive_edges.is_empty() {
-        let model = pattern.sheet().ok_or_else(|| {
-            to_py(NanofoldError::invalid(
-                "pattern",
-                pattern.name(),
-                "a cone has no flat sheet to fold",
-            ))
-        })?;
-        let columns = settings
-            .drive_edges
-            .iter()
-            .map(
-                |&(edge, angle)| match model.column_of_edge.get(edge).copied().flatten() {
-                    Some(column) => Ok((column, angle)),
-                    None => Err(to_py(NanofoldError::invalid(
-                        "drive",
-                        edge,
-                        format!(
-                            "edge {edge} is not a crease of {} (keys are FOLD edge indices)",
-                            pattern.name()
-                        ),
-                    ))),
-                },
-            )
-            .collect::<PyResult<Vec<_>>>()?;
-        settings.settings.fold.drive = nanofold::folding::Drive::Creases(columns);
-    }
     run_detached(py, move || {
         let clock = Instant::now();
-        let report = commands::fold(&pattern, &settings.settings)?;
-        let (commands::Detail::Fold(path), Some(model)) = (&report.detail, pattern.sheet()) else {
-            unreachable!("fold answers with a path on the sheet");
+        let run = commands::fold_run(&pattern, &fold)?;
+        let commands::Detail::Fold(path) = &run.report.detail else {
+            unreachable!("fold answers with a path");
         };
-        let frames = nanofold::folding::path_frames(model, path, settings.frames)?;
-        let mut summary = report.to_json(&pattern);
-        summary["frames"] = json!(frames.len());
+        let mut summary = run.report.to_json(&pattern);
+        summary["frames"] = json!(run.frames.len());
         Ok(payload(
             summary,
             json!({
-                "trajectory": trajectory(&report),
-                "extra": extra(&report),
+                "trajectory": trajectory(&run.report),
+                "extra": extra(&run.report),
                 "progress": path.steps.iter().map(|s| s.progress).collect::<Vec<_>>(),
-                "fold_file": fold_path_fold(model, &frames),
-                "folded_file": crease_pattern_fold(
-                    &model.pattern,
-                    Some(&report.final_fold_angles_rad),
-                    "end state of nanofold fold (a crease pattern with its fold angles)",
-                ),
+                "fold_file": run.animation,
+                "folded_file": run.end_state,
             }),
             clock,
         ))
@@ -318,7 +298,9 @@ fn trajectory(report: &commands::Report) -> Vec<Vec<f64>> {
 /// `constraints`: the curves' report as `constraints --json` prints it, and the samples.
 #[pyfunction]
 fn constraints(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(String, String)> {
-    let settings = settings::constraint_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
+    let settings = options::<commands::ConstraintOptions>(settings, "settings")?
+        .settings()
+        .map_err(to_py)?;
     let pattern = pattern.pattern.clone();
     run_detached(py, move || {
         let clock = Instant::now();
@@ -330,7 +312,7 @@ fn constraints(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyRes
 /// Builds a generated pattern: its FOLD text.
 #[pyfunction]
 fn generate(py: Python<'_>, kind: String, parameters: &str) -> PyResult<String> {
-    let generator = settings::generator(&kind, &parse_json(parameters, "parameters")?).map_err(to_py)?;
+    let generator = commands::Generator::from_options(&kind, &parse_json(parameters, "parameters")?).map_err(to_py)?;
     run_detached(py, move || Ok(generator.to_fold()?.to_string()))
 }
 
@@ -351,7 +333,7 @@ impl SceneHandle {
 fn on_scene<T: Send + 'static>(
     py: Python<'_>,
     scene: &SceneHandle,
-    work: impl FnOnce(&Scene) -> nanofold::Result<T> + Send + 'static,
+    work: impl FnOnce(&Scene) -> nanofold::prelude::Result<T> + Send + 'static,
 ) -> PyResult<T> {
     let scene = scene.scene.clone();
     run_detached(py, move || {
@@ -369,11 +351,7 @@ impl SceneHandle {
     /// "strip", "closed" or "network".
     #[getter]
     fn kind(&self) -> &'static str {
-        self.with(|s| match s.system {
-            nanofold::dynamics::scene::System::Strip(_) => "strip",
-            nanofold::dynamics::scene::System::Closed(_) => "closed",
-            nanofold::dynamics::scene::System::Network(_) => "network",
-        })
+        self.with(commands::scene_kind)
     }
 }
 
@@ -381,7 +359,7 @@ impl SceneHandle {
 #[pyfunction]
 fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base: String) -> PyResult<SceneHandle> {
     let scene = run_detached(py, move || {
-        nanofold::read::scene::parse_scene(&text, &source, &name, Path::new(&base))?.build()
+        commands::parse_scene(&text, &source, &name, Path::new(&base))
     })?;
     Ok(SceneHandle {
         scene: Arc::new(Mutex::new(scene)),
@@ -391,7 +369,9 @@ fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base:
 /// `simulate`: the summary, response.json and a network's motion.fold.
 #[pyfunction]
 fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(String, String)> {
-    let settings = settings::simulation_settings(&parse_json(settings, "settings")?).map_err(to_py)?;
+    let settings = options::<commands::SimulateOptions>(settings, "settings")?
+        .settings()
+        .map_err(to_py)?;
     on_scene(py, scene, move |scene| {
         let clock = Instant::now();
         let report = commands::simulate(scene, &settings)?;

@@ -98,7 +98,7 @@ def test_a_folded_miura_from_the_generator_is_rigid_and_unfolds_flat():
         (lambda: nanofold.fold("patterns/many/miura_4x4.fold", to=200), nanofold.InvalidFieldError, "drive.to"),
         (lambda: nanofold.fold("patterns/many/miura_4x4.fold", drive={3: 1.0}), nanofold.InvalidFieldError, "drive"),
         (lambda: nanofold.simulate("patterns/bridge_step.scene.json", rtol=-1), nanofold.InvalidFieldError, "rtol"),
-        (lambda: nanofold.constraints("patterns/miura_vertex.fold", driver=9), nanofold.InvalidFieldError, "driver"),
+        (lambda: nanofold.constraints("patterns/miura_vertex.fold", drive=9), nanofold.InvalidFieldError, "drive"),
         (lambda: nanofold.Pattern.open("patterns/nothing.fold"), nanofold.FileReadError, "path"),
         (lambda: nanofold.Pattern.open("patterns/bridge_step.scene.json"), nanofold.InputError, None),
         (lambda: nanofold.Scene.open("patterns/bridge_step.scene.json").replace({"plates.9.length_um": 1}),

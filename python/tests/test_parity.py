@@ -68,13 +68,13 @@ def test_simulate_equals_the_command_line(scene, tmp_path):
 
 
 def test_constraints_equal_the_command_line(tmp_path):
-    vertex = nanofold.constraints("patterns/miura_vertex.fold", driver=0, degree=6, samples=101)
+    vertex = nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree=6, samples=101)
     assert comparable(vertex.to_dict()) == comparable(
         cli_json("constraints", "patterns/miura_vertex.fold", "--drive", "0", "--degree", "6", "--samples", "101",
                  "--out", str(tmp_path / "c1"))
     )
     folded = "patterns/many/miura_4x4_folded.fold"
-    network = nanofold.constraints(folded, driver=_first_crease(folded), degree=5, samples=41)
+    network = nanofold.constraints(folded, drive=_first_crease(folded), degree=5, samples=41)
     assert comparable(network.to_dict()) == comparable(
         cli_json("constraints", folded, "--drive", str(_first_crease(folded)), "--degree", "5", "--samples", "41",
                  "--out", str(tmp_path / "c2"))

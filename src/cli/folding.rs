@@ -466,8 +466,8 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
         .collect::<Result<Vec<_>>>()?;
     let mujoco = args.format == super::ExportFormat::Mujoco;
     let settings = ConstraintSettings {
-        driver: args.drive,
-        locks,
+        drive: args.drive,
+        lock: locks,
         free: args.free.clone(),
         degree: match degree {
             Some(d) => Degree::Fixed(d),
@@ -476,7 +476,7 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
                 at_most: if mujoco { 4 } else { nanofold::constraints::MAX_DEGREE },
             },
         },
-        domain: args.range.as_deref().map(super::parse_range).transpose()?,
+        range: args.range.as_deref().map(super::parse_range).transpose()?,
         samples: args.samples,
     };
     let pattern = nanofold::commands::Pattern::from_crease_pattern(model.pattern.clone())?;
@@ -484,10 +484,10 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
         flags(
             e,
             &[
-                ("domain", "--range"),
+                ("range", "--range"),
                 ("samples", "--samples"),
-                ("driver", "--drive"),
-                ("locks", "--lock"),
+                ("drive", "--drive"),
+                ("lock", "--lock"),
                 ("free", "--free"),
                 ("degree", "--degree"),
                 ("tolerance", "--tol"),

@@ -32,17 +32,17 @@ pub enum Degree {
 pub struct ConstraintSettings {
     /// The driving crease, by the file's index (a FOLD edge index; for a native vertex its
     /// position in `creases`).
-    pub driver: usize,
+    pub drive: usize,
     /// Creases held at angles (file index, rad); the others close every vertex around them.
-    pub locks: Vec<(usize, f64)>,
+    pub lock: Vec<(usize, f64)>,
     /// When not empty: the only creases left free besides the driver (every other held at
-    /// its folded angle, unless `locks` sets its angle).
+    /// its folded angle, unless `lock` sets its angle).
     pub free: Vec<usize>,
     /// The curves' degree.
     pub degree: Degree,
     /// The driving angle's range, rad (None: flat to the folded angle; for many vertices
     /// from 5% of it, as the flat state is a branch point).
-    pub domain: Option<[f64; 2]>,
+    pub range: Option<[f64; 2]>,
     /// Sweep samples (2 to 100 000).
     pub samples: usize,
 }
@@ -50,11 +50,11 @@ pub struct ConstraintSettings {
 impl Default for ConstraintSettings {
     fn default() -> Self {
         ConstraintSettings {
-            driver: 0,
-            locks: Vec::new(),
+            drive: 0,
+            lock: Vec::new(),
             free: Vec::new(),
             degree: Degree::Fixed(4),
-            domain: None,
+            range: None,
             samples: 201,
         }
     }
@@ -127,11 +127,11 @@ fn vertex_constraints(pattern: &crate::pattern::Pattern, settings: &ConstraintSe
             )
         })
     };
-    let driver = index(settings.driver, "driver")?;
+    let driver = index(settings.drive, "drive")?;
     let mut locks = settings
-        .locks
+        .lock
         .iter()
-        .map(|&(i, angle)| Ok((index(i, "locks")?, angle)))
+        .map(|&(i, angle)| Ok((index(i, "lock")?, angle)))
         .collect::<Result<Vec<_>>>()?;
     if !settings.free.is_empty() {
         let free = settings
@@ -146,7 +146,7 @@ fn vertex_constraints(pattern: &crate::pattern::Pattern, settings: &ConstraintSe
         }
     }
     let setup = Setup::new(pattern, driver, &locks)?;
-    let domain = match settings.domain {
+    let domain = match settings.range {
         Some(d) => d,
         None => default_domain(pattern, driver)?,
     };
@@ -195,10 +195,10 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
     };
     let mut rho = model.given_fold_angles();
     let mut locked = Vec::new();
-    for &(edge, angle) in &settings.locks {
-        locked.push((column(edge, "locks")?, angle));
+    for &(edge, angle) in &settings.lock {
+        locked.push((column(edge, "lock")?, angle));
     }
-    let driver = column(settings.driver, "driver")?;
+    let driver = column(settings.drive, "drive")?;
     let mut free = vec![settings.free.is_empty(); model.crease_count()];
     for &edge in &settings.free {
         free[column(edge, "free")?] = true;
@@ -216,8 +216,8 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
         let mut solver = crate::folding::normal::NormalSolver::new(1e-10);
         if crate::folding::restore_closure(&model, &mut rho, 1e-12, &mut solver)?.is_none() {
             return Err(NanofoldError::invalid(
-                "locks",
-                format!("{:?}", settings.locks),
+                "lock",
+                format!("{:?}", settings.lock),
                 "no rigid state near the file's with these creases held",
             ));
         }
@@ -229,7 +229,7 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
             "constraint curves of many vertices start from a folded state (e.g. folded.fold written by `nanofold fold`); this pattern is flat",
         ));
     }
-    let domain = settings.domain.unwrap_or_else(|| {
+    let domain = settings.range.unwrap_or_else(|| {
         let (a, b) = (0.05 * rho[driver], rho[driver]);
         [a.min(b), a.max(b)]
     });

@@ -1,7 +1,7 @@
 //! Generated crease patterns behind the door: one [`Generator`] for every family
 //! `docs/model.md#pattern-generators` describes, written as FOLD the way `generate` writes it.
 
-use crate::error::Result;
+use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
 use crate::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use crate::write::folding_output::crease_pattern_fold;
@@ -73,5 +73,138 @@ impl Generator {
     pub fn to_fold(&self) -> Result<serde_json::Value> {
         let (model, state) = self.build()?;
         Ok(crease_pattern_fold(&model.pattern, state.as_deref(), &self.note()))
+    }
+}
+
+/// A Miura-ori's options as the front ends name them (`generate miura --rows …`).
+#[derive(Debug, Clone, Copy, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct MiuraOptions {
+    rows: usize,
+    cols: usize,
+    angle_deg: f64,
+    width: f64,
+    slant: f64,
+    fold_deg: f64,
+}
+
+impl Default for MiuraOptions {
+    fn default() -> Self {
+        let d = MiuraSpec::default();
+        MiuraOptions {
+            rows: d.rows,
+            cols: d.cols,
+            angle_deg: d.sector_angle.to_degrees(),
+            width: d.width,
+            slant: d.slant,
+            fold_deg: 0.0,
+        }
+    }
+}
+
+/// A square twist's options.
+#[derive(Debug, Clone, Copy, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct SquareTwistOptions {
+    side: f64,
+    half_sheet: f64,
+    twist_deg: f64,
+    flip_pleats: bool,
+}
+
+impl Default for SquareTwistOptions {
+    fn default() -> Self {
+        let d = SquareTwistSpec::default();
+        SquareTwistOptions {
+            side: d.side,
+            half_sheet: d.half_sheet,
+            twist_deg: d.twist.to_degrees(),
+            flip_pleats: d.flip_pleats,
+        }
+    }
+}
+
+/// A waterbomb tessellation's options.
+#[derive(Debug, Clone, Copy, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct WaterbombOptions {
+    rows: usize,
+    cols: usize,
+    row_height: f64,
+}
+
+impl Default for WaterbombOptions {
+    fn default() -> Self {
+        let d = WaterbombSpec::default();
+        WaterbombOptions {
+            rows: d.rows,
+            cols: d.cols,
+            row_height: d.row_height,
+        }
+    }
+}
+
+/// A bird base's options.
+#[derive(Debug, Clone, Copy, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct BirdBaseOptions {
+    half_side: f64,
+}
+
+impl Default for BirdBaseOptions {
+    fn default() -> Self {
+        BirdBaseOptions {
+            half_side: BirdBaseSpec::default().half_side,
+        }
+    }
+}
+
+impl Generator {
+    /// A family by its name (`miura`, `square_twist`, `waterbomb`, `bird_base`) with its
+    /// options by the front ends' names (lengths in the sheet's units, angles in degrees:
+    /// `angle_deg`, `fold_deg`, `twist_deg`); unknown names are refused by name.
+    pub fn from_options(family: &str, options: &serde_json::Value) -> Result<Generator> {
+        use super::options::options_from_json;
+        Ok(match family {
+            "miura" => {
+                let o: MiuraOptions = options_from_json(options)?;
+                Generator::Miura(MiuraSpec {
+                    rows: o.rows,
+                    cols: o.cols,
+                    sector_angle: o.angle_deg.to_radians(),
+                    width: o.width,
+                    slant: o.slant,
+                    zigzag_fold_angle: o.fold_deg.to_radians(),
+                })
+            }
+            "square_twist" | "square-twist" => {
+                let o: SquareTwistOptions = options_from_json(options)?;
+                Generator::SquareTwist(SquareTwistSpec {
+                    side: o.side,
+                    half_sheet: o.half_sheet,
+                    twist: o.twist_deg.to_radians(),
+                    flip_pleats: o.flip_pleats,
+                })
+            }
+            "waterbomb" => {
+                let o: WaterbombOptions = options_from_json(options)?;
+                Generator::Waterbomb(WaterbombSpec {
+                    rows: o.rows,
+                    cols: o.cols,
+                    row_height: o.row_height,
+                })
+            }
+            "bird_base" | "bird-base" => {
+                let o: BirdBaseOptions = options_from_json(options)?;
+                Generator::BirdBase(BirdBaseSpec { half_side: o.half_side })
+            }
+            other => {
+                return Err(NanofoldError::invalid(
+                    "kind",
+                    other,
+                    "expected \"miura\", \"square_twist\", \"waterbomb\" or \"bird_base\"",
+                ))
+            }
+        })
     }
 }

@@ -9,6 +9,27 @@ use crate::write::folding_output::{network_modes_fold, network_motion_fold};
 use crate::write::output::{closed_modes_json, modes_json, network_modes_json, response_json, response_summary};
 use serde_json::Value;
 
+/// Reads and builds a scene file (`*.scene.json`); a closed chain's or a device's
+/// `pattern` is read relative to the scene's folder.
+pub fn open_scene(path: &std::path::Path) -> Result<Scene> {
+    crate::read::load_scene(path)?.build()
+}
+
+/// Reads and builds scene text: `source` names it in errors, `name` names the scene when
+/// it has none, `base` is the folder its `pattern` path is relative to.
+pub fn parse_scene(text: &str, source: &str, name: &str, base: &std::path::Path) -> Result<Scene> {
+    crate::read::parse_scene(text, source, name, base)?.build()
+}
+
+/// What a scene simulates, in one word: `strip`, `closed` or `network`.
+pub fn scene_kind(scene: &Scene) -> &'static str {
+    match scene.system {
+        System::Strip(_) => "strip",
+        System::Closed(_) => "closed",
+        System::Network(_) => "network",
+    }
+}
+
 /// Each mode's frames in modes.fold move its largest crease this far either way, rad.
 pub const MODE_AMPLITUDE: f64 = 0.1;
 

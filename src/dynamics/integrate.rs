@@ -11,7 +11,7 @@ use crate::error::{NanofoldError, NumericalError, Result};
 use diffsol::{
     NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Vector,
 };
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
 
 /// Contact scanning: sub-intervals of a solver step in which some gap comes within reach of
@@ -29,7 +29,7 @@ const NEWTON_FAILURE_FLOOR: usize = 1000;
 pub const IMPLICIT_RATIO: f64 = 100.0;
 
 /// diffsol's integrators; `Auto` picks Tsit45 for short runs and ESDIRK34 for long (stiff) ones.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Chosen from the time scales.
@@ -39,6 +39,7 @@ pub enum Method {
     /// The L-stable ESDIRK34 Runge–Kutta method.
     Esdirk34,
     /// TR-BDF2.
+    #[serde(alias = "tr_bdf2")]
     TrBdf2,
     /// Tsitouras 5(4), explicit.
     Tsit45,

@@ -38,13 +38,15 @@ pub enum ModelKind {
 }
 
 /// The user's choice: a model, or `Auto` from the time-scale ratio.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ModelChoice {
     /// Quasi-static from a time-scale ratio of [`QUASI_STATIC_RATIO`] up, else dynamic.
     Auto,
     /// Always integrate.
     Dynamic,
     /// Always the quasi-static path (its error is still measured).
+    #[serde(alias = "quasi-static")]
     QuasiStatic,
 }
 

@@ -2,7 +2,7 @@
 //! reading can be added without touching the solver.
 
 use crate::geometry::sphere::{geodesic_with_gradient, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A great-circle arc (one sector) between nodes `a` and `b`, of length `length`.
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -40,13 +40,14 @@ pub trait Energy: Send + Sync {
 }
 
 /// Which energy to use, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EnergyKind {
     /// U_s = Σ_e Σ_{v∉e} (γ(v,a_e) + γ(v,b_e) − α_e)^(−p), default p = 2: a barrier
     /// wherever a node touches an arc.
     Separable,
     /// U_m = Σ_e Σ_{v∉e} γ(v, m_e)^(−p), default p = 4: no barrier away from midpoints.
+    #[serde(alias = "non_separable")]
     NonSeparable,
 }
 

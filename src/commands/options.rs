@@ -1,0 +1,414 @@
+//! Every command's options as the front ends name them: the command line's flags are these
+//! names with hyphens, Python's keywords are these names. One name has one unit everywhere:
+//! a fold's target in percent, angles a person types in degrees (`_deg` where the name does
+//! not say it: `drive`, `lock`, `range`, `max_step`), tolerances in rad. Each deserialises
+//! from a JSON object (unknown names refused by name) and becomes the engines' validated
+//! settings by one function, so the command line and Python cannot disagree.
+
+use super::constraints::{ConstraintSettings, Degree};
+use super::Settings;
+use crate::dynamics::integrate::Method;
+use crate::dynamics::simulate::{ModelChoice, SimulationSettings};
+use crate::error::{NanofoldError, Result};
+use crate::folding::{Drive, FoldSettings};
+use crate::pattern::LoadOptions;
+use crate::unfold::energy::EnergyKind;
+use crate::unfold::qp::QpMethod;
+use crate::unfold::UnfoldSettings;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// Options of a JSON object: `null` values are left at their defaults (Python passes
+/// `None` for a keyword it was not given).
+pub fn options_from_json<T: serde::de::DeserializeOwned>(value: &serde_json::Value) -> Result<T> {
+    let mut value = value.clone();
+    if let Some(object) = value.as_object_mut() {
+        object.retain(|_, v| !v.is_null());
+    } else if !value.is_null() {
+        return Err(NanofoldError::invalid(
+            "options",
+            crate::read::input::short_json(&value),
+            "expected named options (a JSON object)",
+        ));
+    } else {
+        value = serde_json::json!({});
+    }
+    crate::read::input::from_value(&value)
+}
+
+/// Options that read themselves from a JSON object (see [`options_from_json`]): what the
+/// Python package hands over.
+pub trait FromJson: Sized {
+    /// The options of `value`; unknown names are refused by name.
+    fn from_json(value: &serde_json::Value) -> Result<Self>;
+}
+
+impl<T: serde::de::DeserializeOwned> FromJson for T {
+    fn from_json(value: &serde_json::Value) -> Result<Self> {
+        options_from_json(value)
+    }
+}
+
+/// How a pattern file is read (`check`, `unfold`, `fold`, `constraints`).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReadOptions {
+    /// Largest accepted loop-closure residual of a folded state, rad.
+    pub closure_tol: f64,
+    /// |Σα − 2π| below which a closed vertex's sectors are taken to close the paper, rad.
+    pub angle_sum_tol: f64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        let d = LoadOptions::default();
+        ReadOptions {
+            closure_tol: d.closure_tol,
+            angle_sum_tol: d.angle_sum_tol,
+        }
+    }
+}
+
+impl ReadOptions {
+    /// The readers' validated options.
+    pub fn load_options(&self) -> Result<LoadOptions> {
+        let options = LoadOptions {
+            closure_tol: self.closure_tol,
+            angle_sum_tol: self.angle_sum_tol,
+        };
+        options.validate()?;
+        Ok(options)
+    }
+}
+
+/// `unfold` (and the unfolding a `check` runs).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct UnfoldOptions {
+    /// The repulsive energy (`docs/model.md#energy`).
+    pub energy: EnergyKind,
+    /// Its exponent (None: 2 separable, 4 non-separable).
+    pub p: Option<f64>,
+    /// The direction solver.
+    pub qp: QpMethod,
+    /// Flat when every |fold angle| is at most this, rad.
+    pub flat_tol: f64,
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Weight κ of the direction's bending metric (0: the plain QP).
+    pub bending_metric: f64,
+    /// Restarts from perturbed states before a stuck verdict.
+    pub restarts: usize,
+    /// Seed of the restarts' perturbations.
+    pub seed: u64,
+}
+
+impl Default for UnfoldOptions {
+    fn default() -> Self {
+        let d = UnfoldSettings::default();
+        UnfoldOptions {
+            energy: d.energy,
+            p: d.p,
+            qp: d.qp,
+            flat_tol: d.flat_tol,
+            max_iterations: d.max_iterations,
+            bending_metric: d.bending_metric,
+            restarts: d.restarts,
+            seed: d.seed,
+        }
+    }
+}
+
+impl UnfoldOptions {
+    /// The unfolding settings, validated.
+    pub fn settings(&self) -> Result<UnfoldSettings> {
+        let settings = UnfoldSettings {
+            energy: self.energy,
+            p: self.p,
+            qp: self.qp,
+            flat_tol: self.flat_tol,
+            max_iterations: self.max_iterations,
+            bending_metric: self.bending_metric,
+            restarts: self.restarts,
+            seed: self.seed,
+            ..UnfoldSettings::default()
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+}
+
+/// `fold`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FoldOptions {
+    /// Stop when the most folded crease reaches this percentage of a full fold (an
+    /// assignment drive; 0.1 to 100).
+    pub to: f64,
+    /// Drive these creases (FOLD edge index) to these angles, degrees, instead of the
+    /// assignment.
+    pub drive: BTreeMap<usize, f64>,
+    /// Largest change of any fold angle in one step, degrees: a cap, the step control
+    /// chooses below it.
+    pub max_step: f64,
+    /// Most steps.
+    pub max_steps: usize,
+    /// Frames of the FOLD animation (2 to 10 000).
+    pub frames: usize,
+}
+
+/// Most frames of a fold's animation.
+pub const MAX_FRAMES: usize = 10_000;
+
+impl Default for FoldOptions {
+    fn default() -> Self {
+        let d = FoldSettings::default();
+        FoldOptions {
+            to: 100.0,
+            drive: BTreeMap::new(),
+            max_step: d.max_step.to_degrees(),
+            max_steps: d.max_steps,
+            frames: 11,
+        }
+    }
+}
+
+impl FoldOptions {
+    /// The folding settings for `pattern`, validated (a driven edge must be one of its
+    /// creases).
+    pub fn settings(&self, model: &crate::folding::FoldingModel) -> Result<FoldSettings> {
+        let drive = if self.drive.is_empty() {
+            Drive::Assignment { to: self.to }
+        } else {
+            Drive::Creases(
+                self.drive
+                    .iter()
+                    .map(|(&edge, &degrees)| {
+                        let column = model.column_of_edge.get(edge).copied().flatten().ok_or_else(|| {
+                            NanofoldError::invalid(
+                                "drive",
+                                edge,
+                                format!(
+                                    "not a crease of the pattern (its {} edges: creases are the M, V and U ones)",
+                                    model.pattern.edges.len()
+                                ),
+                            )
+                        })?;
+                        Ok((column, degrees.to_radians()))
+                    })
+                    .collect::<Result<_>>()?,
+            )
+        };
+        if !(2..=MAX_FRAMES).contains(&self.frames) {
+            return Err(NanofoldError::invalid(
+                "frames",
+                self.frames,
+                format!("must lie in [2, {MAX_FRAMES}]"),
+            ));
+        }
+        let settings = FoldSettings {
+            drive,
+            max_step: self.max_step.to_radians(),
+            max_steps: self.max_steps,
+            ..FoldSettings::default()
+        };
+        settings.validate(model)?;
+        Ok(settings)
+    }
+}
+
+/// `check`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CheckOptions {
+    /// Largest closure residual of a state called rigid, rad.
+    pub closure_tol: f64,
+}
+
+impl Default for CheckOptions {
+    fn default() -> Self {
+        CheckOptions {
+            closure_tol: Settings::default().check.closure_tol,
+        }
+    }
+}
+
+/// A constraint curve's degree as the front ends give it: a number, or `"auto"` with a
+/// tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum DegreeOption {
+    /// This degree (1 to 20).
+    Fixed(usize),
+    /// `"auto"`: the lowest degree whose fit meets `tol`.
+    Named(AutoDegree),
+}
+
+/// The one word a degree may be instead of a number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AutoDegree {
+    /// The lowest degree whose fit meets `tol`.
+    Auto,
+}
+
+/// `constraints`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ConstraintOptions {
+    /// The driving crease (the file's index: a FOLD edge index).
+    pub drive: usize,
+    /// Creases held at angles, degrees.
+    pub lock: BTreeMap<usize, f64>,
+    /// When not empty: the only creases left free besides the driver.
+    pub free: Vec<usize>,
+    /// The curves' degree.
+    pub degree: DegreeOption,
+    /// With degree `"auto"`: the largest accepted fit error, rad.
+    pub tol: Option<f64>,
+    /// The driving angle's range [from, to], degrees (None: flat to the folded angle; for
+    /// many vertices from 5% of it).
+    pub range: Option<[f64; 2]>,
+    /// Sweep samples.
+    pub samples: usize,
+}
+
+impl Default for ConstraintOptions {
+    fn default() -> Self {
+        let d = ConstraintSettings::default();
+        ConstraintOptions {
+            drive: d.drive,
+            lock: BTreeMap::new(),
+            free: Vec::new(),
+            degree: DegreeOption::Fixed(4),
+            tol: None,
+            range: None,
+            samples: d.samples,
+        }
+    }
+}
+
+impl ConstraintOptions {
+    /// The sweep's settings (checked against the pattern when it runs).
+    pub fn settings(&self) -> Result<ConstraintSettings> {
+        let degree = match (self.degree, self.tol) {
+            (DegreeOption::Fixed(n), None) => Degree::Fixed(n),
+            (DegreeOption::Named(AutoDegree::Auto), Some(tol)) => Degree::Auto {
+                tol,
+                at_most: crate::constraints::MAX_DEGREE,
+            },
+            (DegreeOption::Named(AutoDegree::Auto), None) => {
+                return Err(NanofoldError::invalid(
+                    "degree",
+                    "\"auto\"",
+                    "needs tol (the largest accepted fit error, rad)",
+                ))
+            }
+            (DegreeOption::Fixed(_), Some(_)) => {
+                return Err(NanofoldError::invalid(
+                    "tol",
+                    "given",
+                    "applies only to degree \"auto\"",
+                ))
+            }
+        };
+        Ok(ConstraintSettings {
+            drive: self.drive,
+            lock: self.lock.iter().map(|(&c, &deg)| (c, deg.to_radians())).collect(),
+            free: self.free.clone(),
+            degree,
+            range: self.range.map(|[a, b]| [a.to_radians(), b.to_radians()]),
+            samples: self.samples,
+        })
+    }
+}
+
+/// `simulate`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimulateOptions {
+    /// Equations to solve; `auto` compares the forcing time with the fastest period.
+    pub model: ModelChoice,
+    /// Integrator.
+    pub method: Method,
+    /// Relative tolerance (the absolute one is the same in rad).
+    pub rtol: f64,
+    /// End time, s (None: the scene's `time.t_end_s`).
+    pub t_end: Option<f64>,
+    /// Integrate through contacts instead of stopping at the first.
+    pub ignore_collisions: bool,
+    /// Integrator steps before the run stops with an error.
+    pub max_steps: usize,
+}
+
+impl Default for SimulateOptions {
+    fn default() -> Self {
+        let d = SimulationSettings::default();
+        SimulateOptions {
+            model: d.model,
+            method: d.method,
+            rtol: d.rtol,
+            t_end: d.t_end,
+            ignore_collisions: d.ignore_collisions,
+            max_steps: d.max_steps,
+        }
+    }
+}
+
+impl SimulateOptions {
+    /// The simulation settings, validated.
+    pub fn settings(&self) -> Result<SimulationSettings> {
+        let settings = SimulationSettings {
+            model: self.model,
+            method: self.method,
+            rtol: self.rtol,
+            t_end: self.t_end,
+            ignore_collisions: self.ignore_collisions,
+            max_steps: self.max_steps,
+            ..SimulationSettings::default()
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_engines_defaults_and_unknown_names_are_refused() {
+        let fold: FoldOptions = options_from_json(&serde_json::json!({"to": null})).unwrap();
+        assert_eq!(fold, FoldOptions::default());
+        let (unfold, engine) = (UnfoldOptions::default().settings().unwrap(), UnfoldSettings::default());
+        assert_eq!(format!("{unfold:?}"), format!("{engine:?}"));
+        let simulate = SimulateOptions::default().settings().unwrap();
+        assert_eq!((simulate.rtol, simulate.max_steps), (1e-8, 5_000_000));
+        let error = options_from_json::<FoldOptions>(&serde_json::json!({"too": 90})).unwrap_err();
+        assert!(error.to_string().contains("too"), "{error}");
+        let error = options_from_json::<UnfoldOptions>(&serde_json::json!({"energy": "elastic"})).unwrap_err();
+        assert!(error.to_string().contains("energy"), "{error}");
+        // Python's spelling and the command line's both name the same choice.
+        for name in ["non_separable", "non-separable"] {
+            let options: UnfoldOptions = options_from_json(&serde_json::json!({ "energy": name })).unwrap();
+            assert_eq!(options.energy, EnergyKind::NonSeparable);
+        }
+    }
+
+    #[test]
+    fn degrees_and_percent_become_the_engines_radians_and_fractions() {
+        let options: ConstraintOptions = options_from_json(
+            &serde_json::json!({"drive": 2, "lock": {"1": 90.0}, "degree": "auto", "tol": 1e-6, "range": [0.0, 180.0]}),
+        )
+        .unwrap();
+        let settings = options.settings().unwrap();
+        assert_eq!(settings.lock, vec![(1, std::f64::consts::FRAC_PI_2)]);
+        assert_eq!(settings.range, Some([0.0, std::f64::consts::PI]));
+        assert!(matches!(settings.degree, Degree::Auto { tol, .. } if tol == 1e-6));
+        let error = options_from_json::<ConstraintOptions>(&serde_json::json!({"degree": "auto"}))
+            .unwrap()
+            .settings()
+            .unwrap_err();
+        assert!(error.to_string().contains("tol"), "{error}");
+    }
+}
