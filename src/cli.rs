@@ -476,21 +476,18 @@ fn unfold_one(
 ) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
-    let pattern = match nanofold::read::load_pattern(pattern_path, &solver.load_options()) {
-        Ok(pattern) => pattern,
-        Err(e) if nanofold::commands::takes_many_vertices(&e, pattern_path) => {
-            return folding::unfold_network_one(pattern_path, solver, dir, progress)
-        }
-        Err(e) => return Err(reading(pattern_path, e)),
+    let (opened, projection) = open_pattern(pattern_path, solver)?;
+    let Some(pattern) = opened.vertex() else {
+        return folding::unfold_network_one(pattern_path, &opened, projection, solver, dir, progress);
     };
-    let report = unfold_observed(&pattern, &settings, progress)?;
-    let model = UnfoldModel::new(&pattern);
+    let report = unfold_observed(pattern, &settings, progress)?;
+    let model = UnfoldModel::new(pattern);
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
-    let trajectory = serde_json::to_string(&trajectory_json(&pattern, &settings, &report, 1000))?;
-    let animation = fold_animation(&pattern, &model, &report);
+    let trajectory = serde_json::to_string(&trajectory_json(pattern, &settings, &report, 1000))?;
+    let animation = fold_animation(pattern, &model, &report);
     let fold = serde_json::to_string_pretty(&animation)?;
-    let svg = unfold_svg(&pattern, &report)?;
+    let svg = unfold_svg(pattern, &report)?;
     let page = nanofold::plot::page::page_of_fold(&animation, &pattern.name, &[], None)?;
     let files = [
         ("trajectory.json", trajectory.as_bytes()),
@@ -505,7 +502,7 @@ fn unfold_one(
         &files,
     )
     .with_context(|| format!("writing {}", dir.display()))?;
-    let mut summary = summary(&pattern, pattern_path, &report);
+    let mut summary = summary(pattern, pattern_path, &report);
     summary["out"] = json!(dir.display().to_string());
     let mut text = String::new();
     writeln!(
@@ -640,46 +637,53 @@ fn print_failure(path: &Path, error: &anyhow::Error, as_json: bool) {
     }
 }
 
+/// Reads a pattern through the door: a single vertex for its engine, a crease pattern of
+/// many vertices for the other; with `--project`, a sheet's state moved to the nearest rigid
+/// state first.
+fn open_pattern(
+    path: &Path,
+    solver: &SolverArgs,
+) -> Result<(nanofold::commands::Pattern, Option<nanofold::commands::Projection>)> {
+    let pattern = nanofold::commands::Pattern::open(path, &solver.load_options()).map_err(|e| reading(path, e))?;
+    if !solver.project {
+        return Ok((pattern, None));
+    }
+    pattern
+        .projected()
+        .map_err(|e| with_flags(e, &[("fold_angles", "--project")]))
+}
+
 fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel: &ParallelArgs) -> Result<bool> {
     let settings = solver.settings()?;
     let files = expand_patterns(patterns)?;
     parallel.all(&files, |path| {
-        let outcome = nanofold::read::load_pattern(path, &solver.load_options());
-        if let Err(e) = &outcome {
-            if nanofold::commands::takes_many_vertices(e, path) {
-                return match folding::check_json(path, solver.closure_tol, solver.project) {
-                    Ok((value, _)) if as_json => {
-                        println!("{value}");
-                        true
-                    }
-                    Ok((_, line)) => {
-                        println!("{line}");
-                        true
-                    }
-                    Err(e) => {
-                        print_failure(path, &e, as_json);
-                        false
-                    }
-                };
+        let outcome = open_pattern(path, solver).and_then(|(pattern, projection)| match pattern.vertex() {
+            // A crease pattern of many vertices: its state or its assignment.
+            None => folding::check_json(path, &pattern, projection.as_ref(), solver.closure_tol),
+            // A single vertex: its unfolding's verdict.
+            Some(vertex) => {
+                let report = unfold(vertex, &settings)?;
+                let line = format!(
+                    "{}: {} ({} iterations, {:.3} ms) {}",
+                    path.display(),
+                    report.verdict.as_str(),
+                    report.iterations,
+                    report.seconds * 1e3,
+                    report.evidence
+                );
+                Ok((summary(vertex, path, &report), line))
             }
-        }
-        let outcome = outcome.and_then(|p| unfold(&p, &settings).map(|r| (p, r)));
+        });
         match outcome {
-            Ok((pattern, report)) if as_json => println!("{}", summary(&pattern, path, &report)),
-            Ok((_, report)) => println!(
-                "{}: {} ({} iterations, {:.3} ms) {}",
-                path.display(),
-                report.verdict.as_str(),
-                report.iterations,
-                report.seconds * 1e3,
-                report.evidence
-            ),
+            Ok((value, line)) => {
+                println!("{}", if as_json { value.to_string() } else { line });
+                true
+            }
             Err(e) => {
-                print_failure(path, &anyhow::Error::new(e), as_json);
-                return false;
+                print_failure(path, &e, as_json);
+                false
             }
         }
-        true
     })
 }
 

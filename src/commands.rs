@@ -74,16 +74,36 @@ impl Engine {
     }
 }
 
-/// Any crease pattern nanofold reads: a single vertex (the single-vertex engine's, with
-/// its sheet when it has one) or a crease pattern of many vertices.
+/// Any crease pattern nanofold reads, decided once from its input: a single vertex (the
+/// single-vertex engine's, with its sheet when its sectors close one) or a crease pattern of
+/// many vertices.
 #[derive(Debug, Clone)]
-pub struct Pattern {
-    vertex: Option<VertexPattern>,
-    sheet: Option<FoldingModel>,
-    /// The file it was read from.
-    source: Option<String>,
+pub enum Pattern {
+    /// One interior or boundary vertex.
+    Vertex {
+        /// The vertex.
+        vertex: Box<VertexPattern>,
+        /// Its sheet of panels (None: sectors that close no flat sheet, a cone).
+        sheet: Option<Box<FoldingModel>>,
+        /// Where it came from.
+        origin: Origin,
+    },
+    /// A crease pattern of many vertices (or of creases that meet at no vertex).
+    Sheet {
+        /// Its panels, stars and closures.
+        model: Box<FoldingModel>,
+        /// Where it came from.
+        origin: Origin,
+    },
+}
+
+/// Where a pattern came from, and what its reading left out.
+#[derive(Debug, Clone, Default)]
+pub struct Origin {
+    /// The file it was read from (None: built in code).
+    pub source: Option<String>,
     /// What was ignored of a FOLD animation's frames.
-    frames_note: Option<String>,
+    pub frames_note: Option<String>,
 }
 
 impl Pattern {
@@ -92,106 +112,177 @@ impl Pattern {
     pub fn open(path: &Path, options: &LoadOptions) -> Result<Pattern> {
         let text = crate::read::input::read_text(path, crate::read::input::MAX_PATTERN_BYTES)?;
         let origin = path.display().to_string();
-        let mut pattern = Pattern::parse(&text, &crate::read::pattern_name(path), &origin, options)?;
-        pattern.source = Some(origin);
-        Ok(pattern)
+        Ok(Pattern::parse(&text, &crate::read::pattern_name(path), &origin, options)?.with_source(origin))
     }
 
     /// Reads pattern text (FOLD or a native vertex) as [`Pattern::open`] reads a file;
-    /// `name` names the pattern when the text has no title, `origin` names it in errors.
+    /// `name` names the pattern when the text has no title, `origin` names it in errors. The
+    /// text is parsed once; both readers read the one value.
     pub fn parse(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
-        let frames_note = crate::read::input::parse_json(text, origin)
-            .ok()
-            .and_then(|v| crate::read::frames_note(&v));
-        let sheet_of_text = || crate::read::parse_crease_pattern(text, name, origin);
-        match crate::read::parse_pattern(text, name, origin, options) {
+        let value = crate::read::input::parse_json(text, origin)?;
+        let origin_of = || Origin {
+            source: None,
+            frames_note: crate::read::frames_note(&value),
+        };
+        // A FOLD object is a crease pattern too; a native vertex is not.
+        let as_sheet = || crate::read::crease_pattern_of_value(&value, name, origin);
+        match crate::read::pattern_of_value(&value, name, origin, options) {
             Ok(vertex) => {
-                let sheet = sheet_of_text()
-                    .ok()
-                    .and_then(|p| FoldingModel::new(p).ok())
-                    .or_else(|| sheet_of_vertex(&vertex).ok());
-                Ok(Pattern {
-                    vertex: Some(vertex),
-                    sheet,
-                    source: None,
-                    frames_note,
+                let sheet = match crate::read::is_fold_object(&value) {
+                    true => as_sheet().ok().and_then(|p| FoldingModel::new(p).ok()),
+                    false => None,
+                }
+                .or_else(|| sheet_of_vertex(&vertex).ok());
+                Ok(Pattern::Vertex {
+                    vertex: Box::new(vertex),
+                    sheet: sheet.map(Box::new),
+                    origin: origin_of(),
                 })
             }
-            Err(e) if refused_as_vertex(&e, || sheet_of_text().is_ok()) => Ok(Pattern {
-                vertex: None,
-                sheet: Some(FoldingModel::new(sheet_of_text()?)?),
-                source: None,
-                frames_note,
-            }),
-            Err(e) => Err(e),
+            Err(refusal) => {
+                let sheet = as_sheet();
+                if !refused_as_vertex(&refusal, sheet.is_ok()) {
+                    return Err(refusal);
+                }
+                Ok(Pattern::Sheet {
+                    model: Box::new(FoldingModel::new(sheet?)?),
+                    origin: origin_of(),
+                })
+            }
         }
     }
 
     /// A crease pattern of any number of vertices (validated, its stars and panels found).
     pub fn from_crease_pattern(pattern: CreasePattern) -> Result<Pattern> {
-        Ok(Pattern {
-            vertex: None,
-            sheet: Some(FoldingModel::new(pattern)?),
-            source: None,
-            frames_note: None,
+        Ok(Pattern::Sheet {
+            model: Box::new(FoldingModel::new(pattern)?),
+            origin: Origin::default(),
         })
+    }
+
+    fn origin(&self) -> &Origin {
+        match self {
+            Pattern::Vertex { origin, .. } | Pattern::Sheet { origin, .. } => origin,
+        }
     }
 
     /// The same pattern, read from `source` (the file its reports name).
     pub fn with_source(mut self, source: impl Into<String>) -> Pattern {
-        self.source = Some(source.into());
+        match &mut self {
+            Pattern::Vertex { origin, .. } | Pattern::Sheet { origin, .. } => origin.source = Some(source.into()),
+        }
         self
     }
 
     /// The file it was read from (None: built in code).
     pub fn source(&self) -> Option<&str> {
-        self.source.as_deref()
+        self.origin().source.as_deref()
     }
 
     /// The pattern's name.
     pub fn name(&self) -> &str {
-        match (&self.vertex, &self.sheet) {
-            (Some(v), _) => &v.name,
-            (None, Some(s)) => &s.pattern.name,
-            (None, None) => unreachable!("a pattern has one form or both"),
+        match self {
+            Pattern::Vertex { vertex, .. } => &vertex.name,
+            Pattern::Sheet { model, .. } => &model.pattern.name,
         }
     }
 
     /// The engine that checks and unfolds it.
     pub fn engine(&self) -> Engine {
-        if self.vertex.is_some() {
-            Engine::Vertex
-        } else {
-            Engine::Network
+        match self {
+            Pattern::Vertex { .. } => Engine::Vertex,
+            Pattern::Sheet { .. } => Engine::Network,
         }
     }
 
     /// Its single vertex, when the single-vertex engine takes it.
     pub fn vertex(&self) -> Option<&VertexPattern> {
-        self.vertex.as_ref()
+        match self {
+            Pattern::Vertex { vertex, .. } => Some(vertex),
+            Pattern::Sheet { .. } => None,
+        }
     }
 
     /// Its sheet of panels (None: a vertex whose sectors do not close a flat sheet, a cone).
     pub fn sheet(&self) -> Option<&FoldingModel> {
-        self.sheet.as_ref()
+        match self {
+            Pattern::Vertex { sheet, .. } => sheet.as_deref(),
+            Pattern::Sheet { model, .. } => Some(model),
+        }
     }
 
     /// Crease labels in the order of every fold-angle vector the reports give.
     pub fn crease_labels(&self) -> Vec<String> {
-        match (&self.vertex, &self.sheet) {
-            (Some(v), _) => v.creases.iter().map(|c| c.label.clone()).collect(),
-            (None, Some(s)) => s.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
-            (None, None) => unreachable!("a pattern has one form or both"),
+        match self {
+            Pattern::Vertex { vertex, .. } => vertex.creases.iter().map(|c| c.label.clone()).collect(),
+            Pattern::Sheet { model, .. } => model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
         }
     }
 
     /// The state the pattern carries, rad (file order of the creases).
     pub fn fold_angles(&self) -> Vec<f64> {
-        match (&self.vertex, &self.sheet) {
-            (Some(v), _) => v.creases.iter().map(|c| c.folded_angle).collect(),
-            (None, Some(s)) => s.given_fold_angles(),
-            (None, None) => unreachable!("a pattern has one form or both"),
+        match self {
+            Pattern::Vertex { vertex, .. } => vertex.creases.iter().map(|c| c.folded_angle).collect(),
+            Pattern::Sheet { model, .. } => model.given_fold_angles(),
         }
+    }
+}
+
+/// How far a crease pattern's state was moved to make it rigid ([`Pattern::projected`]).
+#[derive(Debug, Clone)]
+pub struct Projection {
+    /// The move and the state before it, in words.
+    pub note: String,
+    /// The same as JSON (`projection` in the reports).
+    pub json: serde_json::Value,
+}
+
+impl Pattern {
+    /// What a FOLD animation's frames the reading left out (None: nothing).
+    pub fn frames_note(&self) -> Option<&str> {
+        self.origin().frames_note.as_deref()
+    }
+
+    /// The pattern with its state moved to the nearest rigid state (a crease pattern whose
+    /// state does not close at some vertex, or a folded form whose facets bend, as a
+    /// compliant simulator exports it), and how far it moved. A single vertex is its own
+    /// engine's input and is returned as it is, with no projection.
+    pub fn projected(self) -> Result<(Pattern, Option<Projection>)> {
+        let (model, origin) = match self {
+            Pattern::Sheet { model, origin } => (model, origin),
+            vertex => return Ok((vertex, None)),
+        };
+        let rho = model.given_fold_angles();
+        let projection = crate::folding::project_to_rigid(&model, &rho, 1e-11)?;
+        let fit = model.pattern.folded_form;
+        let mut note = format!(
+            "projected onto the rigid states: fold angles moved by up to {:.3e} rad (RMS {:.3e}), worst vertex closure {:.3e} rad before",
+            projection.max_change, projection.rms_change, projection.residual_before
+        );
+        if let Some(fit) = fit {
+            note.push_str(&format!(
+                ", folded form with facets bent by up to {:.3e} rad and faces developing with a mismatch of {:.3e}",
+                fit.max_facet_angle, fit.development_error
+            ));
+        }
+        let json = serde_json::json!({
+            "max_change_rad": projection.max_change,
+            "rms_change_rad": projection.rms_change,
+            "residual_before_rad": projection.residual_before,
+            "newton_iterations": projection.iterations,
+            "folded_form": fit.map(|f| serde_json::json!({
+                "max_facet_angle_rad": f.max_facet_angle,
+                "development_error": f.development_error,
+                "face_nonplanarity": f.face_nonplanarity,
+            })),
+        });
+        Ok((
+            Pattern::Sheet {
+                model: Box::new(model.with_fold_angles(&projection.fold_angles)),
+                origin,
+            },
+            Some(Projection { note, json }),
+        ))
     }
 }
 
@@ -199,12 +290,11 @@ impl From<VertexPattern> for Pattern {
     /// A single vertex, with its sheet when its sectors close one (unit rays about the
     /// origin, ray 0 along its mesh's direction or +x).
     fn from(vertex: VertexPattern) -> Pattern {
-        let sheet = sheet_of_vertex(&vertex).ok();
-        Pattern {
-            vertex: Some(vertex),
+        let sheet = sheet_of_vertex(&vertex).ok().map(Box::new);
+        Pattern::Vertex {
+            vertex: Box::new(vertex),
             sheet,
-            source: None,
-            frames_note: None,
+            origin: Origin::default(),
         }
     }
 }
@@ -279,11 +369,11 @@ fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
 /// 3D folded form, no fold angles, a mesh larger than a vertex's); otherwise (a vertex whose
 /// folded state does not close, say) only if it reads as a crease pattern.
 pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
-    refused_as_vertex(error, || crate::read::load_crease_pattern(path).is_ok())
+    refused_as_vertex(error, crate::read::load_crease_pattern(path).is_ok())
 }
 
-/// [`takes_many_vertices`] with the crease-pattern reading as a closure.
-fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: impl FnOnce() -> bool) -> bool {
+/// [`takes_many_vertices`] with the crease-pattern reading's outcome.
+fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: bool) -> bool {
     use NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
     let not_a_vertex = match error {
         MultipleVertices { .. } => true,
@@ -295,7 +385,7 @@ fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: impl FnOnce() -> boo
         }
         _ => false,
     };
-    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && reads_as_sheet())
+    not_a_vertex || (!matches!(error, ClosureViolated { .. }) && reads_as_sheet)
 }
 
 /// Every answer any command gives, in one vocabulary.
@@ -484,6 +574,7 @@ impl Report {
             }
             (Detail::NetworkUnfold(report), _, Some(model)) => {
                 let adjustments: Vec<String> = pattern
+                    .origin()
                     .frames_note
                     .clone()
                     .into_iter()

@@ -47,34 +47,34 @@ impl Setup {
         }
         let label = |c: usize| pattern.creases[c].label.clone();
         if driver >= pattern.creases.len() {
-            return Err(NanofoldError::invalid("driver", driver, "no such crease"));
+            return Err(NanofoldError::invalid("drive", driver, "no such crease"));
         }
         let mut locked: Vec<(usize, f64)> = Vec::new();
         for &(crease, angle) in user_locks {
             if crease == driver {
                 return Err(NanofoldError::invalid(
-                    "locks",
+                    "lock",
                     pattern.user_index(crease),
                     format!("cannot drive a locked crease ({} is the driver)", label(crease)),
                 ));
             }
             if !angle.is_finite() || angle.abs() > PI + 1e-12 {
                 return Err(NanofoldError::invalid(
-                    "locks",
+                    "lock",
                     format!("{}={}", pattern.user_index(crease), angle.to_degrees()),
                     "a lock angle must lie in [−180°, 180°]",
                 ));
             }
             if pattern.creases[crease].assignment == Assignment::Flat && angle != 0.0 {
                 return Err(NanofoldError::invalid(
-                    "locks",
+                    "lock",
                     format!("{}={}", pattern.user_index(crease), angle.to_degrees()),
                     format!("{} is a flat (F) crease and stays at 0°", label(crease)),
                 ));
             }
             if locked.iter().any(|&(c, _)| c == crease) {
                 return Err(NanofoldError::invalid(
-                    "locks",
+                    "lock",
                     pattern.user_index(crease),
                     "the same crease is locked twice",
                 ));
@@ -84,7 +84,7 @@ impl Setup {
         let driver_crease = &pattern.creases[driver];
         if driver_crease.locked {
             return Err(NanofoldError::invalid(
-                "driver",
+                "drive",
                 pattern.user_index(driver),
                 format!(
                     "cannot drive a locked crease ({} is locked in the pattern)",
@@ -94,7 +94,7 @@ impl Setup {
         }
         if driver_crease.assignment == Assignment::Flat {
             return Err(NanofoldError::invalid(
-                "driver",
+                "drive",
                 pattern.user_index(driver),
                 format!("cannot drive a flat (F) crease ({})", label(driver)),
             ));
@@ -116,7 +116,7 @@ impl Setup {
                 .collect::<Vec<_>>()
                 .join(", ");
             return Err(NanofoldError::invalid(
-                "locks",
+                "lock",
                 format!("{} lock(s)", user_locks.len()),
                 format!(
                     "{} creases besides the driver are free ({free}) but loop closure fixes only 3: \
@@ -128,7 +128,7 @@ impl Setup {
         }
         if dependents.is_empty() {
             return Err(NanofoldError::invalid(
-                "locks",
+                "lock",
                 format!("{} lock(s)", user_locks.len()),
                 "no crease is left to follow the driver",
             ));
@@ -189,7 +189,7 @@ pub fn default_domain(pattern: &Pattern, driver: usize) -> Result<[f64; 2]> {
     let folded = pattern.creases[driver].folded_angle;
     if folded.abs() < 1e-9 {
         return Err(NanofoldError::invalid(
-            "domain",
+            "range",
             "(default)",
             format!(
                 "{} is flat in the folded state, so the default domain (flat to folded) is empty: give one",
@@ -204,11 +204,11 @@ pub fn default_domain(pattern: &Pattern, driver: usize) -> Result<[f64; 2]> {
 pub fn check_domain(domain: [f64; 2]) -> Result<()> {
     let shown = format!("{}:{}", domain[0].to_degrees(), domain[1].to_degrees());
     if !domain.iter().all(|v| v.is_finite()) || domain[0] >= domain[1] {
-        return Err(NanofoldError::invalid("domain", shown, "needs finite A < B (degrees)"));
+        return Err(NanofoldError::invalid("range", shown, "needs finite A < B (degrees)"));
     }
     if domain.iter().any(|v| v.abs() > PI + 1e-12) {
         return Err(NanofoldError::invalid(
-            "domain",
+            "range",
             shown,
             "fold angles lie in [−180°, 180°]",
         ));
@@ -251,7 +251,7 @@ pub fn held_pattern(pattern: &Pattern, setup: &Setup) -> Result<Pattern> {
         let folded = pattern.creases[c].folded_angle;
         if (value - folded).abs() > 1e-9 {
             return Err(NanofoldError::invalid(
-                "locks",
+                "lock",
                 format!("{}={}", pattern.user_index(c), value.to_degrees()),
                 format!(
                     "with samples from an unfolding a lock must equal the crease's folded angle {:.6}° (the unfolding starts from the folded state); use a sweep",
@@ -313,7 +313,7 @@ pub fn trajectory_samples(
             check_domain(d)?;
             if d[0] < covered[0] - 1e-9 || d[1] > covered[1] + 1e-9 {
                 return Err(NanofoldError::invalid(
-                    "domain",
+                    "range",
                     format!("{}:{}", d[0].to_degrees(), d[1].to_degrees()),
                     format!(
                         "the unfolding trajectory covers {} ∈ [{:.4}°, {:.4}°] only ({})",

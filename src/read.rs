@@ -57,33 +57,37 @@ pub(crate) fn is_fold_object(value: &serde_json::Value) -> bool {
 
 /// Parses pattern text (FOLD or native); `origin` names it in error messages.
 pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
-    let value = input::parse_json(text, origin)?;
+    pattern_of_value(&input::parse_json(text, origin)?, name, origin, options)
+}
+
+/// A single vertex from a pattern file's JSON (FOLD or native), as [`parse_pattern`] reads it.
+pub fn pattern_of_value(value: &serde_json::Value, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
     if !value.is_object() {
         return Err(NanofoldError::invalid(
             origin,
-            input::short_json(&value),
+            input::short_json(value),
             "a pattern file holds one JSON object (a FOLD file or a native vertex)",
         ));
     }
-    if is_scene_object(&value) {
+    if is_scene_object(value) {
         return Err(NanofoldError::invalid(
             origin,
             "a scene file",
             "this is a scene (it has materials, hinges or time): run it with `simulate` or `modes`",
         ));
     }
-    let builder = if is_fold_object(&value) {
-        let unflattened = fold::unflatten_folded_form(&value)?;
+    let builder = if is_fold_object(value) {
+        let unflattened = fold::unflatten_folded_form(value)?;
         let developed = match unflattened {
             Some(_) => None,
-            None => developed_vertex(&value, name, options.closure_tol),
+            None => developed_vertex(value, name, options.closure_tol),
         };
-        fold::read_fold(developed.as_ref().or(unflattened.as_ref()).unwrap_or(&value), name)?
+        fold::read_fold(developed.as_ref().or(unflattened.as_ref()).unwrap_or(value), name)?
     } else {
-        native::read_native(&value, name)?
+        native::read_native(value, name)?
     };
     let mut pattern = builder.build_with(options)?;
-    pattern.adjustments.extend(frames_note(&value));
+    pattern.adjustments.extend(frames_note(value));
     Ok(pattern)
 }
 
@@ -198,23 +202,27 @@ pub fn load_crease_pattern(path: &Path) -> Result<CreasePattern> {
 
 /// Parses FOLD text as a crease pattern; `origin` names it in errors.
 pub fn parse_crease_pattern(text: &str, name: &str, origin: &str) -> Result<CreasePattern> {
-    let value = input::parse_json(text, origin)?;
-    if is_scene_object(&value) {
+    crease_pattern_of_value(&input::parse_json(text, origin)?, name, origin)
+}
+
+/// A crease pattern from a FOLD file's JSON, as [`parse_crease_pattern`] reads it.
+pub fn crease_pattern_of_value(value: &serde_json::Value, name: &str, origin: &str) -> Result<CreasePattern> {
+    if is_scene_object(value) {
         return Err(NanofoldError::invalid(
             origin,
             "a scene file",
             "this is a scene (it has materials, hinges or time): run it with `simulate` or `modes`",
         ));
     }
-    if !is_fold_object(&value) {
+    if !is_fold_object(value) {
         return Err(NanofoldError::invalid(
             origin,
             "not a FOLD object",
             "a crease pattern of many vertices is read from a FOLD file (vertices_coords, edges_vertices, edges_assignment)",
         ));
     }
-    let unflattened = fold::unflatten_folded_form(&value)?;
-    let mut pattern = fold::read_crease_pattern(unflattened.as_ref().unwrap_or(&value), name)?.build()?;
+    let unflattened = fold::unflatten_folded_form(value)?;
+    let mut pattern = fold::read_crease_pattern(unflattened.as_ref().unwrap_or(value), name)?.build()?;
     // A flat-folded form (fold-convert's) states its fold: its ±180° are the state.
     if unflattened.is_none() {
         angles_as_targets(&mut pattern)?;

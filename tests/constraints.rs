@@ -322,7 +322,7 @@ fn bad_constraint_requests_get_clear_errors() {
     let err = Setup::new(&generic, 0, &[(1, 4.0)]).unwrap_err().to_string();
     assert!(err.contains("[−180°, 180°]"), "{err}");
     let err = sweep_samples(&generic, &setup, [1.0, 0.5], 41).unwrap_err().to_string();
-    assert!(err.contains("`domain`"), "{err}");
+    assert!(err.contains("`range`"), "{err}");
     // --source unfold cannot move a lock away from the folded state.
     let corner = load("corner_cube.fold");
     let setup = Setup::new(&corner, 0, &[(1, 0.0)]).unwrap();

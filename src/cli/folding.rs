@@ -214,41 +214,6 @@ fn flags(error: nanofold::NanofoldError, table: &[(&str, &str)]) -> anyhow::Erro
     super::with_flags(error, table)
 }
 
-/// The model of `path`; with `project`, a state that does not close (or a folded form that
-/// bends) moved to the nearest rigid state, with a note and its JSON.
-fn load_projected(path: &Path, project: bool) -> Result<(FoldingModel, Option<(String, Value)>)> {
-    let model = load_model(path)?;
-    if !project {
-        return Ok((model, None));
-    }
-    let rho = model.given_fold_angles();
-    let projection = nanofold::folding::project_to_rigid(&model, &rho, 1e-11)
-        .map_err(|e| flags(e, &[("fold_angles", "--project")]))?;
-    let fit = model.pattern.folded_form;
-    let mut note = format!(
-        "projected onto the rigid states: fold angles moved by up to {:.3e} rad (RMS {:.3e}), worst vertex closure {:.3e} rad before",
-        projection.max_change, projection.rms_change, projection.residual_before
-    );
-    if let Some(fit) = fit {
-        note.push_str(&format!(
-            ", folded form with facets bent by up to {:.3e} rad and faces developing with a mismatch of {:.3e}",
-            fit.max_facet_angle, fit.development_error
-        ));
-    }
-    let json = json!({
-        "max_change_rad": projection.max_change,
-        "rms_change_rad": projection.rms_change,
-        "residual_before_rad": projection.residual_before,
-        "newton_iterations": projection.iterations,
-        "folded_form": fit.map(|f| json!({
-            "max_facet_angle_rad": f.max_facet_angle,
-            "development_error": f.development_error,
-            "face_nonplanarity": f.face_nonplanarity,
-        })),
-    });
-    Ok((model.with_fold_angles(&projection.fold_angles), Some((note, json))))
-}
-
 fn load_model(path: &Path) -> Result<FoldingModel> {
     let pattern = nanofold::read::load_crease_pattern(path).map_err(|e| reading(path, e))?;
     Ok(FoldingModel::new(pattern)?)
@@ -406,14 +371,21 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
 }
 
 /// `check` on a crease pattern of many vertices: its verdict as a JSON object.
-pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value, String)> {
-    let (model, projection) = load_projected(path, project)?;
+pub fn check_json(
+    path: &Path,
+    pattern: &nanofold::commands::Pattern,
+    projection: Option<&nanofold::commands::Projection>,
+    closure_tol: f64,
+) -> Result<(Value, String)> {
+    let model = pattern
+        .sheet()
+        .expect("a crease pattern of many vertices has its sheet");
     let settings = CheckSettings {
         closure_tol,
         ..CheckSettings::default()
     };
     let start = Instant::now();
-    let (report, unfolding) = nanofold::commands::check_sheet(&model, &settings)?;
+    let (report, unfolding) = nanofold::commands::check_sheet(model, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     let mut line = format!(
         "{}: {} ({} DOF at the {} state, {:.3} ms) {}",
@@ -425,15 +397,15 @@ pub fn check_json(path: &Path, closure_tol: f64, project: bool) -> Result<(Value
         report.evidence
     );
     let mut value = nanofold::write::folding_output::check_summary(
-        &model,
+        model,
         &path.display().to_string(),
         &report,
         unfolding.as_ref(),
         seconds,
     );
-    if let Some((note, json)) = &projection {
-        line.push_str(&format!("; {note}"));
-        value["projection"] = json.clone();
+    if let Some(projection) = projection {
+        line.push_str(&format!("; {}", projection.note));
+        value["projection"] = projection.json.clone();
     }
     if let Some(unfolding) = &unfolding {
         line.push_str(&format!(
@@ -547,6 +519,8 @@ pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usi
 /// returns the JSON summary and the human-readable lines.
 pub fn unfold_network_one(
     pattern_path: &Path,
+    pattern: &nanofold::commands::Pattern,
+    projection: Option<nanofold::commands::Projection>,
     solver: &super::SolverArgs,
     dir: Option<&Path>,
     progress: Option<nanofold::unfold::UnfoldProgress>,
@@ -555,8 +529,11 @@ pub fn unfold_network_one(
     use nanofold::unfold::network::{unfold_network_observed, NetworkUnfoldSettings};
     use nanofold::write::folding_output::states_fold;
     use std::fmt::Write as _;
-    let (model, projection) = load_projected(pattern_path, solver.project)?;
-    let frames_note = nanofold::read::file_frames_note(pattern_path);
+    let model = pattern
+        .sheet()
+        .expect("a crease pattern of many vertices has its sheet");
+    let projection = projection.map(|p| (p.note, p.json));
+    let frames_note = pattern.frames_note().map(str::to_string);
     let settings = NetworkUnfoldSettings {
         energy: solver.energy.into(),
         p: solver.p,
@@ -566,7 +543,7 @@ pub fn unfold_network_one(
     };
     let start_state = model.given_fold_angles();
     let clock = Instant::now();
-    let report = unfold_network_observed(&model, &start_state, &settings, progress)
+    let report = unfold_network_observed(model, &start_state, &settings, progress)
         .map_err(|e| flags(e, &[("flat_tol", "--flat-tol"), ("start", "edges_foldAngle")]))?;
     let seconds = clock.elapsed().as_secs_f64();
     let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);
@@ -583,7 +560,7 @@ pub fn unfold_network_one(
         })
         .collect();
     let fold = states_fold(
-        &model,
+        model,
         Some(&start_state),
         &frames,
         "unfolding written by nanofold unfold",
@@ -612,7 +589,7 @@ pub fn unfold_network_one(
         report.verdict.as_str(),
         report.iterations
     );
-    let svg = angles_svg(&model, &xs, &states, "step", "step", &title)?;
+    let svg = angles_svg(model, &xs, &states, "step", "step", &title)?;
     let page = nanofold::plot::page::page_of_fold(&fold, &model.pattern.name, &[], None)?;
     let files = [
         ("trajectory.json", serde_json::to_string(&trajectory)?),
@@ -628,7 +605,7 @@ pub fn unfold_network_one(
         .chain(model.pattern.reading.iter().cloned())
         .collect();
     let mut summary = nanofold::write::folding_output::network_unfold_summary(
-        &model,
+        model,
         &pattern_path.display().to_string(),
         &report,
         &start_state,

@@ -86,7 +86,7 @@ impl Chebyshev {
         }
         if !domain.iter().all(|v| v.is_finite()) || domain[0] >= domain[1] {
             return Err(NanofoldError::invalid(
-                "domain",
+                "range",
                 format!("[{}, {}]", domain[0], domain[1]),
                 "needs a finite interval with a < b",
             ));

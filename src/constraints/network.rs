@@ -131,7 +131,7 @@ fn tangent(model: &FoldingModel, fold_angles: &[f64], driver: usize, solver: &mu
     let size = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     if v[driver].is_nan() || v[driver].abs() <= 1e-6 * size {
         return Err(NanofoldError::invalid(
-            "driver",
+            "drive",
             format!("edge {}", model.pattern.creases[driver]),
             format!(
                 "the driver does not move along the pattern's motion here (driver rate {:.1e} of the fastest crease's): choose another crease",
@@ -153,7 +153,7 @@ pub fn network_sweep(
 ) -> Result<NetworkSweep> {
     if driver >= model.crease_count() {
         return Err(NanofoldError::invalid(
-            "driver",
+            "drive",
             driver,
             format!("the pattern has {} creases", model.crease_count()),
         ));
@@ -169,14 +169,14 @@ pub fn network_sweep(
     if !(a.is_finite() && b.is_finite() && a < b && a.abs() <= std::f64::consts::PI && b.abs() <= std::f64::consts::PI)
     {
         return Err(NanofoldError::invalid(
-            "domain",
+            "range",
             format!("[{:.4}°, {:.4}°]", a.to_degrees(), b.to_degrees()),
             "needs a < b within [−180°, 180°]",
         ));
     }
     if model.locked_columns[driver] {
         return Err(NanofoldError::invalid(
-            "driver",
+            "drive",
             format!("edge {}", model.pattern.creases[driver]),
             "the crease is locked (edges_nanofold:locked): it cannot drive",
         ));
@@ -203,7 +203,7 @@ pub fn network_sweep(
     let theta0 = rho[driver];
     if theta0 < a - 1e-9 || theta0 > b + 1e-9 {
         return Err(NanofoldError::invalid(
-            "domain",
+            "range",
             format!("[{:.4}°, {:.4}°]", a.to_degrees(), b.to_degrees()),
             format!(
                 "must contain the driver's angle in the state, {:.4}°",

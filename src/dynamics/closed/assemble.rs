@@ -287,7 +287,8 @@ fn scene_fields(error: NanofoldError) -> NanofoldError {
         NanofoldError::InvalidField { field, value, reason } => {
             let field = match field.as_str() {
                 "samples" | "degree" | "source" => format!("constraint.{field}"),
-                "domain" => "constraint.range_deg".to_string(),
+                "range" => "constraint.range_deg".to_string(),
+                "lock" => "locks".to_string(),
                 _ => field,
             };
             NanofoldError::InvalidField { field, value, reason }
