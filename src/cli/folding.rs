@@ -4,10 +4,10 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use nanofold::folding::{fold_path_and_frames, CheckSettings, Drive, FoldPath, FoldSettings, FoldingModel};
+use nanofold::folding::{CheckSettings, FoldingModel};
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
-use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_path_fold, fold_trajectory_json};
+use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_trajectory_json};
 use nanofold::write::output::{number, write_atomic};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -26,8 +26,8 @@ pub struct FoldArgs {
     /// 0.1 to 100).
     #[arg(long, default_value_t = 100.0)]
     pub to: f64,
-    /// Number of snapshots written as FOLD frames (start and end included).
-    #[arg(long, default_value_t = 11, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1000))]
+    /// Number of snapshots written as FOLD frames (start and end included; 2 to 10 000).
+    #[arg(long, default_value_t = 11)]
     pub frames: usize,
     /// Largest change of any fold angle in one step (degrees; 5.7e-5 to 28.6): a cap, the
     /// step control chooses each step below it.
@@ -219,18 +219,6 @@ fn load_model(path: &Path) -> Result<FoldingModel> {
     Ok(FoldingModel::new(pattern)?)
 }
 
-/// Parses "EDGE=DEG" into (crease column, rad).
-fn parse_drive(model: &FoldingModel, text: &str) -> Result<(usize, f64)> {
-    let (edge, degrees) = parse_edge_angle(text, "--drive")?;
-    let Some(column) = model.column_of_edge.get(edge).copied().flatten() else {
-        bail!(
-            "--drive {text}: edge {edge} is not a crease (the pattern has {} edges; creases are M, V or U)",
-            model.pattern.edges.len()
-        );
-    };
-    Ok((column, degrees.to_radians()))
-}
-
 /// `EDGE=DEG` of `flag`: a FOLD edge index and an angle in [-180, 180] degrees.
 fn parse_edge_angle(text: &str, flag: &str) -> Result<(usize, f64)> {
     let (edge, degrees) = text
@@ -250,46 +238,37 @@ fn parse_edge_angle(text: &str, flag: &str) -> Result<(usize, f64)> {
     Ok((edge, degrees))
 }
 
-fn fold_summary(model: &FoldingModel, file: &Path, path: &FoldPath, dof: usize, seconds: f64) -> Value {
-    nanofold::write::folding_output::fold_summary(model, &file.display().to_string(), path, dof, seconds)
-}
-
 /// `nanofold fold PATTERN`.
 pub fn run_fold(args: &FoldArgs) -> Result<()> {
-    let model = load_model(&args.pattern)?;
-    let drive = if args.drive.is_empty() {
-        Drive::Assignment { to: args.to }
-    } else {
-        Drive::Creases(
-            args.drive
-                .iter()
-                .map(|d| parse_drive(&model, d))
-                .collect::<Result<_>>()?,
+    let options = nanofold::commands::FoldOptions {
+        to: args.to,
+        drive: args
+            .drive
+            .iter()
+            .map(|text| parse_edge_angle(text, "--drive"))
+            .collect::<Result<_>>()?,
+        max_step: args.max_step,
+        frames: args.frames,
+        ..nanofold::commands::FoldOptions::default()
+    };
+    let pattern = nanofold::commands::Pattern::open(&args.pattern, &nanofold::prelude::LoadOptions::default())
+        .map_err(|e| reading(&args.pattern, e))?;
+    let run = nanofold::commands::fold_run(&pattern, &options).map_err(|e| {
+        flags(
+            e,
+            &[
+                ("drive.to", "--to"),
+                ("drive", "--drive"),
+                ("max_step", "--max-step"),
+                ("frames", "--frames"),
+            ],
         )
+    })?;
+    let model = pattern.sheet().expect("a pattern that folds has its sheet");
+    let nanofold::commands::Detail::Fold(path) = &run.report.detail else {
+        unreachable!("fold answers with a path")
     };
-    // The step in the flag's degrees, before the library's radians.
-    let lowest_step = nanofold::folding::MIN_STEP.to_degrees();
-    if !(args.max_step >= lowest_step && args.max_step <= 0.5f64.to_degrees()) {
-        bail!(
-            "--max-step {:e}: must lie in [{lowest_step:.1e}, {:.1}] degrees",
-            args.max_step,
-            0.5f64.to_degrees()
-        );
-    }
-    let settings = FoldSettings {
-        drive,
-        max_step: args.max_step.to_radians(),
-        ..FoldSettings::default()
-    };
-    settings
-        .validate(&model)
-        .map_err(|e| flags(e, &[("drive.to", "--to"), ("max_step", "--max-step (in rad)")]))?;
-    let start = Instant::now();
-    // The frames are placed while the path goes on (on a large pattern).
-    let (path, frames) = fold_path_and_frames(&model, &model.given_fold_angles(), &settings, args.frames)?;
-    let seconds = start.elapsed().as_secs_f64();
-    let end = &path.steps.last().expect("a path has its start").fold_angles;
-    let dof = nanofold::folding::jacobian_rank(&nanofold::folding::closure_jacobian(&model, end))?.dof;
+    let (path, frames, seconds) = (path.as_ref(), &run.frames, run.report.seconds);
     let dir = args
         .out
         .clone()
@@ -301,27 +280,17 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         path.steps.len()
     );
     let files = [
-        (
-            "fold.fold",
-            serde_json::to_string_pretty(&fold_path_fold(&model, &frames))?,
-        ),
-        (
-            "folded.fold",
-            serde_json::to_string_pretty(&crease_pattern_fold(
-                &model.pattern,
-                Some(end),
-                "end state of nanofold fold (a crease pattern with its fold angles)",
-            ))?,
-        ),
+        ("fold.fold", serde_json::to_string_pretty(&run.animation)?),
+        ("folded.fold", serde_json::to_string_pretty(&run.end_state)?),
         (
             "trajectory.json",
-            serde_json::to_string(&fold_trajectory_json(&model, &path, 1000))?,
+            serde_json::to_string(&fold_trajectory_json(model, path, 1000))?,
         ),
-        ("fold.svg", fold_svg(&model, &path, &title)?),
+        ("fold.svg", fold_svg(model, path, &title)?),
         (
             "fold.html",
             nanofold::plot::page::page_of_states(
-                &model,
+                model,
                 &title,
                 &frames
                     .iter()
@@ -331,7 +300,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         ),
     ];
     write_outputs(&dir, &args.pattern, &files)?;
-    let mut summary = fold_summary(&model, &args.pattern, &path, dof, seconds);
+    let mut summary = run.report.to_json(&pattern);
     summary["frames"] = json!(frames.len());
     summary["out"] = json!(dir.display().to_string());
     if args.json {
@@ -357,7 +326,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         model.crease_count(),
         model.stars.len(),
         model.pattern.panel_count,
-        dof,
+        summary["dof"],
         path.steps.last().map_or(0.0, |s| s.progress)
     );
     println!(

@@ -160,6 +160,9 @@ pub struct FoldOptions {
 /// Most frames of a fold's animation.
 pub const MAX_FRAMES: usize = 10_000;
 
+/// Largest cap on a fold's step, degrees (0.5 rad).
+pub const MAX_STEP_DEG: f64 = 28.64788975654116;
+
 impl Default for FoldOptions {
     fn default() -> Self {
         let d = FoldSettings::default();
@@ -189,7 +192,7 @@ impl FoldOptions {
                                 "drive",
                                 edge,
                                 format!(
-                                    "not a crease of the pattern (its {} edges: creases are the M, V and U ones)",
+                                    "edge {edge} is not a crease of the pattern (it has {} edges; creases are the M, V and U ones)",
                                     model.pattern.edges.len()
                                 ),
                             )
@@ -199,6 +202,15 @@ impl FoldOptions {
                     .collect::<Result<_>>()?,
             )
         };
+        // In the option's own degrees, before the engine's radians.
+        let (lowest, highest) = (crate::folding::MIN_STEP.to_degrees(), MAX_STEP_DEG);
+        if !(self.max_step >= lowest && self.max_step <= highest) {
+            return Err(NanofoldError::invalid(
+                "max_step",
+                format!("{:e}", self.max_step),
+                format!("must lie in [{lowest:.1e}, {highest:.1}] degrees"),
+            ));
+        }
         if !(2..=MAX_FRAMES).contains(&self.frames) {
             return Err(NanofoldError::invalid(
                 "frames",
