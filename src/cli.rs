@@ -18,7 +18,7 @@ use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::unfold::energy::EnergyKind;
 use nanofold::unfold::qp::QpMethod;
-use nanofold::unfold::{unfold, unfold_observed, UnfoldModel, UnfoldProgress, UnfoldReport, UnfoldSettings};
+use nanofold::unfold::{unfold, UnfoldModel, UnfoldProgress, UnfoldReport, UnfoldSettings};
 use nanofold::write::folder::{folder_name, write_folder_of};
 use nanofold::write::output::{
     closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
@@ -329,11 +329,14 @@ pub struct SolverArgs {
     #[arg(long, default_value_t = UnfoldSettings::default().bending_metric, allow_negative_numbers = true)]
     pub bending_metric: f64,
     /// Iteration limit.
-    #[arg(long, default_value_t = 20_000)]
-    pub max_iter: usize,
+    #[arg(long, alias = "max-iter", default_value_t = nanofold::commands::UnfoldOptions::default().max_iterations)]
+    pub max_iterations: usize,
     /// Restarts from perturbed states before a stuck verdict.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = nanofold::commands::UnfoldOptions::default().restarts)]
     pub restarts: usize,
+    /// Seed of the restarts' perturbations.
+    #[arg(long, default_value_t = nanofold::commands::UnfoldOptions::default().seed)]
+    pub seed: u64,
     /// Largest accepted loop-closure residual of the input's folded state (rad).
     #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub closure_tol: f64,
@@ -341,17 +344,17 @@ pub struct SolverArgs {
 
 impl SolverArgs {
     fn settings(&self) -> Result<UnfoldSettings> {
-        let settings = UnfoldSettings {
+        let options = nanofold::commands::UnfoldOptions {
             energy: self.energy.into(),
             p: self.p,
             qp: self.qp.into(),
             flat_tol: self.flat_tol,
             bending_metric: self.bending_metric,
-            max_iterations: self.max_iter,
+            max_iterations: self.max_iterations,
             restarts: self.restarts,
-            ..UnfoldSettings::default()
+            seed: self.seed,
         };
-        settings.validate().map_err(|e| with_flags(e, UNFOLD_FLAGS))?;
+        let settings = options.settings().map_err(|e| with_flags(e, UNFOLD_FLAGS))?;
         self.load_options()
             .validate()
             .map_err(|e| with_flags(e, UNFOLD_FLAGS))?;
@@ -480,7 +483,14 @@ fn unfold_one(
     let Some(pattern) = opened.vertex() else {
         return folding::unfold_network_one(pattern_path, &opened, projection, solver, dir, progress);
     };
-    let report = unfold_observed(pattern, &settings, progress)?;
+    let door = nanofold::commands::Settings {
+        unfold: settings.clone(),
+        ..nanofold::commands::Settings::default()
+    };
+    let answer = nanofold::commands::unfold_observed(&opened, &door, progress)?;
+    let nanofold::commands::Detail::VertexUnfold(report) = answer.detail else {
+        unreachable!("a single vertex unfolds by the single-vertex engine")
+    };
     let model = UnfoldModel::new(pattern);
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
@@ -1254,7 +1264,7 @@ const UNFOLD_FLAGS: &[(&str, &str)] = &[
     ("p", "--p"),
     ("flat_tol", "--flat-tol"),
     ("bending_metric", "--bending-metric"),
-    ("max_iterations", "--max-iter"),
+    ("max_iterations", "--max-iterations"),
     ("restarts", "--restarts"),
     ("closure_tol", "--closure-tol"),
 ];

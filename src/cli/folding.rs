@@ -495,7 +495,6 @@ pub fn unfold_network_one(
     progress: Option<nanofold::unfold::UnfoldProgress>,
 ) -> Result<(Value, String)> {
     use nanofold::plot::folding::angles_svg;
-    use nanofold::unfold::network::{unfold_network_observed, NetworkUnfoldSettings};
     use nanofold::write::folding_output::states_fold;
     use std::fmt::Write as _;
     let model = pattern
@@ -503,18 +502,17 @@ pub fn unfold_network_one(
         .expect("a crease pattern of many vertices has its sheet");
     let projection = projection.map(|p| (p.note, p.json));
     let frames_note = pattern.frames_note().map(str::to_string);
-    let settings = NetworkUnfoldSettings {
-        energy: solver.energy.into(),
-        p: solver.p,
-        flat_tol: solver.flat_tol,
-        max_iterations: solver.max_iter,
-        ..NetworkUnfoldSettings::default()
+    let settings = nanofold::commands::Settings {
+        unfold: solver.settings()?,
+        ..nanofold::commands::Settings::default()
     };
     let start_state = model.given_fold_angles();
-    let clock = Instant::now();
-    let report = unfold_network_observed(model, &start_state, &settings, progress)
+    let answer = nanofold::commands::unfold_observed(pattern, &settings, progress)
         .map_err(|e| flags(e, &[("flat_tol", "--flat-tol"), ("start", "edges_foldAngle")]))?;
-    let seconds = clock.elapsed().as_secs_f64();
+    let nanofold::commands::Detail::NetworkUnfold(report) = &answer.detail else {
+        unreachable!("a crease pattern of many vertices unfolds by the network engine")
+    };
+    let seconds = answer.seconds;
     let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);
     let last = report.steps.last().expect("the start is recorded");
     // Outputs: 11 snapshots, the trajectory thinned to 1000 steps.
@@ -576,7 +574,7 @@ pub fn unfold_network_one(
     let mut summary = nanofold::write::folding_output::network_unfold_summary(
         model,
         &pattern_path.display().to_string(),
-        &report,
+        report,
         &start_state,
         seconds,
         &adjustments,
