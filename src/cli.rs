@@ -9,16 +9,16 @@ use nanofold::constraints::{
     check_curve, default_domain, fit_to_tolerance, held_pattern, mujoco_snippet, sweep_samples, trajectory_samples,
     ConstraintPoly, ConstraintReport, Setup,
 };
-use nanofold::dynamics::integrate::{Method, ProgressObserver};
+use nanofold::dynamics::integrate::ProgressObserver;
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::scene::{Scene, System};
-use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, SimulationSettings};
-use nanofold::pattern::{LoadOptions, Pattern};
 use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
-use nanofold::unfold::energy::EnergyKind;
-use nanofold::unfold::qp::QpMethod;
-use nanofold::unfold::{unfold, UnfoldModel, UnfoldProgress, UnfoldReport, UnfoldSettings};
+use nanofold::prelude::{
+    simulate, unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, QpMethod, Response,
+    Scene, SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
+    VertexReport as UnfoldReport,
+};
+use nanofold::unfold::UnfoldModel;
 use nanofold::write::folder::{folder_name, write_folder_of};
 use nanofold::write::output::{
     closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
@@ -163,7 +163,7 @@ pub struct SimulateArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     pub method: MethodArg,
     /// Relative tolerance (the absolute tolerance is the same in rad).
-    #[arg(long, default_value_t = 1e-8, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = nanofold::commands::SimulateOptions::default().rtol, allow_negative_numbers = true)]
     pub rtol: f64,
     /// End time in seconds, overriding the scene's time.t_end_s.
     #[arg(long, allow_negative_numbers = true)]
@@ -173,7 +173,7 @@ pub struct SimulateArgs {
     pub ignore_collisions: bool,
     /// Stop with an error after this many integrator steps (a method unsuited to the scene
     /// can need billions).
-    #[arg(long, default_value_t = 5_000_000)]
+    #[arg(long, default_value_t = nanofold::commands::SimulateOptions::default().max_steps)]
     pub max_steps: usize,
     /// Output folder (default: output/<scene name>/).
     #[arg(long)]
@@ -1108,7 +1108,7 @@ fn load_scene(path: &Path) -> Result<Scene> {
 }
 
 fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<()> {
-    let settings = SimulationSettings {
+    let options = nanofold::commands::SimulateOptions {
         model: match args.model {
             ModelArg::Auto => ModelChoice::Auto,
             ModelArg::Dynamic => ModelChoice::Dynamic,
@@ -1124,10 +1124,12 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         rtol: args.rtol,
         ignore_collisions: args.ignore_collisions,
         t_end: args.t_end,
-        progress: Some(progress),
         max_steps: args.max_steps,
     };
-    settings.validate().map_err(simulate_flags)?;
+    let settings = SimulationSettings {
+        progress: Some(progress),
+        ..options.settings().map_err(simulate_flags)?
+    };
     let scene = load_scene(&args.scene)?;
     let simulation = simulate(&scene, &settings).map_err(simulate_flags)?;
     let response = &simulation.response;
