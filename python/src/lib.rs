@@ -399,6 +399,21 @@ fn noop(py: Python<'_>) -> PyResult<String> {
     run_detached(py, || Ok(String::new()))
 }
 
+/// Waits `seconds` on the worker thread, as a long call does, and returns: a call whose
+/// length is known, so the interruption and GIL tests do not depend on how fast the library
+/// is. At most 60 s.
+#[pyfunction]
+fn wait(py: Python<'_>, seconds: f64) -> PyResult<f64> {
+    if !(0.0..=60.0).contains(&seconds) {
+        return Err(to_py(NanofoldError::invalid("seconds", seconds, "must lie in [0, 60]")));
+    }
+    run_detached(py, move || {
+        let clock = Instant::now();
+        std::thread::sleep(Duration::from_secs_f64(seconds));
+        Ok(clock.elapsed().as_secs_f64())
+    })
+}
+
 /// The library's version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -423,6 +438,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(simulate, m)?,
         wrap_pyfunction!(modes, m)?,
         wrap_pyfunction!(noop, m)?,
+        wrap_pyfunction!(wait, m)?,
         wrap_pyfunction!(version, m)?,
     ] {
         m.add_function(function)?;
