@@ -7,8 +7,37 @@
 //! between fold angles, and the folding dynamics of plates on stress-actuated hinges
 //! (strips, closed vertices, networks of panels). The model — every equation, and the
 //! readings chosen where the thesis it comes from is ambiguous — is in `docs/model.md`;
-//! code cites its anchors. The front door is [`commands`]: one [`commands::Pattern`], one
-//! `check`, `fold` and `unfold`.
+//! code cites its anchors.
+//!
+//! ## Where to start
+//!
+//! Most programs need one line, `use nanofold::prelude::*;`, and the front door,
+//! [`commands`]: the command line and the Python package call nothing else.
+//!
+//! | you want to | call |
+//! |---|---|
+//! | read a pattern (FOLD, a native vertex, or built in code) | [`commands::Pattern::open`], [`commands::Pattern::from`] |
+//! | check, fold or unfold it | [`commands::check`], [`commands::fold_run`], [`commands::unfold`] |
+//! | name options as the command line and Python do | [`commands::options`] (`FoldOptions`, `UnfoldOptions`, …) |
+//! | constraint curves between fold angles | [`commands::constraints`] |
+//! | generate a Miura-ori, a twist, a waterbomb, a bird base | [`commands::Generator`] |
+//! | simulate a device, find its modes | [`commands::open_scene`], [`commands::simulate`], [`commands::modes`] |
+//!
+//! ## Which module owns what
+//!
+//! | module | owns |
+//! |---|---|
+//! | [`geometry`] | the sphere around a vertex (geodesics, fold angles from nodes) and one vertex's loop closure |
+//! | [`pattern`] | the validated vertex and crease pattern, their builders and the pattern generators |
+//! | [`read`] | the readers: FOLD, native vertices, scene files and the scene schema |
+//! | [`folding`] | many vertices: closures and their Jacobian, rank, panel poses and contact, folding paths, verdicts |
+//! | [`unfold`] | unfolding by energy descent on the sphere (one vertex) and on the closures (many) |
+//! | [`constraints`] | the constraint curves: exact sweeps, polynomial fits, their errors |
+//! | [`dynamics`] | plates on hinges: models, mass matrices, forcing, contact, integration, modes |
+//! | [`write`](mod@write) | the writers: JSON reports, FOLD animations, MuJoCo models, output folders |
+//! | [`commands`] | the front door over all of the above |
+//! | `plot` | SVG figures and 3D pages (feature `plot`) |
+//! | [`error`] | the one error type, [`NanofoldError`], with the numerics' failures |
 //!
 //! ## A pattern from numbers, unfolded
 //!
@@ -60,7 +89,7 @@
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
 //! [`read`] (the file readers) → [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`]
-//! → [`write`] (the file writers) → [`commands`] (the front door) → `plot` (feature `plot`)
+//! → [`write`](mod@write) (the file writers) → [`commands`] (the front door) → `plot` (feature `plot`)
 //! → the `nanofold` binary (feature `cli`). [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.
 

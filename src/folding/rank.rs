@@ -1,6 +1,6 @@
 //! Rank of the closure Jacobian and the degrees of freedom at a state
 //! (`docs/model.md#rigid-folding`): after the exact reductions of
-//! [`reduce`](super::reduction::reduce), faer's column-pivoted QR up to [`DENSE_RANK_LIMIT`]
+//! [`super::reduction::reduce`], faer's column-pivoted QR up to [`DENSE_RANK_LIMIT`]
 //! columns, above it a count of J's null space by subspace iteration on (JᵀJ + μI)⁻¹ with
 //! a sparse Cholesky factorisation.
 
