@@ -227,6 +227,13 @@ pub fn crease_pattern_of_value(value: &serde_json::Value, name: &str, origin: &s
     if unflattened.is_none() {
         angles_as_targets(&mut pattern)?;
     }
+    if !pattern.ignored_vertices.is_empty() {
+        let shown: Vec<String> = pattern.ignored_vertices.iter().map(|v| v.to_string()).collect();
+        pattern.reading.push(format!(
+            "vertices_coords[{}] on no edge (stray points): left out, the vertices after them numbered on without them",
+            shown.join(", ")
+        ));
+    }
     Ok(pattern)
 }
 

@@ -128,6 +128,9 @@ pub struct CreasePattern {
     pub reading: Vec<String>,
     /// Per edge, the file's angles when they were read as targets, not a state, rad.
     pub target_angles: Option<Vec<f64>>,
+    /// Vertices of the file that no edge uses (stray points), left out: their indices in
+    /// the file. The others are numbered on without them.
+    pub ignored_vertices: Vec<usize>,
     /// The centre of the vertices' bounding box in the file's coordinates. `vertices` are
     /// relative to it, so that nothing computed depends on where the paper lies (a pattern
     /// 1e8 from the origin keeps its digits); outputs add it back.
@@ -301,19 +304,10 @@ impl CreasePatternBuilder {
                 "only a crease (M, V, U) can be locked",
             ));
         }
-        // A vertex no edge uses belongs to no face and no panel: nothing could place it.
-        let mut used = vec![false; nv];
-        for &[a, b] in &edges {
-            used[a] = true;
-            used[b] = true;
-        }
-        if let Some(v) = used.iter().position(|u| !u) {
-            return Err(NanofoldError::invalid(
-                format!("vertices_coords[{v}]"),
-                format!("{:?}", vertices[v]),
-                "no edge uses this vertex: remove it (a vertex of the paper lies on its edges)",
-            ));
-        }
+        // A vertex no edge uses (a stray point an editor left) belongs to no face and no
+        // panel: it is left out, the others renumbered, and the reading says so.
+        let (vertices, edges, given_faces, ignored_vertices) = without_stray_vertices(vertices, edges, given_faces)?;
+        let nv = vertices.len();
         let duplicates = duplicate_edge(&edges);
         if let Some((first, second)) = duplicates {
             return Err(NanofoldError::invalid(
@@ -387,11 +381,70 @@ impl CreasePatternBuilder {
             unit,
             reading: Vec::new(),
             target_angles: None,
+            ignored_vertices,
             origin,
             angle_precision,
             length_precision,
         })
     }
+}
+
+/// Leaves out the vertices no edge uses and renumbers the rest (edges and given faces with
+/// them); returns the original indices of those left out. A given face that lists such a
+/// vertex is refused, naming it.
+#[allow(clippy::type_complexity)]
+fn without_stray_vertices(
+    vertices: Vec<[f64; 2]>,
+    edges: Vec<[usize; 2]>,
+    faces: Option<Vec<Vec<usize>>>,
+) -> Result<(Vec<[f64; 2]>, Vec<[usize; 2]>, Option<Vec<Vec<usize>>>, Vec<usize>)> {
+    let mut used = vec![false; vertices.len()];
+    for &[a, b] in &edges {
+        used[a] = true;
+        used[b] = true;
+    }
+    let stray: Vec<usize> = (0..vertices.len()).filter(|&v| !used[v]).collect();
+    if stray.is_empty() {
+        return Ok((vertices, edges, faces, stray));
+    }
+    if stray.len() == vertices.len() {
+        return Err(NanofoldError::invalid(
+            "edges_vertices",
+            "[]",
+            "a crease pattern needs edges (its paper's outline at least)",
+        ));
+    }
+    let mut renumbered = vec![usize::MAX; vertices.len()];
+    let mut kept = Vec::with_capacity(vertices.len() - stray.len());
+    for (v, point) in vertices.into_iter().enumerate() {
+        if used[v] {
+            renumbered[v] = kept.len();
+            kept.push(point);
+        }
+    }
+    let edges = edges.into_iter().map(|[a, b]| [renumbered[a], renumbered[b]]).collect();
+    let faces = match faces {
+        None => None,
+        Some(faces) => Some(
+            faces
+                .into_iter()
+                .enumerate()
+                .map(|(f, face)| {
+                    face.iter()
+                        .map(|&v| match renumbered.get(v) {
+                            Some(&n) if n != usize::MAX => Ok(n),
+                            _ => Err(NanofoldError::invalid(
+                                format!("faces_vertices[{f}]"),
+                                format!("{face:?}"),
+                                format!("vertex {v} is on no edge"),
+                            )),
+                        })
+                        .collect::<Result<Vec<usize>>>()
+                })
+                .collect::<Result<Vec<_>>>()?,
+        ),
+    };
+    Ok((kept, edges, faces, stray))
 }
 
 /// The length precision over the shortest edge: the angle the file's rounding can move
