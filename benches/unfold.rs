@@ -2,11 +2,11 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use nanofold::geometry::sphere::Vec3;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};
 
-fn library() -> Vec<Pattern> {
+fn library() -> Vec<VertexPattern> {
     let mut paths: Vec<_> = std::fs::read_dir("patterns")
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))

@@ -10,7 +10,7 @@
 use nanofold::folding::{fold_path, Drive, FoldSettings, FoldingModel};
 use nanofold::pattern::LoadOptions;
 use nanofold::unfold::network::{
-    start_descent, unfold_network_observed, NetworkReport, NetworkStart, NetworkUnfoldSettings,
+    start_descent, unfold_network_observed, NetworkStart, NetworkUnfoldReport, NetworkUnfoldSettings,
 };
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldProgress, UnfoldSettings};
 use std::hint::black_box;
@@ -32,7 +32,7 @@ fn bare_loop(model: &UnfoldModel, settings: &UnfoldSettings) -> usize {
 
 /// The many-vertex descent driven by a bare loop, as `unfold_network` drove it before it
 /// was an argmin solver.
-fn bare_descent(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> NetworkReport {
+fn bare_descent(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> NetworkUnfoldReport {
     let mut descent = match start_descent(model, start, settings).unwrap() {
         NetworkStart::Decided(report) => return report,
         NetworkStart::Descent(descent) => descent,

@@ -31,7 +31,7 @@ use crate::folding::{check_pattern, fold_path, CheckReport, CheckSettings, FoldP
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
 use crate::pattern::{Assignment, Chain, LoadOptions, RayRole};
 use crate::unfold::network::{
-    unfold_network, unfold_network_observed, NetworkReport, NetworkUnfoldSettings, NetworkVerdict,
+    unfold_network, unfold_network_observed, NetworkUnfoldReport, NetworkUnfoldSettings, NetworkVerdict,
 };
 use crate::unfold::{UnfoldProgress, UnfoldReport, UnfoldSettings};
 use serde::Serialize;
@@ -52,7 +52,7 @@ pub use options::{
 pub use scene::{modes, open_scene, parse_scene, scene_kind, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
 
 /// The single-vertex pattern type of the engine behind the door.
-pub use crate::pattern::Pattern as VertexPattern;
+pub use crate::pattern::VertexPattern;
 
 /// Which engine answers for a pattern.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -525,9 +525,9 @@ pub enum Detail {
     /// The single-vertex unfolding (also `check` of a single vertex).
     VertexUnfold(Box<UnfoldReport>),
     /// The many-vertex unfolding.
-    NetworkUnfold(Box<NetworkReport>),
+    NetworkUnfold(Box<NetworkUnfoldReport>),
     /// The many-vertex check, with the unfolding by energy a rigid folded state also gets.
-    NetworkCheck(Box<CheckReport>, Option<Box<NetworkReport>>),
+    NetworkCheck(Box<CheckReport>, Option<Box<NetworkUnfoldReport>>),
     /// A folding path.
     Fold(Box<FoldPath>),
 }
@@ -736,7 +736,10 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
 
 /// The many-vertex check, and a rigid folded state's unfolding by energy beside it
 /// (`docs/model.md#energy-unfolding-of-many-vertices`): what `check` answers for a sheet.
-pub fn check_sheet(model: &FoldingModel, settings: &CheckSettings) -> Result<(CheckReport, Option<NetworkReport>)> {
+pub fn check_sheet(
+    model: &FoldingModel,
+    settings: &CheckSettings,
+) -> Result<(CheckReport, Option<NetworkUnfoldReport>)> {
     let report = check_pattern(model, settings)?;
     let unfolding = if report.has_state && report.verdict == crate::folding::PatternVerdict::Rigid {
         Some(unfold_network(

@@ -10,7 +10,7 @@ pub mod sweep;
 
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
-use crate::pattern::{Assignment, Chain, Pattern};
+use crate::pattern::{Assignment, Chain, VertexPattern};
 use chebyshev::{eval_monomial, Chebyshev};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -23,7 +23,7 @@ pub const MAX_DEGREE: usize = 20;
 pub const MAX_SAMPLES: usize = 100_000;
 
 /// Which crease drives, which are held and at what angle, which follow. Indices are into
-/// [`Pattern::creases`].
+/// [`VertexPattern::creases`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setup {
     /// The driving crease.
@@ -37,7 +37,7 @@ pub struct Setup {
 impl Setup {
     /// Validates a driver and user locks (crease index, rad) against the pattern: the chain
     /// must be closed, the driver free, and exactly one degree of freedom must remain.
-    pub fn new(pattern: &Pattern, driver: usize, user_locks: &[(usize, f64)]) -> Result<Setup> {
+    pub fn new(pattern: &VertexPattern, driver: usize, user_locks: &[(usize, f64)]) -> Result<Setup> {
         if pattern.chain == Chain::Open {
             return Err(NanofoldError::invalid(
                 "chain",
@@ -141,7 +141,7 @@ impl Setup {
     }
 
     /// Ray fold angles with the held creases at their lock values and the others folded.
-    pub(crate) fn base_ray_angles(&self, pattern: &Pattern) -> Vec<f64> {
+    pub(crate) fn base_ray_angles(&self, pattern: &VertexPattern) -> Vec<f64> {
         let mut rho = pattern.folded_ray_angles();
         for &(c, value) in &self.locked {
             rho[pattern.creases[c].ray] = value;
@@ -185,7 +185,7 @@ impl CurveSamples {
 }
 
 /// The default sweep domain: from flat to the driver's folded angle.
-pub fn default_domain(pattern: &Pattern, driver: usize) -> Result<[f64; 2]> {
+pub fn default_domain(pattern: &VertexPattern, driver: usize) -> Result<[f64; 2]> {
     let folded = pattern.creases[driver].folded_angle;
     if folded.abs() < 1e-9 {
         return Err(NanofoldError::invalid(
@@ -230,7 +230,7 @@ pub fn check_domain(domain: [f64; 2]) -> Result<()> {
 /// assert!((end[2].to_degrees() - 90.0).abs() < 1e-6);
 /// # Ok::<(), NanofoldError>(())
 /// ```
-pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
+pub fn sweep_samples(pattern: &VertexPattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
     check_domain(domain)?;
     if !(2..=MAX_SAMPLES).contains(&samples) {
         return Err(NanofoldError::invalid(
@@ -245,7 +245,7 @@ pub fn sweep_samples(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples
 /// The pattern to unfold for constraint samples along an unfolding: every held crease of
 /// `setup` locked at its folded angle. A lock at another angle is refused (the unfolding
 /// starts from the folded state).
-pub fn held_pattern(pattern: &Pattern, setup: &Setup) -> Result<Pattern> {
+pub fn held_pattern(pattern: &VertexPattern, setup: &Setup) -> Result<VertexPattern> {
     let mut held = pattern.clone();
     for &(c, value) in &setup.locked {
         let folded = pattern.creases[c].folded_angle;
@@ -281,7 +281,7 @@ pub fn held_pattern(pattern: &Pattern, setup: &Setup) -> Result<Pattern> {
 /// # Ok::<(), NanofoldError>(())
 /// ```
 pub fn trajectory_samples(
-    pattern: &Pattern,
+    pattern: &VertexPattern,
     setup: &Setup,
     domain: Option<[f64; 2]>,
     fold_angles: &[Vec<f64>],
@@ -379,7 +379,7 @@ pub(crate) fn check_in_domain(driver_label: &str, domain: [f64; 2], theta: f64, 
 /// The fitted constraint θ_r = f(θ_c) for one driving crease: what dynamics consume.
 #[derive(Debug, Clone)]
 pub struct ConstraintPoly {
-    /// Driving crease (index into [`Pattern::creases`]) and its label for errors.
+    /// Driving crease (index into [`VertexPattern::creases`]) and its label for errors.
     pub driver: usize,
     /// The driver's label, for errors.
     pub driver_label: String,
@@ -400,7 +400,7 @@ pub struct ConstraintPoly {
 
 impl ConstraintPoly {
     /// Least-squares fit of degree `degree` (1 ≤ D ≤ 20) to every dependent.
-    pub fn fit(pattern: &Pattern, samples: &CurveSamples, degree: usize) -> Result<ConstraintPoly> {
+    pub fn fit(pattern: &VertexPattern, samples: &CurveSamples, degree: usize) -> Result<ConstraintPoly> {
         if degree == 0 || degree > MAX_DEGREE {
             return Err(NanofoldError::invalid(
                 "degree",
@@ -547,7 +547,7 @@ impl ConstraintPoly {
 /// G = ∂f/∂θ_c from the implicit function theorem on exact loop closure (T4.18):
 /// J_dep G = −J_driver, with J the closure Jacobian at the given crease angles (file order,
 /// which must close the loop). An error at a singular configuration, where G is undefined.
-pub fn implicit_jacobian(pattern: &Pattern, setup: &Setup, crease_angles: &[f64]) -> Result<Vec<f64>> {
+pub fn implicit_jacobian(pattern: &VertexPattern, setup: &Setup, crease_angles: &[f64]) -> Result<Vec<f64>> {
     let mut rho = setup.base_ray_angles(pattern);
     for (c, crease) in pattern.creases.iter().enumerate() {
         rho[crease.ray] = crease_angles[c];
@@ -650,7 +650,12 @@ pub const MAX_CHECKED_COEFFICIENTS: usize = MAX_DEGREE + 1;
 /// Measures the polynomial `coeffs_deg` (degrees → degrees, ascending powers) of crease `c`
 /// (internal index) against the exact samples: a published curve's error, in the same
 /// terms as a fit's.
-pub fn check_curve(pattern: &Pattern, samples: &CurveSamples, c: usize, coeffs_deg: &[f64]) -> Result<CheckedCurve> {
+pub fn check_curve(
+    pattern: &VertexPattern,
+    samples: &CurveSamples,
+    c: usize,
+    coeffs_deg: &[f64],
+) -> Result<CheckedCurve> {
     let setup = &samples.setup;
     let label = pattern
         .creases
@@ -718,7 +723,7 @@ pub fn check_curve(pattern: &Pattern, samples: &CurveSamples, c: usize, coeffs_d
 impl ConstraintReport {
     /// Evaluates the fit: monomial coefficients, errors against the samples, and loop
     /// closure on a grid 10× finer than the samples.
-    pub fn new(pattern: &Pattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<ConstraintReport> {
+    pub fn new(pattern: &VertexPattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<ConstraintReport> {
         let setup = &samples.setup;
         let base = setup.base_ray_angles(pattern);
         let driver_ray = pattern.creases[setup.driver].ray;
@@ -801,7 +806,7 @@ impl ConstraintReport {
 
 /// The smallest degree (1…20) whose fit error (Chebyshev and monomial forms) is ≤ `tol`.
 pub fn fit_to_tolerance(
-    pattern: &Pattern,
+    pattern: &VertexPattern,
     samples: &CurveSamples,
     tol: f64,
 ) -> Result<(ConstraintPoly, ConstraintReport)> {

@@ -78,7 +78,7 @@ pub enum Chain {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RayRole {
-    /// A user crease; the index is into [`Pattern::creases`].
+    /// A user crease; the index is into [`VertexPattern::creases`].
     Crease(usize),
     /// An end of the sheet at a boundary vertex.
     Boundary,
@@ -97,7 +97,7 @@ pub struct Crease {
     pub folded_angle: f64,
     /// Held at `folded_angle` while unfolding.
     pub locked: bool,
-    /// Index of this crease's ray in [`Pattern::rays`].
+    /// Index of this crease's ray in [`VertexPattern::rays`].
     pub ray: usize,
     /// FOLD edge index, for FOLD input.
     pub fold_edge: Option<usize>,
@@ -124,7 +124,7 @@ pub struct FlatMesh {
 
 /// A validated single vertex.
 #[derive(Debug, Clone)]
-pub struct Pattern {
+pub struct VertexPattern {
     /// Names the pattern (and its output folder).
     pub name: String,
     /// Interior (closed) or boundary (open) vertex.
@@ -209,13 +209,13 @@ pub struct CreaseSpec {
     pub locked: bool,
     /// FOLD edge index, for FOLD input.
     pub fold_edge: Option<usize>,
-    /// Position in the caller's crease order (the order of [`Pattern::creases`]).
+    /// Position in the caller's crease order (the order of [`VertexPattern::creases`]).
     pub order: usize,
     /// Name of the fold-angle field, for errors.
     pub angle_field: String,
 }
 
-/// Builds a [`Pattern`] from numbers: sector angles and creases counter-clockwise.
+/// Builds a [`VertexPattern`] from numbers: sector angles and creases counter-clockwise.
 ///
 /// ```
 /// use nanofold::pattern::{Assignment, VertexBuilder};
@@ -305,13 +305,13 @@ impl VertexBuilder {
     }
 
     /// Validates with the default [`LoadOptions`] (`docs/model.md#the-vertex`).
-    pub fn build(self) -> Result<Pattern> {
+    pub fn build(self) -> Result<VertexPattern> {
         self.build_with(&LoadOptions::default())
     }
 
     /// Validates and splits sectors of π or more (`docs/model.md#the-vertex`). An open chain built with
     /// [`VertexBuilder::crease`] gets its two boundary rays here.
-    pub fn build_with(mut self, options: &LoadOptions) -> Result<Pattern> {
+    pub fn build_with(mut self, options: &LoadOptions) -> Result<VertexPattern> {
         options.validate()?;
         if self.chain == Chain::Open && !matches!(self.rays.first(), Some(RaySpec::Boundary)) {
             self.rays.insert(0, RaySpec::Boundary);
@@ -322,13 +322,13 @@ impl VertexBuilder {
                 .map(|k| format!("sector_angles[{k}]"))
                 .collect();
         }
-        Pattern::build(self, options)
+        VertexPattern::build(self, options)
     }
 }
 
-impl Pattern {
+impl VertexPattern {
     /// Validates and splits a builder's vertex (`docs/model.md#the-vertex`).
-    fn build(raw: VertexBuilder, options: &LoadOptions) -> Result<Pattern> {
+    fn build(raw: VertexBuilder, options: &LoadOptions) -> Result<VertexPattern> {
         let VertexBuilder {
             name,
             chain,
@@ -473,7 +473,7 @@ impl Pattern {
             .map(|(i, c)| c.ok_or_else(|| NanofoldError::invalid("creases", i, "crease order has a gap")))
             .collect::<Result<_>>()?;
 
-        let mut pattern = Pattern {
+        let mut pattern = VertexPattern {
             name,
             chain,
             rays,
@@ -539,7 +539,7 @@ impl Pattern {
         self.creases[crease].fold_edge.unwrap_or(crease)
     }
 
-    /// The crease a user index names, if any (inverse of [`Pattern::user_index`]).
+    /// The crease a user index names, if any (inverse of [`VertexPattern::user_index`]).
     pub fn crease_from_user_index(&self, index: usize) -> Option<usize> {
         (0..self.creases.len()).find(|&i| self.user_index(i) == index)
     }

@@ -10,7 +10,7 @@ pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
-use crate::pattern::Pattern;
+use crate::pattern::VertexPattern;
 use crate::unfold::UnfoldReport;
 use crate::write::output::{snapshot_indices, write_atomic};
 use canvas::{canvas, px, pxi, shown_at};
@@ -167,7 +167,7 @@ pub fn series_colour(i: usize) -> RGBColor {
 }
 
 /// Renders `unfold.svg` to a string.
-pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
+pub fn unfold_svg(pattern: &VertexPattern, report: &UnfoldReport) -> Result<String> {
     let mut svg = String::new();
     {
         let root = canvas(&mut svg, (1000, 680));
@@ -266,14 +266,14 @@ pub fn unfold_svg(pattern: &Pattern, report: &UnfoldReport) -> Result<String> {
 }
 
 /// Writes `unfold.svg`.
-pub fn write_unfold_svg(path: &Path, pattern: &Pattern, report: &UnfoldReport) -> Result<()> {
+pub fn write_unfold_svg(path: &Path, pattern: &VertexPattern, report: &UnfoldReport) -> Result<()> {
     write_atomic(path, unfold_svg(pattern, report)?.as_bytes())
 }
 
 /// Renders `constraints.svg`: every crease against the driving angle, exact samples as
 /// lines and the fitted polynomials dashed (like the thesis's figure 5-9), and the fit
 /// error |f − exact| on a log scale below.
-pub fn constraints_svg(pattern: &Pattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<String> {
+pub fn constraints_svg(pattern: &VertexPattern, samples: &CurveSamples, poly: &ConstraintPoly) -> Result<String> {
     let mut svg = String::new();
     {
         let root = canvas(&mut svg, (1000, 800));

@@ -13,7 +13,7 @@ pub use scene::{load_scene, parse_scene};
 
 use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::CreasePattern;
-use crate::pattern::{LoadOptions, Pattern};
+use crate::pattern::{LoadOptions, VertexPattern};
 use std::path::Path;
 
 /// Is this a pattern file (a FOLD file or a native vertex, not a scene)?
@@ -42,7 +42,7 @@ pub fn pattern_name(path: &Path) -> String {
 /// assert!(missing.unwrap_err().to_string().contains("nothing.fold"));
 /// # Ok::<(), NanofoldError>(())
 /// ```
-pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<Pattern> {
+pub fn load_pattern(path: &Path, options: &LoadOptions) -> Result<VertexPattern> {
     let text = input::read_text(path, input::MAX_PATTERN_BYTES)?;
     parse_pattern(&text, &pattern_name(path), &path.display().to_string(), options)
 }
@@ -56,12 +56,17 @@ pub(crate) fn is_fold_object(value: &serde_json::Value) -> bool {
 }
 
 /// Parses pattern text (FOLD or native); `origin` names it in error messages.
-pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
+pub fn parse_pattern(text: &str, name: &str, origin: &str, options: &LoadOptions) -> Result<VertexPattern> {
     pattern_of_value(&input::parse_json(text, origin)?, name, origin, options)
 }
 
 /// A single vertex from a pattern file's JSON (FOLD or native), as [`parse_pattern`] reads it.
-pub fn pattern_of_value(value: &serde_json::Value, name: &str, origin: &str, options: &LoadOptions) -> Result<Pattern> {
+pub fn pattern_of_value(
+    value: &serde_json::Value,
+    name: &str,
+    origin: &str,
+    options: &LoadOptions,
+) -> Result<VertexPattern> {
     if !value.is_object() {
         return Err(NanofoldError::invalid(
             origin,

@@ -30,7 +30,7 @@ pub use solver::{ProjectedGradient, SplitMix64, StepOutcome, Termination};
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics;
 use crate::geometry::sphere::Vec3;
-use crate::pattern::Pattern;
+use crate::pattern::VertexPattern;
 use argmin::core::observers::ObserverMode;
 use argmin::core::Executor;
 use energy::EnergyWorkspace;
@@ -137,13 +137,13 @@ pub struct UnfoldReport {
 /// assert!(report.flat_layout_error < 1e-10);
 /// # Ok::<(), NanofoldError>(())
 /// ```
-pub fn unfold(pattern: &Pattern, settings: &UnfoldSettings) -> Result<UnfoldReport> {
+pub fn unfold(pattern: &VertexPattern, settings: &UnfoldSettings) -> Result<UnfoldReport> {
     unfold_observed(pattern, settings, None)
 }
 
 /// [`unfold`], telling `progress` of every recorded step.
 pub fn unfold_observed(
-    pattern: &Pattern,
+    pattern: &VertexPattern,
     settings: &UnfoldSettings,
     progress: Option<UnfoldProgress>,
 ) -> Result<UnfoldReport> {
@@ -310,7 +310,7 @@ fn verdict(solver: &ProjectedGradient, settings: &UnfoldSettings) -> (Verdict, S
 
 /// The report of a closed chain whose sectors do not sum to 2π (a cone): no flat state.
 fn not_flat_foldable(
-    pattern: &Pattern,
+    pattern: &VertexPattern,
     settings: &UnfoldSettings,
     model: &UnfoldModel,
     start: Vec<Vec3>,

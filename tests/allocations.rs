@@ -3,7 +3,7 @@
 //! the default direct path), and a whole unfolding's total is bounded.
 
 use nanofold::geometry::kinematics::solve_closure;
-use nanofold::pattern::{Assignment, LoadOptions, Pattern, VertexBuilder};
+use nanofold::pattern::{Assignment, LoadOptions, VertexBuilder, VertexPattern};
 use nanofold::unfold::{ProjectedGradient, SplitMix64, StepOutcome, UnfoldModel, UnfoldSettings};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -56,7 +56,7 @@ fn count(work: impl FnOnce()) -> usize {
 
 /// A closed vertex of n creases with random sectors, folded by moving every other crease
 /// and closing the loop with the rest.
-fn random_vertex(n: usize) -> Pattern {
+fn random_vertex(n: usize) -> VertexPattern {
     let mut rng = SplitMix64(7);
     let weights: Vec<f64> = (0..n).map(|_| 1.0 + rng.next_f64()).collect();
     let total: f64 = weights.iter().sum();
@@ -79,7 +79,7 @@ fn random_vertex(n: usize) -> Pattern {
 }
 
 /// Allocations of each of the `steps` descent steps after the first.
-fn allocations_per_step(pattern: &Pattern, steps: usize) -> Vec<usize> {
+fn allocations_per_step(pattern: &VertexPattern, steps: usize) -> Vec<usize> {
     let model = UnfoldModel::new(pattern);
     let settings = UnfoldSettings::default();
     let mut solver = ProjectedGradient::new(&model, &settings, model.folded_nodes()).unwrap();

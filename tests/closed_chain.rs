@@ -14,10 +14,10 @@ use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use std::path::Path;
 
-fn degree4() -> Pattern {
+fn degree4() -> VertexPattern {
     nanofold::read::load_pattern(Path::new("patterns/degree4_generic.fold"), &LoadOptions::default()).unwrap()
 }
 

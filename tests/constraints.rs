@@ -4,17 +4,17 @@
 use nanofold::constraints::chebyshev::{eval_monomial, Chebyshev};
 use nanofold::constraints::*;
 use nanofold::geometry::kinematics::closure_residual;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::unfold::UnfoldSettings;
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
-fn load(name: &str) -> Pattern {
+fn load(name: &str) -> VertexPattern {
     nanofold::read::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap()
 }
 
-fn ray_angles(pattern: &Pattern, crease_angles: &[f64]) -> Vec<f64> {
+fn ray_angles(pattern: &VertexPattern, crease_angles: &[f64]) -> Vec<f64> {
     let mut rho = pattern.folded_ray_angles();
     for (c, crease) in pattern.creases.iter().enumerate() {
         rho[crease.ray] = crease_angles[c];
@@ -25,7 +25,7 @@ fn ray_angles(pattern: &Pattern, crease_angles: &[f64]) -> Vec<f64> {
 /// A flat-foldable degree-4 vertex with consecutive sectors α, β, π−α, π−β built from its
 /// closed form: ρ2 = −ρ0, ρ3 = ρ1, tan(ρ1/2) = k tan(ρ0/2), k = sin((α+β)/2)/sin((α−β)/2).
 /// The loader rejects the file unless the closed form closes the loop.
-fn flat_foldable_vertex(alpha_deg: f64, beta_deg: f64, rho0_deg: f64) -> (Pattern, f64) {
+fn flat_foldable_vertex(alpha_deg: f64, beta_deg: f64, rho0_deg: f64) -> (VertexPattern, f64) {
     let (alpha, beta) = (alpha_deg.to_radians(), beta_deg.to_radians());
     let k = ((alpha + beta) / 2.0).sin() / ((alpha - beta) / 2.0).sin();
     let rho0 = rho0_deg.to_radians();
@@ -201,7 +201,7 @@ fn constraint_jacobian_and_its_rate_match_finite_differences() {
 }
 
 /// Constraint samples along an unfolding of the pattern with the setup's locks held.
-fn unfold_samples(pattern: &Pattern, setup: &Setup) -> nanofold::Result<CurveSamples> {
+fn unfold_samples(pattern: &VertexPattern, setup: &Setup) -> nanofold::Result<CurveSamples> {
     let settings = UnfoldSettings::default();
     let report = nanofold::unfold::unfold(&held_pattern(pattern, setup)?, &settings)?;
     let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();

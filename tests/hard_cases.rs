@@ -9,7 +9,7 @@
 mod bench_common;
 mod common;
 use common::native_json;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::state::StepKind;
 use nanofold::unfold::{unfold, Termination, UnfoldSettings, Verdict};
@@ -20,7 +20,7 @@ fn vertex(sectors: &[f64], fold: f64) -> String {
     native_json(sectors, &vec![fold; sectors.len()])
 }
 
-fn load(text: &str) -> nanofold::Result<Pattern> {
+fn load(text: &str) -> nanofold::Result<VertexPattern> {
     nanofold::read::parse_pattern(text, "hard", "hard", &LoadOptions::default())
 }
 

@@ -1,10 +1,10 @@
 //! The pattern library: expected verdicts, residuals and outputs (regression).
 
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::unfold::{unfold, UnfoldSettings, Verdict};
 use std::path::Path;
 
-fn run(name: &str) -> (Pattern, nanofold::unfold::UnfoldReport) {
+fn run(name: &str) -> (VertexPattern, nanofold::unfold::UnfoldReport) {
     let pattern = nanofold::read::load_pattern(&Path::new("patterns").join(name), &LoadOptions::default()).unwrap();
     let report = unfold(&pattern, &UnfoldSettings::default()).unwrap();
     (pattern, report)

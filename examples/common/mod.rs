@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use nanofold::geometry::kinematics::solve_closure;
-use nanofold::pattern::{LoadOptions, Pattern};
+use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::read::is_pattern_file;
 use nanofold::unfold::SplitMix64;
 use serde_json::json;
@@ -55,7 +55,7 @@ pub fn machine() -> serde_json::Value {
 /// A closed vertex with n random sectors (weights in [1, 2)), folded by driving the even
 /// creases (for n < 6, all but the last three) to random angles in ±0.3 rad while the others
 /// follow by (minimum-norm) loop closure, in 20 continuation steps.
-pub fn many_creases(n: usize) -> Pattern {
+pub fn many_creases(n: usize) -> VertexPattern {
     let mut rng = SplitMix64(7);
     let weights: Vec<f64> = (0..n).map(|_| 1.0 + rng.next_f64()).collect();
     let total: f64 = weights.iter().sum();
@@ -87,7 +87,7 @@ pub fn many_creases(n: usize) -> Pattern {
 }
 
 /// The library's pattern files (scene files aside), in name order.
-pub fn library_patterns() -> Vec<Pattern> {
+pub fn library_patterns() -> Vec<VertexPattern> {
     let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir("patterns")
         .expect("run from the repository root")
         .filter_map(|e| e.ok().map(|e| e.path()))

@@ -113,7 +113,7 @@ pub fn constraints(pattern: &Pattern, settings: &ConstraintSettings) -> Result<C
     }
 }
 
-fn vertex_constraints(pattern: &crate::pattern::Pattern, settings: &ConstraintSettings) -> Result<Constraints> {
+fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &ConstraintSettings) -> Result<Constraints> {
     let index = |i: usize, field: &str| {
         pattern.crease_from_user_index(i).ok_or_else(|| {
             NanofoldError::invalid(

@@ -12,7 +12,7 @@ use super::sweep::{CLOSURE_TOL, REFINE_ITERATIONS};
 use super::{check_in_domain, CurveSamples};
 use crate::error::{NumericalError, Result};
 use crate::geometry::kinematics::{closure_jacobian, forward, refine_closure, solve_closure};
-use crate::pattern::Pattern;
+use crate::pattern::VertexPattern;
 use nalgebra::{DMatrix, Vector3};
 use std::cell::Cell;
 
@@ -68,7 +68,7 @@ pub struct ExactConstraint {
 
 impl ExactConstraint {
     /// The branch traced by an exact sweep (`samples.source` should be `Sweep`).
-    pub fn new(pattern: &Pattern, samples: &CurveSamples) -> Self {
+    pub fn new(pattern: &VertexPattern, samples: &CurveSamples) -> Self {
         let setup = &samples.setup;
         let base = setup.base_ray_angles(pattern);
         let branch_rays = samples

@@ -5,7 +5,7 @@
 use super::{CurveSamples, Setup, Source};
 use crate::error::{NanofoldError, Result};
 use crate::geometry::kinematics::{closure_jacobian, closure_residual, refine_closure, solve_closure};
-use crate::pattern::Pattern;
+use crate::pattern::VertexPattern;
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
@@ -147,7 +147,7 @@ fn max_difference(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Drives `setup.driver` over `domain` on a uniform grid of `samples` points.
-pub fn sweep(pattern: &Pattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
+pub fn sweep(pattern: &VertexPattern, setup: &Setup, domain: [f64; 2], samples: usize) -> Result<CurveSamples> {
     let sectors = &pattern.sector_angles;
     let driver_ray = pattern.creases[setup.driver].ray;
     let mut rho = pattern.folded_ray_angles();
@@ -345,7 +345,7 @@ fn take_limits_at_singular_samples(sectors: &[f64], free: &[usize], points: &mut
     }
 }
 
-fn ray_label(pattern: &Pattern, ray: usize) -> String {
+fn ray_label(pattern: &VertexPattern, ray: usize) -> String {
     pattern
         .creases
         .iter()

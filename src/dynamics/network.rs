@@ -26,4 +26,4 @@ pub use algorithms::{NetworkData, Spatial, SpatialInertia};
 pub use kkt::KktSystem;
 pub use model::{Hinge, NetworkModel, NetworkParts, PanelBody};
 pub use plant::NetworkPlant;
-pub use reduced::{ReducedPlant, Reduction};
+pub use reduced::{FittedReduction, ReducedPlant};

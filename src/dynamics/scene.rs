@@ -10,7 +10,7 @@ use super::strip::StripChain;
 use crate::dynamics::spec::{actuation, drag_law, hinge_stiffness, time_and_outputs};
 use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::CreasePattern;
-use crate::pattern::Pattern;
+use crate::pattern::VertexPattern;
 use crate::read::scene_spec::{
     count_within, finite, limits, material, validate_materials, within, ClosedSpec, NetworkSpec, StripEquations,
     StripSpec, MICROMETRE, NETWORK_FROM_PLATES,
@@ -268,7 +268,7 @@ fn moment_about_crease(i: usize, moment: f64, box_moment: f64) -> Result<f64> {
     }
 }
 
-impl ClosedSpec<Pattern> {
+impl ClosedSpec<VertexPattern> {
     /// Validates the scene and assembles its chain: the sweep, the fit and the tree of
     /// sector plates ([`assemble::closed_chain`]).
     pub fn build(&self) -> Result<Scene> {

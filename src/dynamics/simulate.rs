@@ -6,7 +6,7 @@
 use super::closed::{ClosedPlant, ClosedReport};
 use super::contact::Collision;
 use super::integrate::{integrate, output_times, IntegrationOptions, Method, ProgressObserver, IMPLICIT_RATIO};
-use super::network::plant::NetworkReport;
+use super::network::plant::NetworkRunReport;
 use super::network::{NetworkPlant, ReducedPlant};
 use super::plant::{Plant, Sample, TimeScales};
 use super::quasi_static::{quasi_static_deviation, quasi_static_path};
@@ -184,7 +184,7 @@ pub struct Simulation {
     /// The closed chain's constraint errors, torque magnification and closure residual.
     pub closed: Option<ClosedReport>,
     /// A network's branch, closure residuals and energy balance.
-    pub network: Option<NetworkReport>,
+    pub network: Option<NetworkRunReport>,
 }
 
 /// Runs a scene: the dynamics, or the quasi-static path when the model is chosen so (`auto`:

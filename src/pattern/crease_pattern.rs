@@ -1,7 +1,7 @@
 //! The crease pattern with many vertices (`docs/model.md#crease-patterns`): a planar
 //! straight-line graph on a disc of paper, its panels (faces merged across flat `F` edges),
 //! and at every interior vertex the star of creases whose loop must close. The single
-//! vertex ([`super::Pattern`]) is the special case of one interior (or boundary) vertex.
+//! vertex ([`super::VertexPattern`]) is the special case of one interior (or boundary) vertex.
 
 use super::Assignment;
 use crate::error::{NanofoldError, Result};

@@ -454,7 +454,7 @@ pub struct ConstraintSpec {
 
 /// A closed-chain scene: a single-vertex pattern whose faces are the plates, the crease
 /// where the loop is cut, the anchored face, the locks, the hinges and where f comes from.
-/// `P` is the pattern: a FOLD path in a scene file, a [`crate::pattern::Pattern`] once loaded.
+/// `P` is the pattern: a FOLD path in a scene file, a [`crate::pattern::VertexPattern`] once loaded.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClosedSpec<P> {
@@ -500,7 +500,7 @@ pub struct ClosedSpec<P> {
 }
 
 impl<P> ClosedSpec<P> {
-    /// The same scene with its pattern resolved (e.g. a path loaded into a [`crate::pattern::Pattern`]).
+    /// The same scene with its pattern resolved (e.g. a path loaded into a [`crate::pattern::VertexPattern`]).
     pub fn with_pattern<Q>(self, resolve: impl FnOnce(P) -> Result<Q>) -> Result<ClosedSpec<Q>> {
         Ok(ClosedSpec {
             name: self.name,
@@ -804,7 +804,7 @@ pub enum SceneSpec {
     /// Plates in a row on parallel hinges.
     Strip(StripSpec),
     /// The sectors of a closed single vertex.
-    Closed(Box<ClosedSpec<crate::pattern::Pattern>>),
+    Closed(Box<ClosedSpec<crate::pattern::VertexPattern>>),
     /// The panels of any crease pattern.
     Network(Box<NetworkSpec<crate::pattern::crease_pattern::CreasePattern>>),
 }

@@ -4,7 +4,7 @@
 
 use crate::geometry::kinematics;
 use crate::geometry::sphere::{fold_angle, geodesic, Vec3};
-use crate::pattern::{Assignment, Chain, Pattern, RayRole};
+use crate::pattern::{Assignment, Chain, RayRole, VertexPattern};
 use crate::unfold::energy::Arc;
 use serde::Serialize;
 
@@ -60,7 +60,7 @@ pub(crate) enum ConstraintRow {
 
 impl UnfoldModel {
     /// The solver's view of a pattern.
-    pub fn new(pattern: &Pattern) -> UnfoldModel {
+    pub fn new(pattern: &VertexPattern) -> UnfoldModel {
         let n = pattern.ray_count();
         let arcs: Vec<Arc> = pattern
             .sector_angles

@@ -239,7 +239,7 @@ pub struct NetworkStep {
 
 /// What a many-vertex unfolding found.
 #[derive(Debug, Clone, PartialEq)]
-pub struct NetworkReport {
+pub struct NetworkUnfoldReport {
     /// The verdict.
     pub verdict: NetworkVerdict,
     /// Its evidence in words.
@@ -475,7 +475,11 @@ fn try_state(
 
 /// Unfolds a rigid state of `model` by projected gradient descent on the summed vertex
 /// energies.
-pub fn unfold_network(model: &FoldingModel, start: &[f64], settings: &NetworkUnfoldSettings) -> Result<NetworkReport> {
+pub fn unfold_network(
+    model: &FoldingModel,
+    start: &[f64],
+    settings: &NetworkUnfoldSettings,
+) -> Result<NetworkUnfoldReport> {
     unfold_network_observed(model, start, settings, None)
 }
 
@@ -486,7 +490,7 @@ pub fn unfold_network_observed(
     start: &[f64],
     settings: &NetworkUnfoldSettings,
     progress: Option<UnfoldProgress>,
-) -> Result<NetworkReport> {
+) -> Result<NetworkUnfoldReport> {
     let descent = match start_descent(model, start, settings)? {
         NetworkStart::Decided(report) => return Ok(report),
         NetworkStart::Descent(descent) => descent,
@@ -503,7 +507,7 @@ pub fn unfold_network_observed(
 /// Where an unfolding of many vertices begins.
 pub enum NetworkStart<'a> {
     /// Decided at the start (not a rigid state; no motion): the report.
-    Decided(NetworkReport),
+    Decided(NetworkUnfoldReport),
     /// A descent to drive, from the start restored onto the closure.
     Descent(Box<NetworkDescent<'a>>),
 }
@@ -538,7 +542,7 @@ pub fn start_descent<'a>(
             .iter()
             .position(|&r| r == residual)
             .expect("the largest is one of them");
-        return Ok(NetworkStart::Decided(NetworkReport {
+        return Ok(NetworkStart::Decided(NetworkUnfoldReport {
             verdict: NetworkVerdict::NotRigid,
             evidence: format!(
                 "the start is not a rigid state: vertex {} is {residual:.3e} rad from closing (above 1e-6)",

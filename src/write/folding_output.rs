@@ -335,7 +335,7 @@ pub fn check_summary(
     model: &FoldingModel,
     file: &str,
     report: &CheckReport,
-    unfolding: Option<&crate::unfold::network::NetworkReport>,
+    unfolding: Option<&crate::unfold::network::NetworkUnfoldReport>,
     seconds: f64,
 ) -> Value {
     let mut value = check_fields(model, file, report, seconds);
@@ -434,7 +434,7 @@ pub fn fold_summary(model: &FoldingModel, file: &str, path: &FoldPath, dof: usiz
 pub fn network_unfold_summary(
     model: &FoldingModel,
     file: &str,
-    report: &crate::unfold::network::NetworkReport,
+    report: &crate::unfold::network::NetworkUnfoldReport,
     start: &[f64],
     seconds: f64,
     adjustments: &[String],

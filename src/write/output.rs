@@ -12,7 +12,7 @@ use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{Response, Simulation, SimulationSettings};
 use crate::error::{NanofoldError, Result};
 use crate::geometry::sphere::Vec3;
-use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
+use crate::pattern::{Chain, FlatMesh, RayRole, VertexPattern};
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -82,7 +82,7 @@ struct ExportMesh {
     faces_vertices: Option<Vec<Vec<usize>>>,
 }
 
-fn export_mesh(pattern: &Pattern) -> ExportMesh {
+fn export_mesh(pattern: &VertexPattern) -> ExportMesh {
     if let Some(FlatMesh {
         vertices_coords,
         edges_vertices,
@@ -147,7 +147,7 @@ fn export_mesh(pattern: &Pattern) -> ExportMesh {
 
 /// 3D position of every mesh vertex for the given node positions: each vertex moves with
 /// the (split) sector that contains it.
-fn place_vertices(pattern: &Pattern, mesh: &ExportMesh, nodes: &[Vec3]) -> Vec<[f64; 3]> {
+fn place_vertices(pattern: &VertexPattern, mesh: &ExportMesh, nodes: &[Vec3]) -> Vec<[f64; 3]> {
     let directions = pattern.flat_ray_directions();
     let n = pattern.ray_count();
     let sectors = pattern.sector_angles.len();
@@ -210,7 +210,7 @@ fn frame_letters(mesh: &ExportMesh, angles_degrees: &[f64]) -> Vec<String> {
 /// the input's assignments) with the folded state it started from in `edges_foldAngle`, so
 /// nanofold reads the file back as its input; `file_frames` are the snapshots, 3D `foldedForm` frames whose
 /// assignments follow their angles.
-pub fn fold_animation(pattern: &Pattern, model: &UnfoldModel, report: &UnfoldReport) -> Value {
+pub fn fold_animation(pattern: &VertexPattern, model: &UnfoldModel, report: &UnfoldReport) -> Value {
     let mesh = export_mesh(pattern);
     let picks = snapshot_indices(report, 11);
     let start_nodes = model.folded_nodes();
@@ -273,7 +273,12 @@ struct TrajectoryStep<'a> {
 
 /// `trajectory.json`: settings, crease table and every recorded step (thinned evenly to at
 /// most `max_steps`, first and last kept).
-pub fn trajectory_json(pattern: &Pattern, settings: &UnfoldSettings, report: &UnfoldReport, max_steps: usize) -> Value {
+pub fn trajectory_json(
+    pattern: &VertexPattern,
+    settings: &UnfoldSettings,
+    report: &UnfoldReport,
+    max_steps: usize,
+) -> Value {
     let total = report.trajectory.len();
     let stride = total.div_ceil(max_steps.max(1)).max(1);
     let mut chosen: Vec<usize> = (0..total).step_by(stride).collect();
@@ -427,7 +432,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
 }
 
 /// The single vertex's unfolding as `unfold --json` prints it (`file`: the input's path).
-pub fn vertex_unfold_summary(pattern: &Pattern, file: &str, report: &UnfoldReport) -> Value {
+pub fn vertex_unfold_summary(pattern: &VertexPattern, file: &str, report: &UnfoldReport) -> Value {
     json!({
         "pattern": pattern.name,
         "file": file,

@@ -9,7 +9,7 @@ use crate::dynamics::forcing::{Actuation, Forcing, HingeDrive};
 use crate::dynamics::model::{Joint, Model, Plate};
 use crate::dynamics::spec::{actuation, drag_law, hinge_stiffness};
 use crate::error::{NanofoldError, Result};
-use crate::pattern::{Chain, FlatMesh, Pattern, RayRole};
+use crate::pattern::{Chain, FlatMesh, RayRole, VertexPattern};
 use crate::read::scene_spec::{
     count_within, finite, limits, material, validate_materials, within, ClosedSpec, CreaseHingeSpec, HingeSpec,
     SourceKind, MICROMETRE,
@@ -47,7 +47,7 @@ struct Step {
 
 /// Assembles the closed chain a scene describes: validates the pattern and the hinges,
 /// sets up the step, sweeps and fits the constraint, and builds the tree of sector plates.
-pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
+pub fn closed_chain(spec: &ClosedSpec<VertexPattern>) -> Result<ClosedChain> {
     validate_materials(&spec.materials)?;
     let pattern = &spec.pattern;
     let mesh = check_pattern(pattern)?;
@@ -113,7 +113,7 @@ pub fn closed_chain(spec: &ClosedSpec<Pattern>) -> Result<ClosedChain> {
 }
 
 /// The crease a scene field names by its FOLD edge index.
-fn crease_of(pattern: &Pattern, field: &str, index: usize) -> Result<usize> {
+fn crease_of(pattern: &VertexPattern, field: &str, index: usize) -> Result<usize> {
     pattern.crease_from_user_index(index).ok_or_else(|| {
         NanofoldError::invalid(
             field,
@@ -128,7 +128,7 @@ fn crease_of(pattern: &Pattern, field: &str, index: usize) -> Result<usize> {
 }
 
 /// One hinge per crease, its stiffness from its layers and the crease's length.
-fn crease_hinges(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry) -> Result<Hinges> {
+fn crease_hinges(spec: &ClosedSpec<VertexPattern>, geometry: &SectorGeometry) -> Result<Hinges> {
     let pattern = &spec.pattern;
     let creases = pattern.creases.len();
     let mut of_crease: Vec<Option<usize>> = vec![None; creases];
@@ -168,7 +168,7 @@ fn crease_hinges(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry) -> Resul
 
 /// The driver (the one actuated crease) and its target, the cut, the locks leaving one
 /// freedom, the start and the domain the constraint is swept over.
-fn step_of(spec: &ClosedSpec<Pattern>, hinges: &Hinges) -> Result<Step> {
+fn step_of(spec: &ClosedSpec<VertexPattern>, hinges: &Hinges) -> Result<Step> {
     let pattern = &spec.pattern;
     let creases = pattern.creases.len();
     let actuated: Vec<usize> = (0..creases)
@@ -243,7 +243,7 @@ fn step_of(spec: &ClosedSpec<Pattern>, hinges: &Hinges) -> Result<Step> {
 
 /// f: a Chebyshev fit of the exact sweep (`poly`), or Newton closure on the sweep's branch
 /// (`exact`). The sweep runs here (the numerics of assembling, never of loading).
-fn constraint_source(spec: &ClosedSpec<Pattern>, step: &Step) -> Result<ConstraintSource> {
+fn constraint_source(spec: &ClosedSpec<VertexPattern>, step: &Step) -> Result<ConstraintSource> {
     let pattern = &spec.pattern;
     count_within(
         "constraint.samples",
@@ -298,7 +298,7 @@ fn scene_fields(error: NanofoldError) -> NanofoldError {
 }
 
 /// The sector on the substrate: the anchored face's, or the one after the cut.
-fn anchored_sector(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry, step: &Step) -> Result<usize> {
+fn anchored_sector(spec: &ClosedSpec<VertexPattern>, geometry: &SectorGeometry, step: &Step) -> Result<usize> {
     let pattern = &spec.pattern;
     match spec.anchored_face {
         None => Ok(pattern.creases[step.cut].ray),
@@ -315,7 +315,7 @@ fn anchored_sector(spec: &ClosedSpec<Pattern>, geometry: &SectorGeometry, step: 
 }
 
 /// The outline of the face covering `sector`, m.
-fn outline_of(pattern: &Pattern, geometry: &SectorGeometry, sector: usize) -> Result<Vec<[f64; 2]>> {
+fn outline_of(pattern: &VertexPattern, geometry: &SectorGeometry, sector: usize) -> Result<Vec<[f64; 2]>> {
     geometry.outlines[sector]
         .as_ref()
         .map(|(o, _)| o.clone())
@@ -331,7 +331,7 @@ fn outline_of(pattern: &Pattern, geometry: &SectorGeometry, sector: usize) -> Re
 /// The sector plates on a tree rooted at the anchored sector, both ways round to the cut;
 /// with the crease and the sector of every joint.
 fn sector_tree(
-    spec: &ClosedSpec<Pattern>,
+    spec: &ClosedSpec<VertexPattern>,
     geometry: &SectorGeometry,
     hinges: &Hinges,
     step: &Step,
@@ -402,7 +402,7 @@ fn sector_tree(
 }
 
 /// A closed vertex from a FOLD file with faces, and no sector split by a virtual ray.
-fn check_pattern(pattern: &Pattern) -> Result<&FlatMesh> {
+fn check_pattern(pattern: &VertexPattern) -> Result<&FlatMesh> {
     if pattern.chain != Chain::Closed {
         return Err(NanofoldError::invalid(
             "pattern",
@@ -435,7 +435,7 @@ fn check_pattern(pattern: &Pattern) -> Result<&FlatMesh> {
 
 /// Ray directions, crease ends and which face covers which sector (the one its centroid's
 /// direction falls in), in m about the vertex.
-fn sector_geometry(pattern: &Pattern, mesh: &FlatMesh, unit: f64) -> Result<SectorGeometry> {
+fn sector_geometry(pattern: &VertexPattern, mesh: &FlatMesh, unit: f64) -> Result<SectorGeometry> {
     let rays = pattern.rays.len();
     let centre = mesh.vertices_coords[mesh.center];
     let mut ray_direction = vec![mesh.ray0_direction; rays];

@@ -14,7 +14,7 @@ use crate::dynamics::strip::StripChain;
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
-use crate::pattern::{Assignment, Pattern};
+use crate::pattern::{Assignment, VertexPattern};
 use crate::read::scene_spec::{
     count_within, finite, limits, material, validate_materials, within, ClosedSpec, HingeSpec, NetworkSource,
     NetworkSpec, MICROMETRE,
@@ -324,7 +324,7 @@ fn drive(
 /// its faces the panels, its hinges, drives, locks and anchored face as the chain has them,
 /// and its start (the driver's start angle with the others closed on the chain's branch)
 /// the network's rigid start (`docs/model.md#panel-networks`).
-pub fn from_closed(spec: &ClosedSpec<Pattern>, chain: &ClosedChain) -> Result<NetworkModel> {
+pub fn from_closed(spec: &ClosedSpec<VertexPattern>, chain: &ClosedChain) -> Result<NetworkModel> {
     let pattern = &spec.pattern;
     let mesh = pattern.mesh.as_ref().ok_or_else(|| {
         NanofoldError::invalid(

@@ -14,7 +14,7 @@ const DOMAIN_MARGIN: f64 = 0.1;
 
 /// A network reduced to one driving crease by fitted curves.
 #[derive(Debug, Clone)]
-pub struct Reduction {
+pub struct FittedReduction {
     /// The driver's column.
     pub driver: usize,
     /// Every column's curve against the driver (None for the driver itself).
@@ -51,7 +51,7 @@ pub struct ReducedReport {
     pub balance_frequency_hz: f64,
 }
 
-impl Reduction {
+impl FittedReduction {
     /// The fold angles at driver angle q (extrapolated outside the domain).
     pub fn angles(&self, q: f64, out: &mut [f64]) {
         for (c, curve) in self.curves.iter().enumerate() {

@@ -124,7 +124,7 @@ pub struct NetworkModel {
     pub mass_pattern: Vec<(usize, usize)>,
     /// The fitted curves a one-DOF network moves on instead of its exact closures, when the
     /// scene chooses them (`constraint.source` "poly").
-    pub reduction: Option<super::fitted::Reduction>,
+    pub reduction: Option<super::fitted::FittedReduction>,
 }
 
 /// The inputs of [`NetworkModel::new`], in SI units.

@@ -26,7 +26,7 @@ use std::sync::OnceLock;
 
 /// What a network run reports beside its response.
 #[derive(Debug, Clone, serde::Serialize)]
-pub struct NetworkReport {
+pub struct NetworkRunReport {
     /// Panels.
     pub panels: usize,
     /// Creases.
@@ -116,7 +116,7 @@ impl<'m> NetworkPlant<'m> {
 
     /// The report of a run (its samples, and whether it stopped at a contact): the branch,
     /// closure residuals, energy balance and the pairs meeting at the contact.
-    pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkReport> {
+    pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkRunReport> {
         Ok(network_report(
             self.model,
             &self.contacts,
@@ -484,7 +484,7 @@ pub(crate) fn network_report(
     branch: Option<String>,
     samples: &[Sample],
     contact: bool,
-) -> NetworkReport {
+) -> NetworkRunReport {
     let max_closure_residual = samples
         .iter()
         .map(|s| worst_residual(model, s.angles.as_slice()))
@@ -510,7 +510,7 @@ pub(crate) fn network_report(
         }
         _ => Vec::new(),
     };
-    NetworkReport {
+    NetworkRunReport {
         meeting_at_contact,
         touching_at_start: contacts.touching_at_start().to_vec(),
         panels: model.panels(),

@@ -9,10 +9,12 @@ use super::algorithms::{
     update_bias, update_drag, update_kinematics, update_mass_matrix, update_velocities, NetworkData,
 };
 use super::contact::NetworkProbe;
-pub use super::fitted::{ReducedReport, Reduction};
+pub use super::fitted::{FittedReduction, ReducedReport};
 use super::manifold::{mass_times, tangent_basis, worst_residual};
 use super::model::NetworkModel;
-use super::plant::{fastest_drive_rate, network_report, network_sample, time_scales_of, NetworkPlant, NetworkReport};
+use super::plant::{
+    fastest_drive_rate, network_report, network_sample, time_scales_of, NetworkPlant, NetworkRunReport,
+};
 use crate::constraints::chebyshev::Chebyshev;
 use crate::constraints::network::{fit_network, network_sweep, NetworkCurve};
 use crate::constraints::{MAX_DEGREE, MAX_SAMPLES};
@@ -39,7 +41,7 @@ const CLOSURE_CHECKS: usize = 4;
 
 /// The exact sweep of the driver from the network's folded balance and its fits, as a
 /// scene's `constraint` asks.
-pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<Reduction> {
+pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<FittedReduction> {
     if let Some(degree) = spec.degree {
         if !(1..=MAX_DEGREE).contains(&degree) {
             return Err(NanofoldError::invalid(
@@ -159,7 +161,7 @@ pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<Redu
             *curve = Some(fitted.next().expect("one curve per other crease").chebyshev);
         }
     }
-    let mut reduction = Reduction {
+    let mut reduction = FittedReduction {
         driver,
         curves,
         domain,
@@ -306,13 +308,13 @@ pub struct ReducedWorkspace {
 /// A one-DOF network on its fitted curves as an integrator plant.
 pub struct ReducedPlant<'m> {
     model: &'m NetworkModel,
-    reduction: &'m Reduction,
+    reduction: &'m FittedReduction,
     exact: NetworkPlant<'m>,
 }
 
 impl<'m> ReducedPlant<'m> {
     /// The plant of `model` on `reduction`, with the exact network's contacts and branch.
-    pub fn new(model: &'m NetworkModel, reduction: &'m Reduction, collisions: bool) -> Result<Self> {
+    pub fn new(model: &'m NetworkModel, reduction: &'m FittedReduction, collisions: bool) -> Result<Self> {
         Ok(ReducedPlant {
             model,
             reduction,
@@ -330,7 +332,7 @@ impl<'m> ReducedPlant<'m> {
     }
 
     /// The run's report: the network's, with the curves'.
-    pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkReport> {
+    pub fn report(&self, samples: &[Sample], contact: bool) -> Result<NetworkRunReport> {
         let mut report = network_report(
             self.model,
             self.exact.contacts(),

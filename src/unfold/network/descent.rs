@@ -3,8 +3,8 @@
 //! and the report it ends with (`docs/model.md#energy-unfolding-of-many-vertices`).
 
 use super::{
-    dot, flat_step, major_crease, norm, radial_step, restart, restart_note, try_state, Accepted, NetworkReport,
-    NetworkStep, NetworkUnfoldSettings, NetworkVerdict, Objective, Trial, FLAT_APPROACH, NEAR_FLAT, STALL_TOL,
+    dot, flat_step, major_crease, norm, radial_step, restart, restart_note, try_state, Accepted, NetworkStep,
+    NetworkUnfoldReport, NetworkUnfoldSettings, NetworkVerdict, Objective, Trial, FLAT_APPROACH, NEAR_FLAT, STALL_TOL,
 };
 use crate::error::Result;
 use crate::folding::normal::{NormalFactor, NormalSolver};
@@ -161,9 +161,9 @@ impl<'a> NetworkDescent<'a> {
     }
 
     /// The report, with the iteration count at the stop.
-    pub fn finish(self, (verdict, evidence): DescentStop, iterations: usize) -> NetworkReport {
+    pub fn finish(self, (verdict, evidence): DescentStop, iterations: usize) -> NetworkUnfoldReport {
         let max_closure_residual = self.steps.iter().map(|s| s.max_residual).fold(0.0, f64::max);
-        NetworkReport {
+        NetworkUnfoldReport {
             verdict,
             evidence,
             iterations,
@@ -395,7 +395,7 @@ impl<'a> NetworkDescent<'a> {
 
     /// The report once the executor has stopped: the descent's own stop, or the iteration
     /// budget spent.
-    pub fn into_report(mut self) -> NetworkReport {
+    pub fn into_report(mut self) -> NetworkUnfoldReport {
         match self.stopped.take() {
             Some((stop, iteration)) => self.finish(stop, iteration),
             None => {
