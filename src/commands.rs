@@ -510,7 +510,7 @@ impl From<&crate::folding::StopReason> for Verdict {
 /// Which command a report answers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Command {
+pub enum CommandKind {
     /// [`check`].
     Check,
     /// [`fold`].
@@ -538,7 +538,7 @@ pub struct Report {
     /// The pattern's name.
     pub pattern: String,
     /// The command answered.
-    pub command: Command,
+    pub command: CommandKind,
     /// The engine that answered.
     pub engine: Engine,
     /// The answer.
@@ -671,7 +671,7 @@ pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
 /// ```
 pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<UnfoldProgress>) -> Result<Report> {
     match pattern.vertex() {
-        Some(vertex) => vertex_report(pattern, vertex, Command::Unfold, settings, progress),
+        Some(vertex) => vertex_report(pattern, vertex, CommandKind::Unfold, settings, progress),
         None => {
             let model = sheet_of(pattern, "unfold")?;
             let start = model.given_fold_angles();
@@ -683,7 +683,7 @@ pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<
                 .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
             Ok(Report {
                 pattern: pattern.name().to_string(),
-                command: Command::Unfold,
+                command: CommandKind::Unfold,
                 engine: Engine::Network,
                 verdict: report.verdict.into(),
                 evidence: report.evidence.clone(),
@@ -704,7 +704,7 @@ pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<
 /// flat, by its assignment (rigidly foldable or not, with a witness path).
 pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
     match pattern.vertex() {
-        Some(vertex) => vertex_report(pattern, vertex, Command::Check, settings, None),
+        Some(vertex) => vertex_report(pattern, vertex, CommandKind::Check, settings, None),
         None => {
             let model = sheet_of(pattern, "check")?;
             let clock = Instant::now();
@@ -718,7 +718,7 @@ pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
                 .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
             Ok(Report {
                 pattern: pattern.name().to_string(),
-                command: Command::Check,
+                command: CommandKind::Check,
                 engine: Engine::Network,
                 verdict: report.verdict.into(),
                 evidence: report.evidence.clone(),
@@ -807,7 +807,7 @@ fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: F
         .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
     Report {
         pattern: pattern.name().to_string(),
-        command: Command::Fold,
+        command: CommandKind::Fold,
         engine: Engine::Network,
         verdict: (&path.stop).into(),
         evidence: path.evidence.clone(),
@@ -824,7 +824,7 @@ fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: F
 fn vertex_report(
     pattern: &Pattern,
     vertex: &VertexPattern,
-    command: Command,
+    command: CommandKind,
     settings: &Settings,
     progress: Option<UnfoldProgress>,
 ) -> Result<Report> {

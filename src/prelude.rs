@@ -4,7 +4,8 @@
 //! (under `VertexPattern`, `unfold_vertex`, `VertexReport`, `VertexVerdict`).
 
 pub use crate::commands::{
-    check, fold, unfold, unfold_observed, Command, Detail, Engine, Pattern, Report, Settings, Verdict, VertexPattern,
+    check, fold, unfold, unfold_observed, CommandKind, Detail, Engine, Pattern, Report, Settings, Verdict,
+    VertexPattern,
 };
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::Method;
