@@ -67,10 +67,7 @@ pub enum Engine {
 impl Engine {
     /// The engine's name in reports.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Engine::Vertex => "vertex",
-            Engine::Network => "network",
-        }
+        crate::names::variant_name(&self)
     }
 }
 
@@ -431,25 +428,7 @@ pub enum Verdict {
 impl Verdict {
     /// The verdict's name in outputs.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Verdict::Flat => "flat",
-            Verdict::Stuck => "stuck",
-            Verdict::Locked => "locked",
-            Verdict::LocalMinimum => "local_minimum",
-            Verdict::NotFlatFoldable => "not_flat_foldable",
-            Verdict::Blocked => "blocked",
-            Verdict::IterationLimit => "iteration_limit",
-            Verdict::NotRigid => "not_rigid",
-            Verdict::Rigid => "rigid",
-            Verdict::SelfIntersecting => "self_intersecting",
-            Verdict::RigidlyFoldable => "rigidly_foldable",
-            Verdict::NotRigidlyFoldable => "not_rigidly_foldable",
-            Verdict::Unknown => "unknown",
-            Verdict::Reached => "reached",
-            Verdict::BranchPoint => "branch_point",
-            Verdict::StepLimit => "step_limit",
-            Verdict::ContactBudget => "contact_budget",
-        }
+        crate::names::variant_name(&self)
     }
 }
 

@@ -63,13 +63,7 @@ pub enum Verdict {
 impl Verdict {
     /// The verdict's name in outputs.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Verdict::Flat => "flat",
-            Verdict::Stuck => "stuck",
-            Verdict::Locked => "locked",
-            Verdict::LocalMinimum => "local_minimum",
-            Verdict::NotFlatFoldable => "not_flat_foldable",
-        }
+        crate::names::variant_name(&self)
     }
 }
 

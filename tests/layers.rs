@@ -12,7 +12,7 @@ use std::path::Path;
 /// Rank of a top-level module; modules of equal rank may not import each other.
 fn rank(module: &str) -> Option<usize> {
     Some(match module {
-        "error" => 0,
+        "error" | "names" => 0,
         "geometry" => 1,
         "pattern" => 2,
         "read" => 3,

@@ -155,7 +155,8 @@ fn over_budget(found: usize, when: &str) -> String {
 }
 
 /// Why a folding path stopped.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// The drive's goal was reached.
     Reached,
@@ -186,14 +187,7 @@ pub enum StopReason {
 impl StopReason {
     /// The name used in reports.
     pub fn as_str(&self) -> &'static str {
-        match self {
-            StopReason::Reached => "reached",
-            StopReason::Blocked { .. } => "blocked",
-            StopReason::Locked => "locked",
-            StopReason::BranchPoint { .. } => "branch_point",
-            StopReason::StepLimit => "step_limit",
-            StopReason::ContactBudget { .. } => "contact_budget",
-        }
+        crate::names::variant_name(self)
     }
 }
 

@@ -16,7 +16,8 @@ use crate::pattern::Assignment;
 use nalgebra::Matrix2;
 
 /// The verdict on a crease pattern.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum PatternVerdict {
     /// The given state closes at every vertex and no two panels cross.
     Rigid,
@@ -35,14 +36,7 @@ pub enum PatternVerdict {
 impl PatternVerdict {
     /// The name used in reports.
     pub fn as_str(self) -> &'static str {
-        match self {
-            PatternVerdict::Rigid => "rigid",
-            PatternVerdict::NotRigid => "not_rigid",
-            PatternVerdict::SelfIntersecting => "self_intersecting",
-            PatternVerdict::RigidlyFoldable => "rigidly_foldable",
-            PatternVerdict::NotRigidlyFoldable => "not_rigidly_foldable",
-            PatternVerdict::Unknown => "unknown",
-        }
+        crate::names::variant_name(&self)
     }
 }
 

@@ -196,7 +196,8 @@ impl Default for NetworkUnfoldSettings {
 }
 
 /// The verdict of a many-vertex unfolding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum NetworkVerdict {
     /// Every fold angle reached the flat tolerance along a rigid path.
     Flat,
@@ -215,14 +216,7 @@ pub enum NetworkVerdict {
 impl NetworkVerdict {
     /// The name used in reports.
     pub fn as_str(self) -> &'static str {
-        match self {
-            NetworkVerdict::Flat => "flat",
-            NetworkVerdict::Locked => "locked",
-            NetworkVerdict::LocalMinimum => "local_minimum",
-            NetworkVerdict::Blocked => "blocked",
-            NetworkVerdict::IterationLimit => "iteration_limit",
-            NetworkVerdict::NotRigid => "not_rigid",
-        }
+        crate::names::variant_name(&self)
     }
 }
 
