@@ -5,10 +5,7 @@ mod folding;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
-use nanofold::constraints::{
-    check_curve, default_domain, fit_to_tolerance, held_pattern, mujoco_snippet, sweep_samples, trajectory_samples,
-    ConstraintPoly, ConstraintReport, Setup,
-};
+use nanofold::constraints::{mujoco_snippet, ConstraintReport};
 use nanofold::dynamics::integrate::ProgressObserver;
 use nanofold::dynamics::modes::modes;
 use nanofold::plot::response::{response_svg, snapshots_svg};
@@ -698,7 +695,7 @@ fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel:
 }
 
 /// Parses "J=C0,C1,..." into (crease index, coefficients in degrees).
-fn parse_check(pattern: &Pattern, text: &str) -> Result<(usize, Vec<f64>)> {
+fn parse_check(text: &str) -> Result<(usize, Vec<f64>)> {
     let (index, coeffs) = text
         .split_once('=')
         .with_context(|| format!("invalid --check {text:?}: expected J=C0,C1,..., e.g. --check 3=0.5,0.7,-3e-5"))?;
@@ -714,11 +711,11 @@ fn parse_check(pattern: &Pattern, text: &str) -> Result<(usize, Vec<f64>)> {
                 .with_context(|| format!("invalid --check {text:?}: coefficient {c:?} is not a number"))
         })
         .collect::<Result<Vec<f64>>>()?;
-    Ok((crease_index(pattern, index, "--check")?, coeffs))
+    Ok((index, coeffs))
 }
 
 /// Parses "J=DEG" into (crease index, rad).
-fn parse_lock(pattern: &Pattern, text: &str) -> Result<(usize, f64)> {
+fn parse_lock(text: &str) -> Result<(usize, f64)> {
     let (index, degrees) = text
         .split_once('=')
         .with_context(|| format!("invalid --lock {text:?}: expected J=DEG, e.g. --lock 1=0"))?;
@@ -730,21 +727,10 @@ fn parse_lock(pattern: &Pattern, text: &str) -> Result<(usize, f64)> {
         .trim()
         .parse()
         .with_context(|| format!("invalid --lock {text:?}: angle {degrees:?} is not a number of degrees"))?;
-    let crease = crease_index(pattern, index, "--lock")?;
-    Ok((crease, degrees.to_radians()))
+    Ok((index, degrees))
 }
 
-fn crease_index(pattern: &Pattern, index: usize, flag: &str) -> Result<usize> {
-    pattern.crease_from_user_index(index).with_context(|| {
-        format!(
-            "invalid {flag} {index}: no crease with this index in {} (its creases are {:?})",
-            pattern.name,
-            pattern.user_indices()
-        )
-    })
-}
-
-/// Parses "A:B" (degrees) into [a, b] rad.
+/// Parses "A:B" (degrees) into [a, b], degrees.
 fn parse_range(text: &str) -> Result<[f64; 2]> {
     let (a, b) = text
         .split_once(':')
@@ -754,10 +740,11 @@ fn parse_range(text: &str) -> Result<[f64; 2]> {
             .parse::<f64>()
             .with_context(|| format!("invalid --range {text:?}: {v:?} is not a number of degrees"))
     };
-    Ok([parse(a)?.to_radians(), parse(b)?.to_radians()])
+    Ok([parse(a)?, parse(b)?])
 }
 
 fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
+    use nanofold::commands::{AutoDegree, ConstraintOptions, Constraints, CurveFormat, CurveSource, DegreeOption};
     let degree = match args.degree.as_str() {
         "auto" => None,
         text => {
@@ -771,62 +758,35 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     if degree.is_none() && args.tol.is_none() {
         anyhow::bail!("--degree auto needs --tol RAD (the largest accepted fit error)");
     }
-    if args.format == ExportFormat::Mujoco && degree.is_some_and(|d| d > 4) {
-        anyhow::bail!(
-            "invalid --degree {}: MuJoCo's polycoef holds a quartic at most; use --degree 1..=4 (or auto, capped at 4) with --format mujoco",
-            args.degree
-        );
-    }
-    let options = LoadOptions {
+    let options = ConstraintOptions {
+        drive: args.drive,
+        lock: args.locks.iter().map(|text| parse_lock(text)).collect::<Result<_>>()?,
+        free: args.free.clone(),
+        degree: degree.map_or(DegreeOption::Named(AutoDegree::Auto), DegreeOption::Fixed),
+        tol: args.tol,
+        range: args.range.as_deref().map(parse_range).transpose()?,
+        samples: args.samples,
+        source: match args.source {
+            SourceArg::Sweep => CurveSource::Sweep,
+            SourceArg::Unfold => CurveSource::Unfold,
+        },
+        check: args
+            .checks
+            .iter()
+            .map(|text| parse_check(text))
+            .collect::<Result<_>>()?,
+        format: match args.format {
+            ExportFormat::Json => CurveFormat::Json,
+            ExportFormat::Mujoco => CurveFormat::Mujoco,
+        },
+    };
+    let settings = options.settings().map_err(constraints_flags)?;
+    let read = LoadOptions {
         closure_tol: args.closure_tol,
         ..LoadOptions::default()
     };
-    options.validate().map_err(constraints_flags)?;
-    let pattern = match nanofold::read::load_pattern(&args.pattern, &options) {
-        Ok(pattern) => pattern,
-        Err(e) if nanofold::commands::takes_many_vertices(&e, &args.pattern) => {
-            return folding::run_network_constraints(args, degree)
-        }
-        Err(e) => return Err(reading(&args.pattern, e)),
-    };
-    let driver = crease_index(&pattern, args.drive, "--drive")?;
-    let mut locks = args
-        .locks
-        .iter()
-        .map(|text| parse_lock(&pattern, text))
-        .collect::<Result<Vec<_>>>()?;
-    if !args.free.is_empty() {
-        let free = args
-            .free
-            .iter()
-            .map(|&i| crease_index(&pattern, i, "--free"))
-            .collect::<Result<Vec<_>>>()?;
-        for (c, crease) in pattern.creases.iter().enumerate() {
-            if c != driver && !free.contains(&c) && !locks.iter().any(|(l, _)| *l == c) {
-                locks.push((c, crease.folded_angle));
-            }
-        }
-    }
-    let checks = args
-        .checks
-        .iter()
-        .map(|text| parse_check(&pattern, text))
-        .collect::<Result<Vec<_>>>()?;
-    let range = args.range.as_deref().map(parse_range).transpose()?;
-    let setup = Setup::new(&pattern, driver, &locks).map_err(constraints_flags)?;
-    for ((crease, _), text) in checks.iter().zip(&args.checks) {
-        if !setup.dependents.contains(crease) {
-            anyhow::bail!(
-                "invalid --check {text:?}: {} is {}; a checked curve belongs to a crease that follows the driver",
-                pattern.creases[*crease].label,
-                if *crease == driver {
-                    "the driver"
-                } else {
-                    "held by --lock/--free"
-                }
-            );
-        }
-    }
+    read.validate().map_err(constraints_flags)?;
+    let pattern = nanofold::commands::Pattern::open(&args.pattern, &read).map_err(|e| reading(&args.pattern, e))?;
     // A long sweep (up to 100 000 Newton solves) shows that it is working.
     let spinner = if args.json {
         indicatif::ProgressBar::hidden()
@@ -835,100 +795,33 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     };
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     spinner.set_message(format!("sweeping {} samples", args.samples));
-    let result = constraints_after_setup(args, &pattern, &setup, range, degree, &checks, &spinner);
+    let curves = nanofold::commands::constraints(&pattern, &settings).map_err(constraints_flags);
     spinner.finish_and_clear();
-    let (report, dir, files) = result?;
-    print_constraints(args, &pattern, &report, &dir, &files)
-}
-
-/// Rendered output files: (file name, contents).
-type OutputFiles = Vec<(&'static str, String)>;
-
-/// The sweep, the fit and the files of `constraints`.
-fn constraints_after_setup(
-    args: &ConstraintsArgs,
-    pattern: &Pattern,
-    setup: &Setup,
-    range: Option<[f64; 2]>,
-    degree: Option<usize>,
-    checks: &[(usize, Vec<f64>)],
-    spinner: &indicatif::ProgressBar,
-) -> Result<(ConstraintReport, PathBuf, OutputFiles)> {
-    let (pattern, setup, driver) = (pattern.clone(), setup.clone(), setup.driver);
-    let samples = match args.source {
-        SourceArg::Sweep => {
-            let domain = match range {
-                Some(d) => d,
-                None => default_domain(&pattern, driver).map_err(constraints_flags)?,
-            };
-            sweep_samples(&pattern, &setup, domain, args.samples).map_err(constraints_flags)?
-        }
-        SourceArg::Unfold => {
-            let settings = UnfoldSettings::default();
-            let report = unfold(&held_pattern(&pattern, &setup).map_err(constraints_flags)?, &settings)?;
-            let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
-            trajectory_samples(
-                &pattern,
-                &setup,
-                range,
-                &states,
-                report.verdict.as_str(),
-                settings.flat_tol,
-            )
-            .map_err(constraints_flags)?
-        }
+    let (vertex, samples, poly, report) = match (pattern.vertex(), curves?) {
+        (Some(vertex), Constraints::Vertex { samples, poly, report }) => (vertex, samples, poly, report),
+        (_, network) => return folding::network_constraints_output(args, &pattern, network),
     };
-    spinner.set_message("fitting");
-    let (poly, mut report) = match degree {
-        Some(d) => {
-            let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
-            let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
-            (poly, report)
+    if let Some(tol) = args.tol.filter(|_| args.format == ExportFormat::Mujoco) {
+        if report.max_fit_error() > tol {
+            eprintln!(
+                "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
+                report.max_fit_error()
+            );
         }
-        None if args.format == ExportFormat::Mujoco => {
-            // MuJoCo takes a quartic at most: the smallest degree ≤ 4 meeting --tol, else 4
-            // with the error it has.
-            let tol = args.tol.unwrap_or_default();
-            let mut chosen = None;
-            for d in 1..=4 {
-                let poly = ConstraintPoly::fit(&pattern, &samples, d).map_err(constraints_flags)?;
-                let report = ConstraintReport::new(&pattern, &samples, &poly).map_err(constraints_flags)?;
-                let met = report.max_fit_error() <= tol;
-                chosen = Some((poly, report));
-                if met {
-                    break;
-                }
-            }
-            let (poly, report) = chosen.expect("degrees 1 to 4 were fitted");
-            if report.max_fit_error() > tol {
-                eprintln!(
-                    "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
-                    report.max_fit_error()
-                );
-            }
-            (poly, report)
-        }
-        None => fit_to_tolerance(&pattern, &samples, args.tol.unwrap_or_default()).map_err(constraints_flags)?,
-    };
-    for (crease, coeffs) in checks {
-        report.checked_curves.push(
-            check_curve(&pattern, &samples, *crease, coeffs)
-                .map_err(|e| anyhow::anyhow!("invalid --check for crease {}: {e}", pattern.user_index(*crease)))?,
-        );
     }
     // Render everything before writing anything.
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| default_folder(&pattern.name, &args.pattern));
-    let report_json = serde_json::to_string_pretty(&report)?;
-    let svg = constraints_svg(&pattern, &samples, &poly)?;
+        .unwrap_or_else(|| default_folder(&vertex.name, &args.pattern));
+    let report_json = serde_json::to_string_pretty(report.as_ref())?;
+    let svg = constraints_svg(vertex, &samples, &poly)?;
     let mut files = vec![("constraints.json", report_json), ("constraints.svg", svg)];
     if args.format == ExportFormat::Mujoco {
         files.push(("constraints.xml", mujoco_snippet(&report).map_err(constraints_flags)?));
     }
     write_outputs(&dir, &args.pattern, &files)?;
-    Ok((report, dir, files))
+    print_constraints(args, vertex, &report, &dir, &files)
 }
 
 /// What `constraints` prints of its report.
@@ -1278,6 +1171,9 @@ const CONSTRAINT_FLAGS: &[(&str, &str)] = &[
     ("degree", "--degree"),
     ("tolerance", "--tol"),
     ("source", "--source"),
+    ("free", "--free"),
+    ("check", "--check"),
+    ("tol", "--tol"),
     ("closure_tol", "--closure-tol"),
 ];
 const SIMULATE_FLAGS: &[(&str, &str)] = &[("rtol", "--rtol"), ("t_end", "--t-end"), ("max_steps", "--max-steps")];

@@ -43,11 +43,11 @@ mod generate;
 pub mod options;
 mod scene;
 
-pub use constraints::{constraints, ConstraintSettings, Constraints, Degree};
+pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
 pub use generate::Generator;
 pub use options::{
-    options_from_json, CheckOptions, ConstraintOptions, FoldOptions, FromJson, ReadOptions, SimulateOptions,
-    UnfoldOptions,
+    options_from_json, AutoDegree, CheckOptions, ConstraintOptions, CurveFormat, DegreeOption, FoldOptions, FromJson,
+    ReadOptions, SimulateOptions, UnfoldOptions,
 };
 pub use scene::{modes, open_scene, parse_scene, scene_kind, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, TypeVar, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, TypeVar, Union
 
 import numpy as np
 
@@ -397,12 +397,17 @@ def constraints(
     tol: Optional[float] = None,
     range: Optional[Sequence[float]] = None,
     samples: Optional[int] = None,
+    source: Optional[str] = None,
+    check: Optional[Sequence[Tuple[int, Sequence[float]]]] = None,
+    format: Optional[str] = None,
 ) -> Result:
     """Constraint curves: every free crease as a polynomial of the ``drive`` crease (the
     file's crease index: a FOLD edge index), swept by exact loop closure over ``range``
     (degrees, as ``constraints --range A:B``), with each curve's error. ``lock`` holds
     creases at angles in degrees (``--lock J=DEG``); ``degree`` is 1..20 or ``"auto"`` with
-    ``tol`` (rad).
+    ``tol`` (rad). ``source`` is ``"sweep"`` (exact) or, for a single vertex, ``"unfold"``;
+    ``check`` measures given polynomials, ``[(crease, [c0, c1, ...]), ...]`` in degrees
+    (``--check J=C0,C1,...``); ``format="mujoco"`` caps ``degree="auto"`` at 4.
 
     >>> import nanofold
     >>> c = nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree=6)
@@ -411,7 +416,9 @@ def constraints(
     """
     pat = _pattern(pattern)
     keywords = dict(drive=drive, lock=lock, free=list(free) if free is not None else None,
-                    degree=degree, tol=tol, range=list(range) if range is not None else None, samples=samples)
+                    degree=degree, tol=tol, range=list(range) if range is not None else None, samples=samples,
+                    source=source, check=[[c, list(k)] for c, k in check] if check is not None else None,
+                    format=format)
     summary, rest = _call(_native.constraints, pat._handle, _settings(keywords))
     return Result("constraints", summary, rest)
 

@@ -218,3 +218,15 @@ def test_a_scene_dict_simulates_as_its_file_does():
     by_dict = nanofold.simulate(spec)
     by_scene = nanofold.simulate(nanofold.Scene.open(path).replace({"time.t_end_s": 1e-4}))
     assert by_dict.final_angles_rad.tolist() == by_scene.final_angles_rad.tolist()
+
+
+def test_constraints_take_the_command_lines_options_by_the_same_names():
+    # The Miura vertex's collinear creases fold equal and opposite: rho_2 = -rho_0 exactly,
+    # so the checked curve -theta has no error and +0.5 deg has 0.5 deg everywhere.
+    r = nanofold.constraints("patterns/miura_vertex.fold", drive=0, check=[(2, [0, -1]), (2, [0.5, -1])])
+    errors = [c["max_error_rad"] for c in r.checked_curves]
+    assert errors[0] < 1e-9 and abs(errors[1] - math.radians(0.5)) < 1e-9
+    capped = nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree="auto", tol=1e-12, format="mujoco")
+    assert capped.degree <= 4
+    with pytest.raises(nanofold.InvalidFieldError, match="quartic"):
+        nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree=6, format="mujoco")

@@ -387,54 +387,18 @@ pub fn check_json(
 }
 
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
-pub fn run_network_constraints(args: &super::ConstraintsArgs, degree: Option<usize>) -> Result<()> {
-    use nanofold::commands::{constraints, ConstraintSettings, Constraints, Degree};
+/// What `constraints` writes and prints for a crease pattern of many vertices.
+pub fn network_constraints_output(
+    args: &super::ConstraintsArgs,
+    pattern: &nanofold::commands::Pattern,
+    result: nanofold::commands::Constraints,
+) -> Result<()> {
+    use nanofold::commands::Constraints;
     use nanofold::constraints::network::network_mujoco;
-    if !args.checks.is_empty() {
-        bail!("--check is for single vertices; for a crease pattern of many vertices compare with the sweep in constraints.json");
-    }
-    if args.source != super::SourceArg::Sweep {
-        bail!("--source unfold is for single vertices; a crease pattern of many vertices is swept exactly");
-    }
-    let model = load_model(&args.pattern)?;
-    let locks = args
-        .locks
-        .iter()
-        .map(|text| {
-            let (edge, degrees) = parse_edge_angle(text, "--lock")?;
-            Ok((edge, degrees.to_radians()))
-        })
-        .collect::<Result<Vec<_>>>()?;
     let mujoco = args.format == super::ExportFormat::Mujoco;
-    let settings = ConstraintSettings {
-        drive: args.drive,
-        lock: locks,
-        free: args.free.clone(),
-        degree: match degree {
-            Some(d) => Degree::Fixed(d),
-            None => Degree::Auto {
-                tol: args.tol.unwrap_or_default(),
-                at_most: if mujoco { 4 } else { nanofold::constraints::MAX_DEGREE },
-            },
-        },
-        range: args.range.as_deref().map(super::parse_range).transpose()?,
-        samples: args.samples,
-    };
-    let pattern = nanofold::commands::Pattern::from_crease_pattern(model.pattern.clone())?;
-    let result = constraints(&pattern, &settings).map_err(|e| {
-        flags(
-            e,
-            &[
-                ("range", "--range"),
-                ("samples", "--samples"),
-                ("drive", "--drive"),
-                ("lock", "--lock"),
-                ("free", "--free"),
-                ("degree", "--degree"),
-                ("tolerance", "--tol"),
-            ],
-        )
-    })?;
+    let model = pattern
+        .sheet()
+        .expect("a crease pattern of many vertices has its sheet");
     let Constraints::Network { sweep, curves } = result else {
         bail!("{}: read as a single vertex", args.pattern.display());
     };

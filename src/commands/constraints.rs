@@ -5,7 +5,8 @@
 use super::Pattern;
 use crate::constraints::network::{fit_network, fit_network_to_tolerance, network_sweep, NetworkCurves, NetworkSweep};
 use crate::constraints::{
-    default_domain, fit_to_tolerance, sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup,
+    check_curve, default_domain, fit_to_tolerance, held_pattern, sweep_samples, trajectory_samples, ConstraintPoly,
+    ConstraintReport, CurveSamples, Setup,
 };
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
@@ -45,6 +46,22 @@ pub struct ConstraintSettings {
     pub range: Option<[f64; 2]>,
     /// Sweep samples (2 to 100 000).
     pub samples: usize,
+    /// Where the samples come from (a single vertex may take its unfolding's).
+    pub source: CurveSource,
+    /// Given polynomials to measure against exact closure: (crease by the file's index,
+    /// coefficients in degrees of the driving angle in degrees, constant first).
+    pub checks: Vec<(usize, Vec<f64>)>,
+}
+
+/// Where constraint samples come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveSource {
+    /// Newton loop closure along a kinematic sweep: the exact reference.
+    #[default]
+    Sweep,
+    /// The fold angles along an unfolding trajectory (single vertices).
+    Unfold,
 }
 
 impl Default for ConstraintSettings {
@@ -56,6 +73,8 @@ impl Default for ConstraintSettings {
             degree: Degree::Fixed(4),
             range: None,
             samples: 201,
+            source: CurveSource::Sweep,
+            checks: Vec::new(),
         }
     }
 }
@@ -145,12 +164,51 @@ fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &Constr
             }
         }
     }
+    let checks = settings
+        .checks
+        .iter()
+        .map(|(i, coefficients)| Ok((index(*i, "check")?, coefficients)))
+        .collect::<Result<Vec<_>>>()?;
     let setup = Setup::new(pattern, driver, &locks)?;
-    let domain = match settings.range {
-        Some(d) => d,
-        None => default_domain(pattern, driver)?,
+    for &(crease, _) in &checks {
+        if !setup.dependents.contains(&crease) {
+            return Err(NanofoldError::invalid(
+                "check",
+                pattern.user_index(crease),
+                format!(
+                    "{} is {}; a checked curve belongs to a crease that follows the driver",
+                    pattern.creases[crease].label,
+                    if crease == driver {
+                        "the driver"
+                    } else {
+                        "held by lock or free"
+                    }
+                ),
+            ));
+        }
+    }
+    let samples = match settings.source {
+        CurveSource::Sweep => {
+            let domain = match settings.range {
+                Some(d) => d,
+                None => default_domain(pattern, driver)?,
+            };
+            sweep_samples(pattern, &setup, domain, settings.samples)?
+        }
+        CurveSource::Unfold => {
+            let unfolding = crate::unfold::UnfoldSettings::default();
+            let report = crate::unfold::unfold(&held_pattern(pattern, &setup)?, &unfolding)?;
+            let states: Vec<Vec<f64>> = report.trajectory.iter().map(|s| s.fold_angles.clone()).collect();
+            trajectory_samples(
+                pattern,
+                &setup,
+                settings.range,
+                &states,
+                report.verdict.as_str(),
+                unfolding.flat_tol,
+            )?
+        }
     };
-    let samples = sweep_samples(pattern, &setup, domain, settings.samples)?;
     let (poly, report) = match settings.degree {
         Degree::Fixed(d) => {
             let poly = ConstraintPoly::fit(pattern, &samples, d)?;
@@ -172,6 +230,13 @@ fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &Constr
         }
         Degree::Auto { tol, .. } => fit_to_tolerance(pattern, &samples, tol)?,
     };
+    let mut report = report;
+    for (crease, coefficients) in checks {
+        report.checked_curves.push(
+            check_curve(pattern, &samples, crease, coefficients)
+                .map_err(|e| NanofoldError::invalid("check", pattern.user_index(crease), e.to_string()))?,
+        );
+    }
     Ok(Constraints::Vertex {
         samples: Box::new(samples),
         poly: Box::new(poly),
@@ -180,6 +245,20 @@ fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &Constr
 }
 
 fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> Result<Constraints> {
+    if !settings.checks.is_empty() {
+        return Err(NanofoldError::invalid(
+            "check",
+            format!("{} curves", settings.checks.len()),
+            "is for single vertices; for a crease pattern of many vertices compare with the sweep in constraints.json",
+        ));
+    }
+    if settings.source != CurveSource::Sweep {
+        return Err(NanofoldError::invalid(
+            "source",
+            "unfold",
+            "is for single vertices; a crease pattern of many vertices is swept exactly",
+        ));
+    }
     let mut model = model.clone();
     let column = |edge: usize, field: &str| {
         model.column_of_edge.get(edge).copied().flatten().ok_or_else(|| {

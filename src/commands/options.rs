@@ -5,7 +5,7 @@
 //! from a JSON object (unknown names refused by name) and becomes the engines' validated
 //! settings by one function, so the command line and Python cannot disagree.
 
-use super::constraints::{ConstraintSettings, Degree};
+use super::constraints::{ConstraintSettings, CurveSource, Degree};
 use super::Settings;
 use crate::dynamics::integrate::Method;
 use crate::dynamics::simulate::{ModelChoice, SimulationSettings};
@@ -283,6 +283,26 @@ pub struct ConstraintOptions {
     pub range: Option<[f64; 2]>,
     /// Sweep samples.
     pub samples: usize,
+    /// Where the samples come from: `sweep` (exact) or, for a single vertex, `unfold`.
+    pub source: CurveSource,
+    /// Given polynomials to measure against exact closure: (crease by the file's index,
+    /// coefficients in degrees of the driving angle in degrees, constant first), as many as
+    /// given, a crease more than once if wished.
+    pub check: Vec<(usize, Vec<f64>)>,
+    /// The export the curves are for: `json`, or `mujoco` (a quartic at most: `degree`
+    /// `"auto"` stops at 4).
+    pub format: CurveFormat,
+}
+
+/// What constraint curves are written for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveFormat {
+    /// constraints.json.
+    #[default]
+    Json,
+    /// Also a MuJoCo `<equality>` snippet: polycoef holds a quartic at most.
+    Mujoco,
 }
 
 impl Default for ConstraintOptions {
@@ -296,6 +316,9 @@ impl Default for ConstraintOptions {
             tol: None,
             range: None,
             samples: d.samples,
+            source: CurveSource::Sweep,
+            check: Vec::new(),
+            format: CurveFormat::Json,
         }
     }
 }
@@ -303,11 +326,17 @@ impl Default for ConstraintOptions {
 impl ConstraintOptions {
     /// The sweep's settings (checked against the pattern when it runs).
     pub fn settings(&self) -> Result<ConstraintSettings> {
+        let mujoco = self.format == CurveFormat::Mujoco;
         let degree = match (self.degree, self.tol) {
+            (DegreeOption::Fixed(n), None) if mujoco && n > 4 => return Err(NanofoldError::invalid(
+                "degree",
+                n,
+                "MuJoCo's polycoef holds a quartic at most: 1 to 4 (or \"auto\", capped at 4) with the mujoco format",
+            )),
             (DegreeOption::Fixed(n), None) => Degree::Fixed(n),
             (DegreeOption::Named(AutoDegree::Auto), Some(tol)) => Degree::Auto {
                 tol,
-                at_most: crate::constraints::MAX_DEGREE,
+                at_most: if mujoco { 4 } else { crate::constraints::MAX_DEGREE },
             },
             (DegreeOption::Named(AutoDegree::Auto), None) => {
                 return Err(NanofoldError::invalid(
@@ -331,6 +360,8 @@ impl ConstraintOptions {
             degree,
             range: self.range.map(|[a, b]| [a.to_radians(), b.to_radians()]),
             samples: self.samples,
+            source: self.source,
+            checks: self.check.clone(),
         })
     }
 }
