@@ -982,8 +982,8 @@ fn run_simulate(args: &SimulateArgs) -> Result<()> {
 }
 
 /// A loader's error with the file named, once: I/O and JSON errors name it already.
-pub(crate) fn reading(path: &Path, error: nanofold::NanofoldError) -> anyhow::Error {
-    use nanofold::NanofoldError::{Io, Json};
+pub(crate) fn reading(path: &Path, error: nanofold::prelude::NanofoldError) -> anyhow::Error {
+    use nanofold::prelude::NanofoldError::{Io, Json};
     let names_file = matches!(error, Io { .. } | Json { .. });
     let error = anyhow::Error::new(error);
     if names_file {
@@ -1181,9 +1181,9 @@ const SIMULATE_FLAGS: &[(&str, &str)] = &[("rtol", "--rtol"), ("t_end", "--t-end
 /// Library errors name library fields: an invalid field that a flag sets gets the flag and
 /// its value in front ("invalid --p -1: invalid `p`: …"); a run that a flag can rescue gets
 /// the flags to try.
-fn with_flags(error: nanofold::NanofoldError, flags: &[(&str, &str)]) -> anyhow::Error {
-    use nanofold::error::NumericalError;
-    use nanofold::NanofoldError;
+fn with_flags(error: nanofold::prelude::NanofoldError, flags: &[(&str, &str)]) -> anyhow::Error {
+    use nanofold::prelude::NanofoldError;
+    use nanofold::prelude::NumericalError;
     let context = match &error {
         NanofoldError::InvalidField { field, value, .. } => flags
             .iter()
@@ -1200,11 +1200,11 @@ fn with_flags(error: nanofold::NanofoldError, flags: &[(&str, &str)]) -> anyhow:
     }
 }
 
-fn constraints_flags(error: nanofold::NanofoldError) -> anyhow::Error {
+fn constraints_flags(error: nanofold::prelude::NanofoldError) -> anyhow::Error {
     with_flags(error, CONSTRAINT_FLAGS)
 }
 
-fn simulate_flags(error: nanofold::NanofoldError) -> anyhow::Error {
+fn simulate_flags(error: nanofold::prelude::NanofoldError) -> anyhow::Error {
     with_flags(error, SIMULATE_FLAGS)
 }
 

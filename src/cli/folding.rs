@@ -4,9 +4,10 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use nanofold::folding::{CheckSettings, FoldingModel};
+use nanofold::folding::FoldingModel;
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
+use nanofold::prelude::CheckSettings;
 use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_trajectory_json};
 use nanofold::write::output::{number, write_atomic};
 use serde_json::{json, Value};
@@ -210,7 +211,7 @@ fn write_file(out: &Path, value: &Value) -> Result<()> {
 }
 
 /// Maps library field names to this command's flags.
-fn flags(error: nanofold::NanofoldError, table: &[(&str, &str)]) -> anyhow::Error {
+fn flags(error: nanofold::prelude::NanofoldError, table: &[(&str, &str)]) -> anyhow::Error {
     super::with_flags(error, table)
 }
 
@@ -456,7 +457,7 @@ pub fn unfold_network_one(
     projection: Option<nanofold::commands::Projection>,
     solver: &super::SolverArgs,
     dir: Option<&Path>,
-    progress: Option<nanofold::unfold::UnfoldProgress>,
+    progress: Option<nanofold::prelude::UnfoldProgress>,
 ) -> Result<(Value, String)> {
     use nanofold::plot::folding::angles_svg;
     use nanofold::write::folding_output::states_fold;
