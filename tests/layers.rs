@@ -304,7 +304,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "dynamics::network",
     "dynamics::plant",
     "folding::FoldingModel",
-    "pattern::generate",
     "plot::constraints_svg",
     "plot::folding",
     "plot::page",

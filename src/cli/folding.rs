@@ -5,7 +5,6 @@ use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::folding::FoldingModel;
-use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::plot::folding::fold_svg;
 use nanofold::prelude::CheckSettings;
 use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_trajectory_json};
@@ -54,8 +53,8 @@ pub enum GenerateKind {
         #[arg(long, default_value_t = 4)]
         cols: usize,
         /// The panels' acute angle (degrees).
-        #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
-        angle: f64,
+        #[arg(long, alias = "angle", default_value_t = 60.0, allow_negative_numbers = true)]
+        angle_deg: f64,
         /// Length of the panels' horizontal sides.
         #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         width: f64,
@@ -64,8 +63,8 @@ pub enum GenerateKind {
         slant: f64,
         /// Also write the folded state with the zigzag creases at this angle (degrees; 0 or
         /// absent: the crease pattern alone).
-        #[arg(long, allow_negative_numbers = true)]
-        fold: Option<f64>,
+        #[arg(long, alias = "fold", allow_negative_numbers = true)]
+        fold_deg: Option<f64>,
         /// The FOLD file to write.
         #[arg(long)]
         out: PathBuf,
@@ -79,8 +78,8 @@ pub enum GenerateKind {
         #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
         half_sheet: f64,
         /// Twist angle (degrees, 1 to 45).
-        #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
-        twist: f64,
+        #[arg(long, alias = "twist", default_value_t = 30.0, allow_negative_numbers = true)]
+        twist_deg: f64,
         /// Flip each corner's crease after its smallest sector (breaks big-little-big: no
         /// longer flat-foldable) instead of the classic assignment.
         #[arg(long)]
@@ -119,28 +118,24 @@ pub enum GenerateKind {
 /// `nanofold generate KIND ...`
 pub fn run_generate(kind: &GenerateKind) -> Result<()> {
     use nanofold::commands::Generator;
-    let (generator, out, table): (Generator, &Path, &[(&str, &str)]) = match kind {
+    // The flags by the door's option names; the door builds and validates the family.
+    let (family, options, out, table): (&str, Value, &Path, &[(&str, &str)]) = match kind {
         GenerateKind::Miura {
             rows,
             cols,
-            angle,
+            angle_deg,
             width,
             slant,
-            fold,
+            fold_deg,
             out,
         } => (
-            Generator::Miura(MiuraSpec {
-                rows: *rows,
-                cols: *cols,
-                sector_angle: angle.to_radians(),
-                width: *width,
-                slant: *slant,
-                zigzag_fold_angle: fold.unwrap_or(0.0).to_radians(),
-            }),
+            "miura",
+            json!({"rows": rows, "cols": cols, "angle_deg": angle_deg, "width": width, "slant": slant,
+                   "fold_deg": fold_deg.unwrap_or(0.0)}),
             out,
             &[
-                ("sector_angle", "--angle"),
-                ("zigzag_fold_angle", "--fold"),
+                ("angle_deg", "--angle-deg"),
+                ("fold_deg", "--fold-deg"),
                 ("rows, cols", "--rows, --cols"),
                 ("width", "--width"),
                 ("slant", "--slant"),
@@ -149,18 +144,18 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
         GenerateKind::SquareTwist {
             side,
             half_sheet,
-            twist,
+            twist_deg,
             flip_pleats,
             out,
         } => (
-            Generator::SquareTwist(SquareTwistSpec {
-                side: *side,
-                half_sheet: *half_sheet,
-                twist: twist.to_radians(),
-                flip_pleats: *flip_pleats,
-            }),
+            "square_twist",
+            json!({"side": side, "half_sheet": half_sheet, "twist_deg": twist_deg, "flip_pleats": flip_pleats}),
             out,
-            &[("side", "--side"), ("half_sheet", "--half-sheet"), ("twist", "--twist")],
+            &[
+                ("side", "--side"),
+                ("half_sheet", "--half-sheet"),
+                ("twist_deg", "--twist-deg"),
+            ],
         ),
         GenerateKind::Waterbomb {
             rows,
@@ -168,20 +163,19 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
             row_height,
             out,
         } => (
-            Generator::Waterbomb(WaterbombSpec {
-                rows: *rows,
-                cols: *cols,
-                row_height: *row_height,
-            }),
+            "waterbomb",
+            json!({"rows": rows, "cols": cols, "row_height": row_height}),
             out,
             &[("rows, cols", "--rows, --cols"), ("row_height", "--row-height")],
         ),
         GenerateKind::BirdBase { half_side, out } => (
-            Generator::BirdBase(BirdBaseSpec { half_side: *half_side }),
+            "bird_base",
+            json!({ "half_side": half_side }),
             out,
             &[("half_side", "--half-side")],
         ),
     };
+    let generator = Generator::from_options(family, &options).map_err(|e| flags(e, table))?;
     let (model, state) = generator.build().map_err(|e| flags(e, table))?;
     let value = crease_pattern_fold(&model.pattern, state.as_deref(), &generator.note());
     write_file(out, &value)?;

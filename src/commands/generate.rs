@@ -22,13 +22,16 @@ pub enum Generator {
 impl Generator {
     /// The pattern's sheet (validated, stars and panels found) and, for a folded Miura-ori,
     /// its state.
+    /// Errors name the options (`angle_deg`, `fold_deg`, `twist_deg`, …), as the front ends
+    /// give them.
     pub fn build(&self) -> Result<(FoldingModel, Option<Vec<f64>>)> {
         let builder = match self {
-            Generator::Miura(spec) => spec.build()?,
-            Generator::SquareTwist(spec) => spec.build()?,
-            Generator::Waterbomb(spec) => spec.build()?,
-            Generator::BirdBase(spec) => spec.build()?,
-        };
+            Generator::Miura(spec) => spec.build(),
+            Generator::SquareTwist(spec) => spec.build(),
+            Generator::Waterbomb(spec) => spec.build(),
+            Generator::BirdBase(spec) => spec.build(),
+        }
+        .map_err(by_option_name)?;
         let model = FoldingModel::new(builder.build()?)?;
         let state = match self {
             Generator::Miura(spec) if spec.zigzag_fold_angle != 0.0 => Some(model.given_fold_angles()),
@@ -73,6 +76,23 @@ impl Generator {
     pub fn to_fold(&self) -> Result<serde_json::Value> {
         let (model, state) = self.build()?;
         Ok(crease_pattern_fold(&model.pattern, state.as_deref(), &self.note()))
+    }
+}
+
+/// A generator spec's error under the option that sets the field (the specs hold radians
+/// under the geometry's names; the options take degrees under `_deg` names).
+fn by_option_name(error: NanofoldError) -> NanofoldError {
+    match error {
+        NanofoldError::InvalidField { field, value, reason } => {
+            let field = match field.as_str() {
+                "sector_angle" => "angle_deg".to_string(),
+                "zigzag_fold_angle" => "fold_deg".to_string(),
+                "twist" => "twist_deg".to_string(),
+                _ => field,
+            };
+            NanofoldError::InvalidField { field, value, reason }
+        }
+        other => other,
     }
 }
 
