@@ -8,18 +8,14 @@ use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{mujoco_snippet, ConstraintReport};
 use nanofold::dynamics::integrate::ProgressObserver;
 use nanofold::dynamics::modes::modes;
-use nanofold::plot::response::{response_svg, snapshots_svg};
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::prelude::{
-    simulate, unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, QpMethod, Response,
-    Scene, SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
-    VertexReport as UnfoldReport,
+    unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, QpMethod, Response, Scene,
+    SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern, VertexReport as UnfoldReport,
 };
 use nanofold::unfold::UnfoldModel;
 use nanofold::write::folder::{folder_name, write_folder_of};
-use nanofold::write::output::{
-    closed_modes_json, fold_animation, modes_json, response_json, response_summary, trajectory_json,
-};
+use nanofold::write::output::{closed_modes_json, fold_animation, modes_json, trajectory_json};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -1024,40 +1020,17 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         ..options.settings().map_err(simulate_flags)?
     };
     let scene = load_scene(&args.scene)?;
-    let simulation = simulate(&scene, &settings).map_err(simulate_flags)?;
-    let response = &simulation.response;
+    let report = nanofold::commands::simulate(&scene, &settings).map_err(simulate_flags)?;
+    let (simulation, response) = (&report.simulation, &report.simulation.response);
     // Render everything before writing anything.
     let dir = args.out.clone().unwrap_or_else(|| {
         let file_name = nanofold::read::scene::scene_name(&args.scene);
         PathBuf::from("output").join(folder_name(&scene.name, &file_name))
     });
-    let mut files = vec![
-        (
-            "response.json",
-            serde_json::to_string(&response_json(&scene, &settings, &simulation))?,
-        ),
-        ("response.svg", response_svg(&scene, response)?),
-        ("snapshots.svg", snapshots_svg(&scene, response)?),
-    ];
-    if let System::Network(model) = &scene.system {
-        let motion = nanofold::write::folding_output::network_motion_fold(model, response);
-        let page = nanofold::plot::scene_page::network_response_page(
-            &scene.name,
-            model,
-            &motion,
-            response.collision.as_ref(),
-        )?;
-        files.push(("response.html", page));
-        files.push(("motion.fold", serde_json::to_string(&motion)?));
-    } else {
-        files.push((
-            "response.html",
-            nanofold::plot::scene_page::response_page(&scene, response)?,
-        ));
-    }
+    let files = nanofold::commands::simulation_files(&scene, &report)?;
     write_outputs(&dir, &args.scene, &files)?;
     if args.json {
-        println!("{}", response_summary(&scene, &settings, &simulation));
+        println!("{}", report.summary);
         return Ok(());
     }
     let scales = &response.time_scales;

@@ -49,6 +49,8 @@ pub use options::{
     options_from_json, AutoDegree, CheckOptions, ConstraintOptions, CurveFormat, DegreeOption, FoldOptions, FromJson,
     ReadOptions, SimulateOptions, UnfoldOptions,
 };
+#[cfg(feature = "plot")]
+pub use scene::simulation_files;
 pub use scene::{modes, open_scene, parse_scene, scene_kind, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
 
 /// The single-vertex pattern type of the engine behind the door.

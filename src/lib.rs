@@ -89,8 +89,9 @@
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
 //! [`read`] (the file readers) → [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`]
-//! → [`write`](mod@write) (the file writers) → [`commands`] (the front door) → `plot` (feature `plot`)
-//! → the `nanofold` binary (feature `cli`). [`error`]
+//! → [`write`](mod@write) (the file writers) → `plot` (the figures and pages, feature
+//! `plot`) → [`commands`] (the front door, which renders each command's files) → the
+//! `nanofold` binary (feature `cli`) and the Python package. [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.
 
 pub mod commands;

@@ -83,6 +83,29 @@ pub struct SimulationReport {
     pub simulation: Simulation,
 }
 
+/// The files `simulate` writes for a run (rendered, not written): response.json,
+/// response.svg, snapshots.svg, the 3D page response.html and a network's motion.fold.
+#[cfg(feature = "plot")]
+pub fn simulation_files(scene: &Scene, report: &SimulationReport) -> Result<Vec<(&'static str, String)>> {
+    use crate::plot::response::{response_svg, snapshots_svg};
+    use crate::plot::scene_page::{network_response_page, response_page};
+    let response = &report.simulation.response;
+    let mut files = vec![
+        ("response.json", report.response.to_string()),
+        ("response.svg", response_svg(scene, response)?),
+        ("snapshots.svg", snapshots_svg(scene, response)?),
+    ];
+    match (&scene.system, &report.fold) {
+        (System::Network(model), Some(motion)) => {
+            let page = network_response_page(&scene.name, model, motion, response.collision.as_ref())?;
+            files.push(("response.html", page));
+            files.push(("motion.fold", motion.to_string()));
+        }
+        _ => files.push(("response.html", response_page(scene, response)?)),
+    }
+    Ok(files)
+}
+
 /// Simulates a scene (`settings` validated first) and renders its summaries.
 pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<SimulationReport> {
     settings.validate()?;
