@@ -7,7 +7,6 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::constraints::{mujoco_snippet, ConstraintReport};
 use nanofold::dynamics::integrate::ProgressObserver;
-use nanofold::dynamics::modes::modes;
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::prelude::{
     unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, QpMethod, Response, Scene,
@@ -15,7 +14,7 @@ use nanofold::prelude::{
 };
 use nanofold::unfold::UnfoldModel;
 use nanofold::write::folder::{folder_name, write_folder_of};
-use nanofold::write::output::{closed_modes_json, fold_animation, modes_json, trajectory_json};
+use nanofold::write::output::{fold_animation, trajectory_json};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -1235,23 +1234,29 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
         let file_name = nanofold::read::scene::scene_name(path);
         PathBuf::from("output").join(folder_name(&scene.name, &file_name))
     });
-    let chain = match &scene.system {
-        System::Closed(chain) => return run_modes_closed(&scene.name, path, chain, json, &dir),
-        System::Network(model) => return run_modes_network(&scene.name, path, model, json, &dir),
-        System::Strip(chain) => chain,
-    };
-    let result = modes(&chain.model, chain.target_angles().as_slice())?;
-    let files = [(
-        "modes.html",
-        nanofold::plot::scene_page::strip_modes_page(&scene.name, chain, &result, MODE_AMPLITUDE)?,
-    )];
+    let report = nanofold::commands::modes(&scene)?;
+    let files = nanofold::commands::modes_files(&scene, &report)?;
     write_outputs(&dir, path, &files)?;
     if json {
-        let mut value = modes_json(&scene, &result);
+        let mut value = report.summary.clone();
         value["out"] = serde_json::json!(dir.display().to_string());
         println!("{value}");
         return Ok(());
     }
+    let result = match (&scene.system, &report.detail) {
+        (System::Closed(chain), ModesDetail::Closed(result, eta)) => {
+            print_modes_closed(&scene.name, chain, result, *eta);
+            print_written(&dir, &files);
+            return Ok(());
+        }
+        (System::Network(model), ModesDetail::Network(result)) => {
+            print_modes_network(&scene.name, model, result);
+            print_written(&dir, &files);
+            return Ok(());
+        }
+        (_, ModesDetail::Strip(result)) => result,
+        _ => unreachable!("a report's modes are its scene's kind"),
+    };
     let degrees: Vec<String> = result
         .equilibrium
         .iter()
@@ -1293,34 +1298,11 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-fn run_modes_network(
+fn print_modes_network(
     name: &str,
-    input: &Path,
     model: &nanofold::dynamics::network::NetworkModel,
-    json: bool,
-    dir: &Path,
-) -> Result<()> {
-    let result = nanofold::dynamics::network::modes::folded_modes(model)?;
-    let fold = nanofold::write::folding_output::network_modes_fold(model, &result, MODE_AMPLITUDE)?;
-    let files = [
-        (
-            "modes.html",
-            nanofold::plot::page::page_of_fold(
-                &nanofold::write::folding_output::network_modes_oscillation_fold(model, &result, MODE_AMPLITUDE, 12)?,
-                name,
-                &[],
-                Some((model.unit * 1e6, "µm")),
-            )?,
-        ),
-        ("modes.fold", serde_json::to_string(&fold)?),
-    ];
-    write_outputs(dir, input, &files)?;
-    if json {
-        let mut value = nanofold::write::output::network_modes_json(name, model, &result);
-        value["out"] = serde_json::json!(dir.display().to_string());
-        println!("{value}");
-        return Ok(());
-    }
+    result: &nanofold::dynamics::network::modes::NetworkModes,
+) {
     let modes = &result.modes;
     let eq = &modes.equilibrium;
     println!(
@@ -1385,32 +1367,16 @@ fn run_modes_network(
             modes.modes.frequencies_hz.first().map_or(f64::NAN, |f| (r.balance_frequency_hz - f).abs() / f)
         );
     }
-    print_written(dir, &files);
-    Ok(())
 }
 
-use nanofold::commands::MODE_AMPLITUDE;
+use nanofold::commands::ModesDetail;
 
-fn run_modes_closed(
+fn print_modes_closed(
     name: &str,
-    input: &Path,
     chain: &nanofold::dynamics::closed::ClosedChain,
-    json: bool,
-    dir: &Path,
-) -> Result<()> {
-    let result = chain.folded_modes()?;
-    let eta = chain.torque_magnification()?;
-    let files = [(
-        "modes.html",
-        nanofold::plot::scene_page::closed_modes_page(name, chain, &result, MODE_AMPLITUDE)?,
-    )];
-    write_outputs(dir, input, &files)?;
-    if json {
-        let mut value = closed_modes_json(name, chain, &result, eta);
-        value["out"] = serde_json::json!(dir.display().to_string());
-        println!("{value}");
-        return Ok(());
-    }
+    result: &nanofold::dynamics::closed::modes::ClosedModes,
+    eta: f64,
+) {
     let degrees = |angles: &[f64]| {
         angles
             .iter()
@@ -1474,8 +1440,6 @@ fn run_modes_closed(
             "NOT stable: some eigenvalue of the reduced stiffness is not positive"
         }
     );
-    print_written(dir, &files);
-    Ok(())
 }
 
 /// Runs the parsed command; Ok(false) means "finished, but exit non-zero".

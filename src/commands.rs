@@ -49,9 +49,11 @@ pub use options::{
     options_from_json, AutoDegree, CheckOptions, ConstraintOptions, CurveFormat, DegreeOption, FoldOptions, FromJson,
     ReadOptions, SimulateOptions, UnfoldOptions,
 };
+pub use scene::{
+    modes, open_scene, parse_scene, scene_kind, simulate, ModesDetail, ModesReport, SimulationReport, MODE_AMPLITUDE,
+};
 #[cfg(feature = "plot")]
-pub use scene::simulation_files;
-pub use scene::{modes, open_scene, parse_scene, scene_kind, simulate, ModesReport, SimulationReport, MODE_AMPLITUDE};
+pub use scene::{modes_files, simulation_files};
 
 /// The single-vertex pattern type of the engine behind the door.
 pub use crate::pattern::VertexPattern;

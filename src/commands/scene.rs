@@ -40,6 +40,19 @@ pub struct ModesReport {
     pub summary: Value,
     /// A network's modes.fold.
     pub fold: Option<Value>,
+    /// The modes as the engine found them.
+    pub detail: ModesDetail,
+}
+
+/// The modes of each kind of scene, as its engine gives them.
+#[derive(Debug, Clone)]
+pub enum ModesDetail {
+    /// A strip's modes about its folded equilibrium.
+    Strip(crate::dynamics::modes::Modes),
+    /// A closed chain's, with its torque magnification η.
+    Closed(Box<crate::dynamics::closed::modes::ClosedModes>, f64),
+    /// A network's.
+    Network(Box<crate::dynamics::network::modes::NetworkModes>),
 }
 
 /// Natural frequencies, mode shapes and stability at the scene's folded equilibrium.
@@ -50,6 +63,7 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
             ModesReport {
                 summary: modes_json(scene, &result),
                 fold: None,
+                detail: ModesDetail::Strip(result),
             }
         }
         System::Closed(chain) => {
@@ -58,6 +72,7 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
             ModesReport {
                 summary: closed_modes_json(&scene.name, chain, &result, eta),
                 fold: None,
+                detail: ModesDetail::Closed(Box::new(result), eta),
             }
         }
         System::Network(model) => {
@@ -65,8 +80,39 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
             ModesReport {
                 summary: network_modes_json(&scene.name, model, &result),
                 fold: Some(network_modes_fold(model, &result, MODE_AMPLITUDE)?),
+                detail: ModesDetail::Network(Box::new(result)),
             }
         }
+    })
+}
+
+/// The files `modes` writes (rendered, not written): the 3D page modes.html, and a
+/// network's modes.fold.
+#[cfg(feature = "plot")]
+pub fn modes_files(scene: &Scene, report: &ModesReport) -> Result<Vec<(&'static str, String)>> {
+    use crate::plot::page::page_of_fold;
+    use crate::plot::scene_page::{closed_modes_page, strip_modes_page};
+    use crate::write::folding_output::network_modes_oscillation_fold;
+    Ok(match (&scene.system, &report.detail) {
+        (System::Strip(chain), ModesDetail::Strip(result)) => {
+            vec![(
+                "modes.html",
+                strip_modes_page(&scene.name, chain, result, MODE_AMPLITUDE)?,
+            )]
+        }
+        (System::Closed(chain), ModesDetail::Closed(result, _)) => {
+            vec![(
+                "modes.html",
+                closed_modes_page(&scene.name, chain, result, MODE_AMPLITUDE)?,
+            )]
+        }
+        (System::Network(model), ModesDetail::Network(result)) => {
+            let oscillation = network_modes_oscillation_fold(model, result, MODE_AMPLITUDE, 12)?;
+            let page = page_of_fold(&oscillation, &scene.name, &[], Some((model.unit * 1e6, "µm")))?;
+            let fold = report.fold.as_ref().map_or_else(String::new, Value::to_string);
+            vec![("modes.html", page), ("modes.fold", fold)]
+        }
+        _ => unreachable!("a report's modes are its scene's kind"),
     })
 }
 
