@@ -1188,25 +1188,16 @@ fn run_export(format: &ExportKind) -> Result<()> {
         closure,
     } = format;
     let built = load_scene(scene)?;
-    let scales = match &built.system {
-        System::Strip(chain) => chain.time_scales()?,
-        System::Closed(chain) => chain.time_scales()?,
-        System::Network(model) => {
-            use nanofold::dynamics::plant::Plant;
-            nanofold::dynamics::network::NetworkPlant::new(model, false)?.time_scales()?
-        }
-    };
-    let settings = nanofold::write::mujoco::MujocoSettings {
+    let settings = nanofold::commands::MujocoSettings {
         timestep: *timestep,
         closure: match closure {
-            ClosureArg::Connect => nanofold::write::mujoco::LoopClosure::Connect,
-            ClosureArg::Poly => nanofold::write::mujoco::LoopClosure::Polycoef,
+            ClosureArg::Connect => nanofold::commands::LoopClosure::Connect,
+            ClosureArg::Poly => nanofold::commands::LoopClosure::Polycoef,
         },
     };
-    settings
-        .validate(scales.fastest_period_s)
+    let export = nanofold::commands::export_mujoco(&built, &settings)
         .map_err(|e| with_flags(e, &[("timestep", "--timestep")]))?;
-    let text = nanofold::write::mujoco::scene_mjcf(&built, &settings)?;
+    let (text, fastest_period_s) = (export.mjcf, export.fastest_period_s);
     let out = out.clone().unwrap_or_else(|| {
         PathBuf::from("output")
             .join(&built.name)
@@ -1222,8 +1213,8 @@ fn run_export(format: &ExportKind) -> Result<()> {
         built.name,
         out.display(),
         timestep,
-        scales.fastest_period_s / timestep,
-        scales.fastest_period_s
+        fastest_period_s / timestep,
+        fastest_period_s
     );
     Ok(())
 }

@@ -43,6 +43,7 @@ mod generate;
 pub mod options;
 mod scene;
 
+pub use crate::write::mujoco::{LoopClosure, MujocoSettings};
 pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
 pub use generate::Generator;
 pub use options::{
@@ -50,7 +51,8 @@ pub use options::{
     ReadOptions, SimulateOptions, UnfoldOptions,
 };
 pub use scene::{
-    modes, open_scene, parse_scene, scene_kind, simulate, ModesDetail, ModesReport, SimulationReport, MODE_AMPLITUDE,
+    export_mujoco, modes, open_scene, parse_scene, scene_kind, simulate, ModesDetail, ModesReport, MujocoExport,
+    SimulationReport, MODE_AMPLITUDE,
 };
 #[cfg(feature = "plot")]
 pub use scene::{modes_files, simulation_files};

@@ -301,7 +301,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "dynamics::closed",
     "dynamics::integrate",
     "dynamics::network",
-    "dynamics::plant",
     "folding::FoldingModel",
     "plot::constraints_svg",
     "plot::folding",
@@ -316,7 +315,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "unfold::UnfoldModel",
     "write::folder",
     "write::folding_output",
-    "write::mujoco",
     "write::output",
 ];
 

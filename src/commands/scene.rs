@@ -167,3 +167,29 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
         simulation,
     })
 }
+
+/// A scene as one MuJoCo MJCF model (`export mujoco`), with the fastest natural period its
+/// time step was checked against, s.
+#[derive(Debug, Clone)]
+pub struct MujocoExport {
+    /// The MJCF text.
+    pub mjcf: String,
+    /// The scene's fastest natural period, s (the step must be at most a twentieth of it).
+    pub fastest_period_s: f64,
+}
+
+/// Writes `scene` as MJCF (`docs/model.md#mujoco-scenes`) with `settings` checked against
+/// the scene's fastest natural period.
+pub fn export_mujoco(scene: &Scene, settings: &crate::write::mujoco::MujocoSettings) -> Result<MujocoExport> {
+    use crate::dynamics::plant::Plant;
+    let scales = match &scene.system {
+        System::Strip(chain) => chain.time_scales()?,
+        System::Closed(chain) => chain.time_scales()?,
+        System::Network(model) => crate::dynamics::network::NetworkPlant::new(model, false)?.time_scales()?,
+    };
+    settings.validate(scales.fastest_period_s)?;
+    Ok(MujocoExport {
+        mjcf: crate::write::mujoco::scene_mjcf(scene, settings)?,
+        fastest_period_s: scales.fastest_period_s,
+    })
+}
