@@ -5,15 +5,15 @@ mod folding;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
+use nanofold::commands::outputs::{default_output_folder, folder_name, write_folder_of};
 use nanofold::constraints::{mujoco_snippet, ConstraintReport};
-use nanofold::dynamics::integrate::ProgressObserver;
 use nanofold::plot::{constraints_svg, unfold_svg};
 use nanofold::prelude::{
-    unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, QpMethod, Response, Scene,
-    SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern, VertexReport as UnfoldReport,
+    unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, ProgressObserver, QpMethod,
+    Response, Scene, SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
+    VertexReport as UnfoldReport,
 };
 use nanofold::unfold::UnfoldModel;
-use nanofold::write::folder::{folder_name, write_folder_of};
 use nanofold::write::output::{fold_animation, trajectory_json};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -418,7 +418,7 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         for path in entries {
             if path.is_dir() {
                 walk(&path, seen_dirs, found)?;
-            } else if nanofold::read::is_pattern_file(&path) {
+            } else if nanofold::commands::outputs::is_pattern_file(&path) {
                 found.push(path);
             }
             anyhow::ensure!(
@@ -596,7 +596,7 @@ fn run_unfold(
     let mut jobs: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
     let mut writer_of: std::collections::HashMap<PathBuf, PathBuf> = std::collections::HashMap::new();
     for path in files {
-        let file_name = nanofold::read::pattern_name(&path);
+        let file_name = nanofold::commands::outputs::pattern_name(&path);
         let dir = parent.join(folder_name(&file_name, &file_name));
         if let Some(other) = writer_of.insert(dir.clone(), path.clone()) {
             anyhow::bail!(
@@ -884,7 +884,7 @@ fn print_constraints(
 /// `output/<name>`, where a name that is not one plain folder name (`..`, `/abs`, empty)
 /// gives way to the file's own name.
 fn default_folder(name: &str, file: &Path) -> PathBuf {
-    PathBuf::from("output").join(folder_name(name, &nanofold::read::pattern_name(file)))
+    default_output_folder(name, file)
 }
 
 /// Writes the (file name, contents) set into `dir` as one (see `io::folder`); everything is
@@ -990,7 +990,7 @@ pub(crate) fn reading(path: &Path, error: nanofold::prelude::NanofoldError) -> a
 
 /// Loads a scene file and builds it (the closed chain's sweep and fit run here).
 fn load_scene(path: &Path) -> Result<Scene> {
-    let spec = nanofold::read::load_scene(path).map_err(|e| reading(path, e))?;
+    let spec = nanofold::prelude::load_scene(path).map_err(|e| reading(path, e))?;
     spec.build()
         .with_context(|| format!("building the scene of {}", path.display()))
 }
@@ -1022,10 +1022,10 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     let report = nanofold::commands::simulate(&scene, &settings).map_err(simulate_flags)?;
     let (simulation, response) = (&report.simulation, &report.simulation.response);
     // Render everything before writing anything.
-    let dir = args.out.clone().unwrap_or_else(|| {
-        let file_name = nanofold::read::scene::scene_name(&args.scene);
-        PathBuf::from("output").join(folder_name(&scene.name, &file_name))
-    });
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_output_folder(&scene.name, &args.scene));
     let files = nanofold::commands::simulation_files(&scene, &report)?;
     write_outputs(&dir, &args.scene, &files)?;
     if args.json {
@@ -1206,7 +1206,7 @@ fn run_export(format: &ExportKind) -> Result<()> {
     if out.extension().and_then(|e| e.to_str()) != Some("xml") {
         anyhow::bail!("--out {}: the file name must end in .xml", out.display());
     }
-    nanofold::write::output::write_atomic(&out, text.as_bytes())
+    nanofold::commands::outputs::write_atomic(&out, text.as_bytes())
         .with_context(|| format!("writing {}", out.display()))?;
     println!(
         "{}: wrote {} (MJCF, units µm, pg, µs; RK4 step {:e} s, a {:.0}th of the fastest period {:.3e} s)",
@@ -1221,10 +1221,9 @@ fn run_export(format: &ExportKind) -> Result<()> {
 
 fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     let scene = load_scene(path)?;
-    let dir = out.map(Path::to_path_buf).unwrap_or_else(|| {
-        let file_name = nanofold::read::scene::scene_name(path);
-        PathBuf::from("output").join(folder_name(&scene.name, &file_name))
-    });
+    let dir = out
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| default_output_folder(&scene.name, path));
     let report = nanofold::commands::modes(&scene)?;
     let files = nanofold::commands::modes_files(&scene, &report)?;
     write_outputs(&dir, path, &files)?;

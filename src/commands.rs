@@ -41,6 +41,7 @@ use std::time::Instant;
 mod constraints;
 mod generate;
 pub mod options;
+pub mod outputs;
 mod scene;
 
 pub use crate::write::mujoco::{LoopClosure, MujocoSettings};

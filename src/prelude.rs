@@ -8,7 +8,7 @@ pub use crate::commands::{
     VertexPattern,
 };
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
-pub use crate::dynamics::integrate::Method;
+pub use crate::dynamics::integrate::{Method, ProgressObserver};
 pub use crate::dynamics::scene::{Scene, System};
 pub use crate::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
 pub use crate::error::{NanofoldError, NumericalError, Result};

@@ -4,11 +4,12 @@
 use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
+use nanofold::commands::outputs::write_atomic;
 use nanofold::folding::FoldingModel;
 use nanofold::plot::folding::fold_svg;
 use nanofold::prelude::CheckSettings;
 use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_trajectory_json};
-use nanofold::write::output::{number, write_atomic};
+use nanofold::write::output::number;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -597,7 +598,7 @@ pub struct ViewArgs {
 pub fn run_view(args: &ViewArgs) -> Result<()> {
     let text = nanofold::read::input::read_text(&args.file, MAX_VIEW_BYTES).map_err(|e| reading(&args.file, e))?;
     let value: Value = serde_json::from_str(&text).with_context(|| format!("{}: not JSON", args.file.display()))?;
-    let name = nanofold::read::pattern_name(&args.file);
+    let name = nanofold::commands::outputs::pattern_name(&args.file);
     let three_d = |frame: &Value| {
         frame["vertices_coords"].as_array().is_some_and(|v| {
             v.iter()
