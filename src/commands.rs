@@ -43,6 +43,8 @@ mod generate;
 pub mod options;
 pub mod outputs;
 mod scene;
+#[cfg(feature = "plot")]
+mod view;
 
 pub use crate::write::mujoco::{LoopClosure, MujocoSettings};
 pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
@@ -57,6 +59,8 @@ pub use scene::{
 };
 #[cfg(feature = "plot")]
 pub use scene::{modes_files, simulation_files};
+#[cfg(feature = "plot")]
+pub use view::{view_page, MAX_VIEW_BYTES};
 
 /// The single-vertex pattern type of the engine behind the door.
 pub use crate::pattern::VertexPattern;

@@ -305,8 +305,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "plot::folding",
     "plot::page",
     "plot::unfold_svg",
-    "read::input",
-    "read::load_crease_pattern",
     "unfold::UnfoldModel",
     "write::folding_output",
     "write::output",

@@ -210,11 +210,6 @@ fn flags(error: nanofold::prelude::NanofoldError, table: &[(&str, &str)]) -> any
     super::with_flags(error, table)
 }
 
-fn load_model(path: &Path) -> Result<FoldingModel> {
-    let pattern = nanofold::read::load_crease_pattern(path).map_err(|e| reading(path, e))?;
-    Ok(FoldingModel::new(pattern)?)
-}
-
 /// `EDGE=DEG` of `flag`: a FOLD edge index and an angle in [-180, 180] degrees.
 fn parse_edge_angle(text: &str, flag: &str) -> Result<(usize, f64)> {
     let (edge, degrees) = text
@@ -579,9 +574,6 @@ pub fn unfold_network_one(
     Ok((summary, text))
 }
 
-/// Largest FOLD file `view` reads (an animation repeats its mesh in every frame).
-const MAX_VIEW_BYTES: u64 = 128 << 20;
-
 /// `nanofold view FILE.fold`.
 #[derive(clap::Args)]
 pub struct ViewArgs {
@@ -596,27 +588,8 @@ pub struct ViewArgs {
 /// `nanofold view FILE.fold`: a page of the file's frames as written, or, for a crease
 /// pattern (2D, no 3D frame), of its state placed by the spanning tree.
 pub fn run_view(args: &ViewArgs) -> Result<()> {
-    let text = nanofold::read::input::read_text(&args.file, MAX_VIEW_BYTES).map_err(|e| reading(&args.file, e))?;
-    let value: Value = serde_json::from_str(&text).with_context(|| format!("{}: not JSON", args.file.display()))?;
+    let html = nanofold::commands::view_page(&args.file).map_err(|e| reading(&args.file, e))?;
     let name = nanofold::commands::outputs::pattern_name(&args.file);
-    let three_d = |frame: &Value| {
-        frame["vertices_coords"].as_array().is_some_and(|v| {
-            v.iter()
-                .any(|p| p.as_array().is_some_and(|p| p.len() == 3 && p[2].as_f64() != Some(0.0)))
-        })
-    };
-    let has_3d = three_d(&value) || value["file_frames"].as_array().is_some_and(|f| f.iter().any(three_d));
-    let html = if has_3d && value.get("faces_vertices").is_some() {
-        nanofold::plot::page::page_of_fold(&value, &name, &[], None)?
-    } else {
-        let model = load_model(&args.file)?;
-        let state = model.given_fold_angles();
-        nanofold::plot::page::page_of_states(
-            &model,
-            &model.pattern.name,
-            &[("as read".to_string(), state.as_slice())],
-        )?
-    };
     let dir = args.out.clone().unwrap_or_else(|| default_folder(&name, &args.file));
     write_outputs(&dir, &args.file, &[("view.html", html.clone())])?;
     println!(
