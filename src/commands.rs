@@ -790,6 +790,43 @@ pub fn fold_run(pattern: &Pattern, options: &options::FoldOptions) -> Result<Fol
     })
 }
 
+/// The files `fold` writes for a run (rendered, not written): fold.fold (the animation),
+/// folded.fold (the end state), trajectory.json (every step, thinned to 1000), fold.svg and
+/// the 3D page fold.html.
+#[cfg(feature = "plot")]
+pub fn fold_files(pattern: &Pattern, run: &FoldRun) -> Result<Vec<(&'static str, String)>> {
+    let model = sheet_of(pattern, "fold")?;
+    let Detail::Fold(path) = &run.report.detail else {
+        return Err(NanofoldError::invalid(
+            "run",
+            run.report.pattern.clone(),
+            "is not a fold",
+        ));
+    };
+    let title = format!(
+        "{}: folding ({}, {} steps)",
+        model.pattern.name,
+        path.stop.as_str(),
+        path.steps.len()
+    );
+    let states: Vec<(String, &[f64])> = run
+        .frames
+        .iter()
+        .map(|f| (format!("progress {:.4}", f.progress), f.fold_angles.as_slice()))
+        .collect();
+    let json = |value: &serde_json::Value| {
+        serde_json::to_string_pretty(value).map_err(|e| NanofoldError::invalid("fold.fold", "JSON", e.to_string()))
+    };
+    let trajectory = crate::write::folding_output::fold_trajectory_json(model, path, 1000);
+    Ok(vec![
+        ("fold.fold", json(&run.animation)?),
+        ("folded.fold", json(&run.end_state)?),
+        ("trajectory.json", trajectory.to_string()),
+        ("fold.svg", crate::plot::folding::fold_svg(model, path, &title)?),
+        ("fold.html", crate::plot::page::page_of_states(model, &title, &states)?),
+    ])
+}
+
 fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: FoldPath, clock: Instant) -> Report {
     let last = path
         .steps

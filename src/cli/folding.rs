@@ -6,9 +6,8 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::commands::outputs::write_atomic;
 use nanofold::folding::FoldingModel;
-use nanofold::plot::folding::fold_svg;
 use nanofold::prelude::CheckSettings;
-use nanofold::write::folding_output::{crease_pattern_fold, evenly, fold_trajectory_json};
+use nanofold::write::folding_output::{crease_pattern_fold, evenly};
 use nanofold::write::output::number;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -264,32 +263,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_folder(&model.pattern.name, &args.pattern));
-    let title = format!(
-        "{}: folding ({}, {} steps)",
-        model.pattern.name,
-        path.stop.as_str(),
-        path.steps.len()
-    );
-    let files = [
-        ("fold.fold", serde_json::to_string_pretty(&run.animation)?),
-        ("folded.fold", serde_json::to_string_pretty(&run.end_state)?),
-        (
-            "trajectory.json",
-            serde_json::to_string(&fold_trajectory_json(model, path, 1000))?,
-        ),
-        ("fold.svg", fold_svg(model, path, &title)?),
-        (
-            "fold.html",
-            nanofold::plot::page::page_of_states(
-                model,
-                &title,
-                &frames
-                    .iter()
-                    .map(|f| (format!("progress {:.4}", f.progress), f.fold_angles.as_slice()))
-                    .collect::<Vec<_>>(),
-            )?,
-        ),
-    ];
+    let files = nanofold::commands::fold_files(&pattern, &run)?;
     write_outputs(&dir, &args.pattern, &files)?;
     let mut summary = run.report.to_json(&pattern);
     summary["frames"] = json!(frames.len());
