@@ -92,7 +92,7 @@ def test_a_folded_miura_from_the_generator_is_rigid_and_unfolds_flat():
     "call, error, field",
     [
         (lambda: nanofold.generate.miura(0, 4), nanofold.InvalidFieldError, "rows, cols"),
-        (lambda: nanofold.generate.miura(4, 4, angle_deg=95), nanofold.InvalidFieldError, "sector_angle"),
+        (lambda: nanofold.generate.miura(4, 4, angle_deg=95), nanofold.InvalidFieldError, "angle_deg"),
         (lambda: nanofold.unfold("patterns/miura_vertex.fold", p=-1), nanofold.InvalidFieldError, "p"),
         (lambda: nanofold.unfold("patterns/miura_vertex.fold", energy="quadratic"), nanofold.InvalidFieldError, "energy"),
         (lambda: nanofold.fold("patterns/many/miura_4x4.fold", to=200), nanofold.InvalidFieldError, "drive.to"),
