@@ -7,14 +7,12 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::commands::outputs::{default_output_folder, folder_name, write_folder_of};
 use nanofold::constraints::{mujoco_snippet, ConstraintReport};
-use nanofold::plot::{constraints_svg, unfold_svg};
+use nanofold::plot::constraints_svg;
 use nanofold::prelude::{
     unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, ProgressObserver, QpMethod,
     Response, Scene, SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
     VertexReport as UnfoldReport,
 };
-use nanofold::unfold::UnfoldModel;
-use nanofold::write::output::{fold_animation, trajectory_json};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -480,31 +478,21 @@ fn unfold_one(
         ..nanofold::commands::Settings::default()
     };
     let answer = nanofold::commands::unfold_observed(&opened, &door, progress)?;
-    let nanofold::commands::Detail::VertexUnfold(report) = answer.detail else {
-        unreachable!("a single vertex unfolds by the single-vertex engine")
-    };
-    let model = UnfoldModel::new(pattern);
     let dir = dir.map_or_else(|| default_folder(&pattern.name, pattern_path), Path::to_path_buf);
     // Render everything before writing anything.
-    let trajectory = serde_json::to_string(&trajectory_json(pattern, &settings, &report, 1000))?;
-    let animation = fold_animation(pattern, &model, &report);
-    let fold = serde_json::to_string_pretty(&animation)?;
-    let svg = unfold_svg(pattern, &report)?;
-    let page = nanofold::plot::page::page_of_fold(&animation, &pattern.name, &[], None)?;
-    let files = [
-        ("trajectory.json", trajectory.as_bytes()),
-        ("unfold.fold", fold.as_bytes()),
-        ("unfold.svg", svg.as_bytes()),
-        ("unfold.html", page.as_bytes()),
-    ];
+    let files = nanofold::commands::unfold_files(&opened, &answer, &door)?;
+    let written: Vec<(&str, &[u8])> = files.iter().map(|(name, text)| (*name, text.as_bytes())).collect();
     write_folder_of(
         &dir,
         pattern_path,
         FORCE.load(std::sync::atomic::Ordering::Relaxed),
-        &files,
+        &written,
     )
     .with_context(|| format!("writing {}", dir.display()))?;
-    let mut summary = summary(pattern, pattern_path, &report);
+    let nanofold::commands::Detail::VertexUnfold(report) = &answer.detail else {
+        unreachable!("a single vertex unfolds by the single-vertex engine")
+    };
+    let mut summary = summary(pattern, pattern_path, report);
     summary["out"] = json!(dir.display().to_string());
     let mut text = String::new();
     writeln!(

@@ -827,6 +827,88 @@ pub fn fold_files(pattern: &Pattern, run: &FoldRun) -> Result<Vec<(&'static str,
     ])
 }
 
+/// The files `unfold` writes for a report (rendered, not written): trajectory.json (the
+/// recorded steps, thinned to 1000), unfold.fold (the FOLD animation), unfold.svg and the 3D
+/// page unfold.html, for either engine.
+#[cfg(feature = "plot")]
+pub fn unfold_files(pattern: &Pattern, report: &Report, settings: &Settings) -> Result<Vec<(&'static str, String)>> {
+    use crate::plot::page::page_of_fold;
+    use crate::write::folding_output::{evenly, states_fold};
+    let pretty = |value: &serde_json::Value| {
+        serde_json::to_string_pretty(value).map_err(|e| NanofoldError::invalid("unfold.fold", "JSON", e.to_string()))
+    };
+    match (&report.detail, pattern.vertex(), pattern.sheet()) {
+        (Detail::VertexUnfold(run), Some(vertex), _) => {
+            let model = crate::unfold::UnfoldModel::new(vertex);
+            let trajectory = crate::write::output::trajectory_json(vertex, &settings.unfold, run, 1000);
+            let animation = crate::write::output::fold_animation(vertex, &model, run);
+            Ok(vec![
+                ("trajectory.json", trajectory.to_string()),
+                ("unfold.fold", pretty(&animation)?),
+                ("unfold.svg", crate::plot::unfold_svg(vertex, run)?),
+                ("unfold.html", page_of_fold(&animation, &vertex.name, &[], None)?),
+            ])
+        }
+        (Detail::NetworkUnfold(run), _, Some(model)) => {
+            let steps = &run.steps;
+            // 11 snapshots in the animation, the trajectory thinned to 1000 steps.
+            let frames: Vec<(String, &[f64])> = evenly(steps.len(), 11)
+                .iter()
+                .map(|&i| {
+                    (
+                        format!("step {i}, energy {:.6e}", steps[i].energy),
+                        steps[i].fold_angles.as_slice(),
+                    )
+                })
+                .collect();
+            let animation = states_fold(
+                model,
+                Some(&report.start_fold_angles_rad),
+                &frames,
+                "unfolding written by nanofold unfold",
+            );
+            let written = evenly(steps.len(), 1000);
+            let trajectory = serde_json::json!({
+                "pattern": model.pattern.name,
+                "units": {"angles": "rad"},
+                "creases_edge_index": model.pattern.creases,
+                "verdict": run.verdict.as_str(),
+                "evidence": run.evidence,
+                "recorded_steps": steps.len(),
+                "steps_written": written.len(),
+                "steps": written.iter().map(|&i| serde_json::json!({
+                    "step": i,
+                    "energy": crate::write::output::number(steps[i].energy),
+                    "fold_angles_rad": steps[i].fold_angles,
+                    "max_closure_residual_rad": steps[i].max_residual,
+                })).collect::<Vec<_>>(),
+            });
+            let xs: Vec<f64> = (0..steps.len()).map(|i| i as f64).collect();
+            let states: Vec<&[f64]> = steps.iter().map(|s| s.fold_angles.as_slice()).collect();
+            let title = format!(
+                "{}: fold angles while unfolding ({}, {} steps)",
+                model.pattern.name,
+                run.verdict.as_str(),
+                run.iterations
+            );
+            Ok(vec![
+                ("trajectory.json", trajectory.to_string()),
+                ("unfold.fold", pretty(&animation)?),
+                (
+                    "unfold.svg",
+                    crate::plot::folding::angles_svg(model, &xs, &states, "step", "step", &title)?,
+                ),
+                ("unfold.html", page_of_fold(&animation, &model.pattern.name, &[], None)?),
+            ])
+        }
+        _ => Err(NanofoldError::invalid(
+            "report",
+            report.pattern.clone(),
+            "is not an unfolding of this pattern",
+        )),
+    }
+}
+
 fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: FoldPath, clock: Instant) -> Report {
     let last = path
         .steps

@@ -303,9 +303,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "folding::FoldingModel",
     "plot::constraints_svg",
     "plot::folding",
-    "plot::page",
-    "plot::unfold_svg",
-    "unfold::UnfoldModel",
     "write::folding_output",
     "write::output",
 ];

@@ -7,8 +7,7 @@ use clap::{Args, Subcommand};
 use nanofold::commands::outputs::write_atomic;
 use nanofold::folding::FoldingModel;
 use nanofold::prelude::CheckSettings;
-use nanofold::write::folding_output::{crease_pattern_fold, evenly};
-use nanofold::write::output::number;
+use nanofold::write::folding_output::crease_pattern_fold;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -423,8 +422,6 @@ pub fn unfold_network_one(
     dir: Option<&Path>,
     progress: Option<nanofold::prelude::UnfoldProgress>,
 ) -> Result<(Value, String)> {
-    use nanofold::plot::folding::angles_svg;
-    use nanofold::write::folding_output::states_fold;
     use std::fmt::Write as _;
     let model = pattern
         .sheet()
@@ -444,55 +441,7 @@ pub fn unfold_network_one(
     let seconds = answer.seconds;
     let dir = dir.map_or_else(|| default_folder(&model.pattern.name, pattern_path), Path::to_path_buf);
     let last = report.steps.last().expect("the start is recorded");
-    // Outputs: 11 snapshots, the trajectory thinned to 1000 steps.
-    let snapshots = evenly(report.steps.len(), 11);
-    let frames: Vec<(String, &[f64])> = snapshots
-        .iter()
-        .map(|&i| {
-            (
-                format!("step {i}, energy {:.6e}", report.steps[i].energy),
-                report.steps[i].fold_angles.as_slice(),
-            )
-        })
-        .collect();
-    let fold = states_fold(
-        model,
-        Some(&start_state),
-        &frames,
-        "unfolding written by nanofold unfold",
-    );
-    let written = evenly(report.steps.len(), 1000);
-    let trajectory = json!({
-        "pattern": model.pattern.name,
-        "units": {"angles": "rad"},
-        "creases_edge_index": model.pattern.creases,
-        "verdict": report.verdict.as_str(),
-        "evidence": report.evidence,
-        "recorded_steps": report.steps.len(),
-        "steps_written": written.len(),
-        "steps": written.iter().map(|&i| json!({
-            "step": i,
-            "energy": number(report.steps[i].energy),
-            "fold_angles_rad": report.steps[i].fold_angles,
-            "max_closure_residual_rad": report.steps[i].max_residual,
-        })).collect::<Vec<_>>(),
-    });
-    let xs: Vec<f64> = (0..report.steps.len()).map(|i| i as f64).collect();
-    let states: Vec<&[f64]> = report.steps.iter().map(|s| s.fold_angles.as_slice()).collect();
-    let title = format!(
-        "{}: fold angles while unfolding ({}, {} steps)",
-        model.pattern.name,
-        report.verdict.as_str(),
-        report.iterations
-    );
-    let svg = angles_svg(model, &xs, &states, "step", "step", &title)?;
-    let page = nanofold::plot::page::page_of_fold(&fold, &model.pattern.name, &[], None)?;
-    let files = [
-        ("trajectory.json", serde_json::to_string(&trajectory)?),
-        ("unfold.fold", serde_json::to_string_pretty(&fold)?),
-        ("unfold.svg", svg),
-        ("unfold.html", page),
-    ];
+    let files = nanofold::commands::unfold_files(pattern, &answer, &settings)?;
     write_outputs(&dir, pattern_path, &files)?;
     let adjustments: Vec<String> = projection
         .iter()
