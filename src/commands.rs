@@ -376,11 +376,6 @@ fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
 /// reader? Yes when the refusal says it is not a single vertex (several vertices or none, a
 /// 3D folded form, no fold angles, a mesh larger than a vertex's); otherwise (a vertex whose
 /// folded state does not close, say) only if it reads as a crease pattern.
-pub fn takes_many_vertices(error: &NanofoldError, path: &Path) -> bool {
-    refused_as_vertex(error, crate::read::load_crease_pattern(path).is_ok())
-}
-
-/// [`takes_many_vertices`] with the crease-pattern reading's outcome.
 fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: bool) -> bool {
     use NanofoldError::{ClosureViolated, InvalidField, MissingField, MultipleVertices};
     let not_a_vertex = match error {

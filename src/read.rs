@@ -185,12 +185,6 @@ pub fn frames_note(value: &serde_json::Value) -> Option<String> {
     })
 }
 
-/// [`frames_note`] of a file (None when it cannot be read or has no other frames).
-pub fn file_frames_note(path: &Path) -> Option<String> {
-    let text = input::read_text(path, input::MAX_PATTERN_BYTES).ok()?;
-    frames_note(&input::parse_json(&text, "").ok()?)
-}
-
 /// Loads a FOLD file as a crease pattern of any number of vertices
 /// (`docs/model.md#crease-patterns`).
 ///
