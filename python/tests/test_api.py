@@ -230,3 +230,9 @@ def test_constraints_take_the_command_lines_options_by_the_same_names():
     assert capped.degree <= 4
     with pytest.raises(nanofold.InvalidFieldError, match="quartic"):
         nanofold.constraints("patterns/miura_vertex.fold", drive=0, degree=6, format="mujoco")
+
+
+def test_the_known_length_call_refuses_a_length_out_of_range():
+    for seconds in (-1.0, 61.0):
+        with pytest.raises(nanofold.InvalidFieldError, match="seconds"):
+            nanofold._native.wait(seconds)

@@ -439,6 +439,62 @@ mod tests {
     }
 
     #[test]
+    fn bad_values_of_the_new_options_are_refused_by_name() {
+        let sheet = crate::folding::FoldingModel::new(
+            crate::pattern::generate::MiuraSpec::default()
+                .build()
+                .unwrap()
+                .build()
+                .unwrap(),
+        )
+        .unwrap();
+        let refused = |value: serde_json::Value, field: &str| {
+            let error = options_from_json::<FoldOptions>(&value)
+                .and_then(|o| o.settings(&sheet))
+                .unwrap_err()
+                .to_string();
+            assert!(error.contains(&format!("`{field}`")), "{value}: {error}");
+        };
+        refused(serde_json::json!({"frames": 1}), "frames");
+        refused(serde_json::json!({"frames": 20_000}), "frames");
+        refused(serde_json::json!({"max_step": 40.0}), "max_step");
+        refused(serde_json::json!({"to": 150.0}), "drive.to");
+        refused(serde_json::json!({"drive": {"0": 30.0}}), "drive");
+        refused(serde_json::json!({"frames": "many"}), "frames");
+        let curves = |value: serde_json::Value| {
+            options_from_json::<ConstraintOptions>(&value)
+                .and_then(|o| o.settings())
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(curves(serde_json::json!({"format": "xml"})).contains("format"));
+        assert!(curves(serde_json::json!({"source": "guess"})).contains("source"));
+        assert!(curves(serde_json::json!({"degree": 5, "format": "mujoco"})).contains("quartic"));
+        assert!(curves(serde_json::json!({"degree": 4, "tol": 1e-6})).contains("tol"));
+        assert!(curves(serde_json::json!({"check": [[2, "x"]]})).contains("check"));
+        // What only a single vertex has is refused for a sheet of many, by name.
+        let pattern = super::super::Pattern::from_crease_pattern(sheet.pattern.clone()).unwrap();
+        for (value, field) in [
+            (serde_json::json!({"check": [[0, [0.0, 1.0]]]}), "check"),
+            (serde_json::json!({"source": "unfold"}), "source"),
+        ] {
+            let settings = options_from_json::<ConstraintOptions>(&value)
+                .unwrap()
+                .settings()
+                .unwrap();
+            let error = super::super::constraints(&pattern, &settings).unwrap_err().to_string();
+            assert!(
+                error.contains(&format!("`{field}`")) && error.contains("single vertices"),
+                "{error}"
+            );
+        }
+        let error = options_from_json::<SimulateOptions>(&serde_json::json!({"model": "fast"})).unwrap_err();
+        assert!(error.to_string().contains("model"), "{error}");
+        let error = options_from_json::<FoldOptions>(&serde_json::json!([90])).unwrap_err();
+        assert!(error.to_string().contains("options"), "{error}");
+    }
+
+    #[test]
     fn degrees_and_percent_become_the_engines_radians_and_fractions() {
         let options: ConstraintOptions = options_from_json(
             &serde_json::json!({"drive": 2, "lock": {"1": 90.0}, "degree": "auto", "tol": 1e-6, "range": [0.0, 180.0]}),
