@@ -9,6 +9,7 @@ use nanofold::folding::{
     vertex_residuals, ContactSettings, Drive, FoldSettings, FoldingModel,
 };
 use nanofold::pattern::generate::{MiuraSpec, WaterbombSpec};
+use nanofold::prelude::Named;
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::network::{unfold_network, NetworkEnergy, NetworkUnfoldSettings};
 use std::time::Instant;

@@ -6,6 +6,7 @@ mod common;
 
 use common::{library_patterns, many_creases, timed};
 use nanofold::geometry::sphere::Vec3;
+use nanofold::prelude::Named;
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::QpMethod;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};

@@ -9,9 +9,8 @@ use nanofold::commands::outputs::{default_output_folder, folder_name, write_fold
 use nanofold::constraints::{mujoco_snippet, ConstraintReport};
 use nanofold::plot::constraints_svg;
 use nanofold::prelude::{
-    unfold_vertex as unfold, EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, ProgressObserver, QpMethod,
-    Response, Scene, SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
-    VertexReport as UnfoldReport,
+    EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, Named, ProgressObserver, QpMethod, Response, Scene,
+    SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
 };
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -456,10 +455,6 @@ fn expand_patterns(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 /// Most pattern files one `unfold` run takes.
 const MAX_BATCH_FILES: usize = 10_000;
 
-fn summary(pattern: &Pattern, path: &Path, report: &UnfoldReport) -> serde_json::Value {
-    nanofold::write::output::vertex_unfold_summary(pattern, &path.display().to_string(), report)
-}
-
 /// Unfolds one pattern into `dir`; returns its JSON summary and its human-readable lines.
 fn unfold_one(
     pattern_path: &Path,
@@ -469,9 +464,9 @@ fn unfold_one(
 ) -> Result<(serde_json::Value, String)> {
     use std::fmt::Write as _;
     let settings = solver.settings()?;
-    let (opened, projection) = open_pattern(pattern_path, solver)?;
+    let opened = open_pattern(pattern_path, solver)?;
     let Some(pattern) = opened.vertex() else {
-        return folding::unfold_network_one(pattern_path, &opened, projection, solver, dir, progress);
+        return folding::unfold_network_one(pattern_path, &opened, solver, dir, progress);
     };
     let door = nanofold::commands::Settings {
         unfold: settings.clone(),
@@ -492,7 +487,7 @@ fn unfold_one(
     let nanofold::commands::Detail::VertexUnfold(report) = &answer.detail else {
         unreachable!("a single vertex unfolds by the single-vertex engine")
     };
-    let mut summary = summary(pattern, pattern_path, report);
+    let mut summary = answer.to_json();
     summary["out"] = json!(dir.display().to_string());
     let mut text = String::new();
     writeln!(
@@ -630,13 +625,10 @@ fn print_failure(path: &Path, error: &anyhow::Error, as_json: bool) {
 /// Reads a pattern through the door: a single vertex for its engine, a crease pattern of
 /// many vertices for the other; with `--project`, a sheet's state moved to the nearest rigid
 /// state first.
-fn open_pattern(
-    path: &Path,
-    solver: &SolverArgs,
-) -> Result<(nanofold::commands::Pattern, Option<nanofold::commands::Projection>)> {
+fn open_pattern(path: &Path, solver: &SolverArgs) -> Result<nanofold::commands::Pattern> {
     let pattern = nanofold::commands::Pattern::open(path, &solver.load_options()).map_err(|e| reading(path, e))?;
     if !solver.project {
-        return Ok((pattern, None));
+        return Ok(pattern);
     }
     pattern
         .projected()
@@ -644,25 +636,32 @@ fn open_pattern(
 }
 
 fn run_check(patterns: &[PathBuf], solver: &SolverArgs, as_json: bool, parallel: &ParallelArgs) -> Result<bool> {
-    let settings = solver.settings()?;
+    let settings = nanofold::commands::Settings {
+        unfold: solver.settings()?,
+        check: nanofold::prelude::CheckSettings {
+            closure_tol: solver.closure_tol,
+            ..nanofold::prelude::CheckSettings::default()
+        },
+        ..nanofold::commands::Settings::default()
+    };
     let files = expand_patterns(patterns)?;
     parallel.all(&files, |path| {
-        let outcome = open_pattern(path, solver).and_then(|(pattern, projection)| match pattern.vertex() {
-            // A crease pattern of many vertices: its state or its assignment.
-            None => folding::check_json(path, &pattern, projection.as_ref(), solver.closure_tol),
-            // A single vertex: its unfolding's verdict.
-            Some(vertex) => {
-                let report = unfold(vertex, &settings)?;
-                let line = format!(
+        let outcome = open_pattern(path, solver).and_then(|pattern| {
+            let report = nanofold::commands::check(&pattern, &settings)?;
+            let line = match &report.detail {
+                // A single vertex: its unfolding's verdict.
+                nanofold::commands::Detail::VertexUnfold(unfolding) => format!(
                     "{}: {} ({} iterations, {:.3} ms) {}",
                     path.display(),
                     report.verdict.as_str(),
-                    report.iterations,
-                    report.seconds * 1e3,
+                    unfolding.iterations,
+                    unfolding.seconds * 1e3,
                     report.evidence
-                );
-                Ok((summary(vertex, path, &report), line))
-            }
+                ),
+                // A crease pattern of many vertices: its state or its assignment.
+                _ => folding::check_line(path, &pattern, &report),
+            };
+            Ok((report.to_json(), line))
         });
         match outcome {
             Ok((value, line)) => {

@@ -1,6 +1,7 @@
 //! The library's front door: one [`Pattern`] (a single vertex is a pattern with one interior
-//! vertex), one [`check`], [`fold`] and [`unfold`] that take any pattern, one verdict
-//! vocabulary ([`Verdict`]) and one report shape ([`Report`]). Behind it the two engines
+//! vertex), one [`check`], [`fold`] and [`unfold`] that take any pattern, each with its own
+//! verdict type ([`CheckVerdict`], [`FoldVerdict`], [`UnfoldVerdict`]), and one report shape
+//! ([`Report`]) that serialises as the command's `--json`. Behind it the two engines
 //! stay as they are: the single vertex's unfolding on the sphere
 //! (`docs/model.md#unfolding`) and the many-vertex folding layer
 //! (`docs/model.md#rigid-folding`); a pattern goes to the single-vertex engine whenever that
@@ -16,24 +17,28 @@
 //! assert_eq!((vertex.engine(), sheet.engine()), (Engine::Vertex, Engine::Network));
 //! for pattern in [&vertex, &sheet] {
 //!     let report = unfold(pattern, &settings)?;
-//!     assert_eq!(report.verdict, Verdict::Flat);
+//!     assert_eq!(report.verdict, UnfoldVerdict::Flat);
 //!     assert!(report.final_fold_angles_rad.iter().all(|a| a.abs() <= 1e-6));
 //! }
 //! // The flat Miura-ori's assignment folds rigidly; folding it reaches 100%.
 //! let flat = Pattern::open("patterns/many/miura_4x4.fold".as_ref(), &options)?;
-//! assert_eq!(check(&flat, &settings)?.verdict, Verdict::RigidlyFoldable);
-//! assert_eq!(fold(&flat, &settings)?.verdict, Verdict::Reached);
+//! assert_eq!(check(&flat, &settings)?.verdict, PatternVerdict::RigidlyFoldable);
+//! assert_eq!(fold(&flat, &settings)?.verdict, FoldVerdict::Reached);
 //! # Ok::<(), NanofoldError>(())
 //! ```
 
 use crate::error::{NanofoldError, Result};
+use crate::folding::PatternVerdict;
 use crate::folding::{check_pattern, fold_path, CheckReport, CheckSettings, FoldPath, FoldSettings, FoldingModel};
+use crate::names::{Answer, Named};
 use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
 use crate::pattern::{Assignment, Chain, LoadOptions, RayRole};
-use crate::unfold::network::{
-    unfold_network, unfold_network_observed, NetworkUnfoldReport, NetworkUnfoldSettings, NetworkVerdict,
-};
+use crate::unfold::network::{unfold_network, unfold_network_observed, NetworkUnfoldReport, NetworkUnfoldSettings};
 use crate::unfold::{UnfoldProgress, UnfoldReport, UnfoldSettings};
+use crate::write::summary::{
+    crease_labels, CheckSummary, FoldSummary, FoldedFormBend, NetworkUnfoldSummary, ProjectionFigures, Summary,
+    VertexUnfoldSummary,
+};
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -75,12 +80,7 @@ pub enum Engine {
     Network,
 }
 
-impl Engine {
-    /// The engine's name in reports.
-    pub fn as_str(self) -> &'static str {
-        crate::names::variant_name(&self)
-    }
-}
+impl crate::names::Named for Engine {}
 
 /// Any crease pattern nanofold reads, decided once from its input: a single vertex (the
 /// single-vertex engine's, with its sheet when its sectors close one) or a crease pattern of
@@ -112,6 +112,8 @@ pub struct Origin {
     pub source: Option<String>,
     /// What was ignored of a FOLD animation's frames.
     pub frames_note: Option<String>,
+    /// How far its state was moved to make it rigid (None: not moved).
+    pub projection: Option<Projection>,
 }
 
 impl Pattern {
@@ -131,6 +133,7 @@ impl Pattern {
         let origin_of = || Origin {
             source: None,
             frames_note: crate::read::frames_note(&value),
+            projection: None,
         };
         // A FOLD object is a crease pattern too; a native vertex is not.
         let as_sheet = || crate::read::crease_pattern_of_value(&value, name, origin);
@@ -223,7 +226,7 @@ impl Pattern {
     pub fn crease_labels(&self) -> Vec<String> {
         match self {
             Pattern::Vertex { vertex, .. } => vertex.creases.iter().map(|c| c.label.clone()).collect(),
-            Pattern::Sheet { model, .. } => model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
+            Pattern::Sheet { model, .. } => crease_labels(model),
         }
     }
 
@@ -237,12 +240,12 @@ impl Pattern {
 }
 
 /// How far a crease pattern's state was moved to make it rigid ([`Pattern::projected`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Projection {
     /// The move and the state before it, in words.
     pub note: String,
-    /// The same as JSON (`projection` in the reports).
-    pub json: serde_json::Value,
+    /// The same in figures (`projection` in the reports).
+    pub figures: ProjectionFigures,
 }
 
 impl Pattern {
@@ -251,17 +254,46 @@ impl Pattern {
         self.origin().frames_note.as_deref()
     }
 
+    /// How far [`Pattern::projected`] moved its state (None: not moved).
+    pub fn projection(&self) -> Option<&Projection> {
+        self.origin().projection.as_ref()
+    }
+
+    /// The input's path as reports name it (the name, for a pattern built in code).
+    pub fn file(&self) -> &str {
+        self.source().unwrap_or(self.name())
+    }
+
+    /// How the input was read or moved, in words: the projection, the frames left out and
+    /// the reader's notes, in that order.
+    pub fn adjustments(&self) -> Vec<String> {
+        let origin = self.origin();
+        let reading = match self {
+            Pattern::Sheet { model, .. } => model.pattern.reading.clone(),
+            Pattern::Vertex { .. } => Vec::new(),
+        };
+        origin
+            .projection
+            .iter()
+            .map(|p| p.note.clone())
+            .chain(origin.frames_note.clone())
+            .chain(reading)
+            .collect()
+    }
+
     /// The pattern with its state moved to the nearest rigid state (a crease pattern whose
     /// state does not close at some vertex, or a folded form whose facets bend, as a
     /// compliant simulator exports it), and how far it moved. A single vertex is its own
-    /// engine's input and is returned as it is, with no projection.
-    pub fn projected(self) -> Result<(Pattern, Option<Projection>)> {
+    /// engine's input and is returned as it is, with no projection. The move is the
+    /// pattern's [`Pattern::projection`], and its reports state it.
+    pub fn projected(self) -> Result<Pattern> {
         let (model, origin) = match self {
             Pattern::Sheet { model, origin } => (model, origin),
-            vertex => return Ok((vertex, None)),
+            vertex => return Ok(vertex),
         };
         let rho = model.given_fold_angles();
         let projection = crate::folding::project_to_rigid(&model, &rho, 1e-11)?;
+        let moved = model.with_fold_angles(&projection.fold_angles);
         let fit = model.pattern.folded_form;
         let mut note = format!(
             "projected onto the rigid states: fold angles moved by up to {:.3e} rad (RMS {:.3e}), worst vertex closure {:.3e} rad before",
@@ -273,24 +305,20 @@ impl Pattern {
                 fit.max_facet_angle, fit.development_error
             ));
         }
-        let json = serde_json::json!({
-            "max_change_rad": projection.max_change,
-            "rms_change_rad": projection.rms_change,
-            "residual_before_rad": projection.residual_before,
-            "newton_iterations": projection.iterations,
-            "folded_form": fit.map(|f| serde_json::json!({
-                "max_facet_angle_rad": f.max_facet_angle,
-                "development_error": f.development_error,
-                "face_nonplanarity": f.face_nonplanarity,
-            })),
-        });
-        Ok((
-            Pattern::Sheet {
-                model: Box::new(model.with_fold_angles(&projection.fold_angles)),
-                origin,
+        let figures = ProjectionFigures {
+            max_change_rad: projection.max_change,
+            rms_change_rad: projection.rms_change,
+            residual_before_rad: projection.residual_before,
+            newton_iterations: projection.iterations,
+            folded_form: fit.as_ref().map(FoldedFormBend::from),
+        };
+        Ok(Pattern::Sheet {
+            model: Box::new(moved),
+            origin: Origin {
+                projection: Some(Projection { note, figures }),
+                ..origin
             },
-            Some(Projection { note, json }),
-        ))
+        })
     }
 }
 
@@ -391,104 +419,35 @@ fn refused_as_vertex(error: &NanofoldError, reads_as_sheet: bool) -> bool {
     not_a_vertex || (!matches!(error, ClosureViolated { .. }) && reads_as_sheet)
 }
 
-/// Every answer any command gives, in one vocabulary.
+/// `unfold`'s answer: the unfolding engines' verdict (either engine).
+pub use crate::unfold::Verdict as UnfoldVerdict;
+
+/// `fold`'s answer: why the path stopped.
+pub use crate::folding::StopReason as FoldVerdict;
+
+/// `check`'s answer: a single vertex is judged by unfolding it, a crease pattern of many
+/// vertices by its state or its assignment. It is named in outputs by the inner verdict's
+/// name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Verdict {
-    /// Unfolded to the flat state along a rigid path.
-    Flat,
-    /// Stopped away from flat with restarts disabled: no evidence either way.
-    Stuck,
-    /// No rigid motion at the state (0 degrees of freedom).
-    Locked,
-    /// Motion is possible, but descent and its restarts end away from flat.
-    LocalMinimum,
-    /// A closed vertex whose sectors do not sum to 360° has no flat state.
-    NotFlatFoldable,
-    /// Panels would pass through each other on the way.
-    Blocked,
-    /// The iteration budget ran out.
-    IterationLimit,
-    /// The state does not close at some vertex.
-    NotRigid,
-    /// The state closes at every vertex and no two panels cross.
-    Rigid,
-    /// The state closes but panels pass through each other.
-    SelfIntersecting,
-    /// The assignment folds rigidly from flat (a witness path exists).
-    RigidlyFoldable,
-    /// The assignment cannot fold rigidly from flat.
-    NotRigidlyFoldable,
-    /// Neither could be shown.
-    Unknown,
-    /// A fold reached its goal.
-    Reached,
-    /// A fold stopped at a branch point or the end of its branch.
-    BranchPoint,
-    /// A fold's step budget ran out.
-    StepLimit,
-    /// A fold stopped where more pairs of panels overlap than its contact test measures.
-    ContactBudget,
+#[serde(untagged)]
+pub enum CheckVerdict {
+    /// A single vertex's unfolding (flat, locked, a local minimum, …).
+    Unfolding(UnfoldVerdict),
+    /// A crease pattern's state or assignment (rigid, not rigid, rigidly foldable, …).
+    Pattern(PatternVerdict),
 }
 
-impl Verdict {
-    /// The verdict's name in outputs.
-    pub fn as_str(self) -> &'static str {
-        crate::names::variant_name(&self)
+impl Named for CheckVerdict {}
+
+impl PartialEq<UnfoldVerdict> for CheckVerdict {
+    fn eq(&self, other: &UnfoldVerdict) -> bool {
+        *self == CheckVerdict::Unfolding(*other)
     }
 }
 
-impl From<crate::unfold::Verdict> for Verdict {
-    fn from(v: crate::unfold::Verdict) -> Verdict {
-        use crate::unfold::Verdict as V;
-        match v {
-            V::Flat => Verdict::Flat,
-            V::Stuck => Verdict::Stuck,
-            V::Locked => Verdict::Locked,
-            V::LocalMinimum => Verdict::LocalMinimum,
-            V::NotFlatFoldable => Verdict::NotFlatFoldable,
-        }
-    }
-}
-
-impl From<NetworkVerdict> for Verdict {
-    fn from(v: NetworkVerdict) -> Verdict {
-        match v {
-            NetworkVerdict::Flat => Verdict::Flat,
-            NetworkVerdict::Locked => Verdict::Locked,
-            NetworkVerdict::LocalMinimum => Verdict::LocalMinimum,
-            NetworkVerdict::Blocked => Verdict::Blocked,
-            NetworkVerdict::IterationLimit => Verdict::IterationLimit,
-            NetworkVerdict::NotRigid => Verdict::NotRigid,
-        }
-    }
-}
-
-impl From<crate::folding::PatternVerdict> for Verdict {
-    fn from(v: crate::folding::PatternVerdict) -> Verdict {
-        use crate::folding::PatternVerdict as V;
-        match v {
-            V::Rigid => Verdict::Rigid,
-            V::NotRigid => Verdict::NotRigid,
-            V::SelfIntersecting => Verdict::SelfIntersecting,
-            V::RigidlyFoldable => Verdict::RigidlyFoldable,
-            V::NotRigidlyFoldable => Verdict::NotRigidlyFoldable,
-            V::Unknown => Verdict::Unknown,
-        }
-    }
-}
-
-impl From<&crate::folding::StopReason> for Verdict {
-    fn from(stop: &crate::folding::StopReason) -> Verdict {
-        use crate::folding::StopReason as S;
-        match stop {
-            S::Reached => Verdict::Reached,
-            S::Blocked { .. } => Verdict::Blocked,
-            S::Locked => Verdict::Locked,
-            S::BranchPoint { .. } => Verdict::BranchPoint,
-            S::StepLimit => Verdict::StepLimit,
-            S::ContactBudget { .. } => Verdict::ContactBudget,
-        }
+impl PartialEq<PatternVerdict> for CheckVerdict {
+    fn eq(&self, other: &PatternVerdict) -> bool {
+        *self == CheckVerdict::Pattern(*other)
     }
 }
 
@@ -517,80 +476,86 @@ pub enum Detail {
     Fold(Box<FoldPath>),
 }
 
-/// One report shape for every command and engine.
-#[derive(Debug, Clone)]
-pub struct Report {
+/// One report shape for every command and engine; `V` is the command's verdict type. It
+/// serialises as its [`Summary`] (`check`, `fold` and `unfold --json` print that), the
+/// typed fields beside it being the library's view of the same answer.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report<V> {
     /// The pattern's name.
+    #[serde(skip)]
     pub pattern: String,
     /// The command answered.
+    #[serde(skip)]
     pub command: CommandKind,
     /// The engine that answered.
+    #[serde(skip)]
     pub engine: Engine,
     /// The answer.
-    pub verdict: Verdict,
+    #[serde(skip)]
+    pub verdict: V,
     /// Why, in words.
+    #[serde(skip)]
     pub evidence: String,
     /// Steps the engine took (descent steps, path steps).
+    #[serde(skip)]
     pub steps: usize,
     /// Wall time, s.
+    #[serde(skip)]
     pub seconds: f64,
     /// Every crease's label, in the order of the angle vectors.
+    #[serde(skip)]
     pub crease_labels: Vec<String>,
     /// Fold angles at the start, rad.
+    #[serde(skip)]
     pub start_fold_angles_rad: Vec<f64>,
     /// Fold angles at the end (the state judged, for `check`), rad.
+    #[serde(skip)]
     pub final_fold_angles_rad: Vec<f64>,
     /// Largest constraint residual over the run, rad (the sphere's arcs for a single
     /// vertex, the vertex closures for a network).
+    #[serde(skip)]
     pub max_closure_residual_rad: f64,
     /// The engine's own report.
+    #[serde(skip)]
     pub detail: Detail,
+    /// The answer as `--json` prints it (less the command line's own keys, `out` and
+    /// `frames`).
+    #[serde(flatten)]
+    pub summary: Summary,
 }
 
-impl Report {
-    /// The report as `nanofold <command> --json` prints it for `pattern` (the one it
-    /// answers), less the command line's own keys (`out`, `frames`).
-    pub fn to_json(&self, pattern: &Pattern) -> serde_json::Value {
-        use crate::write::folding_output::{check_summary, fold_summary, network_unfold_summary};
-        let file = pattern.source().unwrap_or(pattern.name());
-        match (&self.detail, pattern.vertex(), pattern.sheet()) {
-            (Detail::VertexUnfold(report), Some(vertex), _) => {
-                crate::write::output::vertex_unfold_summary(vertex, file, report)
-            }
-            (Detail::NetworkUnfold(report), _, Some(model)) => {
-                let adjustments: Vec<String> = pattern
-                    .origin()
-                    .frames_note
-                    .clone()
-                    .into_iter()
-                    .chain(model.pattern.reading.iter().cloned())
-                    .collect();
-                network_unfold_summary(
-                    model,
-                    file,
-                    report,
-                    &self.start_fold_angles_rad,
-                    self.seconds,
-                    &adjustments,
-                    None,
-                )
-            }
-            (Detail::NetworkCheck(report, unfolding), _, Some(model)) => {
-                check_summary(model, file, report, unfolding.as_deref(), self.seconds)
-            }
-            (Detail::Fold(path), _, Some(model)) => {
-                let dof = crate::folding::jacobian_rank(&crate::folding::closure_jacobian(
-                    model,
-                    &self.final_fold_angles_rad,
-                ))
-                .map_or(0, |r| r.dof);
-                fold_summary(model, file, path, dof, self.seconds)
-            }
-            _ => serde_json::json!({
-                "pattern": self.pattern,
-                "verdict": self.verdict.as_str(),
-                "evidence": self.evidence,
-            }),
+impl<V: Named> Answer for Report<V> {
+    fn verdict_name(&self) -> &'static str {
+        self.verdict.as_str()
+    }
+
+    fn evidence(&self) -> &str {
+        &self.evidence
+    }
+}
+
+impl<V> Report<V> {
+    /// The report as `--json` prints it: its own serialisation.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("a summary is plain data")
+    }
+
+    /// The same report with its verdict in another command's vocabulary.
+    fn map_verdict<W>(self, to: impl FnOnce(V) -> W) -> Report<W> {
+        Report {
+            pattern: self.pattern,
+            command: self.command,
+            engine: self.engine,
+            verdict: to(self.verdict),
+            evidence: self.evidence,
+            steps: self.steps,
+            seconds: self.seconds,
+            crease_labels: self.crease_labels,
+            start_fold_angles_rad: self.start_fold_angles_rad,
+            final_fold_angles_rad: self.final_fold_angles_rad,
+            max_closure_residual_rad: self.max_closure_residual_rad,
+            detail: self.detail,
+            summary: self.summary,
         }
     }
 }
@@ -633,7 +598,7 @@ fn sheet_of<'p>(pattern: &'p Pattern, command: &str) -> Result<&'p FoldingModel>
 
 /// Unfolds a folded pattern to flat: the single vertex by the sphere's energy descent, a
 /// crease pattern of many vertices by descent on its closures.
-pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report<UnfoldVerdict>> {
     unfold_observed(pattern, settings, None)
 }
 
@@ -649,12 +614,16 @@ pub fn unfold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
 /// let counter = steps.clone();
 /// let progress = UnfoldProgress(Arc::new(move |_, _, _| *counter.lock().unwrap() += 1));
 /// let report = unfold_observed(&pattern, &Settings::default(), Some(progress))?;
-/// assert_eq!(report.verdict, Verdict::Flat);
+/// assert_eq!(report.verdict, UnfoldVerdict::Flat);
 /// assert!(*steps.lock().unwrap() > 0);
 /// # Ok(())
 /// # }
 /// ```
-pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<UnfoldProgress>) -> Result<Report> {
+pub fn unfold_observed(
+    pattern: &Pattern,
+    settings: &Settings,
+    progress: Option<UnfoldProgress>,
+) -> Result<Report<UnfoldVerdict>> {
     match pattern.vertex() {
         Some(vertex) => vertex_report(pattern, vertex, CommandKind::Unfold, settings, progress),
         None => {
@@ -662,23 +631,34 @@ pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<
             let start = model.given_fold_angles();
             let clock = Instant::now();
             let report = unfold_network_observed(model, &start, &settings.network_unfold(), progress)?;
+            let seconds = clock.elapsed().as_secs_f64();
             let last = report
                 .steps
                 .last()
                 .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+            let summary = NetworkUnfoldSummary::new(
+                model,
+                pattern.file(),
+                &report,
+                &start,
+                seconds,
+                pattern.adjustments(),
+                pattern.projection().map(|p| p.figures.clone()),
+            );
             Ok(Report {
                 pattern: pattern.name().to_string(),
                 command: CommandKind::Unfold,
                 engine: Engine::Network,
-                verdict: report.verdict.into(),
+                verdict: report.verdict,
                 evidence: report.evidence.clone(),
                 steps: report.iterations,
-                seconds: clock.elapsed().as_secs_f64(),
+                seconds,
                 crease_labels: pattern.crease_labels(),
                 start_fold_angles_rad: start,
                 final_fold_angles_rad: last,
                 max_closure_residual_rad: report.max_closure_residual,
                 detail: Detail::NetworkUnfold(Box::new(report)),
+                summary: Summary::NetworkUnfold(Box::new(summary)),
             })
         }
     }
@@ -687,33 +667,44 @@ pub fn unfold_observed(pattern: &Pattern, settings: &Settings, progress: Option<
 /// Judges a pattern: a single vertex by unfolding it (flat, locked, a local minimum, …), a
 /// crease pattern of many vertices by its state (rigid, not rigid, self-intersecting) or,
 /// flat, by its assignment (rigidly foldable or not, with a witness path).
-pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report<CheckVerdict>> {
     match pattern.vertex() {
-        Some(vertex) => vertex_report(pattern, vertex, CommandKind::Check, settings, None),
+        Some(vertex) => Ok(
+            vertex_report(pattern, vertex, CommandKind::Check, settings, None)?.map_verdict(CheckVerdict::Unfolding)
+        ),
         None => {
             let model = sheet_of(pattern, "check")?;
             let clock = Instant::now();
             let (report, unfolding) = check_sheet(model, &settings.check)?;
-            let unfolding = unfolding.map(Box::new);
+            let seconds = clock.elapsed().as_secs_f64();
             let start = model.given_fold_angles();
             let judged = report
                 .witness
                 .as_ref()
                 .and_then(|w| w.steps.last())
                 .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+            let summary = CheckSummary::new(
+                model,
+                pattern.file(),
+                &report,
+                unfolding.as_ref(),
+                seconds,
+                pattern.projection().map(|p| p.figures.clone()),
+            );
             Ok(Report {
                 pattern: pattern.name().to_string(),
                 command: CommandKind::Check,
                 engine: Engine::Network,
-                verdict: report.verdict.into(),
+                verdict: CheckVerdict::Pattern(report.verdict),
                 evidence: report.evidence.clone(),
                 steps: report.witness.as_ref().map_or(0, |w| w.steps.len()),
-                seconds: clock.elapsed().as_secs_f64(),
+                seconds,
                 crease_labels: pattern.crease_labels(),
                 start_fold_angles_rad: start,
                 final_fold_angles_rad: judged,
                 max_closure_residual_rad: report.max_vertex_residual_rad,
-                detail: Detail::NetworkCheck(Box::new(report), unfolding),
+                detail: Detail::NetworkCheck(Box::new(report), unfolding.map(Box::new)),
+                summary: Summary::Check(Box::new(summary)),
             })
         }
     }
@@ -726,7 +717,7 @@ pub fn check_sheet(
     settings: &CheckSettings,
 ) -> Result<(CheckReport, Option<NetworkUnfoldReport>)> {
     let report = check_pattern(model, settings)?;
-    let unfolding = if report.has_state && report.verdict == crate::folding::PatternVerdict::Rigid {
+    let unfolding = if report.has_state && report.verdict == PatternVerdict::Rigid {
         Some(unfold_network(
             model,
             &model.given_fold_angles(),
@@ -740,7 +731,7 @@ pub fn check_sheet(
 
 /// Folds a pattern from its state (flat: along its assignment) by the many-vertex path
 /// (a single vertex on its sheet), as `settings.fold` drives it.
-pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
+pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report<FoldVerdict>> {
     let model = sheet_of(pattern, "fold")?;
     let start = model.given_fold_angles();
     let clock = Instant::now();
@@ -753,7 +744,7 @@ pub fn fold(pattern: &Pattern, settings: &Settings) -> Result<Report> {
 #[derive(Debug, Clone)]
 pub struct FoldRun {
     /// The report.
-    pub report: Report,
+    pub report: Report<FoldVerdict>,
     /// The animation's frames, evenly spaced in progress.
     pub frames: Vec<crate::folding::PathFrame>,
     /// fold.fold: the crease pattern with one frame per snapshot.
@@ -826,7 +817,11 @@ pub fn fold_files(pattern: &Pattern, run: &FoldRun) -> Result<Vec<(&'static str,
 /// recorded steps, thinned to 1000), unfold.fold (the FOLD animation), unfold.svg and the 3D
 /// page unfold.html, for either engine.
 #[cfg(feature = "plot")]
-pub fn unfold_files(pattern: &Pattern, report: &Report, settings: &Settings) -> Result<Vec<(&'static str, String)>> {
+pub fn unfold_files(
+    pattern: &Pattern,
+    report: &Report<UnfoldVerdict>,
+    settings: &Settings,
+) -> Result<Vec<(&'static str, String)>> {
     use crate::plot::page::page_of_fold;
     use crate::write::folding_output::{evenly, states_fold};
     let pretty = |value: &serde_json::Value| {
@@ -904,24 +899,33 @@ pub fn unfold_files(pattern: &Pattern, report: &Report, settings: &Settings) -> 
     }
 }
 
-fn fold_report(pattern: &Pattern, model: &FoldingModel, start: Vec<f64>, path: FoldPath, clock: Instant) -> Report {
+fn fold_report(
+    pattern: &Pattern,
+    model: &FoldingModel,
+    start: Vec<f64>,
+    path: FoldPath,
+    clock: Instant,
+) -> Report<FoldVerdict> {
+    let seconds = clock.elapsed().as_secs_f64();
     let last = path
         .steps
         .last()
         .map_or_else(|| start.clone(), |s| s.fold_angles.clone());
+    let summary = FoldSummary::new(model, pattern.file(), &path, seconds);
     Report {
         pattern: pattern.name().to_string(),
         command: CommandKind::Fold,
         engine: Engine::Network,
-        verdict: (&path.stop).into(),
+        verdict: path.stop.clone(),
         evidence: path.evidence.clone(),
         steps: path.steps.len().saturating_sub(1),
-        seconds: clock.elapsed().as_secs_f64(),
-        crease_labels: model.pattern.creases.iter().map(|e| format!("edges[{e}]")).collect(),
+        seconds,
+        crease_labels: crease_labels(model),
         start_fold_angles_rad: start,
         final_fold_angles_rad: last,
         max_closure_residual_rad: path.max_closure_residual,
         detail: Detail::Fold(Box::new(path)),
+        summary: Summary::Fold(Box::new(summary)),
     }
 }
 
@@ -931,13 +935,14 @@ fn vertex_report(
     command: CommandKind,
     settings: &Settings,
     progress: Option<UnfoldProgress>,
-) -> Result<Report> {
+) -> Result<Report<UnfoldVerdict>> {
     let report = crate::unfold::unfold_observed(vertex, &settings.unfold, progress)?;
+    let summary = VertexUnfoldSummary::new(vertex, pattern.file(), &report);
     Ok(Report {
         pattern: pattern.name().to_string(),
         command,
         engine: Engine::Vertex,
-        verdict: report.verdict.into(),
+        verdict: report.verdict,
         evidence: report.evidence.clone(),
         steps: report.iterations,
         seconds: report.seconds,
@@ -946,5 +951,6 @@ fn vertex_report(
         final_fold_angles_rad: report.final_fold_angles_rad.clone(),
         max_closure_residual_rad: report.max_arc_residual,
         detail: Detail::VertexUnfold(Box::new(report)),
+        summary: Summary::VertexUnfold(Box::new(summary)),
     })
 }

@@ -57,7 +57,7 @@
 //!     .build()?;
 //! // A single vertex is a pattern too: the same `unfold` takes it and a sheet of many.
 //! let report = unfold(&Pattern::from(pattern), &Settings::default())?;
-//! assert_eq!(report.verdict, Verdict::Flat);
+//! assert_eq!(report.verdict, UnfoldVerdict::Flat);
 //! assert!(report.max_closure_residual_rad < 1e-10);
 //! // Reversed, the engine's recorded trajectory is a folding path.
 //! let Detail::VertexUnfold(engine) = &report.detail else { unreachable!() };

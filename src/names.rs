@@ -4,6 +4,22 @@
 
 use serde::ser::{self, Impossible, Serialize};
 
+/// An enum named in outputs by its serde names: a verdict, an engine, a stop.
+pub trait Named: Serialize {
+    /// The variant's name in outputs (its serde name).
+    fn as_str(&self) -> &'static str {
+        variant_name(self)
+    }
+}
+
+/// A command's answer: a verdict named in outputs, and why.
+pub trait Answer {
+    /// The verdict's name in outputs.
+    fn verdict_name(&self) -> &'static str;
+    /// Why, in words.
+    fn evidence(&self) -> &str;
+}
+
 /// The serde name of `value`'s variant (`rename_all` applied): `"not_rigid"` for
 /// `NotRigid` under `snake_case`. A value that is not an enum variant has no name: that is
 /// a programming error, caught by the tests of every enum that uses this.

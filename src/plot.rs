@@ -10,6 +10,7 @@ pub mod work_precision;
 
 use crate::constraints::{ConstraintPoly, CurveSamples};
 use crate::error::{NanofoldError, Result};
+use crate::names::Named;
 use crate::pattern::VertexPattern;
 use crate::unfold::UnfoldReport;
 use crate::write::output::{snapshot_indices, write_atomic};

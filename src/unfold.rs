@@ -44,7 +44,8 @@ use std::time::Instant;
 /// angle is scaled by (1 − 10⁻³) and the constraints restored (documented in README).
 const FLAT_FOLDED_BACKOFF: f64 = 1e-3;
 
-/// The answer to "does this pattern unfold?" (`docs/model.md#verdicts`).
+/// The answer to "does this pattern unfold?" (`docs/model.md#verdicts`), from either
+/// engine: the single vertex's ([`unfold`]) or the crease pattern's ([`network`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
@@ -54,18 +55,21 @@ pub enum Verdict {
     Stuck,
     /// No motion is possible: the constraint Jacobian has no null space (rigid state).
     Locked,
-    /// Motion is possible, but every restart from a perturbed state came back stuck.
+    /// Motion is possible, but every restart from a perturbed state came back stuck (a
+    /// crease pattern: the projected gradient vanished away from flat).
     LocalMinimum,
     /// A closed chain whose sector angles do not sum to 2π has no flat state.
     NotFlatFoldable,
+    /// Every step the line search tried put panels through each other (a crease pattern).
+    Blocked,
+    /// The iteration budget ran out (a crease pattern).
+    IterationLimit,
+    /// The start is not a rigid state (a vertex of a crease pattern does not close):
+    /// nothing to unfold rigidly.
+    NotRigid,
 }
 
-impl Verdict {
-    /// The verdict's name in outputs.
-    pub fn as_str(self) -> &'static str {
-        crate::names::variant_name(&self)
-    }
-}
+impl crate::names::Named for Verdict {}
 
 /// Everything an unfolding run produced.
 #[derive(Debug, Clone, Serialize)]
@@ -339,5 +343,15 @@ fn not_flat_foldable(
         adjustments: pattern.adjustments.clone(),
         trajectory: Vec::new(),
         final_nodes: start,
+    }
+}
+
+impl crate::names::Answer for UnfoldReport {
+    fn verdict_name(&self) -> &'static str {
+        crate::names::variant_name(&self.verdict)
+    }
+
+    fn evidence(&self) -> &str {
+        &self.evidence
     }
 }

@@ -6,3 +6,4 @@ pub mod folder;
 pub mod folding_output;
 pub mod mujoco;
 pub mod output;
+pub mod summary;

@@ -5,6 +5,7 @@ use nanofold::constraints::chebyshev::{eval_monomial, Chebyshev};
 use nanofold::constraints::*;
 use nanofold::geometry::kinematics::closure_residual;
 use nanofold::pattern::{LoadOptions, VertexPattern};
+use nanofold::prelude::Named;
 use nanofold::unfold::UnfoldSettings;
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};

@@ -5,6 +5,7 @@
 //! plane, ±180 targets), so the clean pattern is the independent answer.
 
 use nanofold::folding::{check_pattern, fold_path, CheckSettings, FoldSettings, FoldingModel, PatternVerdict};
+use nanofold::prelude::Named;
 use nanofold::read::parse_crease_pattern;
 use serde_json::{json, Value};
 
@@ -248,7 +249,7 @@ fn fully_folded_vertex_exports_unfold_flat() {
             "{name}: {start:?}"
         );
         let report = unfold(&pattern, &Settings::default()).unwrap();
-        assert_eq!(report.verdict, Verdict::Flat, "{name}: {}", report.evidence);
+        assert_eq!(report.verdict, UnfoldVerdict::Flat, "{name}: {}", report.evidence);
         assert!(report.final_fold_angles_rad.iter().all(|a| a.abs() <= 1e-6));
     }
     // A sheet of many vertices folded flat: every crease read at ±180° by its assignment, none

@@ -387,7 +387,7 @@ fn degree4_modes_are_the_tangents_of_the_single_vertex_branches() {
 /// dividing by q11 = 0), gets finite modes at every vertex and the unturned verdict.
 #[test]
 fn degree4_modes_do_not_depend_on_the_first_crease() {
-    use nanofold::commands::{check, Generator, Pattern, Settings, Verdict};
+    use nanofold::commands::{check, Generator, Pattern, Settings};
     use nanofold::folding::{degree4_modes, Star};
     let miura = Generator::Miura(MiuraSpec {
         rows: 3,
@@ -412,7 +412,12 @@ fn degree4_modes_do_not_depend_on_the_first_crease() {
         );
     }
     let report = check(&turned, &Settings::default()).unwrap();
-    assert_eq!(report.verdict, Verdict::RigidlyFoldable, "{}", report.evidence);
+    assert_eq!(
+        report.verdict,
+        nanofold::prelude::PatternVerdict::RigidlyFoldable,
+        "{}",
+        report.evidence
+    );
     for sectors_deg in [
         [50.0, 130.0, 130.0, 50.0],
         [60.0, 120.0, 120.0, 60.0],
@@ -1119,7 +1124,8 @@ fn the_bird_base_folds_with_the_flat_foldable_vertex_closed_form() {
 #[test]
 fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
     use nanofold::folding::{check_pattern, CheckSettings, PatternVerdict};
-    use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings, NetworkVerdict};
+    use nanofold::unfold::network::{unfold_network, NetworkUnfoldSettings};
+    use nanofold::unfold::Verdict;
     let dir = Path::new("tests/fixtures/fold-convert");
     for (name, unfolds) in [
         ("bird_base", true),
@@ -1151,17 +1157,12 @@ fn flat_folded_forms_from_fold_convert_are_read_as_their_crease_patterns() {
         assert_eq!(report.verdict, PatternVerdict::Rigid, "{name}: {}", report.evidence);
         let unfolding = unfold_network(&model, &rho, &NetworkUnfoldSettings::default()).unwrap();
         if unfolds {
-            assert_eq!(
-                unfolding.verdict,
-                NetworkVerdict::Flat,
-                "{name}: {}",
-                unfolding.evidence
-            );
+            assert_eq!(unfolding.verdict, Verdict::Flat, "{name}: {}", unfolding.evidence);
             assert_eq!(unfolding.crossings_refused, 0, "{name}");
         } else {
             assert_eq!(
                 unfolding.verdict,
-                NetworkVerdict::LocalMinimum,
+                Verdict::LocalMinimum,
                 "{name}: {}",
                 unfolding.evidence
             );

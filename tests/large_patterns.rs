@@ -19,19 +19,19 @@ fn strip(panels: usize, width: f64, height: f64) -> String {
     common::strip_fold(panels, width, height).to_string()
 }
 
-fn check_text(text: &str) -> Report {
+fn check_text(text: &str) -> Report<CheckVerdict> {
     let pattern = Pattern::parse(text, "large", "large", &LoadOptions::default()).unwrap();
     check(&pattern, &Settings::default()).unwrap()
 }
 
-fn dof(report: &Report) -> usize {
+fn dof(report: &Report<CheckVerdict>) -> usize {
     let Detail::NetworkCheck(engine, _) = &report.detail else {
         panic!("a crease pattern of many vertices");
     };
     engine.rank.dof
 }
 
-fn witness(report: &Report) -> &nanofold::folding::FoldPath {
+fn witness(report: &Report<CheckVerdict>) -> &nanofold::folding::FoldPath {
     let Detail::NetworkCheck(engine, _) = &report.detail else {
         panic!("a crease pattern of many vertices");
     };
@@ -82,7 +82,7 @@ fn a_strip_has_one_dof_per_crease() {
 #[test]
 fn an_accordion_of_thin_panels_folds() {
     let report = check_text(&strip(3000, 0.002, 100.0));
-    assert_eq!(report.verdict, Verdict::RigidlyFoldable, "{}", report.evidence);
+    assert_eq!(report.verdict, PatternVerdict::RigidlyFoldable, "{}", report.evidence);
     let path = witness(&report);
     assert!(path.steps.last().unwrap().progress > 0.9, "{}", path.evidence);
 }

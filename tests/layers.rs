@@ -304,7 +304,6 @@ const CLI_PAST_THE_DOOR: &[&str] = &[
     "plot::constraints_svg",
     "plot::folding",
     "write::folding_output",
-    "write::output",
 ];
 
 #[test]

@@ -21,7 +21,7 @@ struct Case {
 /// What must not change, with each crease's angle keyed by its edge in the original file.
 #[derive(Debug, Clone)]
 struct Outcome {
-    verdict: Verdict,
+    verdict: CheckVerdict,
     dof: usize,
     /// (original edge index, fold angle of the state read) for every crease.
     angles: Vec<(usize, f64)>,
@@ -304,7 +304,7 @@ fn fold_ends_in_the_same_state_however_the_file_is_placed() {
         },
         ..Settings::default()
     };
-    let end = |fold: &Value, original_edge: &[usize]| -> (Verdict, Vec<(usize, f64)>) {
+    let end = |fold: &Value, original_edge: &[usize]| -> (String, Vec<(usize, f64)>) {
         let pattern = Pattern::parse(&fold.to_string(), "miura", "miura", &LoadOptions::default()).unwrap();
         let report = nanofold::prelude::fold(&pattern, &settings).unwrap();
         let creases = &pattern.sheet().unwrap().pattern.creases;
@@ -314,7 +314,7 @@ fn fold_ends_in_the_same_state_however_the_file_is_placed() {
             .map(|(&e, &rho)| (original_edge[e], rho))
             .collect();
         angles.sort_by_key(|x| x.0);
-        (report.verdict, angles)
+        (report.verdict.as_str().to_string(), angles)
     };
     let identity: Vec<usize> = (0..edge_count(&fold)).collect();
     let (verdict, angles) = end(&fold, &identity);

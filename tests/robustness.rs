@@ -74,7 +74,7 @@ fn a_flat_start_with_the_smallest_accepted_sector_is_flat_at_once() {
     let a = 1.1e-6_f64.to_degrees();
     let pattern = parse(&flat_vertex(&[a, 90.0, 90.0, 180.0 - a])).unwrap();
     let report = unfold_vertex(&pattern, &UnfoldSettings::default()).unwrap();
-    assert_eq!(report.verdict, VertexVerdict::Flat, "{}", report.evidence);
+    assert_eq!(report.verdict, UnfoldVerdict::Flat, "{}", report.evidence);
     assert_eq!(report.iterations, 0);
     let largest = report.final_fold_angles_rad.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
     assert!(largest <= 1e-12, "{largest}");
@@ -513,7 +513,7 @@ fn four_hundred_flat_held_creases_unfold() {
         serde_json::json!({"chain": "closed", "angle_unit": "deg", "sector_angles": sectors, "creases": creases});
     let pattern = parse(&text.to_string()).unwrap();
     let report = unfold_vertex(&pattern, &UnfoldSettings::default()).unwrap();
-    assert_eq!(report.verdict, VertexVerdict::Flat, "{}", report.evidence);
+    assert_eq!(report.verdict, UnfoldVerdict::Flat, "{}", report.evidence);
     assert!(report.flat_layout_error < 1e-10, "{}", report.flat_layout_error);
 }
 

@@ -9,6 +9,7 @@ use nanofold::folding::{
     FoldingModel, PathFrame,
 };
 use nanofold::pattern::generate::MiuraSpec;
+use nanofold::prelude::Named;
 use serde_json::{json, Value};
 use std::path::Path;
 

@@ -31,6 +31,7 @@ use nanofold::dynamics::strip::StripPlant;
 use nanofold::geometry::sphere::Vec3;
 use nanofold::pattern::LoadOptions;
 use nanofold::plot::work_precision::{largest_sizes, power_law_fit};
+use nanofold::prelude::Named;
 use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::qp::{self, QpMethod};
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};

@@ -199,7 +199,7 @@ fn check(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(S
         let clock = Instant::now();
         let report = commands::check(&pattern, &settings)?;
         Ok(payload(
-            report.to_json(&pattern),
+            report.to_json(),
             json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
             clock,
         ))
@@ -219,7 +219,7 @@ fn unfold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(
         let clock = Instant::now();
         let report = commands::unfold(&pattern, &settings)?;
         Ok(payload(
-            report.to_json(&pattern),
+            report.to_json(),
             json!({"trajectory": trajectory(&report), "extra": extra(&report)}),
             clock,
         ))
@@ -238,7 +238,7 @@ fn fold(py: Python<'_>, pattern: &PatternHandle, settings: &str) -> PyResult<(St
         let commands::Detail::Fold(path) = &run.report.detail else {
             unreachable!("fold answers with a path");
         };
-        let mut summary = run.report.to_json(&pattern);
+        let mut summary = run.report.to_json();
         summary["frames"] = json!(run.frames.len());
         Ok(payload(
             summary,

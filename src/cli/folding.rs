@@ -6,11 +6,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::commands::outputs::write_atomic;
 use nanofold::folding::FoldingModel;
-use nanofold::prelude::CheckSettings;
+use nanofold::prelude::Named;
 use nanofold::write::folding_output::crease_pattern_fold;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// Arguments of `fold`.
 #[derive(Args, Clone)]
@@ -264,7 +263,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
         .unwrap_or_else(|| default_folder(&model.pattern.name, &args.pattern));
     let files = nanofold::commands::fold_files(&pattern, &run)?;
     write_outputs(&dir, &args.pattern, &files)?;
-    let mut summary = run.report.to_json(&pattern);
+    let mut summary = run.report.to_json();
     summary["frames"] = json!(frames.len());
     summary["out"] = json!(dir.display().to_string());
     if args.json {
@@ -303,51 +302,35 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
     Ok(())
 }
 
-/// `check` on a crease pattern of many vertices: its verdict as a JSON object.
-pub fn check_json(
+/// `check`'s line for a crease pattern of many vertices.
+pub fn check_line(
     path: &Path,
     pattern: &nanofold::commands::Pattern,
-    projection: Option<&nanofold::commands::Projection>,
-    closure_tol: f64,
-) -> Result<(Value, String)> {
-    let model = pattern
-        .sheet()
-        .expect("a crease pattern of many vertices has its sheet");
-    let settings = CheckSettings {
-        closure_tol,
-        ..CheckSettings::default()
+    report: &nanofold::commands::Report<nanofold::commands::CheckVerdict>,
+) -> String {
+    let nanofold::commands::Detail::NetworkCheck(check, unfolding) = &report.detail else {
+        unreachable!("a crease pattern of many vertices is checked by the network engine")
     };
-    let start = Instant::now();
-    let (report, unfolding) = nanofold::commands::check_sheet(model, &settings)?;
-    let seconds = start.elapsed().as_secs_f64();
     let mut line = format!(
         "{}: {} ({} DOF at the {} state, {:.3} ms) {}",
         path.display(),
         report.verdict.as_str(),
-        report.rank.dof,
-        if report.has_state { "given" } else { "flat" },
-        seconds * 1e3,
+        check.rank.dof,
+        if check.has_state { "given" } else { "flat" },
+        report.seconds * 1e3,
         report.evidence
     );
-    let mut value = nanofold::write::folding_output::check_summary(
-        model,
-        &path.display().to_string(),
-        &report,
-        unfolding.as_ref(),
-        seconds,
-    );
-    if let Some(projection) = projection {
+    if let Some(projection) = pattern.projection() {
         line.push_str(&format!("; {}", projection.note));
-        value["projection"] = projection.json.clone();
     }
-    if let Some(unfolding) = &unfolding {
+    if let Some(unfolding) = unfolding {
         line.push_str(&format!(
             "; unfolding by energy: {} ({})",
             unfolding.verdict.as_str(),
             unfolding.evidence
         ));
     }
-    Ok((value, line))
+    line
 }
 
 /// `constraints` on a crease pattern of many vertices with one degree of freedom.
@@ -417,7 +400,6 @@ pub fn network_constraints_output(
 pub fn unfold_network_one(
     pattern_path: &Path,
     pattern: &nanofold::commands::Pattern,
-    projection: Option<nanofold::commands::Projection>,
     solver: &super::SolverArgs,
     dir: Option<&Path>,
     progress: Option<nanofold::prelude::UnfoldProgress>,
@@ -426,13 +408,10 @@ pub fn unfold_network_one(
     let model = pattern
         .sheet()
         .expect("a crease pattern of many vertices has its sheet");
-    let projection = projection.map(|p| (p.note, p.json));
-    let frames_note = pattern.frames_note().map(str::to_string);
     let settings = nanofold::commands::Settings {
         unfold: solver.settings()?,
         ..nanofold::commands::Settings::default()
     };
-    let start_state = model.given_fold_angles();
     let answer = nanofold::commands::unfold_observed(pattern, &settings, progress)
         .map_err(|e| flags(e, &[("flat_tol", "--flat-tol"), ("start", "edges_foldAngle")]))?;
     let nanofold::commands::Detail::NetworkUnfold(report) = &answer.detail else {
@@ -443,25 +422,16 @@ pub fn unfold_network_one(
     let last = report.steps.last().expect("the start is recorded");
     let files = nanofold::commands::unfold_files(pattern, &answer, &settings)?;
     write_outputs(&dir, pattern_path, &files)?;
-    let adjustments: Vec<String> = projection
-        .iter()
-        .map(|(note, _)| note.clone())
-        .chain(frames_note.clone())
-        .chain(model.pattern.reading.iter().cloned())
-        .collect();
-    let mut summary = nanofold::write::folding_output::network_unfold_summary(
-        model,
-        &pattern_path.display().to_string(),
-        report,
-        &start_state,
-        seconds,
-        &adjustments,
-        projection.as_ref().map(|(_, json)| json),
-    );
+    let mut summary = answer.to_json();
     summary["out"] = json!(dir.display().to_string());
     let flat_layout_error = summary["flat_layout_error"].as_f64().unwrap_or(f64::NAN);
     let mut text = String::new();
-    for note in projection.iter().map(|(note, _)| note).chain(&frames_note) {
+    let notes = pattern
+        .projection()
+        .map(|p| p.note.as_str())
+        .into_iter()
+        .chain(pattern.frames_note());
+    for note in notes {
         writeln!(text, "{}: {note}", model.pattern.name)?;
     }
     writeln!(

@@ -10,6 +10,7 @@ use crate::constraints::{
 };
 use crate::error::{NanofoldError, Result};
 use crate::folding::FoldingModel;
+use crate::names::Named;
 use serde_json::Value;
 
 /// How the curves' degree is chosen.

@@ -184,12 +184,7 @@ pub enum StopReason {
     },
 }
 
-impl StopReason {
-    /// The name used in reports.
-    pub fn as_str(&self) -> &'static str {
-        crate::names::variant_name(self)
-    }
-}
+impl crate::names::Named for StopReason {}
 
 /// One accepted state along the path.
 #[derive(Debug, Clone, PartialEq)]
@@ -1257,6 +1252,16 @@ pub fn project_to_rigid(model: &FoldingModel, fold_angles: &[f64], tol: f64) -> 
         residual_before,
         iterations,
     })
+}
+
+impl crate::names::Answer for FoldPath {
+    fn verdict_name(&self) -> &'static str {
+        crate::names::variant_name(&self.stop)
+    }
+
+    fn evidence(&self) -> &str {
+        &self.evidence
+    }
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ use super::poses::{panel_poses, tree_mismatch};
 use super::rank::{jacobian_rank, RankReport};
 use super::second_order::{second_order, SecondOrder, CERTIFICATE};
 use crate::error::Result;
+use crate::names::Named;
 use crate::pattern::crease_pattern::EdgeKind;
 use crate::pattern::Assignment;
 use nalgebra::Matrix2;
@@ -33,12 +34,7 @@ pub enum PatternVerdict {
     Unknown,
 }
 
-impl PatternVerdict {
-    /// The name used in reports.
-    pub fn as_str(self) -> &'static str {
-        crate::names::variant_name(&self)
-    }
-}
+impl crate::names::Named for PatternVerdict {}
 
 /// Tolerances of a check.
 #[derive(Debug, Clone, PartialEq)]
@@ -683,4 +679,14 @@ pub fn degree4_modes_within(star: &Star, zero_tolerance: f64) -> Option<Vec<[f64
         modes.push(unit.map(|x| -x));
     }
     Some(modes)
+}
+
+impl crate::names::Answer for CheckReport {
+    fn verdict_name(&self) -> &'static str {
+        crate::names::variant_name(&self.verdict)
+    }
+
+    fn evidence(&self) -> &str {
+        &self.evidence
+    }
 }

@@ -16,6 +16,7 @@ use crate::unfold::barrier::{BarrierSettings, PanelBarrier};
 use crate::unfold::energy::{Arc, Energy, EnergyKind, EnergyWorkspace};
 use crate::unfold::observe::UnfoldProgress;
 use crate::unfold::solver::SplitMix64;
+use crate::unfold::Verdict;
 use argmin::core::observers::ObserverMode;
 use argmin::core::Executor;
 use std::f64::consts::PI;
@@ -195,31 +196,6 @@ impl Default for NetworkUnfoldSettings {
     }
 }
 
-/// The verdict of a many-vertex unfolding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum NetworkVerdict {
-    /// Every fold angle reached the flat tolerance along a rigid path.
-    Flat,
-    /// No rigid motion at the start (0 degrees of freedom).
-    Locked,
-    /// The projected gradient vanished away from flat.
-    LocalMinimum,
-    /// Every step the line search tried put panels through each other.
-    Blocked,
-    /// The iteration budget ran out.
-    IterationLimit,
-    /// The start is not a rigid state (a vertex does not close): nothing to unfold rigidly.
-    NotRigid,
-}
-
-impl NetworkVerdict {
-    /// The name used in reports.
-    pub fn as_str(self) -> &'static str {
-        crate::names::variant_name(&self)
-    }
-}
-
 /// One accepted state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetworkStep {
@@ -235,7 +211,7 @@ pub struct NetworkStep {
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetworkUnfoldReport {
     /// The verdict.
-    pub verdict: NetworkVerdict,
+    pub verdict: Verdict,
     /// Its evidence in words.
     pub evidence: String,
     /// Descent steps taken.
@@ -537,7 +513,7 @@ pub fn start_descent<'a>(
             .position(|&r| r == residual)
             .expect("the largest is one of them");
         return Ok(NetworkStart::Decided(NetworkUnfoldReport {
-            verdict: NetworkVerdict::NotRigid,
+            verdict: Verdict::NotRigid,
             evidence: format!(
                 "the start is not a rigid state: vertex {} is {residual:.3e} rad from closing (above 1e-6)",
                 model.stars[worst].vertex
@@ -588,10 +564,20 @@ pub fn start_descent<'a>(
     let already_flat = descent.rho.iter().all(|r| r.abs() <= settings.flat_tol);
     if !already_flat && jacobian_rank(&closure_jacobian(model, &descent.rho))?.dof == 0 {
         let stop = (
-            NetworkVerdict::Locked,
+            Verdict::Locked,
             "0 degrees of freedom at the start: no rigid motion".to_string(),
         );
         return Ok(NetworkStart::Decided(descent.finish(stop, 0)));
     }
     Ok(NetworkStart::Descent(Box::new(descent)))
+}
+
+impl crate::names::Answer for NetworkUnfoldReport {
+    fn verdict_name(&self) -> &'static str {
+        crate::names::variant_name(&self.verdict)
+    }
+
+    fn evidence(&self) -> &str {
+        &self.evidence
+    }
 }

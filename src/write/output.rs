@@ -12,6 +12,7 @@ use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{Response, Simulation, SimulationSettings};
 use crate::error::{NanofoldError, Result};
 use crate::geometry::sphere::Vec3;
+use crate::names::Named;
 use crate::pattern::{Chain, FlatMesh, RayRole, VertexPattern};
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
 use nalgebra::DMatrix;
@@ -429,29 +430,6 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
             .collect::<Vec<f64>>());
     }
     value
-}
-
-/// The single vertex's unfolding as `unfold --json` prints it (`file`: the input's path).
-pub fn vertex_unfold_summary(pattern: &VertexPattern, file: &str, report: &UnfoldReport) -> Value {
-    json!({
-        "pattern": pattern.name,
-        "file": file,
-        "verdict": report.verdict,
-        "evidence": report.evidence,
-        "iterations": report.iterations,
-        "seconds": report.seconds,
-        "energy_initial": report.energy_initial,
-        "energy_final": report.energy_final,
-        "initial_fold_angles_rad": report.initial_fold_angles_rad,
-        "final_fold_angles_rad": report.final_fold_angles_rad,
-        "crease_labels": pattern.creases.iter().map(|c| c.label.clone()).collect::<Vec<_>>(),
-        "max_arc_residual": report.max_arc_residual,
-        "planarity_residual": report.planarity_residual,
-        "flat_layout_error": report.flat_layout_error,
-        "restarts_used": report.restarts_used,
-        "crossings_refused": report.crossings_refused,
-        "adjustments": report.adjustments,
-    })
 }
 
 /// `response.json`: the summary plus every output sample.

@@ -4,7 +4,7 @@
 
 use super::{
     dot, flat_step, major_crease, norm, radial_step, restart, restart_note, try_state, Accepted, NetworkStep,
-    NetworkUnfoldReport, NetworkUnfoldSettings, NetworkVerdict, Objective, Trial, FLAT_APPROACH, NEAR_FLAT, STALL_TOL,
+    NetworkUnfoldReport, NetworkUnfoldSettings, Objective, Trial, Verdict, FLAT_APPROACH, NEAR_FLAT, STALL_TOL,
 };
 use crate::error::Result;
 use crate::folding::normal::{NormalFactor, NormalSolver};
@@ -73,7 +73,7 @@ fn lbfgs_direction(
 }
 
 /// Why a descent ends, and the evidence.
-pub type DescentStop = (NetworkVerdict, String);
+pub type DescentStop = (Verdict, String);
 
 /// A descent under way: the state, its energy and gradient, the steps so far, L-BFGS's
 /// memory, the line search's and the restarts' state, and the scratch they reuse. Driven by
@@ -200,7 +200,7 @@ impl<'a> NetworkDescent<'a> {
             self.restart_failed = true;
         }
         Ok(Some((
-            NetworkVerdict::LocalMinimum,
+            Verdict::LocalMinimum,
             format!("{why}; {}", restart_note(self.restarts, self.restart_failed)),
         )))
     }
@@ -238,7 +238,7 @@ impl<'a> NetworkDescent<'a> {
             if u_flat <= u * (1.0 + 1e-12) {
                 self.steps.push(flat);
                 return Ok(Some((
-                    NetworkVerdict::Flat,
+                    Verdict::Flat,
                     format!("descended to max |ρ| = {largest:.1e} rad after {iteration} steps, then finished onto the flat state (within {STALL_TOL:.0e}; energy {u:.9e} → {u_flat:.9e})"),
                 )));
             }
@@ -246,7 +246,7 @@ impl<'a> NetworkDescent<'a> {
         if largest <= settings.flat_tol {
             self.record_flat();
             return Ok(Some((
-                NetworkVerdict::Flat,
+                Verdict::Flat,
                 format!("every fold angle within {:.0e} rad after {iteration} steps (max |ρ| = {largest:.1e}), then set to 0", settings.flat_tol),
             )));
         }
@@ -279,7 +279,7 @@ impl<'a> NetworkDescent<'a> {
         let slope: f64 = self.gradient.iter().zip(&descent).map(|(g, d)| g * d).sum();
         if size <= 1e-14 || slope >= 0.0 {
             return Ok(Some((
-                NetworkVerdict::LocalMinimum,
+                Verdict::LocalMinimum,
                 format!("the projected gradient vanishes (|d| = {size:.1e}) with max |ρ| = {largest:.3e} rad"),
             )));
         }
@@ -350,13 +350,13 @@ impl<'a> NetworkDescent<'a> {
                 // state is rigid and the descent was heading there.
                 self.record_flat();
                 return Ok(Some((
-                    NetworkVerdict::Flat,
+                    Verdict::Flat,
                     format!("the line search stalled {largest:.1e} rad from flat (within {STALL_TOL:.0e}, where the energy's changes are at its rounding), then set to 0"),
                 )));
             }
             if let Some([a, b]) = refused_for_crossing {
                 return Ok(Some((
-                    NetworkVerdict::Blocked,
+                    Verdict::Blocked,
                     format!("every shorter step still puts panels through each other: panels {a} and {b} would meet (max |ρ| = {largest:.3e} rad)"),
                 )));
             }
@@ -400,7 +400,7 @@ impl<'a> NetworkDescent<'a> {
             Some((stop, iteration)) => self.finish(stop, iteration),
             None => {
                 let limit = self.settings.max_iterations;
-                self.finish((NetworkVerdict::IterationLimit, format!("{limit} steps")), limit)
+                self.finish((Verdict::IterationLimit, format!("{limit} steps")), limit)
             }
         }
     }
