@@ -6,11 +6,9 @@ mod folding;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use nanofold::commands::outputs::{default_output_folder, folder_name, write_folder_of};
-use nanofold::constraints::{mujoco_snippet, ConstraintReport};
-use nanofold::plot::constraints_svg;
 use nanofold::prelude::{
     EnergyKind, LoadOptions, Method, ModelChoice, ModelKind, Named, ProgressObserver, QpMethod, Response, Scene,
-    SimulationSettings, System, UnfoldProgress, UnfoldSettings, VertexPattern as Pattern,
+    SimulationSettings, System, UnfoldProgress, UnfoldSettings,
 };
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -779,15 +777,12 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     spinner.set_message(format!("sweeping {} samples", args.samples));
     let curves = nanofold::commands::constraints(&pattern, &settings).map_err(constraints_flags);
     spinner.finish_and_clear();
-    let (vertex, samples, poly, report) = match (pattern.vertex(), curves?) {
-        (Some(vertex), Constraints::Vertex { samples, poly, report }) => (vertex, samples, poly, report),
-        (_, network) => return folding::network_constraints_output(args, &pattern, network),
-    };
+    let curves = curves?;
     if let Some(tol) = args.tol.filter(|_| args.format == ExportFormat::Mujoco) {
-        if report.max_fit_error() > tol {
+        if curves.max_fit_error_rad() > tol {
             eprintln!(
                 "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {tol:e}",
-                report.max_fit_error()
+                curves.max_fit_error_rad()
             );
         }
     }
@@ -795,32 +790,28 @@ fn run_constraints(args: &ConstraintsArgs) -> Result<()> {
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| default_folder(&vertex.name, &args.pattern));
-    let report_json = serde_json::to_string_pretty(report.as_ref())?;
-    let svg = constraints_svg(vertex, &samples, &poly)?;
-    let mut files = vec![("constraints.json", report_json), ("constraints.svg", svg)];
-    if args.format == ExportFormat::Mujoco {
-        files.push(("constraints.xml", mujoco_snippet(&report).map_err(constraints_flags)?));
-    }
+        .unwrap_or_else(|| default_folder(pattern.name(), &args.pattern));
+    let files = nanofold::commands::constraints_files(&pattern, &curves, options.format).map_err(constraints_flags)?;
     write_outputs(&dir, &args.pattern, &files)?;
-    print_constraints(args, vertex, &report, &dir, &files)
-}
-
-/// What `constraints` prints of its report.
-fn print_constraints(
-    args: &ConstraintsArgs,
-    pattern: &Pattern,
-    report: &ConstraintReport,
-    dir: &Path,
-    files: &[(&str, String)],
-) -> Result<()> {
     if args.json {
-        println!("{}", serde_json::to_string(report)?);
+        println!("{}", serde_json::to_string(&curves)?);
         return Ok(());
     }
+    match &curves {
+        Constraints::Vertex { report, .. } => print_constraints(pattern.name(), report, &dir, &files),
+        Constraints::Network { curves, .. } => {
+            folding::print_network_constraints(pattern.name(), curves);
+            print_written(&dir, &files);
+        }
+    }
+    Ok(())
+}
+
+/// What `constraints` prints of a single vertex's curves.
+fn print_constraints(name: &str, report: &nanofold::commands::ConstraintReport, dir: &Path, files: &[(&str, String)]) {
     println!(
         "{}: {} curve(s) of {} over [{:.4}°, {:.4}°], degree {}, {} samples ({:?}, closure residual of samples {:.1e} rad)",
-        pattern.name,
+        name,
         report.curves.len(),
         report.driver_label,
         report.domain_deg[0],
@@ -864,7 +855,6 @@ fn print_constraints(
         );
     }
     print_written(dir, files);
-    Ok(())
 }
 
 /// The first contact of a run, or that there was none, as one line.
@@ -1220,19 +1210,18 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
         println!("{value}");
         return Ok(());
     }
-    let result = match (&scene.system, &report.detail) {
-        (System::Closed(chain), ModesDetail::Closed(result, eta)) => {
-            print_modes_closed(&scene.name, chain, result, *eta);
+    let result = match &report.detail {
+        ModesDetail::Closed(..) => {
+            print_modes_closed(&scene, &report);
             print_written(&dir, &files);
             return Ok(());
         }
-        (System::Network(model), ModesDetail::Network(result)) => {
-            print_modes_network(&scene.name, model, result);
+        ModesDetail::Network(..) => {
+            print_modes_network(&scene, &report);
             print_written(&dir, &files);
             return Ok(());
         }
-        (_, ModesDetail::Strip(result)) => result,
-        _ => unreachable!("a report's modes are its scene's kind"),
+        ModesDetail::Strip(result) => result,
     };
     let degrees: Vec<String> = result
         .equilibrium
@@ -1275,11 +1264,11 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-fn print_modes_network(
-    name: &str,
-    model: &nanofold::dynamics::network::NetworkModel,
-    result: &nanofold::dynamics::network::modes::NetworkModes,
-) {
+fn print_modes_network(scene: &Scene, report: &nanofold::commands::ModesReport) {
+    let (System::Network(model), ModesDetail::Network(result)) = (&scene.system, &report.detail) else {
+        unreachable!("a network's modes")
+    };
+    let name = &scene.name;
     let modes = &result.modes;
     let eq = &modes.equilibrium;
     println!(
@@ -1348,12 +1337,11 @@ fn print_modes_network(
 
 use nanofold::commands::ModesDetail;
 
-fn print_modes_closed(
-    name: &str,
-    chain: &nanofold::dynamics::closed::ClosedChain,
-    result: &nanofold::dynamics::closed::modes::ClosedModes,
-    eta: f64,
-) {
+fn print_modes_closed(scene: &Scene, report: &nanofold::commands::ModesReport) {
+    let (System::Closed(chain), ModesDetail::Closed(result, eta)) = (&scene.system, &report.detail) else {
+        unreachable!("a closed chain's modes")
+    };
+    let (name, eta) = (&scene.name, *eta);
     let degrees = |angles: &[f64]| {
         angles
             .iter()

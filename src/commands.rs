@@ -51,9 +51,13 @@ mod scene;
 #[cfg(feature = "plot")]
 mod view;
 
+pub use crate::constraints::network::NetworkCurves;
+pub use crate::constraints::ConstraintReport;
 pub use crate::write::mujoco::{LoopClosure, MujocoSettings};
+#[cfg(feature = "plot")]
+pub use constraints::constraints_files;
 pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
-pub use generate::Generator;
+pub use generate::{Generated, Generator};
 pub use options::{
     options_from_json, AutoDegree, CheckOptions, ConstraintOptions, CurveFormat, DegreeOption, FoldOptions, FromJson,
     ReadOptions, SimulateOptions, UnfoldOptions,

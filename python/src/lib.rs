@@ -5,7 +5,7 @@
 //! run finishes within the library's own bounds and its result is dropped).
 
 use nanofold::commands::{self, FromJson, Pattern};
-use nanofold::prelude::{NanofoldError, Scene};
+use nanofold::prelude::{NanofoldError, Named, Scene};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
@@ -271,7 +271,7 @@ fn payload(summary: Value, rest: Value, clock: Instant) -> (String, String) {
 }
 
 /// What every command's report has, whether or not its `--json` shows it.
-fn extra(report: &commands::Report) -> Value {
+fn extra<V>(report: &commands::Report<V>) -> Value {
     json!({
         "crease_labels": report.crease_labels,
         "start_fold_angles_rad": report.start_fold_angles_rad,
@@ -282,7 +282,7 @@ fn extra(report: &commands::Report) -> Value {
 }
 
 /// The fold angles of every step the engine recorded.
-fn trajectory(report: &commands::Report) -> Vec<Vec<f64>> {
+fn trajectory<V>(report: &commands::Report<V>) -> Vec<Vec<f64>> {
     match &report.detail {
         commands::Detail::VertexUnfold(r) => r.trajectory.iter().map(|s| s.fold_angles.clone()).collect(),
         commands::Detail::NetworkUnfold(r) => r.steps.iter().map(|s| s.fold_angles.clone()).collect(),

@@ -5,9 +5,7 @@ use super::{default_folder, print_written, reading, write_outputs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use nanofold::commands::outputs::write_atomic;
-use nanofold::folding::FoldingModel;
 use nanofold::prelude::Named;
-use nanofold::write::folding_output::crease_pattern_fold;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -174,24 +172,23 @@ pub fn run_generate(kind: &GenerateKind) -> Result<()> {
         ),
     };
     let generator = Generator::from_options(family, &options).map_err(|e| flags(e, table))?;
-    let (model, state) = generator.build().map_err(|e| flags(e, table))?;
-    let value = crease_pattern_fold(&model.pattern, state.as_deref(), &generator.note());
-    write_file(out, &value)?;
-    report(&model, state.is_some(), out);
-    Ok(())
-}
-
-fn report(model: &FoldingModel, folded: bool, out: &Path) {
+    let generated = generator.generate().map_err(|e| flags(e, table))?;
+    write_file(out, &generated.fold)?;
     println!(
         "{}: {} vertices, {} creases, {} interior vertices, {} panels{}; wrote {}",
-        model.pattern.name,
-        model.pattern.vertices.len(),
-        model.crease_count(),
-        model.stars.len(),
-        model.pattern.panel_count,
-        if folded { " (folded state included)" } else { "" },
+        generated.name,
+        generated.vertices,
+        generated.creases,
+        generated.interior_vertices,
+        generated.panels,
+        if generated.folded {
+            " (folded state included)"
+        } else {
+            ""
+        },
         out.display()
     );
+    Ok(())
 }
 
 fn write_file(out: &Path, value: &Value) -> Result<()> {
@@ -333,54 +330,11 @@ pub fn check_line(
     line
 }
 
-/// `constraints` on a crease pattern of many vertices with one degree of freedom.
-/// What `constraints` writes and prints for a crease pattern of many vertices.
-pub fn network_constraints_output(
-    args: &super::ConstraintsArgs,
-    pattern: &nanofold::commands::Pattern,
-    result: nanofold::commands::Constraints,
-) -> Result<()> {
-    use nanofold::commands::Constraints;
-    use nanofold::constraints::network::network_mujoco;
-    let mujoco = args.format == super::ExportFormat::Mujoco;
-    let model = pattern
-        .sheet()
-        .expect("a crease pattern of many vertices has its sheet");
-    let Constraints::Network { sweep, curves } = result else {
-        bail!("{}: read as a single vertex", args.pattern.display());
-    };
-    if mujoco && curves.max_fit_error_rad > args.tol.unwrap_or(f64::INFINITY) {
-        eprintln!(
-            "note: --degree auto is capped at 4 for MuJoCo; degree 4 leaves {:.3e} rad, above --tol {:e}",
-            curves.max_fit_error_rad,
-            args.tol.unwrap_or_default()
-        );
-    }
-    let dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_folder(&model.pattern.name, &args.pattern));
-    let mut files = vec![
-        ("constraints.json", serde_json::to_string_pretty(&curves)?),
-        (
-            "constraints.svg",
-            nanofold::plot::folding::network_constraints_svg(&sweep, &curves)?,
-        ),
-    ];
-    if args.format == super::ExportFormat::Mujoco {
-        files.push((
-            "constraints.xml",
-            network_mujoco(&curves).map_err(|e| flags(e, &[("degree", "--degree")]))?,
-        ));
-    }
-    write_outputs(&dir, &args.pattern, &files)?;
-    if args.json {
-        println!("{}", serde_json::to_string(&curves)?);
-        return Ok(());
-    }
+/// What `constraints` prints of a crease pattern's curves.
+pub fn print_network_constraints(name: &str, curves: &nanofold::commands::NetworkCurves) {
     println!(
         "{}: {} curves of crease {} over [{:.4}°, {:.4}°], degree {}, {} fitted points and {} checked between them; largest fit error {:.3e} rad, closure residual of the sweep {:.1e} rad",
-        model.pattern.name,
+        name,
         curves.curves.len(),
         curves.driver_edge,
         curves.domain_deg[0],
@@ -391,8 +345,6 @@ pub fn network_constraints_output(
         curves.max_fit_error_rad,
         curves.max_closure_residual_rad
     );
-    print_written(&dir, &files);
-    Ok(())
 }
 
 /// `unfold` of a crease pattern of many vertices (`docs/model.md#energy-unfolding-of-many-vertices`):

@@ -101,14 +101,21 @@ pub enum Constraints {
     },
 }
 
-impl Constraints {
-    /// As `nanofold constraints --json` prints it.
-    pub fn to_json(&self) -> Value {
+/// The curves serialise as their report (the fitted coefficients with their errors): what
+/// `nanofold constraints --json` prints and constraints.json holds.
+impl serde::Serialize for Constraints {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
         match self {
-            Constraints::Vertex { report, .. } => serde_json::to_value(report.as_ref()),
-            Constraints::Network { curves, .. } => serde_json::to_value(curves.as_ref()),
+            Constraints::Vertex { report, .. } => report.serialize(serializer),
+            Constraints::Network { curves, .. } => curves.serialize(serializer),
         }
-        .unwrap_or(Value::Null)
+    }
+}
+
+impl Constraints {
+    /// As `nanofold constraints --json` prints it: its own serialisation.
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(self).unwrap_or(Value::Null)
     }
 
     /// The largest fit error of any curve, rad.
@@ -118,6 +125,46 @@ impl Constraints {
             Constraints::Network { curves, .. } => curves.max_fit_error_rad,
         }
     }
+}
+
+/// The files `constraints` writes (rendered, not written): constraints.json (the curves
+/// with their errors, as `--json` prints them), constraints.svg and, for MuJoCo,
+/// constraints.xml (the curves as equality constraints).
+#[cfg(feature = "plot")]
+pub fn constraints_files(
+    pattern: &Pattern,
+    result: &Constraints,
+    format: super::CurveFormat,
+) -> Result<Vec<(&'static str, String)>> {
+    let json = serde_json::to_string_pretty(result)
+        .map_err(|e| NanofoldError::invalid("constraints.json", "JSON", e.to_string()))?;
+    let mujoco = format == super::CurveFormat::Mujoco;
+    let mut files = vec![("constraints.json", json)];
+    match (result, pattern.vertex()) {
+        (Constraints::Vertex { samples, poly, report }, Some(vertex)) => {
+            files.push(("constraints.svg", crate::plot::constraints_svg(vertex, samples, poly)?));
+            if mujoco {
+                files.push(("constraints.xml", crate::constraints::mujoco_snippet(report)?));
+            }
+        }
+        (Constraints::Network { sweep, curves }, _) => {
+            files.push((
+                "constraints.svg",
+                crate::plot::folding::network_constraints_svg(sweep, curves)?,
+            ));
+            if mujoco {
+                files.push(("constraints.xml", crate::constraints::network::network_mujoco(curves)?));
+            }
+        }
+        (Constraints::Vertex { .. }, None) => {
+            return Err(NanofoldError::invalid(
+                "pattern",
+                pattern.name(),
+                "a single vertex's curves are not this pattern's",
+            ))
+        }
+    }
+    Ok(files)
 }
 
 /// Sweeps the driver across its range by exact loop closure and fits every free crease.

@@ -74,9 +74,41 @@ impl Generator {
 
     /// The pattern as the FOLD object `nanofold generate` writes.
     pub fn to_fold(&self) -> Result<serde_json::Value> {
-        let (model, state) = self.build()?;
-        Ok(crease_pattern_fold(&model.pattern, state.as_deref(), &self.note()))
+        Ok(self.generate()?.fold)
     }
+
+    /// The pattern as `nanofold generate` writes it, with what it says of it.
+    pub fn generate(&self) -> Result<Generated> {
+        let (model, state) = self.build()?;
+        Ok(Generated {
+            name: model.pattern.name.clone(),
+            vertices: model.pattern.vertices.len(),
+            creases: model.crease_count(),
+            interior_vertices: model.stars.len(),
+            panels: model.pattern.panel_count,
+            folded: state.is_some(),
+            fold: crease_pattern_fold(&model.pattern, state.as_deref(), &self.note()),
+        })
+    }
+}
+
+/// A generated crease pattern: its FOLD object and its counts.
+#[derive(Debug, Clone)]
+pub struct Generated {
+    /// The pattern's name.
+    pub name: String,
+    /// Vertices of the sheet.
+    pub vertices: usize,
+    /// Creases.
+    pub creases: usize,
+    /// Interior vertices.
+    pub interior_vertices: usize,
+    /// Panels.
+    pub panels: usize,
+    /// Whether it carries a folded state (a folded Miura-ori).
+    pub folded: bool,
+    /// The FOLD object.
+    pub fold: serde_json::Value,
 }
 
 /// A generator spec's error under the option that sets the field (the specs hold radians
