@@ -35,10 +35,7 @@ use crate::pattern::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKi
 use crate::pattern::{Assignment, Chain, LoadOptions, RayRole};
 use crate::unfold::network::{unfold_network, unfold_network_observed, NetworkUnfoldReport, NetworkUnfoldSettings};
 use crate::unfold::{UnfoldProgress, UnfoldReport, UnfoldSettings};
-use crate::write::summary::{
-    crease_labels, CheckSummary, FoldSummary, FoldedFormBend, NetworkUnfoldSummary, ProjectionFigures, Summary,
-    VertexUnfoldSummary,
-};
+use crate::write::summary::crease_labels;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -54,6 +51,10 @@ mod view;
 pub use crate::constraints::network::NetworkCurves;
 pub use crate::constraints::ConstraintReport;
 pub use crate::write::mujoco::{LoopClosure, MujocoSettings};
+pub use crate::write::summary::{
+    CheckSummary, FlatFoldabilitySummary, FoldSummary, FoldedFormBend, FoldedFormSummary, NetworkUnfoldSummary,
+    ProjectionFigures, Summary, UnfoldBrief, VertexResidual, VertexUnfoldSummary, WitnessSummary,
+};
 #[cfg(feature = "plot")]
 pub use constraints::constraints_files;
 pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
@@ -481,7 +482,7 @@ pub enum Detail {
 }
 
 /// One report shape for every command and engine; `V` is the command's verdict type. It
-/// serialises as its [`Summary`] (`check`, `fold` and `unfold --json` print that), the
+/// serialises as its `Summary` (`check`, `fold` and `unfold --json` print that), the
 /// typed fields beside it being the library's view of the same answer.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report<V> {

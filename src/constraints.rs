@@ -1,12 +1,12 @@
 //! Holonomic constraint curves θ_r = f(θ_c) of a closed vertex (`docs/model.md#constraint-curves`): which creases
-//! drive, hold and follow ([`Setup`]), exact samples ([`sweep`] or an unfolding), least-squares
+//! drive, hold and follow ([`Setup`]), exact samples (`sweep` or an unfolding), least-squares
 //! Chebyshev fits ([`ConstraintPoly`], with the Jacobian G of T4.18 and its rate), and the
 //! exported report with its errors against exact loop closure.
 
 pub mod chebyshev;
 pub mod exact;
 pub mod network;
-pub mod sweep;
+pub(crate) mod sweep;
 
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
@@ -216,7 +216,7 @@ pub fn check_domain(domain: [f64; 2]) -> Result<()> {
     Ok(())
 }
 
-/// Exact samples by a kinematic sweep (see [`sweep::sweep`]): the driver moves over
+/// Exact samples by a kinematic sweep (see `sweep::sweep`): the driver moves over
 /// `domain` (rad) and loop closure is solved at each of `samples` points.
 ///
 /// ```

@@ -1,7 +1,7 @@
 //! Dynamics of rigid plates on hinges (`docs/model.md#dynamics`): the [`model`] and its
-//! [`algorithms`] (product-of-exponentials kinematics, M, C, drag), the [`forcing`] law,
+//! [`algorithms`] (product-of-exponentials kinematics, M, C, drag), the `forcing` law,
 //! [`scene`]s (a strip or a closed vertex), the two [`plant`]s ([`strip`], [`closed`]) and one
-//! [`simulate`] for both: diffsol [`integrate`] with [`contact`] location, or the
+//! [`simulate`] for both: diffsol [`integrate`] with `contact` location, or the
 //! [`quasi_static`] path; [`modes`] at an equilibrium.
 //!
 //! Layout after Pinocchio: a [`Model`] is immutable, a [`Data`] holds the scratch the
@@ -9,8 +9,8 @@
 
 pub mod algorithms;
 pub mod closed;
-pub mod contact;
-pub mod forcing;
+pub(crate) mod contact;
+pub(crate) mod forcing;
 pub mod integrate;
 pub mod model;
 pub mod modes;
@@ -19,7 +19,7 @@ pub mod plant;
 pub mod quasi_static;
 pub mod scene;
 pub mod simulate;
-pub mod spec;
+pub(crate) mod spec;
 pub mod strip;
 
 pub use model::{Data, Drag, Joint, Model, Plate};

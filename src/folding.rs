@@ -2,18 +2,18 @@
 //! the per-vertex closure conditions and their sparse Jacobian, the degrees of freedom at
 //! a state, the panels' poses, and the test that no two panels pass through each other.
 
-pub mod closure;
-pub mod contact;
-pub mod frames;
-pub mod model;
+pub(crate) mod closure;
+pub(crate) mod contact;
+pub(crate) mod frames;
+pub(crate) mod model;
 pub mod normal;
-pub mod path;
-pub mod poses;
-pub mod rank;
-pub mod reduction;
+pub(crate) mod path;
+pub(crate) mod poses;
+pub(crate) mod rank;
+pub(crate) mod reduction;
 pub mod second_order;
-pub mod simd_state;
-pub mod verdict;
+pub(crate) mod simd_state;
+pub(crate) mod verdict;
 
 pub use closure::{closure_jacobian, closure_residual, vertex_residuals, worst_of, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};

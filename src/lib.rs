@@ -100,7 +100,7 @@ pub mod dynamics;
 pub mod error;
 pub mod folding;
 pub mod geometry;
-pub mod names;
+pub(crate) mod names;
 pub mod pattern;
 #[cfg(feature = "plot")]
 pub mod plot;

@@ -2,9 +2,9 @@
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
 mod canvas;
-pub mod folding;
+pub(crate) mod folding;
 pub mod page;
-pub mod response;
+pub(crate) mod response;
 pub mod scene_page;
 pub mod work_precision;
 

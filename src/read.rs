@@ -2,11 +2,11 @@
 //! scene files), parsed and validated into patterns and scene descriptions. They sit just
 //! above `pattern`; loaders parse and validate and run no engine.
 
-pub mod fold;
-pub mod folded_form;
+pub(crate) mod fold;
+pub(crate) mod folded_form;
 pub mod input;
-pub mod native;
-pub mod scene;
+pub(crate) mod native;
+pub(crate) mod scene;
 pub mod scene_spec;
 
 pub use scene::{load_scene, parse_scene};

@@ -1,24 +1,24 @@
 //! The unfolding engine (`docs/model.md#unfolding`): projected-gradient steps on the sphere,
 //! driven to a verdict. The direction is the QP of [`qp`] in tangent coordinates of the free
 //! nodes; a backtracking line search on U refuses steps that carry a node through an arc
-//! ([`checks`]); Newton projection restores the arc-length, unit-norm and held-crease
-//! constraints ([`manifold`]).
+//! (`checks`); Newton projection restores the arc-length, unit-norm and held-crease
+//! constraints (`manifold`).
 //!
 //! Layout after Pinocchio and argmin: [`UnfoldModel`] is the immutable description, the
 //! [`solver::ProjectedGradient`] takes one step per call (an argmin `Solver`), argmin's
-//! `Executor` drives it with [`observe`]rs recording the trajectory and progress, and
+//! `Executor` drives it with `observe`rs recording the trajectory and progress, and
 //! [`unfold`] turns its termination into a [`Verdict`] with evidence.
 
 pub mod barrier;
-pub mod checks;
+pub(crate) mod checks;
 pub mod energy;
-pub mod manifold;
-pub mod model;
+pub(crate) mod manifold;
+pub(crate) mod model;
 pub mod network;
-pub mod observe;
+pub(crate) mod observe;
 pub mod qp;
-pub mod settings;
-pub mod solver;
+pub(crate) mod settings;
+pub(crate) mod solver;
 pub mod state;
 
 pub use checks::{find_crossing, node_arc_clearance, planarity_residual, touching_charges};

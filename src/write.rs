@@ -2,8 +2,8 @@
 //! output folders they go into, written atomically. They sit above the engines whose results
 //! they write.
 
-pub mod folder;
+pub(crate) mod folder;
 pub mod folding_output;
 pub mod mujoco;
 pub mod output;
-pub mod summary;
+pub(crate) mod summary;

@@ -5,7 +5,7 @@
 //! run finishes within the library's own bounds and its result is dropped).
 
 use nanofold::commands::{self, FromJson, Pattern};
-use nanofold::prelude::{NanofoldError, Named, Scene};
+use nanofold::prelude::{Named, NanofoldError, Scene};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;

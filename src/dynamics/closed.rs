@@ -7,9 +7,9 @@
 //! the reduced equation Gᵀ[M(G θ̈_c + Ġ θ̇_c) + C G θ̇_c + N] = τ_c written for one coordinate.
 //! The elastic sum runs over every crease, the cut one included: it is a hinge too.
 
-pub mod assemble;
+pub(crate) mod assemble;
 pub mod modes;
-pub mod statics;
+pub(crate) mod statics;
 
 use super::algorithms::{
     coriolis_torques, drag_torques, quadratic_form, update_corners, update_kinematics, update_mass_matrix,

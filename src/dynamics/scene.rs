@@ -22,7 +22,7 @@ use crate::read::scene_spec::SceneSpec;
 
 impl SceneSpec {
     /// Validates and assembles the scene. A closed chain is assembled by
-    /// [`assemble::closed_chain`]: sweep, fit, chain.
+    /// `assemble::closed_chain`: sweep, fit, chain.
     pub fn build(&self) -> Result<Scene> {
         match self {
             SceneSpec::Strip(spec) => spec.build(),
@@ -270,7 +270,7 @@ fn moment_about_crease(i: usize, moment: f64, box_moment: f64) -> Result<f64> {
 
 impl ClosedSpec<VertexPattern> {
     /// Validates the scene and assembles its chain: the sweep, the fit and the tree of
-    /// sector plates ([`assemble::closed_chain`]).
+    /// sector plates (`assemble::closed_chain`).
     pub fn build(&self) -> Result<Scene> {
         // The cheap checks first: the chain's assembly runs a sweep.
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
@@ -290,7 +290,7 @@ impl ClosedSpec<VertexPattern> {
 }
 
 impl NetworkSpec<CreasePattern> {
-    /// Validates the scene and assembles its network ([`super::network::assemble::network`]).
+    /// Validates the scene and assembles its network (`super::network::assemble::network`).
     pub fn build(&self) -> Result<Scene> {
         let t_end = time_and_outputs(&self.time, &self.outputs)?;
         let model = super::network::assemble::network(self)?;

@@ -19,7 +19,7 @@ pub struct ContactSettings {
     /// other are measured (for the smallest clearance reported); the cost grows with its
     /// square.
     pub search: f64,
-    /// Most pairs of panels measured in one test, per panel (at least [`MIN_PAIR_BUDGET`]
+    /// Most pairs of panels measured in one test, per panel (at least `MIN_PAIR_BUDGET`
     /// in all): layers stacked deep (an accordion folded nearly flat) overlap in every pair,
     /// and past this the test stops and says so ([`ContactReport::overflow`]).
     pub pairs_per_panel: usize,

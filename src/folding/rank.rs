@@ -49,10 +49,10 @@ const COUNT_REGULARISATION: f64 = 1e-15;
 /// How the rank was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RankMethod {
-    /// Column-pivoted QR of the dense J (threshold [`rank_tolerance`] on |R_ii|/|R_00|).
+    /// Column-pivoted QR of the dense J (threshold `rank_tolerance` on |R_ii|/|R_00|).
     PivotedQr,
     /// The smallest singular values of J by subspace iteration on (JᵀJ + μI)⁻¹ (threshold
-    /// [`rank_tolerance`] on σ / largest column norm).
+    /// `rank_tolerance` on σ / largest column norm).
     SubspaceIteration,
 }
 
@@ -81,12 +81,12 @@ pub struct RankReport {
     pub largest_dropped: f64,
     /// Which method counted what the exact reductions left.
     pub method: RankMethod,
-    /// Creases the exact reductions ([`reduce`]) merged or eliminated before the count.
+    /// Creases the exact reductions (`reduce`) merged or eliminated before the count.
     pub reduced: usize,
 }
 
 /// Rank and degrees of freedom of J: creases no star ties counted at once, the rest reduced
-/// exactly ([`reduce`]: ties merged, rows held by one crease eliminated), and what remains
+/// exactly (`reduce`: ties merged, rows held by one crease eliminated), and what remains
 /// counted by the dense pivoted QR up to [`DENSE_RANK_LIMIT`] columns, the sparse null-space
 /// count above.
 pub fn jacobian_rank(jacobian: &ClosureJacobian) -> Result<RankReport> {

@@ -36,7 +36,7 @@ pub struct UnfoldSettings {
     /// Iterations spent past `flat_tol` polishing towards the exact flat state, until the
     /// line search is stationary (U resolves ρ only to about √ε ≈ 1e-8 there).
     pub polish_iterations: usize,
-    /// Recorded steps at most, 1 ..= [`MAX_ITERATIONS_LIMIT`].
+    /// Recorded steps at most, 1 ..= `MAX_ITERATIONS_LIMIT`.
     pub max_iterations: usize,
     /// Constraints are restored to this residual after every step, radians, in [1e-15, 1e-6].
     pub restore_tol: f64,

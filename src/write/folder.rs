@@ -120,7 +120,7 @@ fn fill(temporary: &Path, dir: &Path, files: &[(&str, &[u8])]) -> std::result::R
     Ok(())
 }
 
-/// [`write_folder`] for the results of `input`: the folder also gets [`OWNER_FILE`] naming
+/// `write_folder` for the results of `input`: the folder also gets `OWNER_FILE` naming
 /// the input (its canonical path), and a folder that holds another input's results is
 /// refused unless `replace_other` (the command line's `--force`).
 pub fn write_folder_of(dir: &Path, input: &Path, replace_other: bool, files: &[(&str, &[u8])]) -> Result<()> {
