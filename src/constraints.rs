@@ -11,7 +11,7 @@ pub(crate) mod sweep;
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, VertexPattern};
-use chebyshev::{eval_monomial, Chebyshev};
+use chebyshev::{eval_monomial, Chebyshev, FittedCurves};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -387,10 +387,8 @@ pub struct ConstraintPoly {
     pub locked: Vec<(usize, f64)>,
     /// The creases f returns, in this order.
     pub dependents: Vec<usize>,
-    /// Fitted interval of the driving angle, rad.
-    pub domain: [f64; 2],
-    /// One series per dependent.
-    pub curves: Vec<Chebyshev>,
+    /// One series per dependent, on the driving angle's fitted interval (rad).
+    pub fitted: FittedCurves,
     /// Largest |f − sample| per dependent, rad.
     pub max_fit_error: Vec<f64>,
     /// Largest |f′ − G| per dependent over the regular samples, G by the implicit function
@@ -442,8 +440,10 @@ impl ConstraintPoly {
             driver_label: pattern.creases[samples.setup.driver].label.clone(),
             locked: samples.setup.locked.clone(),
             dependents: samples.setup.dependents.clone(),
-            domain: samples.domain,
-            curves,
+            fitted: FittedCurves {
+                domain: samples.domain,
+                curves,
+            },
             max_fit_error,
             max_slope_error,
         })
@@ -451,7 +451,7 @@ impl ConstraintPoly {
 
     /// Polynomial degree.
     pub fn degree(&self) -> usize {
-        self.curves.first().map_or(0, Chebyshev::degree)
+        self.fitted.degree()
     }
 
     fn check_domain(&self, theta: f64) -> Result<()> {
@@ -459,13 +459,13 @@ impl ConstraintPoly {
     }
 
     fn check_extended_domain(&self, theta: f64, margin: f64) -> Result<()> {
-        check_in_domain(&self.driver_label, self.domain, theta, margin)
+        check_in_domain(&self.driver_label, self.fitted.domain, theta, margin)
     }
 
     /// f(θ_c): the dependents' angles, written into `out` (one per dependent).
     pub fn eval_into(&self, theta: f64, out: &mut [f64]) -> Result<()> {
         self.check_domain(theta)?;
-        for (o, curve) in out.iter_mut().zip(&self.curves) {
+        for (o, curve) in out.iter_mut().zip(&self.fitted.curves) {
             *o = curve.eval(theta);
         }
         Ok(())
@@ -474,7 +474,7 @@ impl ConstraintPoly {
     /// G = ∂f/∂θ_c (T4.18), one entry per dependent.
     pub fn jacobian_into(&self, theta: f64, out: &mut [f64]) -> Result<()> {
         self.check_domain(theta)?;
-        for (o, curve) in out.iter_mut().zip(&self.curves) {
+        for (o, curve) in out.iter_mut().zip(&self.fitted.curves) {
             *o = curve.eval_with_derivatives(theta).1;
         }
         Ok(())
@@ -483,7 +483,7 @@ impl ConstraintPoly {
     /// Ġ = d/dt ∂f/∂θ_c = f″(θ_c) θ̇_c, for the Ġ θ̇_c term of the closed-chain equations.
     pub fn jacobian_dot_into(&self, theta: f64, theta_dot: f64, out: &mut [f64]) -> Result<()> {
         self.check_domain(theta)?;
-        for (o, curve) in out.iter_mut().zip(&self.curves) {
+        for (o, curve) in out.iter_mut().zip(&self.fitted.curves) {
             *o = curve.eval_with_derivatives(theta).2 * theta_dot;
         }
         Ok(())
@@ -499,32 +499,28 @@ impl ConstraintPoly {
     /// accepted states).
     pub fn evaluate_extended(&self, theta: f64, margin: f64, point: &mut exact::ConstraintPoint) -> Result<()> {
         self.check_extended_domain(theta, margin)?;
-        for (k, curve) in self.curves.iter().enumerate() {
-            let (value, slope, curvature) = curve.eval_with_derivatives(theta);
-            point.values[k] = value;
-            point.jacobian[k] = slope;
-            point.curvature[k] = curvature;
-        }
+        self.fitted
+            .evaluate(theta, &mut point.values, &mut point.jacobian, &mut point.curvature);
         Ok(())
     }
 
     /// f(θ_c) as a new vector.
     pub fn eval(&self, theta: f64) -> Result<Vec<f64>> {
-        let mut out = vec![0.0; self.curves.len()];
+        let mut out = vec![0.0; self.fitted.curves.len()];
         self.eval_into(theta, &mut out)?;
         Ok(out)
     }
 
     /// G(θ_c) as a new vector.
     pub fn jacobian(&self, theta: f64) -> Result<Vec<f64>> {
-        let mut out = vec![0.0; self.curves.len()];
+        let mut out = vec![0.0; self.fitted.curves.len()];
         self.jacobian_into(theta, &mut out)?;
         Ok(out)
     }
 
     /// Ġ(θ_c, θ̇_c) as a new vector.
     pub fn jacobian_dot(&self, theta: f64, theta_dot: f64) -> Result<Vec<f64>> {
-        let mut out = vec![0.0; self.curves.len()];
+        let mut out = vec![0.0; self.fitted.curves.len()];
         self.jacobian_dot_into(theta, theta_dot, &mut out)?;
         Ok(out)
     }
@@ -733,7 +729,8 @@ impl ConstraintReport {
         let mut per_curve = vec![0.0_f64; setup.dependents.len()];
         let mut fitted = vec![0.0; setup.dependents.len()];
         for i in 0..fine_count {
-            let theta = poly.domain[0] + (poly.domain[1] - poly.domain[0]) * i as f64 / (fine_count - 1) as f64;
+            let theta = poly.fitted.domain[0]
+                + (poly.fitted.domain[1] - poly.fitted.domain[0]) * i as f64 / (fine_count - 1) as f64;
             poly.eval_into(theta, &mut fitted)?;
             let mut rho = base.clone();
             rho[driver_ray] = theta;
@@ -753,7 +750,7 @@ impl ConstraintReport {
         }
         let mut curves = Vec::new();
         for (j, &c) in setup.dependents.iter().enumerate() {
-            let coeffs_rad = poly.curves[j].monomial_coefficients();
+            let coeffs_rad = poly.fitted.curves[j].monomial_coefficients();
             let coeffs_deg: Vec<f64> = coeffs_rad
                 .iter()
                 .enumerate()
@@ -771,7 +768,7 @@ impl ConstraintReport {
                 label: pattern.creases[c].label.clone(),
                 coeffs_rad,
                 coeffs_deg,
-                chebyshev_coeffs: poly.curves[j].coeffs.clone(),
+                chebyshev_coeffs: poly.fitted.curves[j].coeffs.clone(),
                 max_fit_error_rad: monomial_error.max(poly.max_fit_error[j]),
                 max_slope_error: poly.max_slope_error[j],
                 max_closure_residual: per_curve[j],
@@ -788,8 +785,8 @@ impl ConstraintReport {
                 .map(|&(c, v)| (pattern.user_index(c).to_string(), v))
                 .collect(),
             degree: poly.degree(),
-            domain_rad: poly.domain,
-            domain_deg: [poly.domain[0].to_degrees(), poly.domain[1].to_degrees()],
+            domain_rad: poly.fitted.domain,
+            domain_deg: [poly.fitted.domain[0].to_degrees(), poly.fitted.domain[1].to_degrees()],
             samples: samples.drive_angles.len(),
             samples_max_closure_residual: samples.max_closure_residual,
             max_closure_residual: all_poly_residual,

@@ -281,7 +281,7 @@ pub fn constraints_svg(pattern: &VertexPattern, samples: &CurveSamples, poly: &C
         root.fill(&WHITE).map_err(plot_error)?;
         let (top, bottom) = root.split_vertically(px(480));
         let x_deg: Vec<f64> = samples.drive_angles.iter().map(|x| x.to_degrees()).collect();
-        let domain_deg = (poly.domain[0].to_degrees(), poly.domain[1].to_degrees());
+        let domain_deg = (poly.fitted.domain[0].to_degrees(), poly.fitted.domain[1].to_degrees());
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for angles in &samples.fold_angles {
             for a in angles {
@@ -336,9 +336,10 @@ pub fn constraints_svg(pattern: &VertexPattern, samples: &CurveSamples, poly: &C
                 .map_err(plot_error)?;
             entries.push((format!("{} ({role})", crease.label), colour, LineKind::Solid));
             if let Some(j) = poly.dependents.iter().position(|&d| d == c) {
-                let curve = &poly.curves[j];
+                let curve = &poly.fitted.curves[j];
                 let points = (0..=fine).map(|i| {
-                    let x = poly.domain[0] + (poly.domain[1] - poly.domain[0]) * i as f64 / fine as f64;
+                    let x = poly.fitted.domain[0]
+                        + (poly.fitted.domain[1] - poly.fitted.domain[0]) * i as f64 / fine as f64;
                     (x.to_degrees(), curve.eval(x).to_degrees())
                 });
                 chart
@@ -357,7 +358,7 @@ pub fn constraints_svg(pattern: &VertexPattern, samples: &CurveSamples, poly: &C
         let errors: Vec<Vec<f64>> = poly
             .dependents
             .iter()
-            .zip(&poly.curves)
+            .zip(&poly.fitted.curves)
             .map(|(&c, curve)| {
                 samples
                     .drive_angles

@@ -131,7 +131,7 @@ pub struct UnfoldReport {
 ///     .crease(Assignment::Unassigned, 0.0)
 ///     .build()?;
 /// let report = unfold_vertex(&pattern, &UnfoldSettings::default())?;
-/// assert_eq!(report.verdict, VertexVerdict::Flat);
+/// assert_eq!(report.verdict, UnfoldVerdict::Flat);
 /// assert!(report.flat_layout_error < 1e-10);
 /// # Ok::<(), NanofoldError>(())
 /// ```

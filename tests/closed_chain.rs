@@ -238,7 +238,7 @@ fn polynomial_g_matches_the_implicit_function_theorem_within_the_stated_error() 
         let ConstraintSource::Poly(poly) = &fitted.closed().unwrap().source else {
             panic!("poly source expected")
         };
-        let [lo, hi] = poly.domain;
+        let [lo, hi] = poly.fitted.domain;
         let (mut exact_point, mut poly_point) = (ConstraintPoint::zeros(3), ConstraintPoint::zeros(3));
         let (mut value_error, mut slope_error): (f64, f64) = (0.0, 0.0);
         for i in 0..=1237 {

@@ -1,6 +1,8 @@
 //! Speed against error for the closed chain (issue 5): the corner cube's step 1 with
-//! f = poly (degrees 2…8) and f = exact, each against the exact run (contact time, angles at
-//! contact, loop-closure drift); and the etch ramp quasi-static against dynamic.
+//! f = poly (degrees 2…8), f = exact and the same vertex as a panel network (no cut, no
+//! reduced coordinate), each against the exact run (contact time, angles at contact,
+//! loop-closure drift): which of the two dynamics models a closed vertex runs on is chosen
+//! from this table; and the etch ramp quasi-static against dynamic.
 //! `cargo run --release --example closed_chain_timing` writes
 //! `output/closed_chain_timing/{report.json, poly_vs_exact.svg, ramp.svg}`, the figures drawn
 //! from the report (`figures.rs`); `-- --from REPORT.json` redraws a saved report's figures
@@ -81,7 +83,7 @@ fn main() {
     let mut rows = vec![json!({
         "source": "exact", "seconds": exact_seconds, "fit_error_rad": 0.0, "slope_error": 0.0,
         "max_closure_residual": closure(&exact), "contact_time_s": exact_contact.time,
-        "contact_time_error_s": 0.0, "contact_angle_error_rad": 0.0,
+        "contact_time_error_s": 0.0, "contact_angle_error_rad": 0.0, "steps": exact.response.steps,
     })];
     for degree in 2..=8 {
         let poly_scene = scene(
@@ -107,8 +109,33 @@ fn main() {
             "source": "poly", "degree": degree, "seconds": seconds, "fit_error_rad": report.fit_error,
             "slope_error": report.slope_error, "max_closure_residual": report.max_closure_residual,
             "contact_time_s": contact.time, "contact_time_error_s": dt, "contact_angle_error_rad": dtheta,
+            "steps": run.response.steps,
         }));
     }
+    // The same vertex on the panel network's equations.
+    let network_scene = scene("corner_cube_step1", json!({"source": "network"}));
+    let (seconds, run) = timed(&network_scene, &settings);
+    let contact = run.response.collision.clone().expect("network run reaches contact");
+    let dt = contact.time - exact_contact.time;
+    let end = &run.response.samples.last().unwrap().angles;
+    assert_eq!(end.len(), exact_end.len(), "one angle per crease, in FOLD edge order");
+    let dtheta = (end - &exact_end).amax();
+    let residual = run.network.as_ref().unwrap().max_closure_residual;
+    println!(
+        "{:>7} {:>10.3} {:>10} {:>10} {:>12.1e} {:>12.1e} {:>12.1e}",
+        "network",
+        seconds * 1e3,
+        "0",
+        "0",
+        residual,
+        dt,
+        dtheta
+    );
+    rows.push(json!({
+        "source": "network", "seconds": seconds, "fit_error_rad": 0.0, "slope_error": 0.0,
+        "max_closure_residual": residual, "contact_time_s": contact.time, "contact_time_error_s": dt,
+        "contact_angle_error_rad": dtheta, "steps": run.response.steps,
+    }));
     // The etch ramp: quasi-static (auto) against dynamic ESDIRK34 at two tolerances.
     let ramp = nanofold::read::load_scene(Path::new("patterns/corner_cube_step1_ramp.scene.json"))
         .and_then(|spec| spec.build())

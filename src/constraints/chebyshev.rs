@@ -1,6 +1,9 @@
 //! Chebyshev series on an interval [a, b]: least-squares fits on the scaled variable
 //! t = (2x − a − b)/(b − a) ∈ [−1, 1] for conditioning (`docs/model.md#constraint-curves`), evaluation with first and
-//! second derivatives, and conversion to monomial coefficients in x.
+//! second derivatives, and conversion to monomial coefficients in x; and [`FittedCurves`],
+//! a set of them on one driving angle's domain: the one form in which both dynamics models
+//! move on fitted constraint curves (a closed chain's `poly` source and a panel network
+//! reduced to one coordinate).
 
 use crate::error::{NanofoldError, NumericalError, Result};
 use nalgebra::{DMatrix, DVector};
@@ -13,6 +16,41 @@ pub struct Chebyshev {
     pub domain: [f64; 2],
     /// c_0 … c_D.
     pub coeffs: Vec<f64>,
+}
+
+/// Fold angles fitted against one driving angle: one series per dependent crease, all on the
+/// driver's fitted domain. Evaluation extrapolates outside it; whether a state may lie there
+/// is the caller's decision ([`FittedCurves::covers`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedCurves {
+    /// The driver's fitted interval [a, b], rad.
+    pub domain: [f64; 2],
+    /// One series per dependent crease, in the caller's order.
+    pub curves: Vec<Chebyshev>,
+}
+
+impl FittedCurves {
+    /// The common degree (0 for no curves).
+    pub fn degree(&self) -> usize {
+        self.curves.first().map_or(0, Chebyshev::degree)
+    }
+
+    /// Is q within the domain widened by `margin` on each side?
+    pub fn covers(&self, q: f64, margin: f64) -> bool {
+        q >= self.domain[0] - margin && q <= self.domain[1] + margin
+    }
+
+    /// Curve k's value, slope and curvature at q: (f, f′, f″).
+    pub fn at(&self, k: usize, q: f64) -> (f64, f64, f64) {
+        self.curves[k].eval_with_derivatives(q)
+    }
+
+    /// Every curve's value, slope and curvature at q, written in curve order.
+    pub fn evaluate(&self, q: f64, values: &mut [f64], slopes: &mut [f64], curvatures: &mut [f64]) {
+        for (k, curve) in self.curves.iter().enumerate() {
+            (values[k], slopes[k], curvatures[k]) = curve.eval_with_derivatives(q);
+        }
+    }
 }
 
 impl Chebyshev {

@@ -73,7 +73,7 @@ impl ConstraintSource {
     /// The fitted (or swept) interval of the driving angle, rad.
     pub fn domain(&self) -> [f64; 2] {
         match self {
-            ConstraintSource::Poly(poly) => poly.domain,
+            ConstraintSource::Poly(poly) => poly.fitted.domain,
             ConstraintSource::Exact(exact) => exact.domain,
         }
     }

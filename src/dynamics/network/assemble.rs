@@ -588,3 +588,88 @@ pub fn from_strip(name: &str, chain: &StripChain) -> Result<NetworkModel> {
     }
     Ok(network)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::algorithms::{
+        update_bias, update_drag, update_kinematics, update_mass_matrix, update_velocities, NetworkData,
+    };
+    use crate::dynamics::algorithms as chain_algorithms;
+    use crate::dynamics::model::Data;
+    use crate::dynamics::scene::System;
+    use crate::read::scene_spec::StripEquations;
+
+    /// The serial chain is the network's oracle on a strip: the network's M by composite
+    /// rigid bodies and its Newton–Euler bias C ρ̇ − Q_drag equal the chain's dense M (product
+    /// of exponentials), its Coriolis torques and its drag torques, entry by entry, at states
+    /// far from the start (both drag laws on, rates of 10⁴ rad/s).
+    #[test]
+    fn a_strips_mass_matrix_and_coriolis_torques_are_the_serial_chains() {
+        for path in [
+            "patterns/bridge_step.scene.json",
+            "patterns/thesis/bridge_thesis_reading.scene.json",
+        ] {
+            let mut spec = crate::read::load_scene(path.as_ref()).unwrap();
+            let crate::read::scene_spec::SceneSpec::Strip(strip) = &mut spec else {
+                panic!("{path} is a strip")
+            };
+            strip.equations = StripEquations::Chain;
+            let scene = spec.build().unwrap();
+            let System::Strip(chain) = &scene.system else {
+                panic!("{path}: the chain's equations")
+            };
+            let network = super::from_strip("strip", chain).unwrap();
+            let n = chain.model.dof();
+            assert_eq!(network.columns(), n);
+            // Column c is hinge i (the labels say which).
+            let hinge: Vec<usize> = network
+                .labels
+                .iter()
+                .map(|label| label.strip_prefix("hinge ").unwrap().parse().unwrap())
+                .collect();
+            let mut chain_data = Data::new(&chain.model);
+            let mut network_data = NetworkData::new(&network);
+            for (angles, rates) in [
+                (vec![0.3, -0.5, 1.1, 0.7], vec![1e4, -3e4, 2e4, 5e3]),
+                (vec![1.5, 1.4, 1.6, 2.9], vec![-2e3, 4e4, 1e3, -3e4]),
+            ] {
+                // Hinge i's angle and rate, in network columns.
+                let rho: Vec<f64> = hinge.iter().map(|&i| angles[i]).collect();
+                let rho_dot: Vec<f64> = hinge.iter().map(|&i| rates[i]).collect();
+                chain_algorithms::update_kinematics(&chain.model, &angles, &mut chain_data);
+                chain_algorithms::update_mass_matrix(&chain.model, &mut chain_data);
+                chain_algorithms::update_velocities(&chain.model, &rates, &mut chain_data);
+                let mut coriolis = vec![0.0; n];
+                chain_algorithms::coriolis_torques(&chain.model, &rates, &mut chain_data, &mut coriolis);
+                let mut drag = vec![0.0; n];
+                chain_algorithms::drag_torques(&chain.model, &chain_data, &mut drag);
+                update_kinematics(&network, &rho, &mut network_data);
+                update_mass_matrix(&network, &mut network_data);
+                update_velocities(&network, &rho_dot, &mut network_data);
+                update_drag(&network, &mut network_data);
+                update_bias(&network, &mut network_data);
+                let mass = &chain_data.mass_matrix;
+                let scale = mass.amax();
+                // Every stored entry of the network's M (a strip is one path: all of them).
+                assert_eq!(network.mass_pattern.len(), n * (n + 1) / 2, "{path}");
+                for (&(a, c), value) in network.mass_pattern.iter().zip(&network_data.mass_values) {
+                    let expected = mass[(hinge[a], hinge[c])];
+                    assert!(
+                        (value - expected).abs() <= 1e-12 * scale,
+                        "{path}: M[{a}, {c}] {value:e} vs the chain's {expected:e}"
+                    );
+                }
+                let torques: Vec<f64> = (0..n).map(|i| coriolis[i] - drag[i]).collect();
+                let scale = torques.iter().fold(0.0_f64, |m, t| m.max(t.abs()));
+                assert!(drag.iter().any(|d| d.abs() > 1e-3 * scale), "{path}: drag takes part");
+                for (c, bias) in network_data.bias.iter().enumerate() {
+                    let expected = torques[hinge[c]];
+                    assert!(
+                        (bias - expected).abs() <= 1e-10 * scale,
+                        "{path}: column {c}: C ρ̇ − Q {bias:e} vs the chain's {expected:e}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,9 +1,10 @@
 //! Fitted curves of a one-DOF network (`docs/model.md#fitted-curves-of-a-network`): every
-//! crease's Chebyshev fit against one driving crease, their evaluation with derivatives and
+//! other crease's Chebyshev fit against one driving crease, held as the closed chain's
+//! `poly` source holds its curves ([`FittedCurves`]), placed in the network's columns, and
 //! what a run states of them. Built by [`super::reduced::reduce`]; moved on by
 //! [`super::reduced::ReducedPlant`].
 
-use crate::constraints::chebyshev::Chebyshev;
+use crate::constraints::chebyshev::FittedCurves;
 use crate::error::{NanofoldError, Result};
 use serde::Serialize;
 
@@ -17,10 +18,9 @@ const DOMAIN_MARGIN: f64 = 0.1;
 pub struct FittedReduction {
     /// The driver's column.
     pub driver: usize,
-    /// Every column's curve against the driver (None for the driver itself).
-    pub curves: Vec<Option<Chebyshev>>,
-    /// The fitted range of the driver, rad.
-    pub domain: [f64; 2],
+    /// Every other column's curve against the driver, in column order (the driver's
+    /// column left out), on the driver's fitted range (rad).
+    pub fitted: FittedCurves,
     /// Σ over the creases of |f′| (largest over the domain), the driver's 1 included: how
     /// fast the creases move per unit driver rate.
     pub total_slope: f64,
@@ -52,10 +52,25 @@ pub struct ReducedReport {
 }
 
 impl FittedReduction {
+    /// The fitted curve of column c (None: the driver's own column).
+    fn curve_of(&self, c: usize) -> Option<usize> {
+        match c.cmp(&self.driver) {
+            std::cmp::Ordering::Less => Some(c),
+            std::cmp::Ordering::Equal => None,
+            std::cmp::Ordering::Greater => Some(c - 1),
+        }
+    }
+
+    /// Every column's (ρ, Z, H) at driver angle q: the driver's own (q, 1, 0), the others'
+    /// fitted (f, f′, f″), extrapolated outside the domain.
+    fn column(&self, c: usize, q: f64) -> (f64, f64, f64) {
+        self.curve_of(c).map_or((q, 1.0, 0.0), |k| self.fitted.at(k, q))
+    }
+
     /// The fold angles at driver angle q (extrapolated outside the domain).
     pub fn angles(&self, q: f64, out: &mut [f64]) {
-        for (c, curve) in self.curves.iter().enumerate() {
-            out[c] = curve.as_ref().map_or(q, |f| f.eval(q));
+        for (c, angle) in out.iter_mut().enumerate() {
+            *angle = self.column(c, q).0;
         }
     }
 
@@ -67,14 +82,12 @@ impl FittedReduction {
         slopes: &mut [f64],
         curvatures: &mut [f64],
     ) -> Result<()> {
-        let [a, b] = self.domain;
-        let margin = DOMAIN_MARGIN * (b - a);
-        if !(q >= a - margin && q <= b + margin) {
+        let [a, b] = self.fitted.domain;
+        if !self.fitted.covers(q, DOMAIN_MARGIN * (b - a)) {
             return Err(self.outside(q));
         }
-        for (c, curve) in self.curves.iter().enumerate() {
-            (angles[c], slopes[c], curvatures[c]) =
-                curve.as_ref().map_or((q, 1.0, 0.0), |f| f.eval_with_derivatives(q));
+        for c in 0..angles.len() {
+            (angles[c], slopes[c], curvatures[c]) = self.column(c, q);
         }
         Ok(())
     }

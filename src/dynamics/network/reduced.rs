@@ -15,7 +15,7 @@ use super::model::NetworkModel;
 use super::plant::{
     fastest_drive_rate, network_report, network_sample, time_scales_of, NetworkPlant, NetworkRunReport,
 };
-use crate::constraints::chebyshev::Chebyshev;
+use crate::constraints::chebyshev::FittedCurves;
 use crate::constraints::network::{fit_network, network_sweep, NetworkCurve};
 use crate::constraints::{MAX_DEGREE, MAX_SAMPLES};
 use crate::dynamics::contact::{Collision, ContactProbe};
@@ -154,17 +154,14 @@ pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<Fitt
             best.expect("at least one degree")
         }
     };
-    let mut curves: Vec<Option<Chebyshev>> = vec![None; columns];
-    let mut fitted = fitted.into_iter();
-    for (c, curve) in curves.iter_mut().enumerate() {
-        if c != driver {
-            *curve = Some(fitted.next().expect("one curve per other crease").chebyshev);
-        }
-    }
+    // fit_network gives one curve per crease but the driver, in column order.
+    debug_assert_eq!(fitted.len() + 1, columns);
     let mut reduction = FittedReduction {
         driver,
-        curves,
-        domain,
+        fitted: FittedCurves {
+            domain,
+            curves: fitted.into_iter().map(|curve| curve.chebyshev).collect(),
+        },
         total_slope: 0.0,
         report: ReducedReport {
             driver_edge: model.folding.pattern.creases[driver],
@@ -181,9 +178,9 @@ pub fn reduce(model: &NetworkModel, spec: &NetworkConstraintSpec) -> Result<Fitt
     let at = |k: usize| domain[0] + (domain[1] - domain[0]) * k as f64 / points as f64;
     reduction.total_slope = 1.0
         + reduction
+            .fitted
             .curves
             .iter()
-            .flatten()
             .map(|f| {
                 (0..=points)
                     .map(|k| f.eval_with_derivatives(at(k)).1.abs())
@@ -663,7 +660,7 @@ impl Plant for ReducedPlant<'_> {
     }
 
     fn check_samples(&self, samples: &[Sample]) -> Result<()> {
-        let [a, b] = self.reduction.domain;
+        let [a, b] = self.reduction.fitted.domain;
         let slack = 1e-9 * (b - a);
         let resting = self.exact.branch().map_or(f64::NEG_INFINITY, |b| b.time);
         match samples
