@@ -1006,7 +1006,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
     let files = nanofold::commands::simulation_files(&scene, &report)?;
     write_outputs(&dir, &args.scene, &files)?;
     if args.json {
-        println!("{}", report.summary);
+        println!("{}", report.to_json());
         return Ok(());
     }
     let scales = &response.time_scales;
@@ -1205,7 +1205,7 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<()> {
     let files = nanofold::commands::modes_files(&scene, &report)?;
     write_outputs(&dir, path, &files)?;
     if json {
-        let mut value = report.summary.clone();
+        let mut value = report.to_json();
         value["out"] = serde_json::json!(dir.display().to_string());
         println!("{value}");
         return Ok(());

@@ -22,4 +22,6 @@ pub mod simulate;
 pub(crate) mod spec;
 pub mod strip;
 
+pub use contact::Collision;
+pub use forcing::{Actuation, Forcing, HingeDrive};
 pub use model::{Data, Drag, Joint, Model, Plate};

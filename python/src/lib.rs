@@ -376,7 +376,7 @@ fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(St
         let clock = Instant::now();
         let report = commands::simulate(scene, &settings)?;
         Ok(payload(
-            report.summary,
+            report.to_json(),
             json!({"response": report.response, "fold_file": report.fold}),
             clock,
         ))
@@ -389,7 +389,7 @@ fn modes(py: Python<'_>, scene: &SceneHandle) -> PyResult<(String, String)> {
     on_scene(py, scene, |scene| {
         let clock = Instant::now();
         let report = commands::modes(scene)?;
-        Ok(payload(report.summary, json!({"fold_file": report.fold}), clock))
+        Ok(payload(report.to_json(), json!({"fold_file": report.fold}), clock))
     })
 }
 

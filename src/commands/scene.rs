@@ -6,7 +6,11 @@ use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{simulate as simulate_scene, Simulation, SimulationSettings};
 use crate::error::Result;
 use crate::write::folding_output::{network_modes_fold, network_motion_fold};
-use crate::write::output::{closed_modes_json, modes_json, network_modes_json, response_json, response_summary};
+use crate::write::output::{
+    closed_modes_summary, network_modes_summary, response_json, response_summary, strip_modes_summary,
+};
+use crate::write::summary::{ModesSummary, ResponseSummary};
+use serde::Serialize;
 use serde_json::Value;
 
 /// Reads and builds a scene file (`*.scene.json`); a closed chain's or a device's
@@ -33,15 +37,26 @@ pub fn scene_kind(scene: &Scene) -> &'static str {
 /// Each mode's frames in modes.fold move its largest crease this far either way, rad.
 pub const MODE_AMPLITUDE: f64 = 0.1;
 
-/// A scene's modes: the summary and, for a network, each mode as a pair of FOLD frames.
-#[derive(Debug, Clone)]
+/// A scene's modes: the summary and, for a network, each mode as a pair of FOLD frames. It
+/// serialises as its summary (`nanofold modes --json`, less the command line's `out`).
+#[derive(Debug, Clone, Serialize)]
 pub struct ModesReport {
-    /// As `nanofold modes --json` prints it (less the command line's `out`).
-    pub summary: Value,
+    /// As `nanofold modes --json` prints it.
+    #[serde(flatten)]
+    pub summary: ModesSummary,
     /// A network's modes.fold.
+    #[serde(skip)]
     pub fold: Option<Value>,
     /// The modes as the engine found them.
+    #[serde(skip)]
     pub detail: ModesDetail,
+}
+
+impl ModesReport {
+    /// As `nanofold modes --json` prints it: its own serialisation.
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(self).expect("a summary is plain data")
+    }
 }
 
 /// The modes of each kind of scene, as its engine gives them.
@@ -61,7 +76,7 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
         System::Strip(chain) => {
             let result = crate::dynamics::modes::modes(&chain.model, chain.target_angles().as_slice())?;
             ModesReport {
-                summary: modes_json(scene, &result),
+                summary: ModesSummary::Strip(Box::new(strip_modes_summary(scene, &result))),
                 fold: None,
                 detail: ModesDetail::Strip(result),
             }
@@ -70,7 +85,7 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
             let result = chain.folded_modes()?;
             let eta = chain.torque_magnification()?;
             ModesReport {
-                summary: closed_modes_json(&scene.name, chain, &result, eta),
+                summary: ModesSummary::Closed(Box::new(closed_modes_summary(&scene.name, chain, &result, eta))),
                 fold: None,
                 detail: ModesDetail::Closed(Box::new(result), eta),
             }
@@ -78,7 +93,7 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
         System::Network(model) => {
             let result = crate::dynamics::network::modes::folded_modes(model)?;
             ModesReport {
-                summary: network_modes_json(&scene.name, model, &result),
+                summary: ModesSummary::Network(Box::new(network_modes_summary(&scene.name, model, &result))),
                 fold: Some(network_modes_fold(model, &result, MODE_AMPLITUDE)?),
                 detail: ModesDetail::Network(Box::new(result)),
             }
@@ -116,17 +131,29 @@ pub fn modes_files(scene: &Scene, report: &ModesReport) -> Result<Vec<(&'static 
     })
 }
 
-/// A scene's simulated response in the forms the command line writes.
-#[derive(Debug, Clone)]
+/// A scene's simulated response in the forms the command line writes. It serialises as its
+/// summary (`nanofold simulate --json`).
+#[derive(Debug, Clone, Serialize)]
 pub struct SimulationReport {
     /// As `nanofold simulate --json` prints it.
-    pub summary: Value,
+    #[serde(flatten)]
+    pub summary: ResponseSummary,
     /// response.json: the settings, the model chosen and every sample.
+    #[serde(skip)]
     pub response: Value,
     /// A network's motion.fold.
+    #[serde(skip)]
     pub fold: Option<Value>,
     /// The run itself.
+    #[serde(skip)]
     pub simulation: Simulation,
+}
+
+impl SimulationReport {
+    /// As `nanofold simulate --json` prints it: its own serialisation.
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(self).expect("a summary is plain data")
+    }
 }
 
 /// The files `simulate` writes for a run (rendered, not written): response.json,

@@ -23,7 +23,8 @@ pub(crate) mod rows;
 pub(crate) mod start;
 
 pub use algorithms::{NetworkData, Spatial, SpatialInertia};
+pub use fitted::ReducedReport;
 pub use kkt::KktSystem;
 pub use model::{Hinge, NetworkModel, NetworkParts, PanelBody};
-pub use plant::NetworkPlant;
+pub use plant::{NetworkPlant, NetworkRunReport};
 pub use reduced::{FittedReduction, ReducedPlant};

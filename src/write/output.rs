@@ -15,6 +15,10 @@ use crate::geometry::sphere::Vec3;
 use crate::names::Named;
 use crate::pattern::{Chain, FlatMesh, RayRole, VertexPattern};
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
+use crate::write::summary::{
+    ClosedModesSummary, ClosedRunSummary, CollisionSummary, NetworkModesSummary, NetworkRunSummary, ReleasedLock,
+    ResponseSummary, StripModesSummary, TimeScalesSummary,
+};
 use nalgebra::DMatrix;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -358,83 +362,83 @@ pub fn target_angles(scene: &Scene) -> Vec<f64> {
 /// A closed chain adds `cut_crease`, `anchored_face`, `constraint_source`,
 /// `torque_magnification`, `max_closure_residual` and the fit's errors (angles are every
 /// crease's, in FOLD edge order).
-pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> Value {
+pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> ResponseSummary {
     let response = &simulation.response;
-    let collision = response.collision.as_ref().map(|c| {
-        json!({
-            "time_s": c.time,
-            "pair": c.pair,
-            "point": [c.point.x, c.point.y, c.point.z],
-            "point_um": [c.point.x * 1e6, c.point.y * 1e6, c.point.z * 1e6],
-        })
-    });
-    let final_angles = response
-        .samples
-        .last()
-        .map(|s| s.angles.as_slice().to_vec())
-        .unwrap_or_default();
-    let mut value = json!({
-        "scene": scene.name,
-        "model": response.model,
-        "method": response.method,
-        "rtol": response.rtol,
-        "time_scale_ratio": number(response.time_scales.ratio),
-        "time_scales": {
-            "fastest_period_s": number(response.time_scales.fastest_period_s),
-            "slowest_period_s": number(response.time_scales.slowest_period_s),
-            "forcing_time_s": number(response.time_scales.forcing_time_s),
-            "ratio": number(response.time_scales.ratio),
+    let scales = &response.time_scales;
+    let closed = match (&simulation.closed, scene.closed()) {
+        (Some(closed), Some(chain)) => Some(ClosedRunSummary {
+            cut_crease: closed.cut_crease,
+            anchored_face: closed.anchored_face,
+            driving_crease: closed.driver,
+            constraint_source: closed.constraint_source,
+            constraint_degree: closed.degree,
+            constraint_fit_error_rad: closed.fit_error,
+            constraint_slope_error: closed.slope_error,
+            torque_magnification: closed.torque_magnification,
+            driving_hinge_width_um: closed.driving_hinge_width_um,
+            required_hinge_width_um: closed.required_hinge_width_um,
+            max_closure_residual: closed.max_closure_residual,
+            crease_edges: chain.crease_user_indices.clone(),
+        }),
+        _ => None,
+    };
+    let network = match (&simulation.network, scene.network()) {
+        (Some(report), Some(model)) => Some(NetworkRunSummary {
+            panels: report.panels,
+            creases: report.creases,
+            anchored_face: report.anchored_face,
+            branch: report.branch.clone(),
+            max_closure_residual: report.max_closure_residual,
+            energy_balance_error: report.energy_balance_error,
+            meeting_at_contact: report.meeting_at_contact.clone(),
+            touching_at_start: report.touching_at_start.clone(),
+            reduced: report.reduced.clone(),
+            crease_edges: model.folding.pattern.creases.clone(),
+            release_times_s: model.forcing.hinges.iter().map(|h| h.release_time).collect(),
+        }),
+        _ => None,
+    };
+    ResponseSummary {
+        scene: scene.name.clone(),
+        model: response.model,
+        method: response.method,
+        rtol: response.rtol,
+        time_scale_ratio: scales.ratio,
+        time_scales: TimeScalesSummary {
+            fastest_period_s: scales.fastest_period_s,
+            slowest_period_s: scales.slowest_period_s,
+            forcing_time_s: scales.forcing_time_s,
+            ratio: scales.ratio,
         },
-        "quasi_static_error_estimate_rad": number(response.quasi_static_error_estimate),
-        "measured_quasi_static_error_rad": response.measured_quasi_static_error.map(|(_, e)| e),
-        "quasi_static_check_window_s": response.measured_quasi_static_error.map(|(w, _)| w),
-        "ignore_collisions": settings.ignore_collisions,
-        "t_end_s": response.t_end,
-        "collision": collision,
-        "final_angles_rad": final_angles,
-        "target_angles_rad": target_angles(scene),
-        "steps": response.steps,
-        "rhs_evaluations": response.rhs_evaluations,
-        "seconds": response.seconds,
-    });
-    if let (Some(closed), Some(chain)) = (&simulation.closed, scene.closed()) {
-        value["cut_crease"] = json!(closed.cut_crease);
-        value["anchored_face"] = json!(closed.anchored_face);
-        value["driving_crease"] = json!(closed.driver);
-        value["constraint_source"] = json!(closed.constraint_source);
-        value["constraint_degree"] = json!(closed.degree);
-        value["constraint_fit_error_rad"] = json!(closed.fit_error);
-        value["constraint_slope_error"] = json!(closed.slope_error);
-        value["torque_magnification"] = number(closed.torque_magnification);
-        value["driving_hinge_width_um"] = number(closed.driving_hinge_width_um);
-        value["required_hinge_width_um"] = number(closed.required_hinge_width_um);
-        value["max_closure_residual"] = json!(closed.max_closure_residual);
-        value["crease_edges"] = json!(chain.crease_user_indices);
+        quasi_static_error_estimate_rad: response.quasi_static_error_estimate,
+        measured_quasi_static_error_rad: response.measured_quasi_static_error.map(|(_, e)| e),
+        quasi_static_check_window_s: response.measured_quasi_static_error.map(|(w, _)| w),
+        ignore_collisions: settings.ignore_collisions,
+        t_end_s: response.t_end,
+        collision: response.collision.as_ref().map(|c| CollisionSummary {
+            time_s: c.time,
+            pair: c.pair.clone(),
+            point: [c.point.x, c.point.y, c.point.z],
+            point_um: [c.point.x * 1e6, c.point.y * 1e6, c.point.z * 1e6],
+        }),
+        final_angles_rad: response
+            .samples
+            .last()
+            .map(|s| s.angles.as_slice().to_vec())
+            .unwrap_or_default(),
+        target_angles_rad: target_angles(scene),
+        steps: response.steps,
+        rhs_evaluations: response.rhs_evaluations,
+        seconds: response.seconds,
+        closed,
+        network,
     }
-    if let (Some(report), Some(model)) = (&simulation.network, scene.network()) {
-        value["panels"] = json!(report.panels);
-        value["creases"] = json!(report.creases);
-        value["anchored_face"] = json!(report.anchored_face);
-        value["branch"] = json!(report.branch);
-        value["max_closure_residual"] = json!(report.max_closure_residual);
-        value["energy_balance_error"] = json!(report.energy_balance_error);
-        value["meeting_at_contact"] = json!(report.meeting_at_contact);
-        value["touching_at_start"] = json!(report.touching_at_start);
-        value["reduced"] = json!(report.reduced);
-        value["crease_edges"] = json!(model.folding.pattern.creases);
-        value["release_times_s"] = json!(model
-            .forcing
-            .hinges
-            .iter()
-            .map(|h| h.release_time)
-            .collect::<Vec<f64>>());
-    }
-    value
 }
 
 /// `response.json`: the summary plus every output sample.
 pub fn response_json(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> Value {
-    with_samples(response_summary(scene, settings, simulation), &simulation.response)
+    let summary = serde_json::to_value(response_summary(scene, settings, simulation)).expect("a summary is plain data");
+    with_samples(summary, &simulation.response)
 }
 
 fn with_samples(mut value: Value, response: &Response) -> Value {
@@ -463,62 +467,70 @@ fn with_samples(mut value: Value, response: &Response) -> Value {
 
 /// `nanofold modes --json` of a network: the equilibrium, the released locks, the
 /// frequencies (with and without the constraints' load term) and the shapes over every crease.
-pub fn network_modes_json(name: &str, model: &NetworkModel, result: &NetworkModes) -> Value {
+pub fn network_modes_summary(name: &str, model: &NetworkModel, result: &NetworkModes) -> NetworkModesSummary {
     let modes = &result.modes;
-    let shapes: Vec<Vec<f64>> = (0..modes.crease_shapes.ncols())
-        .map(|k| modes.crease_shapes.column(k).iter().copied().collect())
-        .collect();
-    json!({
-        "scene": name,
-        "panels": model.panels(),
-        "creases": model.columns(),
-        "crease_edges": model.folding.pattern.creases,
-        "anchored_face": model.anchored_face,
-        "degrees_of_freedom": modes.basis.ncols(),
-        "released_locks": result.released.iter().map(|&(c, a)| json!({"edge": model.folding.pattern.creases[c], "angle_rad": a})).collect::<Vec<_>>(),
-        "rest_angles_rad": result.rest_angles,
-        "equilibrium_rad": modes.equilibrium.angles,
-        "equilibrium_newton_steps": modes.equilibrium.iterations,
-        "residual_torque_n_m": modes.equilibrium.residual_torque,
-        "closure_residual_rad": modes.equilibrium.closure_residual,
-        "eigenvalues": modes.modes.eigenvalues,
-        "frequencies_hz": modes.modes.frequencies_hz,
-        "frequencies_without_load_hz": modes.frequencies_without_load_hz,
-        "mode_shapes": shapes,
-        "stable": modes.modes.stable,
-        "reduced": model.reduction.as_ref().map(|r| &r.report),
-    })
+    NetworkModesSummary {
+        scene: name.to_string(),
+        panels: model.panels(),
+        creases: model.columns(),
+        crease_edges: model.folding.pattern.creases.clone(),
+        anchored_face: model.anchored_face,
+        degrees_of_freedom: modes.basis.ncols(),
+        released_locks: result
+            .released
+            .iter()
+            .map(|&(c, angle_rad)| ReleasedLock {
+                edge: model.folding.pattern.creases[c],
+                angle_rad,
+            })
+            .collect(),
+        rest_angles_rad: result.rest_angles.clone(),
+        equilibrium_rad: modes.equilibrium.angles.clone(),
+        equilibrium_newton_steps: modes.equilibrium.iterations,
+        residual_torque_n_m: modes.equilibrium.residual_torque,
+        closure_residual_rad: modes.equilibrium.closure_residual,
+        eigenvalues: modes.modes.eigenvalues.to_vec(),
+        frequencies_hz: modes.modes.frequencies_hz.to_vec(),
+        frequencies_without_load_hz: modes.frequencies_without_load_hz.to_vec(),
+        mode_shapes: columns(&modes.crease_shapes),
+        stable: modes.modes.stable,
+        reduced: model.reduction.as_ref().map(|r| r.report.clone()),
+    }
+}
+
+/// A matrix's columns, each a vector.
+fn columns(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.ncols()).map(|k| m.column(k).iter().copied().collect()).collect()
+}
+
+/// A matrix's rows, each a vector.
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|k| m.row(k).iter().copied().collect()).collect()
 }
 
 /// `nanofold modes` output of a strip.
-pub fn modes_json(scene: &Scene, modes: &Modes) -> Value {
-    let n = modes.eigenvalues.len();
-    json!({
-        "scene": scene.name,
-        "equilibrium_rad": modes.equilibrium.as_slice(),
-        "equilibrium": "folded: K θ = K θ_target, so θ* = θ_target (passive hinges at 0)",
-        "eigenvalues": modes.eigenvalues,
-        "frequencies_hz": modes.frequencies_hz,
-        "mode_shapes": (0..n).map(|k| modes.mode_shapes.column(k).iter().copied().collect::<Vec<f64>>()).collect::<Vec<_>>(),
-        "stable": modes.stable,
-        "stiffness_n_m_per_rad": scene.stiffness(),
-    })
+pub fn strip_modes_summary(scene: &Scene, modes: &Modes) -> StripModesSummary {
+    StripModesSummary {
+        scene: scene.name.clone(),
+        equilibrium_rad: modes.equilibrium.as_slice().to_vec(),
+        equilibrium: "folded: K θ = K θ_target, so θ* = θ_target (passive hinges at 0)",
+        eigenvalues: modes.eigenvalues.to_vec(),
+        frequencies_hz: modes.frequencies_hz.to_vec(),
+        mode_shapes: columns(&modes.mode_shapes),
+        stable: modes.stable,
+        stiffness_n_m_per_rad: scene.stiffness(),
+    }
 }
 
 /// `nanofold modes` output of a closed chain: the strip's keys (`equilibrium_rad` and
 /// `mode_shapes` are over the released coordinates) plus every crease's angles and shapes,
 /// the reduced matrices and the closed-chain keys. Crease numbers are FOLD edge indices.
-pub fn closed_modes_json(name: &str, chain: &ClosedChain, modes: &ClosedModes, torque_magnification: f64) -> Value {
-    let columns = |m: &DMatrix<f64>| {
-        (0..m.ncols())
-            .map(|k| m.column(k).iter().copied().collect::<Vec<f64>>())
-            .collect::<Vec<_>>()
-    };
-    let rows = |m: &DMatrix<f64>| {
-        (0..m.nrows())
-            .map(|k| m.row(k).iter().copied().collect::<Vec<f64>>())
-            .collect::<Vec<_>>()
-    };
+pub fn closed_modes_summary(
+    name: &str,
+    chain: &ClosedChain,
+    modes: &ClosedModes,
+    torque_magnification: f64,
+) -> ClosedModesSummary {
     let stiffness = &modes.hinge_stiffness + &modes.load_stiffness;
     let user = |creases: &[usize]| {
         creases
@@ -526,34 +538,34 @@ pub fn closed_modes_json(name: &str, chain: &ClosedChain, modes: &ClosedModes, t
             .map(|&c| chain.crease_user_indices[c])
             .collect::<Vec<_>>()
     };
-    json!({
-        "scene": name,
-        "cut_crease": chain.crease_user_indices[chain.cut_crease],
-        "anchored_face": chain.anchored_face,
-        "constraint_source": chain.source.name(),
-        "torque_magnification": number(torque_magnification),
-        "max_closure_residual": modes.closure_residual,
-        "coordinates": user(&modes.coordinates),
-        "crease_edges": chain.crease_user_indices,
-        "equilibrium_rad": modes.modes.equilibrium.as_slice(),
-        "equilibrium": "∇V = 0 with every lock released; V = Σ ½ K (θ − rest)² along the loop closure",
-        "equilibrium_crease_angles_rad": modes.equilibrium,
-        "folded_pose_rad": modes.folded_pose,
-        "rest_angles_rad": modes.rest_angles,
-        "residual_torque_n_m": modes.residual_torque,
-        "newton_iterations": modes.newton_iterations,
-        "folded_through": user(&modes.folded_through),
-        "eigenvalues": modes.modes.eigenvalues,
-        "frequencies_hz": modes.modes.frequencies_hz,
-        "frequencies_without_load_hz": modes.frequencies_without_load_hz,
-        "mode_shapes": columns(&modes.modes.mode_shapes),
-        "crease_mode_shapes": columns(&modes.crease_shapes),
-        "stable": modes.modes.stable,
-        "stiffness_n_m_per_rad": chain.crease_stiffness,
-        "reduced_mass_kg_m2": rows(&modes.reduced_mass),
-        "reduced_stiffness_n_m_per_rad": rows(&stiffness),
-        "load_stiffness_n_m_per_rad": rows(&modes.load_stiffness),
-    })
+    ClosedModesSummary {
+        scene: name.to_string(),
+        cut_crease: chain.crease_user_indices[chain.cut_crease],
+        anchored_face: chain.anchored_face,
+        constraint_source: chain.source.name(),
+        torque_magnification,
+        max_closure_residual: modes.closure_residual,
+        coordinates: user(&modes.coordinates),
+        crease_edges: chain.crease_user_indices.clone(),
+        equilibrium_rad: modes.modes.equilibrium.as_slice().to_vec(),
+        equilibrium: "∇V = 0 with every lock released; V = Σ ½ K (θ − rest)² along the loop closure",
+        equilibrium_crease_angles_rad: modes.equilibrium.clone(),
+        folded_pose_rad: modes.folded_pose.clone(),
+        rest_angles_rad: modes.rest_angles.clone(),
+        residual_torque_n_m: modes.residual_torque,
+        newton_iterations: modes.newton_iterations,
+        folded_through: user(&modes.folded_through),
+        eigenvalues: modes.modes.eigenvalues.to_vec(),
+        frequencies_hz: modes.modes.frequencies_hz.to_vec(),
+        frequencies_without_load_hz: modes.frequencies_without_load_hz.to_vec(),
+        mode_shapes: columns(&modes.modes.mode_shapes),
+        crease_mode_shapes: columns(&modes.crease_shapes),
+        stable: modes.modes.stable,
+        stiffness_n_m_per_rad: chain.crease_stiffness.clone(),
+        reduced_mass_kg_m2: rows(&modes.reduced_mass),
+        reduced_stiffness_n_m_per_rad: rows(&stiffness),
+        load_stiffness_n_m_per_rad: rows(&modes.load_stiffness),
+    }
 }
 
 #[cfg(test)]

@@ -521,3 +521,285 @@ impl FoldSummary {
         }
     }
 }
+
+/// `simulate --json`, and the head of `response.json`: the model chosen and why, the
+/// first contact, the end; a closed chain's or a network's own figures beside them (angles
+/// are every crease's, in FOLD edge order).
+#[derive(Debug, Clone, Serialize)]
+pub struct ResponseSummary {
+    /// The scene's name.
+    pub scene: String,
+    /// The equations solved.
+    pub model: crate::dynamics::simulate::ModelKind,
+    /// The integrator (None: quasi-static).
+    pub method: Option<crate::dynamics::integrate::Method>,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Forcing time over the slowest natural period.
+    #[serde(serialize_with = "number")]
+    pub time_scale_ratio: f64,
+    /// The time scales the model was chosen from.
+    pub time_scales: TimeScalesSummary,
+    /// The quasi-static model's error bound, rad.
+    #[serde(serialize_with = "number")]
+    pub quasi_static_error_estimate_rad: f64,
+    /// Its error measured against a dynamic window, rad.
+    pub measured_quasi_static_error_rad: Option<f64>,
+    /// That window, s.
+    pub quasi_static_check_window_s: Option<f64>,
+    /// Whether contacts were integrated through.
+    pub ignore_collisions: bool,
+    /// End of the run, s.
+    pub t_end_s: f64,
+    /// The first contact (None: none).
+    pub collision: Option<CollisionSummary>,
+    /// Angles at the end, rad.
+    pub final_angles_rad: Vec<f64>,
+    /// Every output angle's target, rad.
+    pub target_angles_rad: Vec<f64>,
+    /// Integrator steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations.
+    pub rhs_evaluations: usize,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// A closed chain's figures.
+    #[serde(flatten)]
+    pub closed: Option<ClosedRunSummary>,
+    /// A network's figures.
+    #[serde(flatten)]
+    pub network: Option<NetworkRunSummary>,
+}
+
+/// The time scales a run's model was chosen from, s.
+#[derive(Debug, Clone, Serialize)]
+pub struct TimeScalesSummary {
+    /// Fastest natural period.
+    #[serde(serialize_with = "number")]
+    pub fastest_period_s: f64,
+    /// Slowest natural period.
+    #[serde(serialize_with = "number")]
+    pub slowest_period_s: f64,
+    /// Forcing time.
+    #[serde(serialize_with = "number")]
+    pub forcing_time_s: f64,
+    /// Forcing time over the slowest period.
+    #[serde(serialize_with = "number")]
+    pub ratio: f64,
+}
+
+/// A first contact.
+#[derive(Debug, Clone, Serialize)]
+pub struct CollisionSummary {
+    /// When, s.
+    pub time_s: f64,
+    /// The two bodies that meet.
+    pub pair: [String; 2],
+    /// Where, m.
+    pub point: [f64; 3],
+    /// Where, µm.
+    pub point_um: [f64; 3],
+}
+
+/// A closed chain's figures of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClosedRunSummary {
+    /// The cut crease (FOLD edge).
+    pub cut_crease: usize,
+    /// The face on the substrate.
+    pub anchored_face: usize,
+    /// The driving crease.
+    pub driving_crease: usize,
+    /// "poly" or "exact".
+    pub constraint_source: &'static str,
+    /// The fit's degree (poly only).
+    pub constraint_degree: Option<usize>,
+    /// The fit's largest error, rad.
+    pub constraint_fit_error_rad: f64,
+    /// The fit's largest slope error.
+    pub constraint_slope_error: f64,
+    /// Σ K ρ g over K θ_target at the target.
+    #[serde(serialize_with = "number")]
+    pub torque_magnification: f64,
+    /// The driving hinge's width, µm.
+    #[serde(serialize_with = "number")]
+    pub driving_hinge_width_um: f64,
+    /// The width the magnification asks for, µm.
+    #[serde(serialize_with = "number")]
+    pub required_hinge_width_um: f64,
+    /// Worst loop closure over the run, rad.
+    pub max_closure_residual: f64,
+    /// Every crease's FOLD edge.
+    pub crease_edges: Vec<usize>,
+}
+
+/// A network's figures of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct NetworkRunSummary {
+    /// Panels.
+    pub panels: usize,
+    /// Creases.
+    pub creases: usize,
+    /// The face on the substrate.
+    pub anchored_face: usize,
+    /// The branch followed from a flat start, in words.
+    pub branch: Option<String>,
+    /// Worst vertex closure over the run, rad.
+    pub max_closure_residual: f64,
+    /// Largest energy-balance error (None: not closed by the run's terms).
+    pub energy_balance_error: Option<f64>,
+    /// The pairs that meet at the contact.
+    pub meeting_at_contact: Vec<[String; 2]>,
+    /// The pairs touching at the start.
+    pub touching_at_start: Vec<[String; 2]>,
+    /// The fitted curves a reduced run moved on.
+    pub reduced: Option<crate::dynamics::network::ReducedReport>,
+    /// Every crease's FOLD edge.
+    pub crease_edges: Vec<usize>,
+    /// Each hinge's release time, s.
+    pub release_times_s: Vec<f64>,
+}
+
+/// `modes --json`, whichever kind of scene.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum ModesSummary {
+    /// A strip's.
+    Strip(Box<StripModesSummary>),
+    /// A closed chain's.
+    Closed(Box<ClosedModesSummary>),
+    /// A network's.
+    Network(Box<NetworkModesSummary>),
+}
+
+/// A strip's modes about its folded equilibrium.
+#[derive(Debug, Clone, Serialize)]
+pub struct StripModesSummary {
+    /// The scene's name.
+    pub scene: String,
+    /// θ*, rad.
+    pub equilibrium_rad: Vec<f64>,
+    /// How θ* was found, in words.
+    pub equilibrium: &'static str,
+    /// λ, rad²/s².
+    pub eigenvalues: Vec<f64>,
+    /// f, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// One shape per mode.
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// Whether every λ > 0.
+    pub stable: bool,
+    /// Each hinge's stiffness, N·m/rad.
+    pub stiffness_n_m_per_rad: Vec<f64>,
+}
+
+/// A closed chain's modes: the strip's keys over the released coordinates, every crease's
+/// angles and shapes, the reduced matrices and the closed chain's own keys (crease numbers
+/// are FOLD edges).
+#[derive(Debug, Clone, Serialize)]
+pub struct ClosedModesSummary {
+    /// The scene's name.
+    pub scene: String,
+    /// The cut crease.
+    pub cut_crease: usize,
+    /// The face on the substrate.
+    pub anchored_face: usize,
+    /// "poly" or "exact".
+    pub constraint_source: &'static str,
+    /// Σ K ρ g over K θ_target at the target.
+    #[serde(serialize_with = "number")]
+    pub torque_magnification: f64,
+    /// Worst loop closure at the equilibrium, rad.
+    pub max_closure_residual: f64,
+    /// The released coordinates.
+    pub coordinates: Vec<usize>,
+    /// Every crease's FOLD edge.
+    pub crease_edges: Vec<usize>,
+    /// θ* over the coordinates, rad.
+    pub equilibrium_rad: Vec<f64>,
+    /// How θ* was found, in words.
+    pub equilibrium: &'static str,
+    /// θ* over every crease, rad.
+    pub equilibrium_crease_angles_rad: Vec<f64>,
+    /// The folded pose Newton started from, rad.
+    pub folded_pose_rad: Vec<f64>,
+    /// Every crease's rest angle, rad.
+    pub rest_angles_rad: Vec<f64>,
+    /// Residual torque at θ*, N·m.
+    pub residual_torque_n_m: f64,
+    /// Newton steps.
+    pub newton_iterations: usize,
+    /// Creases past ±180° at θ*.
+    pub folded_through: Vec<usize>,
+    /// λ, rad²/s².
+    pub eigenvalues: Vec<f64>,
+    /// f, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// f without the load term, Hz.
+    pub frequencies_without_load_hz: Vec<f64>,
+    /// Shapes over the coordinates.
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// Shapes over every crease.
+    pub crease_mode_shapes: Vec<Vec<f64>>,
+    /// Whether every λ > 0.
+    pub stable: bool,
+    /// Each crease's stiffness, N·m/rad.
+    pub stiffness_n_m_per_rad: Vec<f64>,
+    /// Γᵀ M Γ, rows.
+    pub reduced_mass_kg_m2: Vec<Vec<f64>>,
+    /// Γᵀ K Γ plus the load term, rows.
+    pub reduced_stiffness_n_m_per_rad: Vec<Vec<f64>>,
+    /// The load term, rows.
+    pub load_stiffness_n_m_per_rad: Vec<Vec<f64>>,
+}
+
+/// A network's modes: the equilibrium, the released locks, the frequencies (with and
+/// without the constraints' load term) and the shapes over every crease.
+#[derive(Debug, Clone, Serialize)]
+pub struct NetworkModesSummary {
+    /// The scene's name.
+    pub scene: String,
+    /// Panels.
+    pub panels: usize,
+    /// Creases.
+    pub creases: usize,
+    /// Every crease's FOLD edge.
+    pub crease_edges: Vec<usize>,
+    /// The face on the substrate.
+    pub anchored_face: usize,
+    /// Degrees of freedom at the equilibrium.
+    pub degrees_of_freedom: usize,
+    /// Locks released, with the angles they held.
+    pub released_locks: Vec<ReleasedLock>,
+    /// Every crease's rest angle, rad.
+    pub rest_angles_rad: Vec<f64>,
+    /// The equilibrium, rad.
+    pub equilibrium_rad: Vec<f64>,
+    /// Newton steps to it.
+    pub equilibrium_newton_steps: usize,
+    /// Residual torque there, N·m.
+    pub residual_torque_n_m: f64,
+    /// Worst closure there, rad.
+    pub closure_residual_rad: f64,
+    /// λ, rad²/s².
+    pub eigenvalues: Vec<f64>,
+    /// f, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// f without the load term, Hz.
+    pub frequencies_without_load_hz: Vec<f64>,
+    /// Shapes over every crease.
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// Whether every λ > 0.
+    pub stable: bool,
+    /// The scene's fitted curves, when it has them.
+    pub reduced: Option<crate::dynamics::network::ReducedReport>,
+}
+
+/// A lock released for the modes.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReleasedLock {
+    /// Its FOLD edge.
+    pub edge: usize,
+    /// The angle it held, rad.
+    pub angle_rad: f64,
+}
