@@ -10,7 +10,7 @@ use nanofold::dynamics::algorithms::{
 };
 use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, SimulationSettings};
 use nanofold::dynamics::Data;
 use std::hint::black_box;
 use std::path::Path;
@@ -78,7 +78,7 @@ fn bench_step(c: &mut Criterion) {
             ..Default::default()
         };
         group.bench_function(format!("tsit45_rtol_{rtol:e}"), |b| {
-            b.iter(|| simulate(&scene, &settings).unwrap())
+            b.iter(|| simulate_scene(&scene, &settings).unwrap())
         });
     }
     group.finish();

@@ -32,7 +32,7 @@ fn main() -> Result<()> {
         folded.frequencies_hz, folded.stable
     );
     for scene in [step, strip(true).build()?] {
-        let run = simulate(&scene, &SimulationSettings::default())?;
+        let run = simulate_scene(&scene, &SimulationSettings::default())?;
         let response = &run.response;
         print!(
             "{}: {:?} model (time-scale ratio {:.1e}), {} steps",

@@ -1,8 +1,13 @@
-//! Dynamics of rigid plates on hinges (`docs/model.md#dynamics`): the [`model`] and its
-//! [`algorithms`] (product-of-exponentials kinematics, M, C, drag), the `forcing` law,
-//! [`scene`]s (a strip or a closed vertex), the two [`plant`]s ([`strip`], [`closed`]) and one
-//! [`simulate`] for both: diffsol [`integrate`] with `contact` location, or the
-//! [`quasi_static`] path; [`modes`] at an equilibrium.
+//! Dynamics of rigid plates on hinges (`docs/model.md#dynamics`). One model of rigid
+//! panels, the panel [`network`] (spatial composite rigid bodies, recursive Newton–Euler,
+//! the loops' closures as constraint rows), runs every device; a strip and a closed vertex
+//! are [`scene`]s that assemble into it. Two other sets of equations stay as model choices
+//! only where `docs/performance.md#which-dynamics-model-runs-a-scene` measures them faster,
+//! each held to the network by tests: the joint-space chain of [`model`] and [`algorithms`]
+//! (product of exponentials, dense M; the network's oracle on a strip) for a short [`strip`],
+//! and the [`closed`] chain's reduced equation on fitted curves for a single vertex. Each
+//! is a [`plant`] for one integrator, [`simulate::simulate_scene`]: diffsol [`integrate`]
+//! with contact location, or the [`quasi_static`] path; [`modes`] at an equilibrium.
 //!
 //! Layout after Pinocchio: a [`Model`] is immutable, a [`Data`] holds the scratch the
 //! algorithms (free functions) fill, so the right-hand side allocates nothing. SI units.

@@ -80,7 +80,7 @@
 //! // closed to about the fit's error.
 //! let scene = load_scene("patterns/corner_cube_step1.scene.json".as_ref())?.build()?;
 //! let run = simulate(&scene, &SimulationSettings::default())?;
-//! let closed = run.closed.unwrap();
+//! let closed = run.simulation.closed.unwrap();
 //! assert!(closed.max_closure_residual < 10.0 * closed.fit_error);
 //! # Ok::<(), NanofoldError>(())
 //! ```

@@ -9,10 +9,11 @@ pub use crate::commands::{
     check, fold, unfold, unfold_observed, CheckVerdict, CommandKind, Detail, Engine, FoldVerdict, Pattern, Report,
     Settings, UnfoldVerdict, VertexPattern,
 };
+pub use crate::commands::{modes, open_scene, simulate, ModesReport, SimulationReport};
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::{Method, ProgressObserver};
 pub use crate::dynamics::scene::{Scene, System};
-pub use crate::dynamics::simulate::{simulate, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
+pub use crate::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
 pub use crate::error::{NanofoldError, NumericalError, Result};
 pub use crate::folding::PatternVerdict;
 pub use crate::folding::{CheckSettings, FoldSettings};

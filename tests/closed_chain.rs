@@ -12,7 +12,7 @@ use nanofold::dynamics::closed::{ClosedChain, ClosedPlant, ConstraintSource};
 use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
 use nanofold::pattern::{LoadOptions, VertexPattern};
 use std::path::Path;
@@ -130,7 +130,7 @@ fn reduced_dynamics_conserve_energy_without_drag() {
             t_end: Some(2.5e-5),
             ..SimulationSettings::default()
         };
-        let response = simulate(&scene, &settings).unwrap().response;
+        let response = simulate_scene(&scene, &settings).unwrap().response;
         assert!(response.collision.is_none(), "{:?}", response.collision);
         let scale = response.samples.iter().map(|s| s.kinetic_energy).fold(0.0, f64::max);
         assert!(scale > 0.0);
@@ -152,7 +152,7 @@ fn reduced_dynamics_conserve_energy_without_drag() {
 fn the_corner_cube_folds_in_two_steps() {
     let settings = SimulationSettings::default();
     let one = common::scene_file("patterns/corner_cube_step1.scene.json");
-    let first = simulate(&one, &settings).unwrap().response;
+    let first = simulate_scene(&one, &settings).unwrap().response;
     let c = first.collision.as_ref().expect("the flap halves close");
     assert!(c.pair[0].starts_with("edges[0]"), "{:?}", c.pair);
     let end = first.samples.last().unwrap();
@@ -165,7 +165,7 @@ fn the_corner_cube_folds_in_two_steps() {
         );
     }
     let two = common::scene_file("patterns/corner_cube_step2.scene.json");
-    let second = simulate(&two, &settings).unwrap().response;
+    let second = simulate_scene(&two, &settings).unwrap().response;
     let c = second.collision.as_ref().expect("the flap lands on the third square");
     assert!(c.pair[0].starts_with("edges[4]"), "{:?}", c.pair);
     let end = second.samples.last().unwrap();
@@ -302,7 +302,7 @@ fn reduced_mass_is_symmetric_positive_definite_along_the_path() {
     for name in ["corner_cube_step1", "corner_cube_step2"] {
         let scene = scene(name, |_| {});
         let chain = scene.closed().unwrap();
-        let response = simulate(&scene, &SimulationSettings::default()).unwrap().response;
+        let response = simulate_scene(&scene, &SimulationSettings::default()).unwrap().response;
         let coordinates = chain.released_coordinates();
         let mut ws = chain.workspace();
         let mut data = Data::new(&chain.model);
@@ -422,7 +422,7 @@ fn folded_corner_cube_modes_are_a_stable_two_dof_linearisation() {
 fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
     for name in ["corner_cube_step1_ramp", "corner_cube_step2_ramp"] {
         let scene = scene(name, |_| {});
-        let auto = simulate(&scene, &SimulationSettings::default()).unwrap().response;
+        let auto = simulate_scene(&scene, &SimulationSettings::default()).unwrap().response;
         assert_eq!(auto.model, ModelKind::QuasiStatic, "{name}");
         let (_, measured) = auto.measured_quasi_static_error.unwrap();
         assert!(
@@ -443,7 +443,7 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
                 rtol: 1e-10,
                 ..SimulationSettings::default()
             };
-            let dynamic = simulate(&scene, &tight).unwrap().response;
+            let dynamic = simulate_scene(&scene, &tight).unwrap().response;
             // Along the ramp ESDIRK34 lags the balance by 1.2e-4 rad (measured; steps of ~1 s,
             // 10⁴ periods: the stiff mode's error escapes the error estimate, and rtol 1e-12
             // still leaves 1.1e-5) while the physical lag is below the 7.6e-8 rad bound: the
@@ -456,7 +456,7 @@ fn a_closed_ramp_is_quasi_static_and_the_dynamics_agree() {
             );
             let last = dynamic.samples.last().unwrap();
             assert!((&last.angles - &end.angles).amax() < 1e-9);
-            let loose = simulate(&scene, &SimulationSettings { rtol: 1e-6, ..tight })
+            let loose = simulate_scene(&scene, &SimulationSettings { rtol: 1e-6, ..tight })
                 .unwrap_err()
                 .to_string();
             assert!(loose.contains("quasi-static path") && loose.contains("rtol"), "{loose}");
@@ -545,7 +545,7 @@ fn the_anchored_face_not_the_cut_decides_the_motion() {
                     v["constraint"] = serde_json::json!({"source": "exact", "range_deg": [-5, 180]});
                 })
                 .unwrap();
-                let run = simulate(&scene, &settings).unwrap();
+                let run = simulate_scene(&scene, &settings).unwrap();
                 assert_eq!(run.closed.unwrap().anchored_face, face);
                 let contact = run.response.collision.expect("the flap halves close");
                 let last = run.response.samples.last().unwrap().angles.as_slice().to_vec();

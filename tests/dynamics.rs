@@ -10,7 +10,7 @@ use nanofold::dynamics::algorithms::{kinetic_energy, update_kinematics, update_m
 use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, ModelChoice, ModelKind, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
 use nanofold::NanofoldError;
 use proptest::prelude::*;
@@ -94,7 +94,7 @@ fn one_hinged_plate_rings_at_the_closed_form_frequency() {
         t_end: Some(3.0 * period),
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap().response;
+    let response = simulate_scene(&scene, &settings).unwrap().response;
     assert_eq!(response.model, ModelKind::Dynamic);
     let worst = response
         .samples
@@ -117,7 +117,7 @@ fn contact_time_of_a_swinging_plate_matches_plane_geometry() {
         method: Method::Tsit45,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap().response;
+    let response = simulate_scene(&scene, &settings).unwrap().response;
     let collision = response.collision.expect("the plate swings past 180°");
     assert_eq!(collision.pair, ["plate 0".to_string(), "substrate".to_string()]);
     assert!(
@@ -146,7 +146,7 @@ fn quasi_static_path_finds_a_plate_on_plate_contact_where_geometry_puts_it() {
         model: ModelChoice::QuasiStatic,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap().response;
+    let response = simulate_scene(&scene, &settings).unwrap().response;
     let collision = response.collision.expect("plate 2 folds onto plate 0");
     assert_eq!(collision.pair, ["plate 2".to_string(), "plate 0".to_string()]);
     let a = (-1.0_f64 / 6.0).acos();
@@ -231,7 +231,7 @@ fn without_drag_the_step_conserves_energy_and_with_drag_it_only_loses_it() {
             t_end: Some(20.0 * slowest_period),
             ..Default::default()
         };
-        let response = simulate(&scene, &settings).unwrap().response;
+        let response = simulate_scene(&scene, &settings).unwrap().response;
         let energies: Vec<f64> = response.samples.iter().map(|s| s.total_energy()).collect();
         let scale = response.samples.iter().map(|s| s.elastic_energy).fold(0.0, f64::max);
         if drag {
@@ -266,7 +266,7 @@ fn step_response_with_drag_settles_to_the_target_when_collisions_are_ignored() {
         ignore_collisions: true,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap().response;
+    let response = simulate_scene(&scene, &settings).unwrap().response;
     assert_eq!(response.method, Some(Method::Tsit45));
     let t_end = response.t_end;
     let swing = |from: f64, to: f64| {
@@ -296,7 +296,7 @@ fn quasi_static_and_dynamic_agree_on_a_slow_ramp_within_the_stated_estimate() {
             ignore_collisions: true,
             ..Default::default()
         };
-        simulate(&scene, &settings).unwrap().response
+        simulate_scene(&scene, &settings).unwrap().response
     };
     let quasi = run(ModelChoice::QuasiStatic);
     let dynamic = run(ModelChoice::Dynamic);
@@ -334,10 +334,10 @@ fn auto_model_choice_follows_the_time_scales() {
     let step = scene_file("patterns/bridge_step.scene.json");
     let ramp = scene_file("patterns/bridge_ramp.scene.json");
     let settings = SimulationSettings::default();
-    let step_response = simulate(&step, &settings).unwrap().response;
+    let step_response = simulate_scene(&step, &settings).unwrap().response;
     assert_eq!(step_response.model, ModelKind::Dynamic);
     assert_eq!(step_response.time_scales.ratio, 0.0);
-    let ramp_response = simulate(&ramp, &settings).unwrap().response;
+    let ramp_response = simulate_scene(&ramp, &settings).unwrap().response;
     assert_eq!(ramp_response.model, ModelKind::QuasiStatic);
     // `docs/model.md#dynamics`: the etch ramp is ~10⁹ fastest periods long.
     assert!(
@@ -450,7 +450,7 @@ fn bad_scenes_get_errors_that_name_the_field() {
         ..Default::default()
     };
     assert!(matches!(
-        simulate(&scene, &bad_rtol),
+        simulate_scene(&scene, &bad_rtol),
         Err(NanofoldError::InvalidField { .. })
     ));
 }
@@ -463,7 +463,7 @@ fn quasi_static_forced_on_a_step_reports_its_large_error() {
         ignore_collisions: true,
         ..Default::default()
     };
-    let response = simulate(&scene, &settings).unwrap().response;
+    let response = simulate_scene(&scene, &settings).unwrap().response;
     assert_eq!(response.model, ModelKind::QuasiStatic);
     let (_, measured) = response.measured_quasi_static_error.unwrap();
     // The undamped step would overshoot by its own size; drag takes a little off.
@@ -482,7 +482,7 @@ fn a_run_that_outgrows_its_step_budget_stops_with_advice() {
         ignore_collisions: true,
         ..Default::default()
     };
-    let message = simulate(&scene, &settings).unwrap_err().to_string();
+    let message = simulate_scene(&scene, &settings).unwrap_err().to_string();
     assert!(
         message.contains("budget of 200 steps") && message.contains("esdirk34"),
         "{message}"

@@ -10,7 +10,7 @@
 //! (README, "Limits", gives its last result).
 
 use nanofold::dynamics::modes::modes;
-use nanofold::dynamics::simulate::{simulate, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, SimulationSettings};
 use nanofold::pattern::LoadOptions;
 use nanofold::unfold::{unfold, UnfoldSettings};
 use proptest::prelude::*;
@@ -109,7 +109,7 @@ fn run_scene(text: &str) -> Outcome {
         max_steps: 3000,
         ..Default::default()
     };
-    match simulate(&scene, &settings) {
+    match simulate_scene(&scene, &settings) {
         Ok(simulation) => {
             let response = &simulation.response;
             for sample in &response.samples {

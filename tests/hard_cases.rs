@@ -125,7 +125,7 @@ fn plates_touching_at_the_first_step_stop_the_run_at_once() {
     // Expectation: corner cube step 2 started at its end (crease 1 at 90°, so the doubled flap
     // already lies folded flat on the third square, crease 4 at −180°) reports that contact at
     // t = 0 with zero steps and finite angles, for the dynamic and the quasi-static model.
-    use nanofold::dynamics::simulate::{simulate, ModelChoice, SimulationSettings};
+    use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, SimulationSettings};
     let text = std::fs::read_to_string("patterns/corner_cube_step2.scene.json").unwrap();
     let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
     value["start_angle_deg"] = serde_json::json!(90);
@@ -137,7 +137,7 @@ fn plates_touching_at_the_first_step_stop_the_run_at_once() {
             model,
             ..SimulationSettings::default()
         };
-        let response = simulate(&scene, &settings).unwrap().response;
+        let response = simulate_scene(&scene, &settings).unwrap().response;
         let contact = response.collision.as_ref().expect("touching at t = 0");
         assert_eq!(contact.time, 0.0, "{model:?}");
         assert!(contact.pair[0].starts_with("edges[4]"), "{model:?}: {:?}", contact.pair);

@@ -54,7 +54,7 @@ fn export(scene: &Path, timestep: f64, out: &Path) -> String {
     std::fs::read_to_string(out).unwrap()
 }
 
-fn simulate(scene: &Path, dir: &Path) -> Value {
+fn simulate_scene(scene: &Path, dir: &Path) -> Value {
     let out = nanofold()
         .arg("simulate")
         .arg(scene)
@@ -252,7 +252,7 @@ fn mujoco_runs_the_exported_bridge_to_nanofolds_first_contact() {
         );
         // One output folder per scene: a folder holds one input's results.
         let stem = Path::new(scene).file_stem().unwrap().to_string_lossy().to_string();
-        let reference = simulate(Path::new(scene), &dir.join(&stem));
+        let reference = simulate_scene(Path::new(scene), &dir.join(&stem));
         let t_nanofold = reference["collision"]["time_s"].as_f64().unwrap() * 1e6;
         assert_eq!(reference["collision"]["pair"][0], "plate 3");
         let result = run_mujoco(&python, &model, 1.05 * t_nanofold);
@@ -317,7 +317,7 @@ fn mujoco_runs_the_exported_corner_cube_to_nanofolds_first_contact() {
         .into();
     let variant = dir.join("corner_cube_step1_from_1deg.scene.json");
     std::fs::write(&variant, scene.to_string()).unwrap();
-    let reference = simulate(&variant, &dir.join("sim"));
+    let reference = simulate_scene(&variant, &dir.join("sim"));
     let t_nanofold = reference["collision"]["time_s"].as_f64().unwrap() * 1e6;
     let result = run_mujoco(&python, &model, 1.2 * t_nanofold);
     let first = &result["first_contact"];
@@ -458,7 +458,7 @@ fn miura_runs(python: &Path, dir: &Path, pattern: &str, t_us: f64, timestep: f64
     let mjcf = export(&scene, timestep, &model);
     let result = run_mujoco(python, &model, t_us);
     let scene = miura_variant(dir, pattern, result["final_time_us"].as_f64().unwrap() * 1e-6);
-    let reference = simulate(&scene, &dir.join(pattern.replace(".fold", "")));
+    let reference = simulate_scene(&scene, &dir.join(pattern.replace(".fold", "")));
     (mjcf, result, reference)
 }
 

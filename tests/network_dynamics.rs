@@ -206,7 +206,7 @@ fn the_miura_sheets_mode_is_the_closed_form_motions() {
 }
 
 fn run(scene: &Scene, rtol: f64, t_end: f64) -> Simulation {
-    simulate(
+    simulate_scene(
         scene,
         &SimulationSettings {
             rtol,
@@ -307,7 +307,7 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
     for (got, want) in release.iter().zip(expected) {
         assert!((got - want).abs() < 1e-9 * 8000.0, "{release:?}");
     }
-    let run = simulate(&closes, &SimulationSettings::default()).unwrap();
+    let run = simulate_scene(&closes, &SimulationSettings::default()).unwrap();
     let contact = run.response.collision.unwrap();
     let angles = &run.response.samples.last().unwrap().angles;
     // The south wall stands at 95°; the east, west and north walls rise together and meet it
@@ -330,7 +330,7 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
     }
 
     let jams = scene_file("patterns/devices/cube_jams.scene.json");
-    let run = simulate(&jams, &SimulationSettings::default()).unwrap();
+    let run = simulate_scene(&jams, &SimulationSettings::default()).unwrap();
     let contact = run.response.collision.unwrap();
     assert_eq!(
         contact.pair,
@@ -458,7 +458,7 @@ fn a_network_scene_must_start_rigid() {
 fn network_fold_animations_hold_rigid_sheets() {
     let scene = scene_file("patterns/devices/cube_jams.scene.json");
     let model = network(&scene);
-    let run = simulate(&scene, &SimulationSettings::default()).unwrap();
+    let run = simulate_scene(&scene, &SimulationSettings::default()).unwrap();
     let motion = nanofold::write::folding_output::network_motion_fold(model, &run.response);
     let check_frames = |model: &NetworkModel, fold: &serde_json::Value| {
         let (flat, edges) = (&model.folding.pattern.vertices, &model.folding.pattern.edges);
@@ -768,7 +768,7 @@ fn fitted_curves_are_refused_where_they_cannot_hold() {
         Some(r#"{"source": "poly", "range_deg": [-72, -60.5]}"#),
     )
     .unwrap();
-    let left = simulate(
+    let left = simulate_scene(
         &narrow,
         &SimulationSettings {
             t_end: Some(6e-5),

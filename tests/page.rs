@@ -150,12 +150,12 @@ fn face_normal(points: &[[f64; 3]], face: &[usize]) -> nalgebra::Vector3<f64> {
 /// first contact (plate 3 with the substrate) is marked on the last frame alone.
 #[test]
 fn a_strips_response_page_shows_its_hinge_angles_and_its_contact() {
-    use nanofold::dynamics::simulate::{simulate, SimulationSettings};
+    use nanofold::dynamics::simulate::{simulate_scene, SimulationSettings};
     let scene = nanofold::prelude::load_scene("patterns/bridge_step.scene.json".as_ref())
         .unwrap()
         .build()
         .unwrap();
-    let simulation = simulate(&scene, &SimulationSettings::default()).unwrap();
+    let simulation = simulate_scene(&scene, &SimulationSettings::default()).unwrap();
     let collision = simulation
         .response
         .collision

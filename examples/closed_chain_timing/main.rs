@@ -17,7 +17,7 @@ use nanofold::dynamics::closed::ClosedPlant;
 use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, ModelChoice, Simulation, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, Simulation, SimulationSettings};
 use nanofold::write::output::write_atomic;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -35,7 +35,7 @@ fn scene(name: &str, constraint: serde_json::Value) -> Scene {
 
 /// Median wall time of RUNS runs (scene set-up excluded), and the last run.
 fn timed(scene: &Scene, settings: &SimulationSettings) -> (f64, Simulation) {
-    common::timed(RUNS, || simulate(scene, settings).expect("run"))
+    common::timed(RUNS, || simulate_scene(scene, settings).expect("run"))
 }
 
 fn main() {

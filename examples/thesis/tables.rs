@@ -7,7 +7,7 @@
 use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::{Scene, System};
-use nanofold::dynamics::simulate::{simulate, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, SimulationSettings};
 use nanofold::pattern::LoadOptions;
 use nanofold::read::{load_pattern, parse_scene};
 use serde_json::Value;
@@ -62,7 +62,7 @@ pub fn closed_khz(scene: &Scene) -> Vec<f64> {
 
 /// First contact of the scene's run, µs.
 pub fn contact_us(scene: &Scene) -> f64 {
-    let run = simulate(scene, &SimulationSettings::default()).unwrap();
+    let run = simulate_scene(scene, &SimulationSettings::default()).unwrap();
     run.response.collision.expect("the run reaches contact").time * 1e6
 }
 

@@ -26,7 +26,7 @@ use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Set
 use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::quasi_static::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, ModelChoice, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, SimulationSettings};
 use nanofold::dynamics::strip::StripPlant;
 use nanofold::geometry::sphere::Vec3;
 use nanofold::pattern::LoadOptions;
@@ -244,7 +244,9 @@ fn dynamics_part() -> Value {
         progress: None,
         ..Default::default()
     };
-    let (reference_seconds, reference) = timed(1, || simulate(&step, &reference_settings).expect("reference").response);
+    let (reference_seconds, reference) = timed(1, || {
+        simulate_scene(&step, &reference_settings).expect("reference").response
+    });
     let reference_contact = reference.collision.clone().expect("the bridge step collides");
     let reference_angles = reference.samples.last().expect("samples").angles.clone();
     println!(
@@ -269,7 +271,7 @@ fn dynamics_part() -> Value {
                 progress: None,
                 ..Default::default()
             };
-            let (seconds, response) = timed(DYNAMIC_RUNS, || simulate(&step, &settings).expect("run").response);
+            let (seconds, response) = timed(DYNAMIC_RUNS, || simulate_scene(&step, &settings).expect("run").response);
             let contact = response.collision.clone().expect("collides");
             let angle_error = (&response.samples.last().expect("samples").angles - &reference_angles).amax();
             let time_error = (contact.time - reference_contact.time).abs();
@@ -293,7 +295,7 @@ fn dynamics_part() -> Value {
         ..Default::default()
     };
     let (quasi_seconds, quasi) = timed(RUNS, || {
-        simulate(&ramp, &quasi_settings).expect("quasi-static").response
+        simulate_scene(&ramp, &quasi_settings).expect("quasi-static").response
     });
     let (window, measured) = quasi.measured_quasi_static_error.expect("auto measures its error");
     let quasi_contact = quasi.collision.clone().expect("the ramp lands");
@@ -319,7 +321,7 @@ fn dynamics_part() -> Value {
             ..Default::default()
         };
         let (seconds, dynamic) = timed(DYNAMIC_RUNS, || {
-            simulate(&ramp, &settings).expect("dynamic ramp").response
+            simulate_scene(&ramp, &settings).expect("dynamic ramp").response
         });
         let contact = dynamic.collision.clone().expect("the ramp lands");
         let deviation = quasi_static_deviation(

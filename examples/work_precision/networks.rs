@@ -13,7 +13,7 @@ use crate::common::timed;
 use nanofold::dynamics::network::NetworkPlant;
 use nanofold::dynamics::plant::Plant;
 use nanofold::dynamics::scene::Scene;
-use nanofold::dynamics::simulate::{simulate, Simulation, SimulationSettings};
+use nanofold::dynamics::simulate::{simulate_scene, Simulation, SimulationSettings};
 use nanofold::folding::FoldingModel;
 use nanofold::pattern::generate::MiuraSpec;
 use nanofold::read::load_scene;
@@ -68,7 +68,7 @@ fn run(scene: &Scene, rtol: f64) -> Simulation {
         progress: None,
         ..Default::default()
     };
-    simulate(scene, &settings).expect("the sheet runs")
+    simulate_scene(scene, &settings).expect("the sheet runs")
 }
 
 fn final_angles(run: &Simulation) -> Vec<f64> {
@@ -312,8 +312,8 @@ fn strips_part() -> Value {
     for plates in STRIP_PLATES {
         let runs = if plates >= 50 { 1 } else { 3 };
         let (chain, network) = (strip(plates, "chain"), strip(plates, "network"));
-        let (chain_seconds, chain_run) = timed(runs, || simulate(&chain, &settings).expect("chain"));
-        let (network_seconds, network_run) = timed(runs, || simulate(&network, &settings).expect("network"));
+        let (chain_seconds, chain_run) = timed(runs, || simulate_scene(&chain, &settings).expect("chain"));
+        let (network_seconds, network_run) = timed(runs, || simulate_scene(&network, &settings).expect("network"));
         let gap = largest_gap(&final_angles(&chain_run), &final_angles(&network_run));
         println!(
             "{plates:>6} {:>10.1} {:>7} {:>10.1} {:>7} {gap:>10.2e}",

@@ -3,7 +3,7 @@
 //! `nanofold simulate --json` print (`docs/model.md#dynamics`).
 
 use crate::dynamics::scene::{Scene, System};
-use crate::dynamics::simulate::{simulate as simulate_scene, Simulation, SimulationSettings};
+use crate::dynamics::simulate::{simulate_scene, Simulation, SimulationSettings};
 use crate::error::Result;
 use crate::write::folding_output::{network_modes_fold, network_motion_fold};
 use crate::write::output::{

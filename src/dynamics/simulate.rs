@@ -62,8 +62,8 @@ impl ModelChoice {
     }
 }
 
-/// Settings of one run, validated by [`SimulationSettings::validate`] (which [`simulate`]
-/// calls).
+/// Settings of one run, validated by [`SimulationSettings::validate`] (which
+/// [`simulate_scene`] calls).
 #[derive(Debug, Clone)]
 pub struct SimulationSettings {
     /// Which equations.
@@ -193,13 +193,13 @@ pub struct Simulation {
 /// ```
 /// use nanofold::prelude::*;
 /// let scene = load_scene("patterns/bridge_ramp.scene.json".as_ref())?.build()?;
-/// let run = simulate(&scene, &SimulationSettings::default())?;
+/// let run = simulate_scene(&scene, &SimulationSettings::default())?;
 /// // A 21-minute etch ramp against kHz modes: quasi-static, with its error measured.
 /// assert_eq!(run.response.model, ModelKind::QuasiStatic);
 /// assert!(run.response.measured_quasi_static_error.unwrap().1 < 1e-6);
 /// # Ok::<(), nanofold::NanofoldError>(())
 /// ```
-pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulation> {
+pub fn simulate_scene(scene: &Scene, settings: &SimulationSettings) -> Result<Simulation> {
     settings.validate()?;
     let t_end = settings.t_end.unwrap_or(scene.t_end);
     let times = output_times(t_end, scene.outputs.samples);

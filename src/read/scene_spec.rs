@@ -293,7 +293,7 @@ impl StripSpec {
     ///     .build()?;
     /// let run = simulate(&scene, &SimulationSettings::default())?;
     /// // No drag: θ = θ_target (1 − cos ωt) overshoots to 200°, past the substrate at 180°.
-    /// assert!(run.response.collision.is_some());
+    /// assert!(run.simulation.response.collision.is_some());
     /// # Ok::<(), NanofoldError>(())
     /// ```
     pub fn new(name: &str) -> Self {
