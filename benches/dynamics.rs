@@ -8,10 +8,10 @@ use nanofold::dynamics::algorithms::{
     coriolis_torques, forward_dynamics, update_coriolis_matrix, update_kinematics, update_mass_matrix,
     update_mass_matrix_derivative, update_velocities,
 };
-use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, SimulationSettings};
 use nanofold::dynamics::Data;
+use nanofold::dynamics::Method;
 use std::hint::black_box;
 use std::path::Path;
 

@@ -3,8 +3,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use nanofold::geometry::sphere::Vec3;
 use nanofold::pattern::{LoadOptions, VertexPattern};
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 
 fn library() -> Vec<VertexPattern> {
     let mut paths: Vec<_> = std::fs::read_dir("patterns")

@@ -10,8 +10,8 @@ use nanofold::folding::{
 };
 use nanofold::pattern::generate::{MiuraSpec, WaterbombSpec};
 use nanofold::prelude::Named;
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::network::{unfold_network, NetworkEnergy, NetworkUnfoldSettings};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 use std::time::Instant;
 
 fn best_of<T>(runs: usize, mut work: impl FnMut() -> T) -> (f64, T) {

@@ -7,7 +7,7 @@ use nanofold::folding::{degree4_modes, FoldingModel};
 use nanofold::pattern::crease_pattern::{CreasePatternBuilder, EdgeKind};
 use nanofold::pattern::generate::{BirdBaseSpec, MiuraSpec, SquareTwistSpec, WaterbombSpec};
 use nanofold::pattern::Assignment;
-use nanofold::write::folding_output::crease_pattern_fold;
+use nanofold::write::crease_pattern_fold;
 
 fn write(name: &str, builder: CreasePatternBuilder, with_state: bool, note: &str) {
     let model = FoldingModel::new(builder.build().unwrap()).unwrap();

@@ -7,9 +7,9 @@ mod common;
 use common::{library_patterns, many_creases, timed};
 use nanofold::geometry::sphere::Vec3;
 use nanofold::prelude::Named;
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::unfold::qp::QpMethod;
+use nanofold::unfold::QpMethod;
 use nanofold::unfold::{unfold, UnfoldModel, UnfoldSettings};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 use std::time::Instant;
 
 fn main() {

@@ -3,15 +3,17 @@
 //! Chebyshev fits ([`ConstraintPoly`], with the Jacobian G of T4.18 and its rate), and the
 //! exported report with its errors against exact loop closure.
 
-pub mod chebyshev;
-pub mod exact;
+pub(crate) mod chebyshev;
+pub(crate) mod exact;
 pub mod network;
 pub(crate) mod sweep;
+pub use chebyshev::{eval_monomial, Chebyshev};
+pub use exact::{ConstraintPoint, ExactConstraint};
 
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics::{closure_residual, refine_closure, solve_closure};
 use crate::pattern::{Assignment, Chain, VertexPattern};
-use chebyshev::{eval_monomial, Chebyshev, FittedCurves};
+use chebyshev::FittedCurves;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;

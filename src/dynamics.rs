@@ -4,10 +4,10 @@
 //! are [`scene`]s that assemble into it. Two other sets of equations stay as model choices
 //! only where `docs/performance.md#which-dynamics-model-runs-a-scene` measures them faster,
 //! each held to the network by tests: the joint-space chain of [`model`] and [`algorithms`]
-//! (product of exponentials, dense M; the network's oracle on a strip) for a short [`strip`],
+//! (product of exponentials, dense M; the network's oracle on a strip) for a short `strip`,
 //! and the [`closed`] chain's reduced equation on fitted curves for a single vertex. Each
-//! is a [`plant`] for one integrator, [`simulate::simulate_scene`]: diffsol [`integrate`]
-//! with contact location, or the [`quasi_static`] path; [`modes`] at an equilibrium.
+//! is a `plant` for one integrator, [`simulate::simulate_scene`]: diffsol `integrate`
+//! with contact location, or the `quasi_static` path; [`modes`] at an equilibrium.
 //!
 //! Layout after Pinocchio: a [`Model`] is immutable, a [`Data`] holds the scratch the
 //! algorithms (free functions) fill, so the right-hand side allocates nothing. SI units.
@@ -16,16 +16,20 @@ pub mod algorithms;
 pub mod closed;
 pub(crate) mod contact;
 pub(crate) mod forcing;
-pub mod integrate;
+pub(crate) mod integrate;
 pub mod model;
 pub mod modes;
 pub mod network;
-pub mod plant;
-pub mod quasi_static;
+pub(crate) mod plant;
+pub(crate) mod quasi_static;
 pub mod scene;
 pub mod simulate;
 pub(crate) mod spec;
-pub mod strip;
+pub(crate) mod strip;
+pub use integrate::Method;
+pub use plant::Plant;
+pub use quasi_static::quasi_static_deviation;
+pub use strip::StripPlant;
 
 pub use contact::Collision;
 pub use forcing::{Actuation, Forcing, HingeDrive};

@@ -6,14 +6,16 @@ pub(crate) mod closure;
 pub(crate) mod contact;
 pub(crate) mod frames;
 pub(crate) mod model;
-pub mod normal;
+pub(crate) mod normal;
 pub(crate) mod path;
 pub(crate) mod poses;
 pub(crate) mod rank;
 pub(crate) mod reduction;
-pub mod second_order;
+pub(crate) mod second_order;
 pub(crate) mod simd_state;
 pub(crate) mod verdict;
+pub use normal::NormalSolver;
+pub use second_order::{cone_range, quadratic_form, second_order, SecondOrder};
 
 pub use closure::{closure_jacobian, closure_residual, vertex_residuals, worst_of, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};

@@ -2,9 +2,10 @@
 //! measured from nodes) and the kinematics of one vertex (fold angles ↔ ray directions,
 //! loop closure), and which boxes overlap (the broad phase of planarity and contact tests).
 
-pub mod broad_phase;
+pub(crate) mod broad_phase;
 pub mod kinematics;
 pub mod sphere;
+pub use broad_phase::overlapping_pairs;
 
 /// Uniform draws in [0, 1) from a fixed seed (xorshift): the deterministic random inputs of
 /// the geometry tests and of the tests built on them.

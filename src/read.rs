@@ -4,10 +4,11 @@
 
 pub(crate) mod fold;
 pub(crate) mod folded_form;
-pub mod input;
+pub(crate) mod input;
 pub(crate) mod native;
 pub(crate) mod scene;
 pub mod scene_spec;
+pub use input::MAX_PATTERN_BYTES;
 
 pub use scene::{load_scene, parse_scene};
 

@@ -1,5 +1,5 @@
 //! The unfolding engine (`docs/model.md#unfolding`): projected-gradient steps on the sphere,
-//! driven to a verdict. The direction is the QP of [`qp`] in tangent coordinates of the free
+//! driven to a verdict. The direction is the QP of `qp` in tangent coordinates of the free
 //! nodes; a backtracking line search on U refuses steps that carry a node through an arc
 //! (`checks`); Newton projection restores the arc-length, unit-norm and held-crease
 //! constraints (`manifold`).
@@ -9,17 +9,21 @@
 //! `Executor` drives it with `observe`rs recording the trajectory and progress, and
 //! [`unfold`] turns its termination into a [`Verdict`] with evidence.
 
-pub mod barrier;
+pub(crate) mod barrier;
 pub(crate) mod checks;
-pub mod energy;
+pub(crate) mod energy;
 pub(crate) mod manifold;
 pub(crate) mod model;
 pub mod network;
 pub(crate) mod observe;
-pub mod qp;
+pub(crate) mod qp;
 pub(crate) mod settings;
 pub(crate) mod solver;
-pub mod state;
+pub(crate) mod state;
+pub use barrier::{barrier_function, BarrierSettings, PanelBarrier};
+pub use energy::{EnergyKind, EnergyWorkspace};
+pub use qp::{solve_clarabel, solve_direct, DirectWorkspace, DirectionProblem, QpMethod, RowSpace};
+pub use state::StepKind;
 
 pub use checks::{find_crossing, node_arc_clearance, planarity_residual, touching_charges};
 pub use model::{HeldFold, UnfoldModel};
@@ -33,7 +37,6 @@ use crate::geometry::sphere::Vec3;
 use crate::pattern::VertexPattern;
 use argmin::core::observers::ObserverMode;
 use argmin::core::Executor;
-use energy::EnergyWorkspace;
 use serde::Serialize;
 use solver::{UnfoldProblem, NEAR_FLAT, OPEN_PATH_STEPS};
 use state::UnfoldState;

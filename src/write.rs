@@ -3,7 +3,12 @@
 //! they write.
 
 pub(crate) mod folder;
-pub mod folding_output;
-pub mod mujoco;
-pub mod output;
+pub(crate) mod folding_output;
+pub(crate) mod mujoco;
+pub(crate) mod output;
 pub(crate) mod summary;
+pub use folding_output::{
+    crease_pattern_fold, network_modes_fold, network_modes_oscillation_fold, network_motion_fold, MOTION_FRAMES,
+};
+pub use mujoco::{scene_mjcf, LoopClosure, MujocoSettings};
+pub use output::write_atomic;

@@ -4,16 +4,16 @@
 
 mod common;
 
-use nanofold::constraints::exact::{ConstraintPoint, ExactConstraint};
 use nanofold::constraints::{sweep_samples, Setup};
+use nanofold::constraints::{ConstraintPoint, ExactConstraint};
 use nanofold::dynamics::algorithms::update_kinematics;
-use nanofold::dynamics::closed::modes::ClosureState;
+use nanofold::dynamics::closed::ClosureState;
 use nanofold::dynamics::closed::{ClosedChain, ClosedPlant, ConstraintSource};
-use nanofold::dynamics::integrate::Method;
-use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
+use nanofold::dynamics::Method;
 use nanofold::pattern::{LoadOptions, VertexPattern};
 use std::path::Path;
 

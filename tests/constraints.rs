@@ -1,8 +1,8 @@
 //! Holonomic constraint curves: sweeps against closed forms, fits against exact data,
 //! Jacobians against finite differences, sweep against unfolding, bad input.
 
-use nanofold::constraints::chebyshev::{eval_monomial, Chebyshev};
 use nanofold::constraints::*;
+use nanofold::constraints::{eval_monomial, Chebyshev};
 use nanofold::geometry::kinematics::closure_residual;
 use nanofold::pattern::{LoadOptions, VertexPattern};
 use nanofold::prelude::Named;

@@ -7,11 +7,11 @@ mod common;
 
 use common::{scene_file, scene_text};
 use nanofold::dynamics::algorithms::{kinetic_energy, update_kinematics, update_mass_matrix, update_poses};
-use nanofold::dynamics::integrate::Method;
 use nanofold::dynamics::modes::modes;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, SimulationSettings};
 use nanofold::dynamics::Data;
+use nanofold::dynamics::Method;
 use nanofold::NanofoldError;
 use proptest::prelude::*;
 use std::f64::consts::PI;

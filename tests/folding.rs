@@ -1545,7 +1545,7 @@ fn the_residual_alone_equals_the_jacobians_residual() {
 /// the size where the supernodal one takes over, at a folded state.
 #[test]
 fn the_normal_equations_are_solved_at_either_factorisation() {
-    use nanofold::folding::normal::NormalSolver;
+    use nanofold::folding::NormalSolver;
     for n in [8, 40] {
         let model = miura(n, n, 60.0, 50.0);
         let jac = closure_jacobian(&model, &model.given_fold_angles());

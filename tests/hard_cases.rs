@@ -10,9 +10,9 @@ mod bench_common;
 mod common;
 use common::native_json;
 use nanofold::pattern::{LoadOptions, VertexPattern};
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::unfold::state::StepKind;
+use nanofold::unfold::StepKind;
 use nanofold::unfold::{unfold, Termination, UnfoldSettings, Verdict};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 use std::f64::consts::TAU;
 
 /// A closed vertex with the given sectors (rad), every crease at `fold` rad.
@@ -93,7 +93,7 @@ fn a_degree_twelve_fit_exported_in_degrees_on_0_to_180_stays_accurate() {
     // coefficients in degrees, where t¹² reaches 180¹² ≈ 1.2e27, are finite and reproduce
     // the exact samples in degrees to within the stated fit error plus 1e-12 rad of rounding
     // (measured: the same as the radian form to 3e-16 rad; fit error 6e-8 rad).
-    use nanofold::constraints::chebyshev::eval_monomial;
+    use nanofold::constraints::eval_monomial;
     use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
     let pattern = nanofold::read::load_pattern(
         std::path::Path::new("patterns/corner_cube.fold"),
@@ -296,8 +296,8 @@ fn a_step_through_a_barrier_is_detected_even_where_the_energy_cannot_see_it() {
         &model.sector_angles,
         &[0.0, -170f64.to_radians(), 0.0, -170f64.to_radians()],
     );
-    let energy = nanofold::unfold::energy::EnergyKind::Separable.build(None);
-    let mut ws = nanofold::unfold::energy::EnergyWorkspace::default();
+    let energy = nanofold::unfold::EnergyKind::Separable.build(None);
+    let mut ws = nanofold::unfold::EnergyWorkspace::default();
     let (u_before, u_after) = (
         energy.value(&before, &model.arcs, &mut ws),
         energy.value(&after, &model.arcs, &mut ws),

@@ -65,7 +65,7 @@ fn a_vertex_far_from_the_rest_changes_nothing() {
             }
         }
     }
-    assert_eq!(nanofold::geometry::broad_phase::overlapping_pairs(&boxes), every);
+    assert_eq!(nanofold::geometry::overlapping_pairs(&boxes), every);
 }
 
 /// Creases that meet no interior vertex are free each on their own: a strip of n panels

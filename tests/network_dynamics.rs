@@ -9,9 +9,9 @@ use common::{full_message, scene_file};
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, Vector3};
 use nanofold::dynamics::algorithms::forward_dynamics;
 use nanofold::dynamics::model::{Joint, Model, Plate};
-use nanofold::dynamics::network::modes::folded_modes;
+use nanofold::dynamics::network::folded_modes;
 use nanofold::dynamics::network::{NetworkModel, NetworkPlant};
-use nanofold::dynamics::plant::Plant;
+use nanofold::dynamics::Plant;
 use nanofold::folding::{panel_poses, Pose};
 use nanofold::pattern::crease_pattern::EdgeKind;
 use nanofold::pattern::Assignment;
@@ -459,7 +459,7 @@ fn network_fold_animations_hold_rigid_sheets() {
     let scene = scene_file("patterns/devices/cube_jams.scene.json");
     let model = network(&scene);
     let run = simulate_scene(&scene, &SimulationSettings::default()).unwrap();
-    let motion = nanofold::write::folding_output::network_motion_fold(model, &run.response);
+    let motion = nanofold::write::network_motion_fold(model, &run.response);
     let check_frames = |model: &NetworkModel, fold: &serde_json::Value| {
         let (flat, edges) = (&model.folding.pattern.vertices, &model.folding.pattern.edges);
         let frames = fold["file_frames"].as_array().unwrap();
@@ -479,7 +479,7 @@ fn network_fold_animations_hold_rigid_sheets() {
         frames.len()
     };
     let count = check_frames(model, &motion);
-    assert_eq!(count, nanofold::write::folding_output::MOTION_FRAMES);
+    assert_eq!(count, nanofold::write::MOTION_FRAMES);
     let times: Vec<f64> = motion["file_frames"]
         .as_array()
         .unwrap()
@@ -513,7 +513,7 @@ fn network_fold_animations_hold_rigid_sheets() {
     let miura = scene_file("patterns/devices/miura_sheet.scene.json");
     let model = network(&miura);
     let modes = folded_modes(model).unwrap();
-    let fold = nanofold::write::folding_output::network_modes_fold(model, &modes, 0.1).unwrap();
+    let fold = nanofold::write::network_modes_fold(model, &modes, 0.1).unwrap();
     assert_eq!(check_frames(model, &fold), 1 + 2 * modes.modes.basis.ncols());
     let frames = fold["file_frames"].as_array().unwrap();
     let angles = |f: &serde_json::Value| -> Vec<f64> {
@@ -831,8 +831,7 @@ fn the_modes_oscillate_about_the_equilibrium() {
     let gap = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     // For each amplitude, each mode's (move at phase 3, leftover of phases 3 + 9).
     let measure = |amplitude: f64| -> Vec<(f64, f64)> {
-        let fold =
-            nanofold::write::folding_output::network_modes_oscillation_fold(model, &modes, amplitude, 12).unwrap();
+        let fold = nanofold::write::network_modes_oscillation_fold(model, &modes, amplitude, 12).unwrap();
         let frames = fold["file_frames"].as_array().unwrap();
         assert_eq!(frames.len(), 1 + 12 * count);
         let coords = |k: usize| -> Vec<f64> {

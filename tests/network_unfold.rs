@@ -5,9 +5,9 @@
 use nanofold::folding::{vertex_residuals, FoldingModel};
 use nanofold::pattern::generate::MiuraSpec;
 use nanofold::pattern::LoadOptions;
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
 use nanofold::unfold::network::{unfold_network, NetworkEnergy, NetworkUnfoldSettings};
 use nanofold::unfold::{unfold, UnfoldSettings, Verdict};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 use std::path::Path;
 
 fn miura(n: usize, zigzag_deg: f64) -> FoldingModel {
@@ -320,7 +320,7 @@ fn three_strips(alpha: f64, beta: f64) -> FoldingModel {
 #[test]
 fn the_panel_barrier_is_c2_and_its_gradient_matches_central_differences() {
     use nanofold::folding::panel_poses;
-    use nanofold::unfold::barrier::{barrier_function, BarrierSettings, PanelBarrier};
+    use nanofold::unfold::{barrier_function, BarrierSettings, PanelBarrier};
     assert_eq!(barrier_function(1.0), (0.0, 0.0));
     for h in [1e-2, 1e-3, 1e-4] {
         let (value, slope) = barrier_function(1.0 - h);
@@ -557,7 +557,7 @@ fn random_trapezoidal_miura_quad_meshes_fold_by_the_closed_form_and_unfold_flat(
 /// angles, and a flat-folded form whose crease pattern has the wrong number of vertices.
 #[test]
 fn new_inputs_are_refused_by_name() {
-    use nanofold::unfold::barrier::{BarrierSettings, PanelBarrier};
+    use nanofold::unfold::{BarrierSettings, PanelBarrier};
     let model = miura(3, 100.0);
     for (settings, field) in [
         (

@@ -8,9 +8,9 @@ use nanofold::geometry::sphere::{
     fold_angle, fold_angle_with_gradient, geodesic, geodesic_cosine_rule, geodesic_with_gradient, Vec3,
 };
 use nanofold::pattern::LoadOptions;
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::unfold::qp::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
+use nanofold::unfold::{solve_clarabel, solve_direct, DirectionProblem, RowSpace};
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
 use proptest::prelude::*;
 use std::f64::consts::{PI, TAU};
 

@@ -2,7 +2,7 @@
 //! quantum, it makes no network request, and bad scenes get errors naming the field. (The
 //! page's drawing is tested in a real browser by `scripts/browser_test.sh`.)
 
-use nanofold::plot::page::{page_html, PageFrame, PageScene, MAX_PAGE_POINTS};
+use nanofold::plot::{page_html, PageFrame, PageScene, MAX_PAGE_POINTS};
 
 fn square(frames: usize) -> PageScene {
     PageScene {
@@ -95,7 +95,7 @@ fn bad_scenes_are_refused_by_name() {
 /// faces, and a physical scale multiplies every coordinate (the scale bar's unit with it).
 #[test]
 fn a_fold_animation_becomes_a_page_in_physical_units() {
-    use nanofold::plot::page::page_of_fold;
+    use nanofold::plot::page_of_fold;
     let fold = serde_json::json!({
         "file_spec": 1.1,
         "frame_unit": "unit",
@@ -162,14 +162,14 @@ fn a_strips_response_page_shows_its_hinge_angles_and_its_contact() {
         .as_ref()
         .expect("the bridge's plate 3 meets the substrate");
     assert_eq!(collision.pair, ["plate 3".to_string(), "substrate".to_string()]);
-    let html = nanofold::plot::scene_page::response_page(&scene, &simulation.response).unwrap();
+    let html = nanofold::plot::response_page(&scene, &simulation.response).unwrap();
     let value = data(&html);
     assert_eq!(value["unit"], "µm");
     assert_eq!(value["fixed"], serde_json::json!([0]));
     let faces: Vec<Vec<usize>> = serde_json::from_value(value["faces"].clone()).unwrap();
     let letters: Vec<char> = value["letters"].as_str().unwrap().chars().collect();
     let frames = value["frames"].as_array().unwrap();
-    assert!(frames.len() > 100 && frames.len() <= nanofold::plot::scene_page::MAX_RESPONSE_FRAMES);
+    assert!(frames.len() > 100 && frames.len() <= nanofold::plot::MAX_RESPONSE_FRAMES);
     let step = value["step"].as_f64().unwrap();
     let start = positions(&value, 0);
     let mut worst: f64 = 0.0;
@@ -214,7 +214,7 @@ fn a_strips_response_page_shows_its_hinge_angles_and_its_contact() {
 #[test]
 fn a_closed_chains_modes_page_oscillates_with_its_loop_closed() {
     use nanofold::dynamics::scene::System;
-    use nanofold::plot::scene_page::{closed_modes_page, closed_scene, MODE_PHASES};
+    use nanofold::plot::{closed_modes_page, closed_scene, MODE_PHASES};
     let scene = nanofold::prelude::load_scene("patterns/corner_cube_step2.scene.json".as_ref())
         .unwrap()
         .build()

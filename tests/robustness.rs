@@ -109,7 +109,7 @@ fn devices_and_oversized_files_are_not_read() {
     let big = dir.join("big.fold");
     let file = std::fs::File::create(&big).unwrap();
     // Sparse: no disk is used.
-    file.set_len(nanofold::read::input::MAX_PATTERN_BYTES + 1).unwrap();
+    file.set_len(nanofold::read::MAX_PATTERN_BYTES + 1).unwrap();
     let e = nanofold::read::load_pattern(&big, &LoadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("byte limit"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();

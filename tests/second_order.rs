@@ -5,8 +5,8 @@
 //! to the one-sign rule, its exclusions agree with the witness search, and it decides
 //! lattices of degree-6 vertices that were `unknown`.
 
-use nanofold::folding::second_order::{cone_range, quadratic_form, second_order, SecondOrder};
 use nanofold::folding::{check_pattern, CheckSettings, FoldingModel, PatternVerdict, Star};
+use nanofold::folding::{cone_range, quadratic_form, second_order, SecondOrder};
 use nanofold::geometry::kinematics::solve_closure;
 use nanofold::read::parse_crease_pattern;
 use serde_json::json;

@@ -1,7 +1,7 @@
 //! The closed chain's timing figures, drawn from the report the example measures (so a kept
 //! report redraws them exactly: `tests/docs_figures.rs` checks the docs' copy).
 
-use nanofold::plot::work_precision::{error_by_parameter_svg, work_precision_svg, ErrorSeries, WorkPoint, WorkSeries};
+use nanofold::plot::{error_by_parameter_svg, work_precision_svg, ErrorSeries, WorkPoint, WorkSeries};
 use serde_json::Value;
 
 fn number(row: &Value, key: &str) -> f64 {

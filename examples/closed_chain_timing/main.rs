@@ -14,11 +14,11 @@ mod figures;
 
 use common::machine;
 use nanofold::dynamics::closed::ClosedPlant;
-use nanofold::dynamics::integrate::Method;
-use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, Simulation, SimulationSettings};
-use nanofold::write::output::write_atomic;
+use nanofold::dynamics::Method;
+use nanofold::write::write_atomic;
 use serde_json::{json, Value};
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! The work-precision figures, drawn from the report the example measures (so a committed
 //! report redraws them exactly: `tests/docs_figures.rs` checks the docs' copies).
 
-use nanofold::plot::work_precision::{scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries};
+use nanofold::plot::{scaling_svg, work_precision_svg, ScalingSeries, WorkPoint, WorkSeries};
 use serde_json::Value;
 
 /// The step cap every unfolding figure is drawn at (the default; the other caps are rows of

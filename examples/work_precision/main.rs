@@ -23,19 +23,19 @@ mod networks;
 
 use common::{library_patterns, machine, many_creases, median, timed};
 use nanofold::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, Setup};
-use nanofold::dynamics::integrate::Method;
-use nanofold::dynamics::quasi_static::quasi_static_deviation;
+use nanofold::dynamics::quasi_static_deviation;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, SimulationSettings};
-use nanofold::dynamics::strip::StripPlant;
+use nanofold::dynamics::Method;
+use nanofold::dynamics::StripPlant;
 use nanofold::geometry::sphere::Vec3;
 use nanofold::pattern::LoadOptions;
-use nanofold::plot::work_precision::{largest_sizes, power_law_fit};
+use nanofold::plot::{largest_sizes, power_law_fit};
 use nanofold::prelude::Named;
-use nanofold::unfold::energy::{EnergyKind, EnergyWorkspace};
-use nanofold::unfold::qp::{self, QpMethod};
 use nanofold::unfold::{unfold, ProjectedGradient, UnfoldModel, UnfoldSettings, Verdict};
-use nanofold::write::output::write_atomic;
+use nanofold::unfold::{DirectWorkspace, QpMethod, RowSpace};
+use nanofold::unfold::{EnergyKind, EnergyWorkspace};
+use nanofold::write::write_atomic;
 use serde_json::{json, Value};
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -384,8 +384,8 @@ fn scaling_part() -> Value {
         // The direction as a step computes it: A factorised in place, then the projection
         // (with the metric, the augmented rows' factorisation too), all buffers reused.
         let problem = solver.direction_problem().expect("direction");
-        let mut row_space = qp::RowSpace::new(&problem.a).expect("factorisation");
-        let mut direct = qp::DirectWorkspace::default();
+        let mut row_space = RowSpace::new(&problem.a).expect("factorisation");
+        let mut direct = DirectWorkspace::default();
         let mut y = vec![0.0; problem.q.len()];
         let direction_seconds = per_call(|| {
             row_space.factorise(&problem.a).expect("factorisation");

@@ -11,15 +11,15 @@
 
 use crate::common::timed;
 use nanofold::dynamics::network::NetworkPlant;
-use nanofold::dynamics::plant::Plant;
 use nanofold::dynamics::scene::Scene;
 use nanofold::dynamics::simulate::{simulate_scene, Simulation, SimulationSettings};
+use nanofold::dynamics::Plant;
 use nanofold::folding::FoldingModel;
 use nanofold::pattern::generate::MiuraSpec;
 use nanofold::read::load_scene;
-use nanofold::write::folding_output::crease_pattern_fold;
-use nanofold::write::mujoco::{scene_mjcf, LoopClosure, MujocoSettings};
-use nanofold::write::output::write_atomic;
+use nanofold::write::crease_pattern_fold;
+use nanofold::write::write_atomic;
+use nanofold::write::{scene_mjcf, LoopClosure, MujocoSettings};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -249,7 +249,7 @@ pub fn networks_part(sizes: &[usize], python: Option<&Path>) -> Value {
     }
     let exponents: Vec<Option<f64>> = fits
         .iter()
-        .map(|points| nanofold::plot::work_precision::power_law_fit(points).map(|f| f.0))
+        .map(|points| nanofold::plot::power_law_fit(points).map(|f| f.0))
         .collect();
     for (what, exponent) in ["set-up", "one integrator step", "one output sample"]
         .iter()

@@ -8,8 +8,9 @@
 //! The elastic sum runs over every crease, the cut one included: it is a hinge too.
 
 pub(crate) mod assemble;
-pub mod modes;
+pub(crate) mod modes;
 pub(crate) mod statics;
+pub use modes::ClosureState;
 
 use super::algorithms::{
     coriolis_torques, drag_torques, quadratic_form, update_corners, update_kinematics, update_mass_matrix,

@@ -46,7 +46,7 @@ pub enum Method {
 }
 
 impl Method {
-    /// `Auto` resolved by the time-scale ratio (see [`IMPLICIT_RATIO`]).
+    /// `Auto` resolved by the time-scale ratio (see `IMPLICIT_RATIO`).
     pub fn resolve(self, scales: &TimeScales) -> Method {
         match self {
             Method::Auto if scales.ratio >= IMPLICIT_RATIO => Method::Esdirk34,

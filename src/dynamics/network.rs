@@ -16,11 +16,12 @@ pub(crate) mod hessian;
 pub(crate) mod kkt;
 pub(crate) mod manifold;
 pub(crate) mod model;
-pub mod modes;
+pub(crate) mod modes;
 pub(crate) mod plant;
 pub(crate) mod reduced;
 pub(crate) mod rows;
 pub(crate) mod start;
+pub use modes::folded_modes;
 
 pub use algorithms::{NetworkData, Spatial, SpatialInertia};
 pub use fitted::ReducedReport;

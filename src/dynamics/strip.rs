@@ -323,11 +323,6 @@ impl ContactSet {
         self.candidates.len()
     }
 
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.candidates.is_empty()
-    }
-
     fn corner_world(&self, data: &Data, plate: usize, corner: usize) -> Point3<f64> {
         data.corners[self.corner_start[plate] + corner]
     }
@@ -360,13 +355,6 @@ impl ContactSet {
                 let local = data.poses[face].inverse_transform_point(&p);
                 model.plates()[face].contains(&local, self.touch_tolerance)
             }
-        }
-    }
-
-    /// Fills `gaps` with every candidate's signed gap at the configuration in `data`.
-    pub fn gaps(&self, data: &Data, gaps: &mut [f64]) {
-        for (k, gap) in gaps.iter_mut().enumerate() {
-            *gap = self.gap(k, data);
         }
     }
 

@@ -28,7 +28,7 @@ pub enum SecondOrder {
     /// No nonzero first-order motion has the assigned signs: the vertex cannot leave flat.
     NoFirstOrder,
     /// Q over the section of the first-order cone ranges over [min, max] (or, where Q was
-    /// seen on both sides of ±[`CERTIFICATE`], the part of it seen before the search stopped).
+    /// seen on both sides of ±`CERTIFICATE`, the part of it seen before the search stopped).
     Range {
         /// Smallest Q on the section.
         min: f64,
@@ -40,7 +40,7 @@ pub enum SecondOrder {
 impl SecondOrder {
     /// Whether this proves that no motion from flat has the assigned signs (|Q| above
     /// `tolerance` everywhere on the section, or no section at all); `tolerance` at least
-    /// [`CERTIFICATE`].
+    /// `CERTIFICATE`.
     pub fn excludes_motion(&self, tolerance: f64) -> bool {
         match *self {
             SecondOrder::OneSign | SecondOrder::NoFirstOrder => true,
@@ -74,7 +74,7 @@ pub fn quadratic_form(sector_angles: &[f64]) -> DMatrix<f64> {
 
 /// The test at a flat star whose creases have the signs `signs` (±1, counter-clockwise as
 /// the star's columns): [`SecondOrder::OneSign`] at degree 3 or more, else Q's range over
-/// the first-order cone's section at degrees 5 to [`MAX_DEGREE`]; None where a sign is 0 (an
+/// the first-order cone's section at degrees 5 to `MAX_DEGREE`; None where a sign is 0 (an
 /// unassigned crease) or neither applies.
 pub fn second_order(star: &Star, signs: &[f64]) -> Option<SecondOrder> {
     let n = star.sector_angles.len();

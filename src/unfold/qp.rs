@@ -5,7 +5,7 @@
 
 mod row_space;
 
-pub use row_space::{ConstraintJacobian, JacobianRow, RowSpace, RANK_TOL};
+pub use row_space::{ConstraintJacobian, JacobianRow, RowSpace};
 
 use crate::error::{NumericalError, Result};
 use clarabel::algebra::CscMatrix;
