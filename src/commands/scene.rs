@@ -187,9 +187,10 @@ pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<Simulati
         System::Network(model) => Some(network_motion_fold(model, &simulation.response)),
         _ => None,
     };
+    let summary = response_summary(scene, settings, &simulation);
     Ok(SimulationReport {
-        summary: response_summary(scene, settings, &simulation),
-        response: response_json(scene, settings, &simulation),
+        response: response_json(&summary, &simulation.response),
+        summary,
         fold,
         simulation,
     })

@@ -90,6 +90,32 @@ impl Scene {
         }
     }
 
+    /// The target of every output angle, rad: each hinge's for a strip; for a closed chain
+    /// the driver's target and the locks' angles (0 for the creases that follow); for a
+    /// network each crease's drive, or a locked crease's start.
+    pub fn target_angles(&self) -> Vec<f64> {
+        match &self.system {
+            System::Strip(chain) => chain.target_angles().as_slice().to_vec(),
+            System::Closed(chain) => {
+                let mut targets = vec![0.0; chain.crease_stiffness.len()];
+                targets[chain.driver] = chain.target();
+                for &(c, value) in &chain.locked {
+                    targets[c] = value;
+                }
+                targets
+            }
+            System::Network(model) => (0..model.columns())
+                .map(|c| {
+                    if model.locked(c) {
+                        model.start[c]
+                    } else {
+                        model.forcing.hinges[c].target
+                    }
+                })
+                .collect(),
+        }
+    }
+
     /// Hinge stiffness per output angle (per hinge of a strip, per crease of a closed
     /// chain), N·m/rad.
     pub fn stiffness(&self) -> Vec<f64> {

@@ -8,7 +8,7 @@ use crate::dynamics::modes::Modes;
 use crate::dynamics::network::modes::NetworkModes;
 use crate::dynamics::network::NetworkModel;
 use crate::dynamics::plant::Sample;
-use crate::dynamics::scene::{Scene, System};
+use crate::dynamics::scene::Scene;
 use crate::dynamics::simulate::{Response, Simulation, SimulationSettings};
 use crate::error::{NanofoldError, Result};
 use crate::geometry::sphere::Vec3;
@@ -333,31 +333,6 @@ pub fn number(x: f64) -> Value {
     }
 }
 
-/// The target of every output angle: each hinge's for a strip; for a closed chain the
-/// driver's target and the locks' angles (0 for the creases that follow).
-pub fn target_angles(scene: &Scene) -> Vec<f64> {
-    match &scene.system {
-        System::Strip(chain) => chain.target_angles().as_slice().to_vec(),
-        System::Closed(chain) => {
-            let mut targets = vec![0.0; chain.crease_stiffness.len()];
-            targets[chain.driver] = chain.target();
-            for &(c, value) in &chain.locked {
-                targets[c] = value;
-            }
-            targets
-        }
-        System::Network(model) => (0..model.columns())
-            .map(|c| {
-                if model.locked(c) {
-                    model.start[c]
-                } else {
-                    model.forcing.hinges[c].target
-                }
-            })
-            .collect(),
-    }
-}
-
 /// The summary of a dynamics run: the `--json` object, and the head of `response.json`.
 /// A closed chain adds `cut_crease`, `anchored_face`, `constraint_source`,
 /// `torque_magnification`, `max_closure_residual` and the fit's errors (angles are every
@@ -426,7 +401,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
             .last()
             .map(|s| s.angles.as_slice().to_vec())
             .unwrap_or_default(),
-        target_angles_rad: target_angles(scene),
+        target_angles_rad: scene.target_angles(),
         steps: response.steps,
         rhs_evaluations: response.rhs_evaluations,
         seconds: response.seconds,
@@ -436,9 +411,9 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
 }
 
 /// `response.json`: the summary plus every output sample.
-pub fn response_json(scene: &Scene, settings: &SimulationSettings, simulation: &Simulation) -> Value {
-    let summary = serde_json::to_value(response_summary(scene, settings, simulation)).expect("a summary is plain data");
-    with_samples(summary, &simulation.response)
+pub fn response_json(summary: &ResponseSummary, response: &Response) -> Value {
+    let summary = serde_json::to_value(summary).expect("a summary is plain data");
+    with_samples(summary, response)
 }
 
 fn with_samples(mut value: Value, response: &Response) -> Value {
