@@ -121,3 +121,41 @@ fn layers_stacked_deep_stop_at_the_contact_budget() {
         Some(settings.pair_budget(model.pattern.panel_count) + 1)
     );
 }
+
+/// A fan of `n` thin panels about one vertex, folded by 60° along the straight line of
+/// creases 0 and n/2 (the others unassigned creases at 0), as a crease pattern.
+fn fan(n: usize) -> Pattern {
+    let tau = std::f64::consts::TAU;
+    let mut vertices = vec![[0.0, 0.0]];
+    vertices.extend((0..n).map(|k| [(tau * k as f64 / n as f64).cos(), (tau * k as f64 / n as f64).sin()]));
+    let mut edges = Vec::new();
+    let (mut assignment, mut angles) = (Vec::new(), Vec::new());
+    for k in 0..n {
+        edges.push([0, k + 1]);
+        let folded = k == 0 || k == n / 2;
+        assignment.push(if folded { "V" } else { "U" });
+        angles.push(if folded { 60.0 } else { 0.0 });
+    }
+    for k in 0..n {
+        edges.push([k + 1, (k + 1) % n + 1]);
+        assignment.push("B");
+        angles.push(0.0);
+    }
+    let text = serde_json::json!({
+        "vertices_coords": vertices, "edges_vertices": edges,
+        "edges_assignment": assignment, "edges_foldAngle": angles,
+    })
+    .to_string();
+    let sheet = nanofold::read::parse_crease_pattern(&text, "fan", "fan").unwrap();
+    Pattern::from_crease_pattern(sheet).unwrap()
+}
+
+/// Every two of a fan's panels meet at its centre: those pairs are the vertex's to order on
+/// the sphere, not the contact test's to measure, so they do not spend its pair budget. A
+/// fan of 500 panels (124 750 pairs at the centre, past the 10⁵ budget) folded along one
+/// line is judged rigid, not left undecided.
+#[test]
+fn panels_meeting_only_at_a_vertex_do_not_spend_the_contact_budget() {
+    let report = check(&fan(500), &Settings::default()).unwrap();
+    assert_eq!(report.verdict, PatternVerdict::Rigid, "{}", report.evidence);
+}

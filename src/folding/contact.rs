@@ -152,8 +152,11 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
         min_clearance: None,
         overflow: None,
     };
-    let pairs = match crate::geometry::broad_phase::overlapping_pairs_within(&boxes, settings.pair_budget(boxes.len()))
-    {
+    // Panels that share a vertex are that vertex's to order: they neither count against
+    // the budget nor get measured (a fan of thin panels meets pairwise at its centre).
+    let apart = |a: usize, b: usize| !share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]);
+    let budget = settings.pair_budget(boxes.len());
+    let pairs = match crate::geometry::broad_phase::overlapping_pairs_where(&boxes, budget, apart) {
         Ok(pairs) => pairs,
         Err(found) => {
             report.overflow = Some(found);
@@ -161,9 +164,6 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
         }
     };
     for (a, b) in pairs {
-        if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) {
-            continue;
-        }
         report.pairs_measured += 1;
         let mut distance = f64::INFINITY;
         let mut crossing = false;
