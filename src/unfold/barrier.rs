@@ -63,13 +63,11 @@ pub fn barrier_function(x: f64) -> (f64, f64) {
     (-m * m * l, -2.0 * m * l - m * m / x)
 }
 
-/// The barrier of a folding model: its activation distance, stiffness and the panels' tree
-/// paths (to turn point velocities into fold-angle derivatives).
+/// The barrier of a folding model: its activation distance, stiffness, the panel pairs left
+/// out and each panel's edges (its gradient goes up the model's tree of panels).
 pub struct PanelBarrier {
     activation: f64,
     stiffness: f64,
-    /// For each panel, the tree steps (indices into `model.tree`) from the root to it.
-    paths: Vec<Vec<usize>>,
     /// Panel pairs left out: layers already touching at the start (a flat-folded state).
     excluded: std::collections::HashSet<(usize, usize)>,
     /// Each panel's distinct triangle edges (vertex pairs).
@@ -87,23 +85,6 @@ impl PanelBarrier {
     /// The barrier for `model`.
     pub fn new(model: &FoldingModel, settings: &BarrierSettings) -> Result<PanelBarrier> {
         settings.validate()?;
-        let panels = model.pattern.panel_count;
-        let mut step_of_panel = vec![None; panels];
-        for (k, step) in model.tree.iter().enumerate() {
-            step_of_panel[step.panel] = Some(k);
-        }
-        let paths = (0..panels)
-            .map(|p| {
-                let mut path = Vec::new();
-                let mut at = p;
-                while let Some(k) = step_of_panel[at] {
-                    path.push(k);
-                    at = model.tree[k].parent;
-                }
-                path.reverse();
-                path
-            })
-            .collect();
         let edges = model
             .panel_triangles
             .iter()
@@ -120,7 +101,6 @@ impl PanelBarrier {
         Ok(PanelBarrier {
             activation: settings.activation * median_panel_size(model),
             stiffness: settings.stiffness,
-            paths,
             edges,
             excluded: Default::default(),
         })
@@ -169,6 +149,13 @@ impl PanelBarrier {
             })
             .collect();
         let mut total = 0.0;
+        // Each panel's barrier force and its moment about the origin; turned into ∂B/∂ρ
+        // once, up the tree, below.
+        let mut wrench = vec![(Point::zeros(), Point::zeros()); pattern.panel_count];
+        let mut push = |panel: usize, point: &Point, force: Point| {
+            wrench[panel].0 += force;
+            wrench[panel].1 += point.cross(&force);
+        };
         for (a, b) in overlapping_pairs(&boxes) {
             if share_vertex(&model.panel_vertices[a], &model.panel_vertices[b]) || self.excluded.contains(&(a, b)) {
                 continue;
@@ -216,26 +203,32 @@ impl PanelBarrier {
                 // dB/dd along n = (p_a − p_b)/d, through both panels' point velocities.
                 let coefficient = self.stiffness * slope / self.activation;
                 let n = (c.on_first - c.on_second) / c.distance;
-                self.add_point_gradient(model, poses, a, &c.on_first, &(n * coefficient), gradient);
-                self.add_point_gradient(model, poses, b, &c.on_second, &(-n * coefficient), gradient);
+                push(a, &c.on_first, n * coefficient);
+                push(b, &c.on_second, -n * coefficient);
             }
         }
+        self.add_wrench_gradient(model, poses, &mut wrench, gradient);
         total
     }
 
-    /// Adds force·∂p/∂ρ for a point p carried by `panel`: each tree step above it turns it
-    /// about that crease's current axis, ∂p/∂ρ = ±u × (p − q).
-    fn add_point_gradient(
+    /// Adds Σ force·∂p/∂ρ over every point p that carries a force: a tree step turns the
+    /// points of every panel below it about its crease's current axis u through q,
+    /// ∂p/∂ρ = ±u × (p − q), so its column gains ±u · (τ − q × F) for the subtree's total
+    /// force F and moment τ about the origin. One sweep from the leaves sums the subtrees
+    /// (`wrench` is spent doing so): linear in the panels, where walking each point's path
+    /// to the root was quadratic in a long strip's length.
+    fn add_wrench_gradient(
         &self,
         model: &FoldingModel,
         poses: &[Pose],
-        panel: usize,
-        point: &Point,
-        force: &Point,
+        wrench: &mut [(Point, Point)],
         gradient: &mut [f64],
     ) {
-        for &k in &self.paths[panel] {
-            let step = &model.tree[k];
+        for step in model.tree.iter().rev() {
+            let (force, moment) = wrench[step.panel];
+            if force == Point::zeros() && moment == Point::zeros() {
+                continue;
+            }
             let [i, j] = model.pattern.edges[step.edge];
             let parent = &poses[step.parent];
             let (from, to) = (
@@ -244,8 +237,9 @@ impl PanelBarrier {
             );
             let axis = (to - from).normalize();
             let sign = if step.panel_on_left { 1.0 } else { -1.0 };
-            let velocity = axis.cross(&(point - from)) * sign;
-            gradient[step.column] += force.dot(&velocity);
+            gradient[step.column] += sign * axis.dot(&(moment - from.cross(&force)));
+            wrench[step.parent].0 += force;
+            wrench[step.parent].1 += moment;
         }
     }
 }
