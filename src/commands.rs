@@ -50,6 +50,7 @@ mod view;
 
 pub use crate::constraints::network::NetworkCurves;
 pub use crate::constraints::ConstraintReport;
+pub use crate::write::folding_output::MAX_TRAJECTORY_ANGLES;
 pub use crate::write::mujoco::{LoopClosure, MujocoSettings};
 pub use crate::write::summary::{
     CheckSummary, FlatFoldabilitySummary, FoldSummary, FoldedFormBend, FoldedFormSummary, NetworkUnfoldSummary,
@@ -782,7 +783,8 @@ pub fn fold_run(pattern: &Pattern, options: &options::FoldOptions) -> Result<Fol
 }
 
 /// The files `fold` writes for a run (rendered, not written): fold.fold (the animation),
-/// folded.fold (the end state), trajectory.json (every step, thinned to 1000), fold.svg and
+/// folded.fold (the end state), trajectory.json (every step, thinned to 1000 and to
+/// [`MAX_TRAJECTORY_ANGLES`] angles in all), fold.svg and
 /// the 3D page fold.html.
 #[cfg(feature = "plot")]
 pub fn fold_files(pattern: &Pattern, run: &FoldRun) -> Result<Vec<(&'static str, String)>> {
@@ -819,7 +821,8 @@ pub fn fold_files(pattern: &Pattern, run: &FoldRun) -> Result<Vec<(&'static str,
 }
 
 /// The files `unfold` writes for a report (rendered, not written): trajectory.json (the
-/// recorded steps, thinned to 1000), unfold.fold (the FOLD animation), unfold.svg and the 3D
+/// recorded steps, thinned to 1000 and to [`MAX_TRAJECTORY_ANGLES`] angles in all),
+/// unfold.fold (the FOLD animation), unfold.svg and the 3D
 /// page unfold.html, for either engine.
 #[cfg(feature = "plot")]
 pub fn unfold_files(
@@ -828,7 +831,7 @@ pub fn unfold_files(
     settings: &Settings,
 ) -> Result<Vec<(&'static str, String)>> {
     use crate::plot::page::page_of_fold;
-    use crate::write::folding_output::{evenly, states_fold};
+    use crate::write::folding_output::{evenly, states_fold, steps_to_write};
     let pretty = |value: &serde_json::Value| {
         serde_json::to_string_pretty(value).map_err(|e| NanofoldError::invalid("unfold.fold", "JSON", e.to_string()))
     };
@@ -862,7 +865,7 @@ pub fn unfold_files(
                 &frames,
                 "unfolding written by nanofold unfold",
             );
-            let written = evenly(steps.len(), 1000);
+            let written = evenly(steps.len(), steps_to_write(1000, model.crease_count()));
             let trajectory = serde_json::json!({
                 "pattern": model.pattern.name,
                 "units": {"angles": "rad"},

@@ -134,7 +134,7 @@ pub fn states_fold(
 
 /// `trajectory.json` of a folding path: every step (thinned evenly to at most `max_steps`).
 pub fn fold_trajectory_json(model: &FoldingModel, path: &FoldPath, max_steps: usize) -> Value {
-    let chosen = evenly(path.steps.len(), max_steps);
+    let chosen = evenly(path.steps.len(), steps_to_write(max_steps, model.crease_count()));
     let steps: Vec<Value> = chosen
         .iter()
         .map(|&i| {
@@ -159,6 +159,17 @@ pub fn fold_trajectory_json(model: &FoldingModel, path: &FoldPath, max_steps: us
         "steps_written": steps.len(),
         "steps": steps,
     })
+}
+
+/// Most fold angles a written trajectory holds (steps × creases): a pattern of many creases
+/// gets fewer steps written, so the file and the memory that renders it stay bounded.
+pub const MAX_TRAJECTORY_ANGLES: usize = 2_000_000;
+
+/// How many of a run's steps a trajectory file writes for `creases` angles a step: up to
+/// `max_steps`, fewer when that would pass [`MAX_TRAJECTORY_ANGLES`] (at least the first
+/// and the last).
+pub fn steps_to_write(max_steps: usize, creases: usize) -> usize {
+    max_steps.min(MAX_TRAJECTORY_ANGLES / creases.max(1)).max(2)
 }
 
 /// `count` indices spread evenly over 0..total, first and last kept.
