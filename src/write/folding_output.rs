@@ -340,3 +340,21 @@ fn modes_states_fold(
     let frames: Vec<(String, &[f64])> = states.iter().map(|(t, s)| (t.clone(), s.as_slice())).collect();
     Ok(network_states_fold(model, &frames, description))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A trajectory keeps its 1000 steps up to 2000 creases, then as many as 2e6 angles
+    /// allow, and never fewer than its two ends.
+    #[test]
+    fn written_trajectories_hold_at_most_two_million_angles() {
+        assert_eq!(steps_to_write(1000, 24), 1000);
+        assert_eq!(steps_to_write(1000, 2000), 1000);
+        assert_eq!(steps_to_write(1000, 49_998), 40);
+        assert_eq!(steps_to_write(1000, 10_000_000), 2);
+        for creases in [1, 7, 2001, 49_998, 199_997] {
+            assert!(steps_to_write(1000, creases) * creases <= MAX_TRAJECTORY_ANGLES.max(2 * creases));
+        }
+    }
+}
