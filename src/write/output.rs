@@ -16,8 +16,8 @@ use crate::names::Named;
 use crate::pattern::{Chain, FlatMesh, RayRole, VertexPattern};
 use crate::unfold::{UnfoldModel, UnfoldReport, UnfoldSettings};
 use crate::write::summary::{
-    ClosedModesSummary, ClosedRunSummary, CollisionSummary, NetworkModesSummary, NetworkRunSummary, ReleasedLock,
-    ResponseSummary, StripModesSummary, TimeScalesSummary,
+    ClosedModesSummary, ClosedRunSummary, CollisionSummary, ModeSet, NetworkModesSummary, NetworkRunSummary,
+    ReleasedLock, ResponseSummary, StripModesSummary, TimeScalesSummary,
 };
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -359,15 +359,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
     };
     let network = match (&simulation.network, scene.network()) {
         (Some(report), Some(model)) => Some(NetworkRunSummary {
-            panels: report.panels,
-            creases: report.creases,
-            anchored_face: report.anchored_face,
-            branch: report.branch.clone(),
-            max_closure_residual: report.max_closure_residual,
-            energy_balance_error: report.energy_balance_error,
-            meeting_at_contact: report.meeting_at_contact.clone(),
-            touching_at_start: report.touching_at_start.clone(),
-            reduced: report.reduced.clone(),
+            run: report.clone(),
             crease_edges: model.folding.pattern.creases.clone(),
             release_times_s: model.forcing.hinges.iter().map(|h| h.release_time).collect(),
         }),
@@ -464,12 +456,19 @@ pub fn network_modes_summary(name: &str, model: &NetworkModel, result: &NetworkM
         equilibrium_newton_steps: modes.equilibrium.iterations,
         residual_torque_n_m: modes.equilibrium.residual_torque,
         closure_residual_rad: modes.equilibrium.closure_residual,
-        eigenvalues: modes.modes.eigenvalues.to_vec(),
-        frequencies_hz: modes.modes.frequencies_hz.to_vec(),
+        modes: mode_set(&modes.modes, &modes.crease_shapes),
         frequencies_without_load_hz: modes.frequencies_without_load_hz.to_vec(),
-        mode_shapes: columns(&modes.crease_shapes),
-        stable: modes.modes.stable,
         reduced: model.reduction.as_ref().map(|r| r.report.clone()),
+    }
+}
+
+/// Eigenvalues, frequencies and stability of `modes`, with `shapes` (one column a mode).
+fn mode_set(modes: &Modes, shapes: &DMatrix<f64>) -> ModeSet {
+    ModeSet {
+        eigenvalues: modes.eigenvalues.to_vec(),
+        frequencies_hz: modes.frequencies_hz.to_vec(),
+        mode_shapes: columns(shapes),
+        stable: modes.stable,
     }
 }
 
@@ -489,10 +488,7 @@ pub fn strip_modes_summary(scene: &Scene, modes: &Modes) -> StripModesSummary {
         scene: scene.name.clone(),
         equilibrium_rad: modes.equilibrium.as_slice().to_vec(),
         equilibrium: "folded: K θ = K θ_target, so θ* = θ_target (passive hinges at 0)",
-        eigenvalues: modes.eigenvalues.to_vec(),
-        frequencies_hz: modes.frequencies_hz.to_vec(),
-        mode_shapes: columns(&modes.mode_shapes),
-        stable: modes.stable,
+        modes: mode_set(modes, &modes.mode_shapes),
         stiffness_n_m_per_rad: scene.stiffness(),
     }
 }
@@ -530,12 +526,9 @@ pub fn closed_modes_summary(
         residual_torque_n_m: modes.residual_torque,
         newton_iterations: modes.newton_iterations,
         folded_through: user(&modes.folded_through),
-        eigenvalues: modes.modes.eigenvalues.to_vec(),
-        frequencies_hz: modes.modes.frequencies_hz.to_vec(),
+        modes: mode_set(&modes.modes, &modes.modes.mode_shapes),
         frequencies_without_load_hz: modes.frequencies_without_load_hz.to_vec(),
-        mode_shapes: columns(&modes.modes.mode_shapes),
         crease_mode_shapes: columns(&modes.crease_shapes),
-        stable: modes.modes.stable,
         stiffness_n_m_per_rad: chain.crease_stiffness.clone(),
         reduced_mass_kg_m2: rows(&modes.reduced_mass),
         reduced_stiffness_n_m_per_rad: rows(&stiffness),

@@ -633,27 +633,12 @@ pub struct ClosedRunSummary {
     pub crease_edges: Vec<usize>,
 }
 
-/// A network's figures of a run.
+/// A network's figures of a run: the run's own report, and where its creases are.
 #[derive(Debug, Clone, Serialize)]
 pub struct NetworkRunSummary {
-    /// Panels.
-    pub panels: usize,
-    /// Creases.
-    pub creases: usize,
-    /// The face on the substrate.
-    pub anchored_face: usize,
-    /// The branch followed from a flat start, in words.
-    pub branch: Option<String>,
-    /// Worst vertex closure over the run, rad.
-    pub max_closure_residual: f64,
-    /// Largest energy-balance error (None: not closed by the run's terms).
-    pub energy_balance_error: Option<f64>,
-    /// The pairs that meet at the contact.
-    pub meeting_at_contact: Vec<[String; 2]>,
-    /// The pairs touching at the start.
-    pub touching_at_start: Vec<[String; 2]>,
-    /// The fitted curves a reduced run moved on.
-    pub reduced: Option<crate::dynamics::network::ReducedReport>,
+    /// What the run reported beside its response.
+    #[serde(flatten)]
+    pub run: crate::dynamics::network::NetworkRunReport,
     /// Every crease's FOLD edge.
     pub crease_edges: Vec<usize>,
     /// Each hinge's release time, s.
@@ -672,6 +657,19 @@ pub enum ModesSummary {
     Network(Box<NetworkModesSummary>),
 }
 
+/// The modes themselves, as every kind of scene states them.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModeSet {
+    /// λ, rad²/s².
+    pub eigenvalues: Vec<f64>,
+    /// f, Hz.
+    pub frequencies_hz: Vec<f64>,
+    /// One shape per mode.
+    pub mode_shapes: Vec<Vec<f64>>,
+    /// Whether every λ > 0.
+    pub stable: bool,
+}
+
 /// A strip's modes about its folded equilibrium.
 #[derive(Debug, Clone, Serialize)]
 pub struct StripModesSummary {
@@ -681,14 +679,9 @@ pub struct StripModesSummary {
     pub equilibrium_rad: Vec<f64>,
     /// How θ* was found, in words.
     pub equilibrium: &'static str,
-    /// λ, rad²/s².
-    pub eigenvalues: Vec<f64>,
-    /// f, Hz.
-    pub frequencies_hz: Vec<f64>,
-    /// One shape per mode.
-    pub mode_shapes: Vec<Vec<f64>>,
-    /// Whether every λ > 0.
-    pub stable: bool,
+    /// The modes.
+    #[serde(flatten)]
+    pub modes: ModeSet,
     /// Each hinge's stiffness, N·m/rad.
     pub stiffness_n_m_per_rad: Vec<f64>,
 }
@@ -731,18 +724,13 @@ pub struct ClosedModesSummary {
     pub newton_iterations: usize,
     /// Creases past ±180° at θ*.
     pub folded_through: Vec<usize>,
-    /// λ, rad²/s².
-    pub eigenvalues: Vec<f64>,
-    /// f, Hz.
-    pub frequencies_hz: Vec<f64>,
+    /// The modes (shapes over the coordinates).
+    #[serde(flatten)]
+    pub modes: ModeSet,
     /// f without the load term, Hz.
     pub frequencies_without_load_hz: Vec<f64>,
-    /// Shapes over the coordinates.
-    pub mode_shapes: Vec<Vec<f64>>,
     /// Shapes over every crease.
     pub crease_mode_shapes: Vec<Vec<f64>>,
-    /// Whether every λ > 0.
-    pub stable: bool,
     /// Each crease's stiffness, N·m/rad.
     pub stiffness_n_m_per_rad: Vec<f64>,
     /// Γᵀ M Γ, rows.
@@ -781,16 +769,11 @@ pub struct NetworkModesSummary {
     pub residual_torque_n_m: f64,
     /// Worst closure there, rad.
     pub closure_residual_rad: f64,
-    /// λ, rad²/s².
-    pub eigenvalues: Vec<f64>,
-    /// f, Hz.
-    pub frequencies_hz: Vec<f64>,
+    /// The modes (shapes over every crease).
+    #[serde(flatten)]
+    pub modes: ModeSet,
     /// f without the load term, Hz.
     pub frequencies_without_load_hz: Vec<f64>,
-    /// Shapes over every crease.
-    pub mode_shapes: Vec<Vec<f64>>,
-    /// Whether every λ > 0.
-    pub stable: bool,
     /// The scene's fitted curves, when it has them.
     pub reduced: Option<crate::dynamics::network::ReducedReport>,
 }
