@@ -23,6 +23,7 @@ pub mod network;
 pub(crate) mod plant;
 pub(crate) mod quasi_static;
 pub mod scene;
+pub mod sensitivity;
 pub mod simulate;
 pub(crate) mod spec;
 pub(crate) mod strip;

@@ -94,6 +94,7 @@
 //! `nanofold` binary (feature `cli`) and the Python package. [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.
 
+pub mod calibrate;
 pub mod commands;
 pub mod constraints;
 pub mod dynamics;

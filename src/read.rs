@@ -5,12 +5,13 @@
 pub(crate) mod fold;
 pub(crate) mod folded_form;
 pub(crate) mod input;
+pub mod measurement;
 pub(crate) mod native;
 pub(crate) mod scene;
 pub mod scene_spec;
 pub use input::MAX_PATTERN_BYTES;
 
-pub use scene::{load_scene, parse_scene};
+pub use scene::{load_scene, parse_scene, scene_from_value, SceneDocument};
 
 use crate::error::{NanofoldError, Result};
 use crate::pattern::crease_pattern::CreasePattern;

@@ -1,5 +1,5 @@
 //! The library's layers depend one way (README, "How it works"): geometry → pattern →
-//! read (the file readers) → folding → unfold and constraints → dynamics → write (the file
+//! read (the file readers) → folding → unfold and constraints → dynamics → calibrate → write (the file
 //! writers) → plot → commands, with `error` beneath them all and the
 //! crate root and prelude above. This reads every library source file, collects the
 //! `crate::…` and `super::…` paths it uses (unit tests aside), and fails on an import of a
@@ -19,9 +19,10 @@ fn rank(module: &str) -> Option<usize> {
         "folding" => 4,
         "unfold" | "constraints" => 5,
         "dynamics" => 6,
-        "write" => 7,
-        "plot" => 8,
-        "commands" => 9,
+        "calibrate" => 7,
+        "write" => 8,
+        "plot" => 9,
+        "commands" => 10,
         _ => return None,
     })
 }

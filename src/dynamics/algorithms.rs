@@ -227,19 +227,19 @@ pub fn update_coriolis_matrix(model: &Model, fold_rates: &[f64], data: &mut Data
 /// Generalised drag force Q_j = Σᵢ a_ijᵀ Fᵢ, N·m (`docs/model.md#drag`); zero without drag.
 /// Its power Q·θ̇ = Σ Fᵢ·vᵢ = −½ C_D ρ A |v|²|v·n| is never positive. Needs
 /// [`update_velocities`].
-pub fn drag_torques(model: &Model, data: &Data, out: &mut [f64]) {
+pub fn drag_torques(model: &Model, data: &mut Data, out: &mut [f64]) {
     out.iter_mut().for_each(|q| *q = 0.0);
     let Some(drag) = model.drag() else { return };
     let n = model.dof();
     for (i, plate) in model.plates().iter().enumerate() {
         let velocity = data.velocities[i];
         let normal = data.poses[i].rotation * Vector3::z();
-        let normal_speed = velocity.dot(&normal);
-        if normal_speed == 0.0 {
+        let sign = data.drag_switches.sign(i, velocity.dot(&normal));
+        if sign == 0.0 {
             continue;
         }
         let magnitude = 0.5 * drag.drag_coefficient * drag.air_density * plate.area * velocity.norm_squared();
-        let force = -magnitude * normal_speed.signum() * normal;
+        let force = -magnitude * sign * normal;
         for &j in model.support(i) {
             out[j] += data.linear_jacobian[i * n + j].dot(&force);
         }

@@ -251,7 +251,7 @@ impl ClosedChain {
         update_mass_matrix(model, &mut ws.data);
         update_velocities(model, &ws.joint_rates, &mut ws.data);
         coriolis_torques(model, &ws.joint_rates, &mut ws.data, &mut ws.coriolis);
-        drag_torques(model, &ws.data, &mut ws.drag);
+        drag_torques(model, &mut ws.data, &mut ws.drag);
         let m = &ws.data.mass_matrix;
         let mut reduced_mass = 0.0;
         let mut force = self.drive_torque(t);
@@ -623,6 +623,14 @@ impl ClosedChain {
 
 impl Plant for ClosedPlant<'_> {
     type Workspace = ClosedData;
+
+    fn switches<'w>(&self, ws: &'w Self::Workspace) -> &'w [f64] {
+        &ws.data.drag_switches.normal_speeds
+    }
+
+    fn freeze_switches(&self, ws: &mut Self::Workspace, signs: Option<&[f64]>) {
+        ws.data.drag_switches.freeze(signs);
+    }
 
     fn workspace(&self) -> ClosedData {
         self.chain.workspace()

@@ -254,6 +254,56 @@ struct Driver<'r, P: Plant> {
 }
 
 impl<P: Plant> Driver<'_, P> {
+    /// The earliest crossing of a located switching function within (s_before, s_now) on the
+    /// step's dense output, by bisection to rounding: (the first scaled time past it, the
+    /// functions crossing there).
+    #[allow(clippy::type_complexity)]
+    fn first_switch<'a, Eqn, S>(
+        &self,
+        solver: &S,
+        (s_before, s_now): (f64, f64),
+        (before, now): (&[f64], &[f64]),
+        (state, angles, rates, accumulated): (&mut NalgebraVec<f64>, &mut [f64], &mut [f64], &mut [f64]),
+        scratch: &mut [f64],
+        ws: &mut P::Workspace,
+    ) -> Result<Option<(f64, Vec<usize>)>>
+    where
+        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        let n = self.plant.dof();
+        let mut earliest: Option<(f64, Vec<usize>)> = None;
+        for k in (0..before.len()).filter(|&k| before[k] * now[k] < 0.0) {
+            let side = before[k].signum();
+            let (mut lo, mut hi) = (s_before, s_now);
+            loop {
+                let mid = 0.5 * (lo + hi);
+                if mid <= lo || mid >= hi {
+                    break;
+                }
+                solver.interpolate_inplace(mid, state)?;
+                for i in 0..n {
+                    angles[i] = state[i];
+                    rates[i] = state[n + i] / self.time_unit;
+                }
+                accumulated.iter_mut().for_each(|a| *a = 0.0);
+                self.plant
+                    .switch_values(mid * self.time_unit, angles, rates, ws, scratch)?;
+                if scratch[k] * side > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            match &mut earliest {
+                Some((s, switched)) if hi == *s => switched.push(k),
+                Some((s, _)) if hi > *s => {}
+                _ => earliest = Some((hi, vec![k])),
+            }
+        }
+        Ok(earliest)
+    }
+
     fn run<'a, Eqn, S>(&self, mut solver: S) -> Result<(Vec<Sample>, Option<Collision>, usize, usize)>
     where
         Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
@@ -302,6 +352,15 @@ impl<P: Plant> Driver<'_, P> {
             let mut at_start = |_: f64, out: &mut [f64]| out.copy_from_slice(&start);
             let mut probe = plant.probe(&mut ws, &mut angles, &mut at_start);
             gaps_at(probe.as_mut(), 0.0, &mut gaps);
+        }
+        // Located switching functions (a sensitivity plant's): their values at the last
+        // accepted state, to catch each sign change and jump there.
+        let switch_count = plant.located_switches();
+        let mut switches_before = vec![0.0; switch_count];
+        let mut switches_now = vec![0.0; switch_count];
+        let mut switches_scratch = vec![0.0; switch_count];
+        if switch_count > 0 {
+            plant.switch_values(t_start, &angles, &rates, &mut ws, &mut switches_before)?;
         }
         // Stop exactly at each kink of the forcing (a ramp reaching its target), so no step
         // straddles it, then at the end.
@@ -397,7 +456,31 @@ impl<P: Plant> Driver<'_, P> {
                     c
                 });
             }
-            let s_stop = collision.as_ref().map_or(s_now, |c| c.time / self.time_unit);
+            let mut switch = None;
+            if switch_count > 0 {
+                solver.interpolate_inplace(s_now, &mut state)?;
+                split(&state, &mut angles, &mut rates, &mut accumulated);
+                plant.switch_values(s_now * self.time_unit, &angles, &rates, &mut ws, &mut switches_now)?;
+                switch = self.first_switch(
+                    &solver,
+                    (s_previous, s_now),
+                    (&switches_before, &switches_now),
+                    (&mut state, &mut angles, &mut rates, &mut accumulated),
+                    &mut switches_scratch,
+                    &mut ws,
+                )?;
+                // A contact after the switch is found again after the jump.
+                if let (Some((s_switch, _)), Some(c)) = (&switch, &collision) {
+                    if *s_switch < c.time / self.time_unit {
+                        collision = None;
+                    }
+                }
+            }
+            let s_stop = match (&collision, &switch) {
+                (Some(c), _) => c.time / self.time_unit,
+                (None, Some((s_switch, _))) => *s_switch,
+                (None, None) => s_now,
+            };
             while next_output < self.output_times.len() && self.output_times[next_output] / self.time_unit <= s_stop {
                 let s = (self.output_times[next_output] / self.time_unit).min(s_now);
                 solver.interpolate_inplace(s, &mut state)?;
@@ -416,6 +499,38 @@ impl<P: Plant> Driver<'_, P> {
                     solver.get_statistics().number_of_nonlinear_solver_fails,
                 ));
             }
+            if let Some((s_switch, switched)) = switch {
+                // Back to the crossing, the jump applied, and on from there.
+                solver.state_mut_back(s_switch)?;
+                let y = solver.state().y.clone();
+                split(&y, &mut angles, &mut rates, &mut accumulated);
+                plant.jump(s_switch * self.time_unit, &mut angles, &mut rates, &switched, &mut ws)?;
+                let mut fresh = y.clone();
+                for i in 0..n {
+                    fresh[i] = angles[i];
+                    fresh[n + i] = rates[i] * self.time_unit;
+                }
+                let mut derivative = solver.state().dy.clone();
+                (self.rhs)(fresh.batch_as_slice(0), s_switch, derivative.batch_as_mut_slice(0));
+                let state_mut = solver.state_mut();
+                state_mut.y.copy_from(&fresh);
+                state_mut.dy.copy_from(&derivative);
+                plant.switch_values(
+                    s_switch * self.time_unit,
+                    &angles,
+                    &rates,
+                    &mut ws,
+                    &mut switches_before,
+                )?;
+                // Just past the crossing: each switched function keeps its new side.
+                for &k in &switched {
+                    switches_before[k] = switches_now[k];
+                }
+                s_previous = s_switch;
+                previous_speed = speed_sum(solver.state().y);
+                continue;
+            }
+            switches_before.copy_from_slice(&switches_now);
             // Every accepted step too: the steps resolve the fastest mode, a fixed grid may alias
             // it. A long run thins them (the stride doubles every STEP_SAMPLE_CHUNK samples), so
             // memory grows with the logarithm of the steps, not the steps.

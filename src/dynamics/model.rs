@@ -118,6 +118,51 @@ pub struct Drag {
     pub air_density: f64,
 }
 
+/// Where the drag law switches (`docs/model.md#drag`): its force on a plate points against
+/// the sign of the plate's normal speed, which is discontinuous where that speed crosses
+/// zero. The speeds at the last evaluation are kept, and a sensitivity computation may hold
+/// the signs fixed while it differences the right-hand side (`docs/model.md#calibration`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DragSwitches {
+    /// Each plate's normal speed at the last evaluation, m/s.
+    pub normal_speeds: Vec<f64>,
+    /// Signs held instead of the speeds' own while `frozen`.
+    signs: Vec<f64>,
+    frozen: bool,
+}
+
+impl DragSwitches {
+    /// Buffers for `plates` plates.
+    pub fn new(plates: usize) -> Self {
+        DragSwitches {
+            normal_speeds: vec![0.0; plates],
+            signs: vec![0.0; plates],
+            frozen: false,
+        }
+    }
+
+    /// Holds the signs at `signs` (one per plate; 0 leaves that plate's own) until called
+    /// with None.
+    pub fn freeze(&mut self, signs: Option<&[f64]>) {
+        self.frozen = signs.is_some();
+        if let Some(signs) = signs {
+            self.signs.copy_from_slice(signs);
+        }
+    }
+
+    /// Records plate p's normal speed and returns the sign its drag acts against (0: none).
+    pub fn sign(&mut self, plate: usize, normal_speed: f64) -> f64 {
+        self.normal_speeds[plate] = normal_speed;
+        if self.frozen && self.signs[plate] != 0.0 {
+            self.signs[plate]
+        } else if normal_speed == 0.0 {
+            0.0
+        } else {
+            normal_speed.signum()
+        }
+    }
+}
+
 /// Immutable description of plates on hinges forming a kinematic tree: joint i carries plate
 /// i and hangs from plate `parent(i)` (or from the fixed ground). Parents come before their
 /// children, so a serial chain is the tree whose joint i hangs from plate i − 1.
@@ -266,6 +311,8 @@ pub struct Data {
     pub(crate) factor: DMatrix<f64>,
     pub(crate) scratch_linear: Vec<Vector3<f64>>,
     pub(crate) scratch_angular: Vec<Vector3<f64>>,
+    /// The drag law's switches at the last evaluation.
+    pub drag_switches: DragSwitches,
 }
 
 impl Data {
@@ -290,6 +337,7 @@ impl Data {
             factor: DMatrix::zeros(n, n),
             scratch_linear: vec![Vector3::zeros(); n],
             scratch_angular: vec![Vector3::zeros(); n],
+            drag_switches: DragSwitches::new(model.plates.len()),
         }
     }
 }

@@ -137,6 +137,44 @@ pub trait Plant {
         out: &mut [f64],
         ws: &mut Self::Workspace,
     ) -> Result<()>;
+    /// The drag law's switching functions at the state of the last
+    /// [`Plant::accelerations`] call: each plate's normal speed, m/s (empty when the plant
+    /// keeps none; `docs/model.md#drag`).
+    fn switches<'w>(&self, _ws: &'w Self::Workspace) -> &'w [f64] {
+        &[]
+    }
+    /// Holds the drag's direction on each plate at `signs` in later evaluations (None: from
+    /// the motion again), so a difference of the right-hand side stays on one side of its
+    /// switches.
+    fn freeze_switches(&self, _ws: &mut Self::Workspace, _signs: Option<&[f64]>) {}
+    /// Switching functions the integrator locates, with a jump of the state at each crossing
+    /// (0: none; a sensitivity plant's).
+    fn located_switches(&self) -> usize {
+        0
+    }
+    /// The located switching functions at (t, q, q̇).
+    fn switch_values(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _q_dot: &[f64],
+        _ws: &mut Self::Workspace,
+        _out: &mut [f64],
+    ) -> Result<()> {
+        Ok(())
+    }
+    /// The jump of the state where the switching functions `switched` cross zero at (t, q,
+    /// q̇), applied in place.
+    fn jump(
+        &self,
+        _t: f64,
+        _q: &mut [f64],
+        _q_dot: &mut [f64],
+        _switched: &[usize],
+        _ws: &mut Self::Workspace,
+    ) -> Result<()> {
+        Ok(())
+    }
     /// An error when a recorded state is not a valid answer (outside a fitted domain, NaN).
     fn check_samples(&self, samples: &[Sample]) -> Result<()>;
     /// Number of contact candidates (0 when collisions are ignored).

@@ -116,6 +116,16 @@ impl Scene {
         }
     }
 
+    /// The FOLD edge of every output angle (a closed chain's creases, a network's
+    /// columns); None for a strip, whose outputs are its hinges in order.
+    pub fn output_edges(&self) -> Option<&[usize]> {
+        match &self.system {
+            System::Strip(_) => None,
+            System::Closed(chain) => Some(&chain.crease_user_indices),
+            System::Network(model) => Some(&model.folding.pattern.creases),
+        }
+    }
+
     /// Hinge stiffness per output angle (per hinge of a strip, per crease of a closed
     /// chain), N·m/rad.
     pub fn stiffness(&self) -> Vec<f64> {

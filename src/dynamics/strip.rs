@@ -131,6 +131,14 @@ pub struct StripWorkspace {
 impl Plant for StripPlant<'_> {
     type Workspace = StripWorkspace;
 
+    fn switches<'w>(&self, ws: &'w Self::Workspace) -> &'w [f64] {
+        &ws.data.drag_switches.normal_speeds
+    }
+
+    fn freeze_switches(&self, ws: &mut Self::Workspace, signs: Option<&[f64]>) {
+        ws.data.drag_switches.freeze(signs);
+    }
+
     fn workspace(&self) -> StripWorkspace {
         StripWorkspace {
             data: Data::new(&self.chain.model),

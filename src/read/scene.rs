@@ -18,6 +18,43 @@ pub fn scene_name(path: &Path) -> String {
         .to_string()
 }
 
+/// A scene file as parsed JSON, before it is read into a description: what a fit edits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneDocument {
+    /// The file's JSON.
+    pub value: serde_json::Value,
+    /// Where it was read from (names it in errors).
+    pub source: String,
+    /// The scene's name when the file gives none.
+    pub fallback_name: String,
+    /// The folder its `pattern` path is relative to.
+    pub base: std::path::PathBuf,
+}
+
+impl SceneDocument {
+    /// Reads a scene file's JSON (strictly, within the scene size limit).
+    pub fn load(path: &Path) -> Result<SceneDocument> {
+        let text = crate::read::input::read_text(path, crate::read::input::MAX_SCENE_BYTES)?;
+        let source = path.display().to_string();
+        Ok(SceneDocument {
+            value: crate::read::input::parse_json(&text, &source)?,
+            fallback_name: scene_name(path),
+            base: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+            source,
+        })
+    }
+
+    /// The description this JSON reads as (its pattern loaded).
+    pub fn spec(&self) -> Result<SceneSpec> {
+        scene_from_value(&self.value, &self.source, &self.fallback_name, &self.base)
+    }
+
+    /// The same document with other JSON (a fit's parameters set).
+    pub fn with_value(&self, value: serde_json::Value) -> SceneDocument {
+        SceneDocument { value, ..self.clone() }
+    }
+}
+
 /// Loads a scene file; a closed chain's `pattern` is read relative to the scene's folder.
 /// Building the scene ([`SceneSpec::build`]) validates it.
 ///
@@ -38,8 +75,23 @@ pub fn load_scene(path: &Path) -> Result<SceneSpec> {
 /// Parses scene text; `source` names it in errors, `fallback_name` names the scene when it
 /// has no `name`, `base` is the folder a closed chain's pattern path is relative to.
 pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -> Result<SceneSpec> {
-    let value = crate::read::input::parse_json(text, source)?;
-    if crate::read::is_fold_object(&value) || value.get("sector_angles").is_some() {
+    scene_from_value(
+        &crate::read::input::parse_json(text, source)?,
+        source,
+        fallback_name,
+        base,
+    )
+}
+
+/// A scene description from parsed JSON (as [`parse_scene`] reads it): a fit changes
+/// numbers in the JSON and rebuilds the scene from it.
+pub fn scene_from_value(
+    value: &serde_json::Value,
+    source: &str,
+    fallback_name: &str,
+    base: &Path,
+) -> Result<SceneSpec> {
+    if crate::read::is_fold_object(value) || value.get("sector_angles").is_some() {
         return Err(NanofoldError::invalid(
             source,
             "a pattern file",
@@ -49,7 +101,7 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
     let closed = value.get("pattern").is_some() && value.get("cut_crease").is_some();
     let network = value.get("pattern").is_some() && !closed;
     let mut spec = if network {
-        let file: NetworkSpec<String> = crate::read::input::from_value(&value)?;
+        let file: NetworkSpec<String> = crate::read::input::from_value(value)?;
         let loaded = file.with_pattern(|path| {
             let resolved = base.join(&path);
             crate::read::load_crease_pattern(&resolved).map_err(|e| {
@@ -62,7 +114,7 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         })?;
         SceneSpec::Network(Box::new(loaded))
     } else if closed {
-        let file: ClosedSpec<String> = crate::read::input::from_value(&value)?;
+        let file: ClosedSpec<String> = crate::read::input::from_value(value)?;
         let loaded = file.with_pattern(|path| {
             let resolved = base.join(&path);
             crate::read::load_pattern(&resolved, &LoadOptions::default()).map_err(|e| {
@@ -75,7 +127,7 @@ pub fn parse_scene(text: &str, source: &str, fallback_name: &str, base: &Path) -
         })?;
         SceneSpec::Closed(Box::new(loaded))
     } else {
-        let file: StripSpec = crate::read::input::from_value(&value)?;
+        let file: StripSpec = crate::read::input::from_value(value)?;
         SceneSpec::Strip(file)
     };
     match &mut spec {

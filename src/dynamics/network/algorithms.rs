@@ -91,6 +91,8 @@ impl SpatialInertia {
 /// Scratch of one [`NetworkModel`], filled by the algorithms.
 #[derive(Debug, Clone)]
 pub struct NetworkData {
+    /// The drag law's switches at the last evaluation.
+    pub drag_switches: crate::dynamics::model::DragSwitches,
     /// Panel rotations (flat → world).
     pub rotation: Vec<Matrix3<f64>>,
     /// Panel translations: a flat point x goes to R x + t.
@@ -126,6 +128,7 @@ impl NetworkData {
         let (np, nc) = (model.panels(), model.columns());
         let rays: usize = model.folding.stars.iter().map(|s| s.columns.len()).sum();
         NetworkData {
+            drag_switches: crate::dynamics::model::DragSwitches::new(np),
             rotation: vec![Matrix3::identity(); np],
             translation: vec![Vector3::zeros(); np],
             twist: vec![Spatial::zero(); nc],
@@ -229,13 +232,13 @@ pub fn update_drag(model: &NetworkModel, data: &mut NetworkData) -> f64 {
         let centre = data.rotation[p] * body.centre + data.translation[p];
         let v = data.velocity[p].point_velocity(&centre);
         let normal = data.rotation[p].column(2).into_owned();
-        let normal_speed = v.dot(&normal);
-        if normal_speed == 0.0 {
+        let sign = data.drag_switches.sign(p, v.dot(&normal));
+        if sign == 0.0 {
             data.drag[p] = Spatial::zero();
             continue;
         }
         let magnitude = 0.5 * drag.drag_coefficient * drag.air_density * body.area * v.norm_squared();
-        let force = -magnitude * normal_speed.signum() * normal;
+        let force = -magnitude * sign * normal;
         power += force.dot(&v);
         data.drag[p] = Spatial {
             angular: centre.cross(&force),

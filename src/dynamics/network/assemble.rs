@@ -642,7 +642,7 @@ mod tests {
                 let mut coriolis = vec![0.0; n];
                 chain_algorithms::coriolis_torques(&chain.model, &rates, &mut chain_data, &mut coriolis);
                 let mut drag = vec![0.0; n];
-                chain_algorithms::drag_torques(&chain.model, &chain_data, &mut drag);
+                chain_algorithms::drag_torques(&chain.model, &mut chain_data, &mut drag);
                 update_kinematics(&network, &rho, &mut network_data);
                 update_mass_matrix(&network, &mut network_data);
                 update_velocities(&network, &rho_dot, &mut network_data);

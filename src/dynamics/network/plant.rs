@@ -221,6 +221,14 @@ impl<'m> NetworkPlant<'m> {
 impl Plant for NetworkPlant<'_> {
     type Workspace = NetworkWorkspace;
 
+    fn switches<'w>(&self, ws: &'w Self::Workspace) -> &'w [f64] {
+        &ws.data.drag_switches.normal_speeds
+    }
+
+    fn freeze_switches(&self, ws: &mut Self::Workspace, signs: Option<&[f64]>) {
+        ws.data.drag_switches.freeze(signs);
+    }
+
     fn workspace(&self) -> NetworkWorkspace {
         let n = self.model.columns();
         NetworkWorkspace {

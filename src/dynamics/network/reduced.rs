@@ -427,6 +427,14 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 impl Plant for ReducedPlant<'_> {
     type Workspace = ReducedWorkspace;
 
+    fn switches<'w>(&self, ws: &'w Self::Workspace) -> &'w [f64] {
+        &ws.data.drag_switches.normal_speeds
+    }
+
+    fn freeze_switches(&self, ws: &mut Self::Workspace, signs: Option<&[f64]>) {
+        ws.data.drag_switches.freeze(signs);
+    }
+
     fn workspace(&self) -> ReducedWorkspace {
         let n = self.model.columns();
         ReducedWorkspace {

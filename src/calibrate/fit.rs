@@ -1,0 +1,710 @@
+//! The fit of a scene to a measurement (`docs/model.md#calibration`): weighted nonlinear
+//! least squares on the simulated trajectory by Levenberg–Marquardt within the bounds, the
+//! Jacobian from the forward sensitivities, then the covariance, intervals and what the
+//! data cannot separate.
+
+use super::parameters::{resolve, with_values, FreeParameter, ResolvedParameter};
+use crate::dynamics::scene::Scene;
+use crate::dynamics::sensitivity::{trajectory_sensitivities, STENCIL};
+use crate::dynamics::Method;
+use crate::error::{NanofoldError, Result};
+use crate::read::measurement::{Measurement, Observed};
+use crate::read::SceneDocument;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Each parameter's step ε in the differences of the sensitivity equations, in the
+/// parameter's scale (|start|).
+pub const SENSITIVITY_STEP: f64 = 1e-3;
+/// A combination of parameters is undetermined when the data fix it no better than this
+/// relative standard error (100 %), or when its singular value is below this fraction of the
+/// largest (numerically degenerate).
+pub const UNDETERMINED_RELATIVE_ERROR: f64 = 1.0;
+/// See [`UNDETERMINED_RELATIVE_ERROR`].
+pub const DEGENERATE_FRACTION: f64 = 1e-8;
+/// A parameter loads on an undetermined combination when its share of the combination's
+/// direction is at least this.
+const LOADING: f64 = 0.1;
+
+/// The noise of the measured columns.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Noise {
+    /// Each column's standard deviation estimated from its residuals.
+    Estimated,
+    /// Given, in each column's unit (degrees, µm): by column name, else the default.
+    Given {
+        /// For columns not named.
+        default: Option<f64>,
+        /// By column name.
+        columns: BTreeMap<String, f64>,
+    },
+}
+
+/// How a fit runs, validated by [`FitSettings::validate`].
+#[derive(Debug, Clone)]
+pub struct FitSettings {
+    /// The parameters to fit.
+    pub free: Vec<FreeParameter>,
+    /// The measurement's noise.
+    pub noise: Noise,
+    /// Relative tolerance of each simulation.
+    pub rtol: f64,
+    /// Levenberg–Marquardt iterations at most.
+    pub max_iterations: usize,
+    /// The integrator.
+    pub method: Method,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        FitSettings {
+            free: Vec::new(),
+            noise: Noise::Estimated,
+            rtol: 1e-8,
+            max_iterations: 50,
+            method: Method::Auto,
+        }
+    }
+}
+
+impl FitSettings {
+    /// Every setting in range; errors name the setting and its value.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1e-3) {
+            return Err(NanofoldError::invalid("rtol", self.rtol, "must lie in (0, 1e-3)"));
+        }
+        if self.max_iterations == 0 || self.max_iterations > 10_000 {
+            return Err(NanofoldError::invalid(
+                "max_iterations",
+                self.max_iterations,
+                "must lie in 1..=10000",
+            ));
+        }
+        if let Noise::Given { default, columns } = &self.noise {
+            for (name, &sigma) in columns
+                .iter()
+                .map(|(k, v)| (k.as_str(), v))
+                .chain(default.iter().map(|d| ("default", d)))
+            {
+                if !(sigma.is_finite() && sigma > 0.0) {
+                    return Err(NanofoldError::invalid(
+                        format!("noise.{name}"),
+                        sigma,
+                        "a standard deviation must be finite and > 0",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How the fit ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitStatus {
+    /// The step and the change of the objective fell below their tolerances.
+    Converged,
+    /// The iteration budget ran out first.
+    MaxIterations,
+    /// No step within the bounds lowers the objective further (λ at its ceiling).
+    Stalled,
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, Serialize)]
+pub struct FittedParameter {
+    /// Its path in the scene file.
+    pub path: String,
+    /// The scene file's value.
+    pub start: f64,
+    /// The estimate.
+    pub estimate: f64,
+    /// Its bounds.
+    pub bounds: [f64; 2],
+    /// Whether the estimate sits on a bound (its interval is then not a confidence interval).
+    pub at_bound: bool,
+    /// Whether the data determine it (it loads on no undetermined combination).
+    pub determined: bool,
+    /// Standard error (None when undetermined).
+    pub standard_error: Option<f64>,
+    /// 95 % interval, estimate ± t₀.₉₇₅ × standard error (None when undetermined).
+    pub interval_95: Option<[f64; 2]>,
+}
+
+/// A direction in parameter space the data cannot fix.
+#[derive(Debug, Clone, Serialize)]
+pub struct Combination {
+    /// Its singular value in the scaled, weighted sensitivity matrix.
+    pub singular_value: f64,
+    /// The relative standard error along it (the residual scale over the singular value).
+    pub relative_standard_error: f64,
+    /// Each parameter's share of the direction (in relative changes), largest first.
+    pub loadings: Vec<(String, f64)>,
+    /// In words: what moves together without changing the fit.
+    pub description: String,
+}
+
+/// Residuals of one measured column.
+#[derive(Debug, Clone, Serialize)]
+pub struct ColumnResiduals {
+    /// The column.
+    pub name: String,
+    /// Observed values used.
+    pub observations: usize,
+    /// Its standard deviation, in its unit.
+    pub noise: f64,
+    /// `given` or `estimated`.
+    pub noise_source: &'static str,
+    /// Root mean square residual.
+    pub rms: f64,
+    /// Largest |residual|.
+    pub max_abs: f64,
+}
+
+/// Everything a fit found. It serialises as `nanofold fit --json` prints it.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    /// The scene file fitted.
+    pub scene: String,
+    /// The measurement.
+    pub measurement: String,
+    /// How it ended.
+    pub status: FitStatus,
+    /// Levenberg–Marquardt iterations.
+    pub iterations: usize,
+    /// Simulations run (with sensitivities, and of trial steps).
+    pub simulations: usize,
+    /// Observations n and parameters m.
+    pub observations: usize,
+    /// Degrees of freedom n − m.
+    pub degrees_of_freedom: usize,
+    /// Σ wᵢ rᵢ² at the estimate.
+    pub weighted_sum_of_squares: f64,
+    /// S / (n − m): ≈ 1 when the given noise is right (1 by construction when estimated).
+    pub reduced_chi_square: f64,
+    /// t₀.₉₇₅ with n − m degrees of freedom.
+    pub t_quantile: f64,
+    /// The parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Correlations of the determined parameters (None for an undetermined one).
+    pub correlation: Vec<Vec<Option<f64>>>,
+    /// Singular values of the scaled, weighted sensitivity matrix, largest first.
+    pub singular_values: Vec<f64>,
+    /// Combinations the data cannot separate.
+    pub undetermined: Vec<Combination>,
+    /// Per column.
+    pub residuals: Vec<ColumnResiduals>,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// Measured against fitted, per time (not in `--json`: fit.csv holds it).
+    #[serde(skip)]
+    pub table: FitTable,
+    /// The fitted scene file (its pattern path made absolute).
+    #[serde(skip)]
+    pub fitted_scene: serde_json::Value,
+}
+
+/// Measured and fitted values at every measured time.
+#[derive(Debug, Clone, Default)]
+pub struct FitTable {
+    /// s.
+    pub times: Vec<f64>,
+    /// Column names.
+    pub columns: Vec<String>,
+    /// Per column, per time: the measured value (None where missing).
+    pub measured: Vec<Vec<Option<f64>>>,
+    /// Per column, per time: the fitted model's value.
+    pub fitted: Vec<Vec<f64>>,
+}
+
+/// What each measured column reads from a simulation.
+#[derive(Debug, Clone, Copy)]
+enum Output {
+    /// Output angle k, reported in degrees.
+    Angle(usize),
+}
+
+/// One evaluation of the model at a parameter vector.
+struct Evaluation {
+    /// Fitted values per column per time.
+    predicted: Vec<Vec<f64>>,
+    /// Weighted residuals (ŷ − y)/σ of every observation.
+    residuals: DVector<f64>,
+    /// ∂residuals/∂u, when asked.
+    jacobian: Option<DMatrix<f64>>,
+}
+
+/// The problem: the document, its parameters, the measurement and how columns map.
+struct Problem<'a> {
+    document: &'a SceneDocument,
+    parameters: Vec<ResolvedParameter>,
+    measurement: &'a Measurement,
+    outputs: Vec<Output>,
+    sigma: Vec<f64>,
+    settings: &'a FitSettings,
+    simulations: usize,
+}
+
+impl Problem<'_> {
+    fn values(&self, u: &[f64]) -> Vec<f64> {
+        self.parameters.iter().zip(u).map(|(p, x)| x * p.scale).collect()
+    }
+
+    fn scene(&self, values: &[f64]) -> Result<Scene> {
+        with_values(self.document, &self.parameters, values).spec()?.build()
+    }
+
+    fn evaluate(&mut self, u: &[f64], jacobian: bool) -> Result<Evaluation> {
+        let values = self.values(u);
+        let base = self.scene(&values)?;
+        let mut perturbed = Vec::new();
+        if jacobian {
+            for j in 0..u.len() {
+                let mut at = values.clone();
+                let mut four = Vec::with_capacity(4);
+                for k in STENCIL {
+                    at[j] = values[j] + k * SENSITIVITY_STEP * self.parameters[j].scale;
+                    four.push(self.scene(&at)?);
+                }
+                perturbed.push(four.try_into().expect("four offsets"));
+            }
+        }
+        self.simulations += 1;
+        let run = trajectory_sensitivities(
+            &base,
+            &perturbed,
+            SENSITIVITY_STEP,
+            &self.measurement.times,
+            self.settings.method,
+            self.settings.rtol,
+        )?;
+        if run.times.len() != self.measurement.times.len() {
+            let missing = self.measurement.times[run.times.len().min(self.measurement.times.len() - 1)];
+            return Err(NanofoldError::invalid(
+                format!("{}: time_s", self.measurement.source),
+                missing,
+                "the simulation gives no state at this time (before the motion's start)",
+            ));
+        }
+        let columns = &self.measurement.columns;
+        let mut predicted = vec![vec![0.0; run.times.len()]; columns.len()];
+        let rows: usize = self.measurement.observations();
+        let mut residuals = DVector::zeros(rows);
+        let mut matrix = jacobian.then(|| DMatrix::zeros(rows, u.len()));
+        let mut e = 0;
+        for (c, column) in columns.iter().enumerate() {
+            let Output::Angle(k) = self.outputs[c];
+            for (i, measured) in column.values.iter().enumerate() {
+                predicted[c][i] = run.angles[i][k].to_degrees();
+                if let Some(y) = measured {
+                    residuals[e] = (predicted[c][i] - y) / self.sigma[c];
+                    if let Some(m) = &mut matrix {
+                        for j in 0..u.len() {
+                            m[(e, j)] = run.sensitivities[i][(k, j)].to_degrees() / self.sigma[c];
+                        }
+                    }
+                    e += 1;
+                }
+            }
+        }
+        Ok(Evaluation {
+            predicted,
+            residuals,
+            jacobian: matrix,
+        })
+    }
+}
+
+/// Which output each measured column reads, or an error naming the column.
+fn map_columns(scene: &Scene, measurement: &Measurement) -> Result<Vec<Output>> {
+    let edges = scene.output_edges();
+    let count = scene.target_angles().len();
+    measurement
+        .columns
+        .iter()
+        .map(|column| {
+            let field = format!("{}: column {}", measurement.source, column.name);
+            match (&column.observed, edges) {
+                (Observed::Angle { index, .. }, None) if *index < count => Ok(Output::Angle(*index)),
+                (Observed::Angle { index, .. }, None) => Err(NanofoldError::invalid(
+                    field,
+                    index,
+                    format!("the strip has hinges 0 to {}", count - 1),
+                )),
+                (Observed::Angle { hinge: true, .. }, Some(_)) => Err(NanofoldError::invalid(
+                    field,
+                    &column.name,
+                    "hinge_<i>_deg names a strip's hinge; this scene's creases are FOLD edges: write crease_<edge>_deg",
+                )),
+                (Observed::Angle { index, .. }, Some(edges)) => match edges.iter().position(|e| e == index) {
+                    Some(k) => Ok(Output::Angle(k)),
+                    None => Err(NanofoldError::invalid(
+                        field,
+                        index,
+                        format!("edge {index} is not one of the scene's creases (edges {edges:?})"),
+                    )),
+                },
+                (Observed::Point { .. }, _) => Err(NanofoldError::invalid(
+                    field,
+                    &column.name,
+                    "tracked points are not fitted yet: give fold angles (crease_<i>_deg)",
+                )),
+            }
+        })
+        .collect()
+}
+
+/// Fits the free parameters of `document` to `measurement` (`docs/model.md#calibration`).
+pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSettings) -> Result<FitReport> {
+    let started = Instant::now();
+    settings.validate()?;
+    let parameters = resolve(document, &settings.free)?;
+    let scene = document.spec()?.build()?;
+    let outputs = map_columns(&scene, measurement)?;
+    let m = parameters.len();
+    let n = measurement.observations();
+    if n <= m {
+        return Err(NanofoldError::invalid(
+            measurement.source.clone(),
+            format!("{n} observations"),
+            format!("fitting {m} parameters needs more observations than parameters"),
+        ));
+    }
+    let (given, sigma) = match &settings.noise {
+        Noise::Estimated => (false, vec![1.0; measurement.columns.len()]),
+        Noise::Given { default, columns } => {
+            if let Some(unknown) = columns
+                .keys()
+                .find(|k| !measurement.columns.iter().any(|c| &c.name == *k))
+            {
+                return Err(NanofoldError::invalid(
+                    format!("noise.{unknown}"),
+                    columns[unknown],
+                    format!("{} has no column {unknown}", measurement.source),
+                ));
+            }
+            let sigma = measurement
+                .columns
+                .iter()
+                .map(|c| {
+                    columns.get(&c.name).copied().or(*default).ok_or_else(|| {
+                        NanofoldError::invalid(
+                            format!("noise.{}", c.name),
+                            "missing",
+                            "give every column's noise (or a default), or let it be estimated",
+                        )
+                    })
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            (true, sigma)
+        }
+    };
+    let mut problem = Problem {
+        document,
+        parameters,
+        measurement,
+        outputs,
+        sigma,
+        settings,
+        simulations: 0,
+    };
+    let start: Vec<f64> = problem.parameters.iter().map(|p| p.start / p.scale).collect();
+    let (mut u, mut status, mut iterations) = levenberg_marquardt(&mut problem, start)?;
+    if !given && measurement.columns.len() > 1 {
+        // Columns of different noise: weigh each by its estimated σ and fit again from here.
+        let at = problem.evaluate(&u, false)?;
+        problem.sigma = column_noise(&problem, &at.residuals, n, m);
+        let (again, again_status, more) = levenberg_marquardt(&mut problem, u)?;
+        (u, status, iterations) = (again, again_status, iterations + more);
+    }
+    if !given {
+        // σ of each column from its residuals, so the residuals below are in units of it.
+        let at = problem.evaluate(&u, false)?;
+        problem.sigma = column_noise(&problem, &at.residuals, n, m);
+    }
+    let at = problem.evaluate(&u, true)?;
+    let report = statistics(&problem, &u, &at, given, n, m)?;
+    let values = problem.values(&u);
+    let fitted = with_values(document, &problem.parameters, &values);
+    Ok(FitReport {
+        scene: document.source.clone(),
+        measurement: measurement.source.clone(),
+        status,
+        iterations,
+        simulations: problem.simulations,
+        seconds: started.elapsed().as_secs_f64(),
+        fitted_scene: absolute_pattern(&fitted),
+        ..report
+    })
+}
+
+/// Each column's σ from its residuals (weighted by the current σ), with the n − m correction.
+fn column_noise(problem: &Problem, residuals: &DVector<f64>, n: usize, m: usize) -> Vec<f64> {
+    let correction = n as f64 / (n - m) as f64;
+    let mut e = 0;
+    problem
+        .measurement
+        .columns
+        .iter()
+        .enumerate()
+        .map(|(c, column)| {
+            let count = column.values.iter().flatten().count();
+            let sum: f64 = (e..e + count).map(|k| (residuals[k] * problem.sigma[c]).powi(2)).sum();
+            e += count;
+            let sigma = (correction * sum / count.max(1) as f64).sqrt();
+            if sigma > 0.0 {
+                sigma
+            } else {
+                f64::MIN_POSITIVE.sqrt()
+            }
+        })
+        .collect()
+}
+
+/// Levenberg–Marquardt (Marquardt's diagonal scaling, Nielsen's damping update) within the
+/// bounds: trial points are clamped to them. Returns the estimate in scaled units, how it
+/// ended and the iterations.
+fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f64>, FitStatus, usize)> {
+    let lower: Vec<f64> = problem.parameters.iter().map(|p| p.lower / p.scale).collect();
+    let upper: Vec<f64> = problem.parameters.iter().map(|p| p.upper / p.scale).collect();
+    let m = start.len();
+    let mut u = start;
+    let mut current = problem.evaluate(&u, true)?;
+    let mut cost = current.residuals.norm_squared();
+    let mut lambda: Option<f64> = None;
+    let mut nu = 2.0;
+    for iteration in 1..=problem.settings.max_iterations {
+        let jacobian = current.jacobian.as_ref().expect("evaluated with its Jacobian");
+        let normal = jacobian.transpose() * jacobian;
+        let gradient = jacobian.transpose() * &current.residuals;
+        // Projected gradient: a component pushing out through an active bound is no descent.
+        let projected = (0..m)
+            .map(|j| {
+                let g = gradient[j];
+                if (u[j] <= lower[j] && g > 0.0) || (u[j] >= upper[j] && g < 0.0) {
+                    0.0
+                } else {
+                    g.abs()
+                }
+            })
+            .fold(0.0, f64::max);
+        if projected <= 1e-12 * (1.0 + cost) {
+            return Ok((u, FitStatus::Converged, iteration - 1));
+        }
+        let diagonal: Vec<f64> = (0..m).map(|j| normal[(j, j)].max(1e-12 * normal.max())).collect();
+        let mut damping = *lambda.get_or_insert(1e-3);
+        loop {
+            let mut system = normal.clone();
+            for j in 0..m {
+                system[(j, j)] += damping * diagonal[j];
+            }
+            let Some(step) = system.cholesky().map(|c| c.solve(&(-&gradient))) else {
+                damping *= nu;
+                nu *= 2.0;
+                continue;
+            };
+            let trial: Vec<f64> = (0..m).map(|j| (u[j] + step[j]).clamp(lower[j], upper[j])).collect();
+            let taken = DVector::from_iterator(m, (0..m).map(|j| trial[j] - u[j]));
+            let predicted = -(2.0 * gradient.dot(&taken) + (&normal * &taken).dot(&taken));
+            let small_step = (0..m).all(|j| taken[j].abs() <= 1e-10 * (u[j].abs() + 1e-10));
+            if small_step {
+                return Ok((u, FitStatus::Converged, iteration));
+            }
+            let outcome = problem.evaluate(&trial, false).ok();
+            let trial_cost = outcome.as_ref().map_or(f64::INFINITY, |e| e.residuals.norm_squared());
+            let rho = if predicted > 0.0 {
+                (cost - trial_cost) / predicted
+            } else {
+                -1.0
+            };
+            if rho > 0.0 && trial_cost < cost {
+                let relative_decrease = (cost - trial_cost) / cost.max(f64::MIN_POSITIVE);
+                u = trial;
+                current = problem.evaluate(&u, true)?;
+                cost = current.residuals.norm_squared();
+                damping *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                nu = 2.0;
+                lambda = Some(damping);
+                if relative_decrease < 1e-12 {
+                    return Ok((u, FitStatus::Converged, iteration));
+                }
+                break;
+            }
+            damping *= nu;
+            nu *= 2.0;
+            if damping > 1e16 {
+                return Ok((u, FitStatus::Stalled, iteration));
+            }
+        }
+    }
+    Ok((u, FitStatus::MaxIterations, problem.settings.max_iterations))
+}
+
+/// Covariance, intervals, correlations and identifiability at the estimate.
+fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usize, m: usize) -> Result<FitReport> {
+    let jacobian = at.jacobian.as_ref().expect("evaluated with its Jacobian");
+    let sum_of_squares = at.residuals.norm_squared();
+    let dof = n - m;
+    let reduced = sum_of_squares / dof as f64;
+    let s2 = if given { 1.0 } else { reduced };
+    let svd = jacobian.clone().svd(false, true);
+    let v_t = svd.v_t.as_ref().expect("asked for V");
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+    let largest = svd.singular_values[order[0]];
+    let mut covariance = DMatrix::<f64>::zeros(m, m);
+    let mut undetermined = Vec::new();
+    let mut loose = vec![false; m];
+    for &k in &order {
+        let sigma = svd.singular_values[k];
+        let direction: Vec<f64> = (0..m).map(|j| v_t[(k, j)]).collect();
+        let relative_error = s2.sqrt() / sigma;
+        if sigma <= DEGENERATE_FRACTION * largest || relative_error > UNDETERMINED_RELATIVE_ERROR {
+            let mut loadings: Vec<(String, f64)> = problem
+                .parameters
+                .iter()
+                .zip(&direction)
+                .filter(|(_, w)| w.abs() >= LOADING)
+                .map(|(p, &w)| (p.path.clone(), w))
+                .collect();
+            loadings.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+            for (j, w) in direction.iter().enumerate() {
+                if w.abs() >= LOADING {
+                    loose[j] = true;
+                }
+            }
+            undetermined.push(Combination {
+                singular_value: sigma,
+                relative_standard_error: relative_error,
+                description: describe(&loadings),
+                loadings,
+            });
+            continue;
+        }
+        for a in 0..m {
+            for b in 0..m {
+                covariance[(a, b)] += s2 * direction[a] * direction[b] / (sigma * sigma);
+            }
+        }
+    }
+    let t = t_quantile(dof);
+    let values = problem.values(u);
+    let parameters: Vec<FittedParameter> = problem
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(j, p)| {
+            let se = (!loose[j]).then(|| covariance[(j, j)].sqrt() * p.scale);
+            FittedParameter {
+                path: p.path.clone(),
+                start: p.start,
+                estimate: values[j],
+                bounds: [p.lower, p.upper],
+                at_bound: values[j] <= p.lower || values[j] >= p.upper,
+                determined: !loose[j],
+                standard_error: se,
+                interval_95: se.map(|se| [values[j] - t * se, values[j] + t * se]),
+            }
+        })
+        .collect();
+    let correlation = (0..m)
+        .map(|a| {
+            (0..m)
+                .map(|b| {
+                    (!loose[a] && !loose[b])
+                        .then(|| covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt())
+                })
+                .collect()
+        })
+        .collect();
+    let mut singular_values: Vec<f64> = order.iter().map(|&k| svd.singular_values[k]).collect();
+    singular_values.iter_mut().for_each(|s| *s = s.max(0.0));
+    let measurement = problem.measurement;
+    let mut residuals = Vec::new();
+    let mut e = 0;
+    for (c, column) in measurement.columns.iter().enumerate() {
+        let count = column.values.iter().flatten().count();
+        let values: Vec<f64> = (e..e + count).map(|k| at.residuals[k] * problem.sigma[c]).collect();
+        e += count;
+        residuals.push(ColumnResiduals {
+            name: column.name.clone(),
+            observations: count,
+            noise: problem.sigma[c],
+            noise_source: if given { "given" } else { "estimated" },
+            rms: (values.iter().map(|r| r * r).sum::<f64>() / count.max(1) as f64).sqrt(),
+            max_abs: values.iter().fold(0.0, |a, r| a.max(r.abs())),
+        });
+    }
+    Ok(FitReport {
+        scene: String::new(),
+        measurement: String::new(),
+        status: FitStatus::Converged,
+        iterations: 0,
+        simulations: 0,
+        observations: n,
+        degrees_of_freedom: dof,
+        weighted_sum_of_squares: sum_of_squares,
+        reduced_chi_square: reduced,
+        t_quantile: t,
+        parameters,
+        correlation,
+        singular_values,
+        undetermined,
+        residuals,
+        seconds: 0.0,
+        table: FitTable {
+            times: measurement.times.clone(),
+            columns: measurement.columns.iter().map(|c| c.name.clone()).collect(),
+            measured: measurement.columns.iter().map(|c| c.values.clone()).collect(),
+            fitted: at.predicted.clone(),
+        },
+        fitted_scene: serde_json::Value::Null,
+    })
+}
+
+/// The 0.975 quantile of Student's t with `dof` degrees of freedom.
+pub fn t_quantile(dof: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    StudentsT::new(0.0, 1.0, dof as f64)
+        .map(|t| t.inverse_cdf(0.975))
+        .unwrap_or(f64::NAN)
+}
+
+/// An undetermined direction in words.
+fn describe(loadings: &[(String, f64)]) -> String {
+    match loadings {
+        [(a, wa), (b, wb)] => {
+            // Moving along (wa Δln a + wb Δln b) leaves the fit unchanged: a^wb · b^(−wa) is
+            // what the data fix.
+            let ratio = wb / wa;
+            if (ratio + 1.0).abs() < 0.2 {
+                format!("only the product {a} × {b} is determined")
+            } else if (ratio - 1.0).abs() < 0.2 {
+                format!("only the ratio {a} / {b} is determined")
+            } else {
+                format!("only {a} × {b}^({:.3}) is determined", -1.0 / ratio)
+            }
+        }
+        [(a, _)] => format!("{a} does not change the fitted trajectory"),
+        _ => {
+            let names: Vec<&str> = loadings.iter().map(|(n, _)| n.as_str()).collect();
+            format!("one combination of {} is not determined", names.join(", "))
+        }
+    }
+}
+
+/// The document's JSON with its `pattern` made absolute (the fitted scene is written
+/// elsewhere than the original).
+fn absolute_pattern(document: &SceneDocument) -> serde_json::Value {
+    let mut value = document.value.clone();
+    if let Some(serde_json::Value::String(pattern)) = value.get("pattern") {
+        let joined = document.base.join(pattern);
+        let absolute = joined.canonicalize().unwrap_or(joined);
+        value["pattern"] = serde_json::Value::String(absolute.display().to_string());
+    }
+    value
+}

@@ -1,0 +1,653 @@
+//! Forward sensitivities of a scene's trajectory to its parameters
+//! (`docs/model.md#calibration`): the variational equations S̈ = ∂a/∂q S + ∂a/∂q̇ Ṡ + ∂a/∂u
+//! integrated with the motion under one error control, for any plant.
+//!
+//! The caller hands the scene at the parameters u and at u + kε eⱼ, k = −2, −1, 1, 2, for
+//! each parameter j (one scene per perturbation, built from the scene file, so any number
+//! the file holds can be a parameter). Each column's right-hand side is two fourth-order
+//! central differences, [8(f₊₁ − f₋₁) − (f₊₂ − f₋₂)] / 12h: along the state,
+//! ∂a/∂q Sⱼ + ∂a/∂q̇ Ṡⱼ from the base plant at (q + khSⱼ, q̇ + khṠⱼ) with h sized so the
+//! shift is [`STATE_SHIFT`] rad whatever |Sⱼ| is; along the parameter, ∂a/∂uⱼ from the
+//! perturbed plants at (q, q̇). Fourth order lets both steps be large enough that rounding in
+//! a (a stiff strip's accelerations carry ~1e-14 of it) stays far below the tolerance, and a
+//! small state shift keeps the error where the right-hand side is only once differentiable
+//! (quadratic drag at a turning point) small. The adaptive integrator never differentiates
+//! its own step choices, so the columns are as accurate as the motion.
+
+use super::closed::{ClosedChain, ClosedPlant};
+use super::contact::{Collision, ContactProbe};
+use super::forcing::Forcing;
+use super::integrate::{integrate, IntegrationOptions, Method};
+use super::network::{NetworkModel, NetworkPlant, ReducedPlant};
+use super::plant::{InitialState, Plant, Sample, TimeScales};
+use super::scene::{Scene, System};
+use super::strip::{StripChain, StripPlant};
+use crate::error::{NanofoldError, Result};
+use nalgebra::{DMatrix, DVector};
+
+/// The motion and its sensitivities at the requested times.
+#[derive(Debug, Clone)]
+pub struct TrajectorySensitivity {
+    /// The output times, s (those the run reached).
+    pub times: Vec<f64>,
+    /// Every output angle (each hinge's, each crease's) at each time, rad.
+    pub angles: Vec<DVector<f64>>,
+    /// ∂angles/∂uⱼ at each time: one row per output angle, one column per parameter, rad per
+    /// unit of the parameter's scaled coordinate u.
+    pub sensitivities: Vec<DMatrix<f64>>,
+    /// Accepted integrator steps.
+    pub steps: usize,
+}
+
+/// The offsets, in steps ε, of the four perturbed scenes of each parameter.
+pub const STENCIL: [f64; 4] = [-2.0, -1.0, 1.0, 2.0];
+/// The largest shift of an angle (rad) or a rate (rad per unit of scaled time) in the
+/// differences along the state.
+pub const STATE_SHIFT: f64 = 1e-4;
+
+/// The fourth-order central difference from values at the [`STENCIL`] offsets.
+fn stencil(values: [f64; 4], epsilon: f64) -> f64 {
+    (8.0 * (values[2] - values[1]) - (values[3] - values[0])) / (12.0 * epsilon)
+}
+
+/// Integrates `base` and the sensitivity of its output angles to each parameter whose
+/// perturbed scenes (at u + kε, k in [`STENCIL`]) are `perturbed[j]`, from the start to the last of
+/// `times` (increasing, the first ≥ 0), without contacts, by `method` (`Auto`: from the
+/// time scales) at relative tolerance `rtol`.
+pub fn trajectory_sensitivities(
+    base: &Scene,
+    perturbed: &[[Scene; 4]],
+    epsilon: f64,
+    times: &[f64],
+    method: Method,
+    rtol: f64,
+) -> Result<TrajectorySensitivity> {
+    if !(epsilon.is_finite() && epsilon > 0.0) {
+        return Err(NanofoldError::invalid("epsilon", epsilon, "must be a finite step > 0"));
+    }
+    let mismatch = |j: usize| {
+        NanofoldError::invalid(
+            format!("perturbed[{j}]"),
+            "a scene of another kind or size",
+            "a parameter may change numbers of a scene, not what it simulates",
+        )
+    };
+    macro_rules! pairs {
+        ($kind:ident, $make:expr) => {{
+            let mut plants = Vec::with_capacity(perturbed.len());
+            for (j, scenes) in perturbed.iter().enumerate() {
+                let mut four = Vec::with_capacity(4);
+                for scene in scenes {
+                    match &scene.system {
+                        System::$kind(inner) => four.push($make(inner)?),
+                        _ => return Err(mismatch(j)),
+                    }
+                }
+                let four: [_; 4] = four.try_into().map_err(|_| mismatch(j))?;
+                plants.push(four);
+            }
+            plants
+        }};
+    }
+    match &base.system {
+        System::Strip(chain) => {
+            let plants = pairs!(Strip, strip_plant);
+            run(&strip_plant(chain)?, &plants, epsilon, times, method, rtol)
+        }
+        System::Closed(chain) => {
+            let plants = pairs!(Closed, closed_plant);
+            run(&closed_plant(chain)?, &plants, epsilon, times, method, rtol)
+        }
+        System::Network(model) if model.reduction.is_some() => {
+            let plants = pairs!(Network, reduced_plant);
+            run(&reduced_plant(model)?, &plants, epsilon, times, method, rtol)
+        }
+        System::Network(model) => {
+            let plants = pairs!(Network, network_plant);
+            run(&network_plant(model)?, &plants, epsilon, times, method, rtol)
+        }
+    }
+}
+
+fn strip_plant(chain: &StripChain) -> Result<StripPlant<'_>> {
+    Ok(StripPlant::new(chain, false))
+}
+
+fn closed_plant(chain: &ClosedChain) -> Result<ClosedPlant<'_>> {
+    Ok(ClosedPlant::new(chain, false))
+}
+
+fn network_plant(model: &NetworkModel) -> Result<NetworkPlant<'_>> {
+    NetworkPlant::new(model, false)
+}
+
+fn reduced_plant(model: &NetworkModel) -> Result<ReducedPlant<'_>> {
+    match &model.reduction {
+        Some(reduction) => ReducedPlant::new(model, reduction, false),
+        None => Err(NanofoldError::invalid(
+            "reduction",
+            "none",
+            "a parameter may change numbers of a scene, not whether its motion is reduced",
+        )),
+    }
+}
+
+fn run<P: Plant>(
+    base: &P,
+    perturbed: &[[P; 4]],
+    epsilon: f64,
+    times: &[f64],
+    method: Method,
+    rtol: f64,
+) -> Result<TrajectorySensitivity> {
+    let plant = Augmented {
+        base,
+        perturbed,
+        epsilon,
+        time_unit: 1.0 / base.slowest_omega()?,
+        switch_count: base.switches(&base.workspace()).len(),
+        mode: std::cell::RefCell::new(vec![0.0; base.switches(&base.workspace()).len()]),
+        initial: std::cell::OnceCell::new(),
+    };
+    let mut grid = Vec::with_capacity(times.len() + 1);
+    if times.first().is_none_or(|&t| t > 0.0) {
+        grid.push(0.0);
+    }
+    grid.extend_from_slice(times);
+    let method = method.resolve(&base.time_scales()?);
+    let options = IntegrationOptions {
+        rtol,
+        progress: None,
+        record_steps: false,
+        max_steps: 5_000_000,
+    };
+    let run = integrate(&plant, method, &grid, options)?;
+    let (n, m) = (plant.outputs(), perturbed.len());
+    let mut result = TrajectorySensitivity {
+        times: Vec::with_capacity(times.len()),
+        angles: Vec::with_capacity(times.len()),
+        sensitivities: Vec::with_capacity(times.len()),
+        steps: run.steps,
+    };
+    let mut requested = times.iter().peekable();
+    for sample in &run.samples {
+        while requested.next_if(|&&t| t < sample.time).is_some() {}
+        if requested.next_if(|&&t| t == sample.time).is_none() {
+            continue;
+        }
+        result.times.push(sample.time);
+        result.angles.push(sample.angles.rows(0, n).into_owned());
+        result
+            .sensitivities
+            .push(DMatrix::from_fn(n, m, |i, j| sample.angles[n * (1 + j) + i]));
+    }
+    Ok(result)
+}
+
+/// The plant of the motion and its m sensitivity columns: coordinates (q, S₁ … Sₘ).
+struct Augmented<'p, P: Plant> {
+    base: &'p P,
+    perturbed: &'p [[P; 4]],
+    epsilon: f64,
+    /// 1/ω_slow, s: rates times it are rad per unit of scaled time.
+    time_unit: f64,
+    /// The base plant's drag switches.
+    switch_count: usize,
+    /// The drag's side on each plate, locked between located switches (0: not yet moving,
+    /// its own): the motion's right-hand side is then smooth within every step, and each
+    /// switch is taken where it is crossed.
+    mode: std::cell::RefCell<Vec<f64>>,
+    /// The start, found once.
+    initial: std::cell::OnceCell<InitialState>,
+}
+
+/// Scratch of the augmented plant: the base's and each perturbed plant's.
+struct AugmentedWorkspace<W> {
+    base: W,
+    perturbed: Vec<[W; 4]>,
+    shifted_q: Vec<f64>,
+    shifted_rates: Vec<f64>,
+    /// The accelerations at the four offsets.
+    stencil: [Vec<f64>; 4],
+    /// The drag's signs held while differencing.
+    signs: Vec<f64>,
+    /// Accelerations on either side of a switch, and a direction.
+    before: Vec<f64>,
+    after: Vec<f64>,
+    direction: Vec<f64>,
+}
+
+impl<P: Plant> Augmented<'_, P> {
+    fn columns(&self) -> usize {
+        self.perturbed.len()
+    }
+
+    /// Output angles per sample of the base plant.
+    fn outputs(&self) -> usize {
+        let mut ws = self.base.workspace();
+        let q = self.base.initial_coordinates();
+        let rates = vec![0.0; q.len()];
+        self.base
+            .sample(0.0, &q, &rates, &[], &mut ws)
+            .map_or(0, |s| s.angles.len())
+    }
+
+    /// Holds the drag's signs of the base and every perturbed plant: at the locked mode
+    /// (`effective` false), or at the signs the base's last evaluation used (`effective`).
+    fn freeze(&self, ws: &mut AugmentedWorkspace<P::Workspace>, effective: bool) {
+        let mode = self.mode.borrow();
+        for (p, sign) in ws.signs.iter_mut().enumerate() {
+            let speed = self.base.switches(&ws.base).get(p).copied().unwrap_or(0.0);
+            *sign = match (mode[p], effective) {
+                (locked, _) if locked != 0.0 => locked,
+                (_, true) if speed != 0.0 => speed.signum(),
+                _ => 0.0,
+            };
+        }
+        let signs = Some(ws.signs.as_slice());
+        self.base.freeze_switches(&mut ws.base, signs);
+        for (four, plants) in ws.perturbed.iter_mut().zip(self.perturbed) {
+            for (w, plant) in four.iter_mut().zip(plants) {
+                plant.freeze_switches(w, signs);
+            }
+        }
+    }
+
+    /// Each column's acceleration with the signs held: along the parameter, then the state.
+    fn column_accelerations(
+        &self,
+        t: f64,
+        q: &[f64],
+        q_dot: &[f64],
+        ws: &mut AugmentedWorkspace<P::Workspace>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let n = self.base.dof();
+        for (j, four) in self.perturbed.iter().enumerate() {
+            let column = &mut out[n * (1 + j)..n * (2 + j)];
+            for (k, plant) in four.iter().enumerate() {
+                plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
+            }
+            for (i, c) in column.iter_mut().enumerate() {
+                *c = stencil(std::array::from_fn(|k| ws.stencil[k][i]), self.epsilon);
+            }
+            if let Some(h) = self.state_step(j, q_dot, q) {
+                for (k, offset) in STENCIL.iter().enumerate() {
+                    self.shift(j, offset * h, q, q_dot, &mut ws.shifted_q, &mut ws.shifted_rates);
+                    self.base
+                        .accelerations(t, &ws.shifted_q, &ws.shifted_rates, &mut ws.base, &mut ws.stencil[k])?;
+                }
+                for (i, c) in column.iter_mut().enumerate() {
+                    *c += stencil(std::array::from_fn(|k| ws.stencil[k][i]), h);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// ∇gᵢ·(dq, dq̇) at (q, q̇): the fourth-order difference of drag switch i of the base.
+    fn switch_derivative(
+        &self,
+        t: f64,
+        i: usize,
+        (q, q_dot): (&[f64], &[f64]),
+        (dq, dq_dot): (&[f64], &[f64]),
+        ws: &mut AugmentedWorkspace<P::Workspace>,
+    ) -> Result<f64> {
+        let size = dq
+            .iter()
+            .map(|x| x.abs())
+            .chain(dq_dot.iter().map(|x| x.abs() * self.time_unit))
+            .fold(0.0, f64::max);
+        if !(size > 0.0 && size.is_finite()) {
+            return Ok(0.0);
+        }
+        let h = STATE_SHIFT / size;
+        let mut values = [0.0; 4];
+        for (k, offset) in STENCIL.iter().enumerate() {
+            for r in 0..q.len() {
+                ws.shifted_q[r] = q[r] + offset * h * dq[r];
+                ws.shifted_rates[r] = q_dot[r] + offset * h * dq_dot[r];
+            }
+            self.base
+                .accelerations(t, &ws.shifted_q, &ws.shifted_rates, &mut ws.base, &mut ws.stencil[k])?;
+            values[k] = self.base.switches(&ws.base)[i];
+        }
+        Ok(stencil(values, h))
+    }
+
+    /// The step h along column j's (Sⱼ, Ṡⱼ) that shifts no angle or scaled rate by more than
+    /// [`STATE_SHIFT`]; None when the column is zero.
+    fn state_step(&self, j: usize, q_dot: &[f64], q: &[f64]) -> Option<f64> {
+        let n = self.base.dof();
+        let (s, s_dot) = (&q[n * (1 + j)..n * (2 + j)], &q_dot[n * (1 + j)..n * (2 + j)]);
+        let size = s
+            .iter()
+            .map(|x| x.abs())
+            .chain(s_dot.iter().map(|x| x.abs() * self.time_unit))
+            .fold(0.0, f64::max);
+        (size > 0.0 && size.is_finite()).then(|| STATE_SHIFT / size)
+    }
+
+    /// (q + khSⱼ, q̇ + khṠⱼ) into the shifted buffers.
+    fn shift(&self, j: usize, kh: f64, q: &[f64], q_dot: &[f64], shifted_q: &mut [f64], shifted_rates: &mut [f64]) {
+        let n = self.base.dof();
+        let (s, s_dot) = (&q[n * (1 + j)..n * (2 + j)], &q_dot[n * (1 + j)..n * (2 + j)]);
+        for i in 0..n {
+            shifted_q[i] = q[i] + kh * s[i];
+            shifted_rates[i] = q_dot[i] + kh * s_dot[i];
+        }
+    }
+}
+
+impl<P: Plant> Plant for Augmented<'_, P> {
+    type Workspace = AugmentedWorkspace<P::Workspace>;
+
+    fn workspace(&self) -> Self::Workspace {
+        let n = self.base.dof();
+        AugmentedWorkspace {
+            base: self.base.workspace(),
+            perturbed: self
+                .perturbed
+                .iter()
+                .map(|four| four.each_ref().map(P::workspace))
+                .collect(),
+            shifted_q: vec![0.0; n],
+            shifted_rates: vec![0.0; n],
+            stencil: std::array::from_fn(|_| vec![0.0; n]),
+            signs: vec![0.0; self.switch_count],
+            before: vec![0.0; n],
+            after: vec![0.0; n],
+            direction: vec![0.0; n],
+        }
+    }
+
+    fn dof(&self) -> usize {
+        self.base.dof() * (1 + self.columns())
+    }
+
+    fn forcing(&self) -> &Forcing {
+        self.base.forcing()
+    }
+
+    fn time_scales(&self) -> Result<TimeScales> {
+        self.base.time_scales()
+    }
+
+    fn quasi_static_error_estimate(&self) -> Result<f64> {
+        self.base.quasi_static_error_estimate()
+    }
+
+    fn slowest_omega(&self) -> Result<f64> {
+        self.base.slowest_omega()
+    }
+
+    fn initial_coordinates(&self) -> Vec<f64> {
+        let mut q = self.base.initial_coordinates();
+        q.resize(self.dof(), 0.0);
+        q
+    }
+
+    /// The base's start; each column's start is the difference of the perturbed plants'
+    /// starts, less the motion over the difference of their start times (a plant that leaves
+    /// a flat start along a branch starts later when it is stiffer).
+    fn initial_state(&self) -> Result<InitialState> {
+        if let Some(state) = self.initial.get() {
+            return Ok(state.clone());
+        }
+        let start = self.base.initial_state()?;
+        let n = self.base.dof();
+        let mut ws = self.base.workspace();
+        let mut acceleration = vec![0.0; n];
+        self.base
+            .accelerations(start.time, &start.coordinates, &start.rates, &mut ws, &mut acceleration)?;
+        let mut coordinates = start.coordinates.clone();
+        let mut rates = start.rates.clone();
+        let eps = self.epsilon;
+        for four in self.perturbed {
+            let states = [
+                four[0].initial_state()?,
+                four[1].initial_state()?,
+                four[2].initial_state()?,
+                four[3].initial_state()?,
+            ];
+            let dt = stencil(states.each_ref().map(|s| s.time), eps);
+            for (i, (rate, accel)) in start.rates.iter().zip(&acceleration).enumerate() {
+                coordinates.push(stencil(states.each_ref().map(|s| s.coordinates[i]), eps) - rate * dt);
+                rates.push(stencil(states.each_ref().map(|s| s.rates[i]), eps) - accel * dt);
+            }
+        }
+        let state = InitialState {
+            time: start.time,
+            coordinates,
+            rates,
+            accumulated: Vec::new(),
+            note: start.note,
+        };
+        Ok(self.initial.get_or_init(|| state).clone())
+    }
+
+    /// The base's projection; then each plate that has started moving has its drag's side
+    /// locked until its switch is located.
+    fn project(&self, t: f64, q: &mut [f64], q_dot: &mut [f64], ws: &mut Self::Workspace) -> Result<bool> {
+        let n = self.base.dof();
+        let projected = self.base.project(t, &mut q[..n], &mut q_dot[..n], &mut ws.base)?;
+        if self.switch_count == 0 {
+            return Ok(projected);
+        }
+        self.freeze(ws, false);
+        self.base
+            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+        let mut missed = Vec::new();
+        {
+            let mut mode = self.mode.borrow_mut();
+            for (p, (locked, speed)) in mode.iter_mut().zip(self.base.switches(&ws.base)).enumerate() {
+                if *locked == 0.0 && *speed != 0.0 {
+                    *locked = speed.signum();
+                } else if *locked * speed < 0.0 {
+                    missed.push(p);
+                }
+            }
+        }
+        // A crossing the integrator did not locate (one in and out within a step leaves
+        // none to see): taken here, at the end of the step.
+        if !missed.is_empty() {
+            self.jump(t, q, q_dot, &missed, ws)?;
+            return Ok(true);
+        }
+        Ok(projected)
+    }
+
+    /// The motion's accelerations, then each column's with the drag's signs held at the
+    /// motion's (a difference straddling a switch would see its jump; the integrator applies
+    /// the jump where the switch is crossed instead).
+    fn accelerations(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()> {
+        let n = self.base.dof();
+        self.freeze(ws, false);
+        self.base
+            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut out[..n])?;
+        self.freeze(ws, true);
+        self.column_accelerations(t, q, q_dot, ws, out)
+    }
+
+    fn located_switches(&self) -> usize {
+        self.switch_count
+    }
+
+    fn switch_values(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()> {
+        let n = self.base.dof();
+        self.freeze(ws, false);
+        self.base
+            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+        out.copy_from_slice(self.base.switches(&ws.base));
+        Ok(())
+    }
+
+    /// Each column's jump where drag switch i is crossed (Hiskens & Pai 2000): the crossing
+    /// time moves by τⱼ = −(∇g·Xⱼ + ∂g/∂uⱼ) / (∇g·f⁻), and Ṡⱼ jumps by (a⁻ − a⁺) τⱼ, a⁻ and
+    /// a⁺ the accelerations with the drag on the old and the new side (the angles are
+    /// continuous, so Sⱼ does not jump).
+    fn jump(
+        &self,
+        t: f64,
+        q: &mut [f64],
+        q_dot: &mut [f64],
+        switched: &[usize],
+        ws: &mut Self::Workspace,
+    ) -> Result<()> {
+        let n = self.base.dof();
+        for &i in switched {
+            // The side it crosses to: the speed's sign just past the crossing.
+            self.freeze(ws, false);
+            self.base
+                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+            let speed = self.base.switches(&ws.base)[i];
+            let old_side = self.mode.borrow()[i];
+            // Just past the crossing the speed may round to zero: the side is then the other.
+            let new_side = match (speed, old_side) {
+                (0.0, 0.0) => continue,
+                (0.0, old) => -old,
+                (speed, _) => speed.signum(),
+            };
+            self.mode.borrow_mut()[i] = -new_side;
+            self.freeze(ws, true);
+            self.base
+                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.before)?;
+            self.mode.borrow_mut()[i] = new_side;
+            self.freeze(ws, true);
+            self.base
+                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+            ws.direction.copy_from_slice(&q_dot[..n]);
+            let before = std::mem::take(&mut ws.before);
+            let direction = std::mem::take(&mut ws.direction);
+            let along_motion = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&direction, &before), ws);
+            ws.direction = direction;
+            let along_motion = along_motion?;
+            if along_motion == 0.0 || !along_motion.is_finite() {
+                ws.before = before;
+                continue;
+            }
+            for j in 0..self.columns() {
+                let (s, s_dot) = (
+                    q[n * (1 + j)..n * (2 + j)].to_vec(),
+                    q_dot[n * (1 + j)..n * (2 + j)].to_vec(),
+                );
+                let along_column = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&s, &s_dot), ws)?;
+                let mut values = [0.0; 4];
+                for (k, plant) in self.perturbed[j].iter().enumerate() {
+                    plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
+                    values[k] = plant.switches(&ws.perturbed[j][k])[i];
+                }
+                let tau = -(along_column + stencil(values, self.epsilon)) / along_motion;
+                for r in 0..n {
+                    q_dot[n * (1 + j) + r] += (before[r] - ws.after[r]) * tau;
+                }
+            }
+            ws.before = before;
+        }
+        Ok(())
+    }
+
+    /// The base's sample, its angles followed by each column's output sensitivities (the
+    /// difference of the perturbed plants' outputs at the shifted states).
+    fn sample(
+        &self,
+        t: f64,
+        q: &[f64],
+        q_dot: &[f64],
+        _accumulated: &[f64],
+        ws: &mut Self::Workspace,
+    ) -> Result<Sample> {
+        let n = self.base.dof();
+        let mut sample = self.base.sample(t, &q[..n], &q_dot[..n], &[], &mut ws.base)?;
+        let outputs = sample.angles.len();
+        let mut angles = sample.angles.as_slice().to_vec();
+        let mut rates = sample.rates.as_slice().to_vec();
+        for (j, four) in self.perturbed.iter().enumerate() {
+            let mut along_parameter = Vec::with_capacity(4);
+            for (k, plant) in four.iter().enumerate() {
+                along_parameter.push(plant.sample(t, &q[..n], &q_dot[..n], &[], &mut ws.perturbed[j][k])?);
+            }
+            let mut along_state = Vec::with_capacity(4);
+            let h = self.state_step(j, q_dot, q);
+            for offset in STENCIL {
+                self.shift(
+                    j,
+                    offset * h.unwrap_or(0.0),
+                    q,
+                    q_dot,
+                    &mut ws.shifted_q,
+                    &mut ws.shifted_rates,
+                );
+                along_state.push(
+                    self.base
+                        .sample(t, &ws.shifted_q, &ws.shifted_rates, &[], &mut ws.base)?,
+                );
+            }
+            let derivative = |of: &dyn Fn(&Sample) -> f64| {
+                stencil(std::array::from_fn(|k| of(&along_parameter[k])), self.epsilon)
+                    + h.map_or(0.0, |h| stencil(std::array::from_fn(|k| of(&along_state[k])), h))
+            };
+            for i in 0..outputs {
+                angles.push(derivative(&|s| s.angles[i]));
+                rates.push(derivative(&|s| s.rates[i]));
+            }
+        }
+        sample.angles = DVector::from_vec(angles);
+        sample.rates = DVector::from_vec(rates);
+        Ok(sample)
+    }
+
+    fn balance(&self, _drive: &[f64], _q: &mut [f64], _ws: &mut Self::Workspace) -> Result<()> {
+        Err(NanofoldError::invalid(
+            "model",
+            "quasi_static",
+            "sensitivities are integrated with the dynamics only",
+        ))
+    }
+
+    fn balance_rates(
+        &self,
+        q: &[f64],
+        drive: &[f64],
+        _drive_rates: &[f64],
+        _out: &mut [f64],
+        ws: &mut Self::Workspace,
+    ) -> Result<()> {
+        let mut q = q.to_vec();
+        self.balance(drive, &mut q, ws)
+    }
+
+    fn check_samples(&self, samples: &[Sample]) -> Result<()> {
+        match samples.iter().find(|s| s.angles.iter().any(|a| !a.is_finite())) {
+            Some(s) => Err(NanofoldError::invalid(
+                "sensitivities",
+                format!("NaN at t = {:e} s", s.time),
+                "the motion or its sensitivities left the finite numbers",
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn contact_count(&self) -> usize {
+        0
+    }
+
+    fn touching(&self, _t: f64, _q: &[f64], _ws: &mut Self::Workspace) -> Option<Collision> {
+        None
+    }
+
+    fn contact_lever(&self) -> f64 {
+        self.base.contact_lever()
+    }
+
+    fn probe<'a>(
+        &'a self,
+        ws: &'a mut Self::Workspace,
+        q: &'a mut [f64],
+        path: &'a mut dyn FnMut(f64, &mut [f64]),
+    ) -> Box<dyn ContactProbe + 'a> {
+        let n = self.base.dof();
+        self.base.probe(&mut ws.base, &mut q[..n], path)
+    }
+}
