@@ -1,9 +1,10 @@
 //! Calibration: the sensitivities against central differences of whole runs, recovery of
 //! known parameters from noisy synthetic measurements, identifiability, bad input.
 
-use nanofold::calibrate::{resolve, with_values, FreeParameter, SENSITIVITY_STEP};
+use nanofold::calibrate::{fit, resolve, with_values, FitSettings, FitStatus, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::sensitivity::{trajectory_sensitivities, STENCIL};
 use nanofold::dynamics::Method;
+use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
 use nanofold::read::SceneDocument;
 
 fn free(path: &str, lower: f64, upper: f64) -> FreeParameter {
@@ -81,5 +82,91 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
             worst / largest
         );
         assert!(worst <= 1e-6 * largest, "parameter {j}: {worst:e} against {largest:e}");
+    }
+}
+
+/// A deterministic normal sample (splitmix64 and Box–Muller): the tests' noise.
+struct Noise(u64);
+
+impl Noise {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn normal(&mut self) -> f64 {
+        let (u, v) = (self.uniform().max(1e-300), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// A measurement of `columns` (output index, name) of `document` simulated at `values` of
+/// `parameters`, with Gaussian noise of `sigma` degrees.
+fn synthetic(
+    document: &SceneDocument,
+    parameters: &[nanofold::calibrate::ResolvedParameter],
+    values: &[f64],
+    times: &[f64],
+    columns: &[(usize, &str)],
+    sigma: f64,
+    noise: &mut Noise,
+) -> Measurement {
+    let scene = with_values(document, parameters, values).spec().unwrap().build().unwrap();
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, times, Method::Auto, 1e-10).unwrap();
+    Measurement {
+        source: "synthetic.csv".into(),
+        times: times.to_vec(),
+        columns: columns
+            .iter()
+            .map(|&(k, name)| MeasuredColumn {
+                name: name.into(),
+                observed: Observed::Angle { index: k, hinge: false },
+                values: run.angles.iter().map(|a| Some(a[k].to_degrees() + sigma * noise.normal())).collect(),
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn the_bridge_fit_recovers_its_parameters_within_their_intervals() {
+    let truth_document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref()).unwrap();
+    let free = vec![
+        free("hinges[*].target_angle_deg", 30.0, 150.0),
+        free("environment.drag_coefficient", 0.1, 10.0),
+        free("hinges[*].layers[1].thickness_um", 0.01, 1.0),
+    ];
+    let parameters = resolve(&truth_document, &free).unwrap();
+    let truth = [90.0, 1.28, 0.1];
+    let mut noise = Noise(7);
+    let t = times(9e-5, 200);
+    let measured = synthetic(
+        &truth_document,
+        &parameters,
+        &truth,
+        &t,
+        &[(0, "crease_0_deg"), (3, "crease_3_deg")],
+        0.5,
+        &mut noise,
+    );
+    // Start the fit away from the truth.
+    let start = with_values(&truth_document, &parameters, &[80.0, 2.0, 0.12]);
+    let settings = FitSettings {
+        free,
+        ..FitSettings::default()
+    };
+    let report = fit(&start, &measured, &settings).unwrap();
+    eprintln!("{}", serde_json::to_string_pretty(&report).unwrap());
+    assert_eq!(report.status, FitStatus::Converged);
+    for (p, truth) in report.parameters.iter().zip(truth) {
+        let [lo, hi] = p.interval_95.unwrap();
+        assert!(lo <= truth && truth <= hi, "{}: {truth} outside [{lo}, {hi}]", p.path);
+        assert!(hi - lo < 0.2 * truth, "{}: interval [{lo}, {hi}] too wide to mean anything", p.path);
+    }
+    // The noise was estimated from the residuals: about the 0.5° it was.
+    for column in &report.residuals {
+        assert!((column.noise - 0.5).abs() < 0.1, "{}: σ {}", column.name, column.noise);
     }
 }

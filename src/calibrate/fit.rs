@@ -495,6 +495,17 @@ fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f6
         if projected <= 1e-12 * (1.0 + cost) {
             return Ok((u, FitStatus::Converged, iteration - 1));
         }
+        // Converged once the Gauss–Newton step would lower S by less than 1e-6 of its mean
+        // square per degree of freedom: the estimates would move by under 1e-3 of their
+        // standard errors.
+        let scale = cost / (problem.measurement.observations() - m).max(1) as f64;
+        if let Some(newton) = normal.clone().cholesky().map(|c| c.solve(&(-&gradient))) {
+            let clamped = DVector::from_iterator(m, (0..m).map(|j| (u[j] + newton[j]).clamp(lower[j], upper[j]) - u[j]));
+            let decrease = -(2.0 * gradient.dot(&clamped) + (&normal * &clamped).dot(&clamped));
+            if decrease <= 1e-6 * scale {
+                return Ok((u, FitStatus::Converged, iteration - 1));
+            }
+        }
         let diagonal: Vec<f64> = (0..m).map(|j| normal[(j, j)].max(1e-12 * normal.max())).collect();
         let mut damping = *lambda.get_or_insert(1e-3);
         loop {
