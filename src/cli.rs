@@ -87,6 +87,11 @@ pub enum Command {
     /// its actuation: writes response.json, response.svg and snapshots.svg, and a device's 3D
     /// page (`docs/model.md#dynamics`).
     Simulate(SimulateArgs),
+    /// Fit a scene's parameters to a measured trajectory (`docs/model.md#calibration`):
+    /// estimates with standard errors and 95 % intervals, correlations, what the data cannot
+    /// separate, residuals; writes fit.json, fit.csv, fitted.scene.json, fit.svg and the fitted
+    /// motion's page response.html.
+    Fit(FitArgs),
     /// Write a scene in another tool's format: `export mujoco SCENE` writes one complete MJCF
     /// model (`docs/model.md#mujoco-scenes`).
     Export {
@@ -166,6 +171,39 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Print the summary as one JSON object on stdout (no progress bar).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `nanofold fit`.
+#[derive(Args)]
+pub struct FitArgs {
+    /// The scene file (.scene.json) whose parameters are fitted.
+    pub scene: PathBuf,
+    /// The measured trajectory: CSV with time_s and columns crease_<i>_deg (FOLD edge i; a
+    /// strip's hinge i) or hinge_<i>_deg; empty cells are missing observations.
+    pub measured: PathBuf,
+    /// A parameter to fit, PATH=LOWER:UPPER, its path into the scene file (e.g.
+    /// environment.drag_coefficient=0.5:4, hinges[*].target_angle_deg=60:120); repeat it.
+    #[arg(long, required = true)]
+    pub free: Vec<String>,
+    /// The measurement's noise in each column's unit: SIGMA for every column or
+    /// COLUMN=SIGMA (repeat it); without it, each column's is estimated from its residuals.
+    #[arg(long)]
+    pub noise: Vec<String>,
+    /// Relative tolerance of each simulation.
+    #[arg(long, default_value_t = nanofold::commands::FitOptions::default().rtol, allow_negative_numbers = true)]
+    pub rtol: f64,
+    /// Levenberg–Marquardt iterations at most.
+    #[arg(long, default_value_t = nanofold::commands::FitOptions::default().max_iterations)]
+    pub max_iterations: usize,
+    /// Integrator (diffsol).
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    pub method: MethodArg,
+    /// Output folder (default: output/<scene name>-fit/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
 }
@@ -972,6 +1010,113 @@ fn load_scene(path: &Path) -> Result<Scene> {
         .with_context(|| format!("building the scene of {}", path.display()))
 }
 
+fn method_of(arg: MethodArg) -> Method {
+    match arg {
+        MethodArg::Auto => Method::Auto,
+        MethodArg::Bdf => Method::Bdf,
+        MethodArg::Esdirk34 => Method::Esdirk34,
+        MethodArg::TrBdf2 => Method::TrBdf2,
+        MethodArg::Tsit45 => Method::Tsit45,
+    }
+}
+
+const FIT_FLAGS: &[(&str, &str)] = &[
+    ("rtol", "--rtol"),
+    ("max_iterations", "--max-iterations"),
+    ("free", "--free"),
+];
+
+fn run_fit(args: &FitArgs) -> Result<()> {
+    use nanofold::commands::{FitOptions, FreeOption, NoiseOption};
+    let noise = match args.noise.as_slice() {
+        [] => None,
+        [single] if !single.contains('=') => {
+            Some(NoiseOption::All(single.parse().map_err(|_| {
+                anyhow::anyhow!("invalid --noise {single}: give SIGMA or COLUMN=SIGMA")
+            })?))
+        }
+        many => {
+            let mut columns = std::collections::BTreeMap::new();
+            for item in many {
+                let (name, value) = item
+                    .split_once('=')
+                    .ok_or_else(|| anyhow::anyhow!("invalid --noise {item}: with several, each is COLUMN=SIGMA"))?;
+                let sigma = value
+                    .parse()
+                    .map_err(|_| anyhow::anyhow!("invalid --noise {item}: `{value}` is not a number"))?;
+                columns.insert(name.to_string(), sigma);
+            }
+            Some(NoiseOption::Columns(columns))
+        }
+    };
+    let options = FitOptions {
+        free: args.free.iter().cloned().map(FreeOption::Text).collect(),
+        noise,
+        rtol: args.rtol,
+        max_iterations: args.max_iterations,
+        method: method_of(args.method),
+    };
+    let fit_flags = |e| with_flags(e, FIT_FLAGS);
+    let settings = options.settings().map_err(fit_flags)?;
+    let document = nanofold::commands::open_scene_document(&args.scene).map_err(|e| reading(&args.scene, e))?;
+    let measured = nanofold::commands::open_measurement(&args.measured).map_err(|e| reading(&args.measured, e))?;
+    let report = nanofold::commands::fit(&document, &measured, &settings).map_err(fit_flags)?;
+    let files = nanofold::commands::fit_files(&report)?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_output_folder(&format!("{}-fit", document.fallback_name), &args.scene));
+    write_outputs(&dir, &args.measured, &files)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{} fitted to {}: {:?} after {} iterations ({} simulations, {:.2} s); {} observations, {} degrees of freedom, reduced χ² {:.3}",
+        args.scene.display(),
+        args.measured.display(),
+        report.status,
+        report.iterations,
+        report.simulations,
+        report.seconds,
+        report.observations,
+        report.degrees_of_freedom,
+        report.reduced_chi_square
+    );
+    for p in &report.parameters {
+        match (p.standard_error, p.interval_95) {
+            (Some(se), Some([lo, hi])) => println!(
+                "  {}: {:.6e} ± {:.2e} (95 %: {:.6e} to {:.6e}; scene {}){}",
+                p.path,
+                p.estimate,
+                se,
+                lo,
+                hi,
+                p.start,
+                if p.at_bound { ", at a bound" } else { "" }
+            ),
+            _ => println!(
+                "  {}: {:.6e}, not determined by the data (scene {})",
+                p.path, p.estimate, p.start
+            ),
+        }
+    }
+    for c in &report.undetermined {
+        println!(
+            "  undetermined: {} (singular value {:.2e}, relative error {:.1e})",
+            c.description, c.singular_value, c.relative_standard_error
+        );
+    }
+    for r in &report.residuals {
+        println!(
+            "  {}: {} samples, rms {:.3e}, max {:.3e}, σ {:.3e} ({})",
+            r.name, r.observations, r.rms, r.max_abs, r.noise, r.noise_source
+        );
+    }
+    print_written(&dir, &files);
+    Ok(())
+}
+
 fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<()> {
     let options = nanofold::commands::SimulateOptions {
         model: match args.model {
@@ -1429,6 +1574,7 @@ pub fn run(cli: Cli) -> Result<bool> {
         Command::View(args) => folding::run_view(&args).map(|_| true),
         Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
+        Command::Fit(args) => run_fit(&args).map(|_| true),
         Command::Modes { scene, json, out } => run_modes(&scene, json, out.as_deref()).map(|_| true),
         Command::Export { format } => run_export(&format).map(|_| true),
     }

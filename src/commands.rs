@@ -41,6 +41,7 @@ use std::path::Path;
 use std::time::Instant;
 
 mod constraints;
+mod fit;
 mod generate;
 pub mod options;
 pub mod outputs;
@@ -59,6 +60,13 @@ pub use crate::write::summary::{
 #[cfg(feature = "plot")]
 pub use constraints::constraints_files;
 pub use constraints::{constraints, ConstraintSettings, Constraints, CurveSource, Degree};
+#[cfg(feature = "plot")]
+pub use fit::fit_files;
+pub use fit::{
+    fit, fit_table_csv, open_measurement, open_scene_document, parse_measurement, ColumnResiduals, Combination,
+    FitOptions, FitReport, FitSettings, FitStatus, FitTable, FittedParameter, FreeOption, FreeParameter, Measurement,
+    Noise, NoiseOption, Observed, SceneDocument,
+};
 pub use generate::{Generated, Generator};
 pub use options::{
     options_from_json, AutoDegree, CheckOptions, ConstraintOptions, CurveFormat, DegreeOption, FoldOptions, FromJson,

@@ -2,6 +2,7 @@
 //! views, like the thesis's figures 3-3 to 3-5) and the constraint curves (figure 5-9).
 
 mod canvas;
+pub(crate) mod fit;
 pub(crate) mod folding;
 pub(crate) mod page;
 pub(crate) mod response;

@@ -9,6 +9,7 @@ pub use crate::commands::{
     check, fold, unfold, unfold_observed, CheckVerdict, CommandKind, Detail, Engine, FoldVerdict, Pattern, Report,
     Settings, UnfoldVerdict, VertexPattern,
 };
+pub use crate::commands::{fit, open_measurement, open_scene_document, FitReport, FitSettings, FreeParameter};
 pub use crate::commands::{modes, open_scene, simulate, ModesReport, SimulationReport};
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::{Method, ProgressObserver};

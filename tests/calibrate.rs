@@ -114,7 +114,11 @@ fn synthetic(
     sigma: f64,
     noise: &mut Noise,
 ) -> Measurement {
-    let scene = with_values(document, parameters, values).spec().unwrap().build().unwrap();
+    let scene = with_values(document, parameters, values)
+        .spec()
+        .unwrap()
+        .build()
+        .unwrap();
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, times, Method::Auto, 1e-10).unwrap();
     Measurement {
         source: "synthetic.csv".into(),
@@ -124,7 +128,11 @@ fn synthetic(
             .map(|&(k, name)| MeasuredColumn {
                 name: name.into(),
                 observed: Observed::Angle { index: k, hinge: false },
-                values: run.angles.iter().map(|a| Some(a[k].to_degrees() + sigma * noise.normal())).collect(),
+                values: run
+                    .angles
+                    .iter()
+                    .map(|a| Some(a[k].to_degrees() + sigma * noise.normal()))
+                    .collect(),
             })
             .collect(),
     }
@@ -163,7 +171,11 @@ fn the_bridge_fit_recovers_its_parameters_within_their_intervals() {
     for (p, truth) in report.parameters.iter().zip(truth) {
         let [lo, hi] = p.interval_95.unwrap();
         assert!(lo <= truth && truth <= hi, "{}: {truth} outside [{lo}, {hi}]", p.path);
-        assert!(hi - lo < 0.2 * truth, "{}: interval [{lo}, {hi}] too wide to mean anything", p.path);
+        assert!(
+            hi - lo < 0.2 * truth,
+            "{}: interval [{lo}, {hi}] too wide to mean anything",
+            p.path
+        );
     }
     // The noise was estimated from the residuals: about the 0.5° it was.
     for column in &report.residuals {

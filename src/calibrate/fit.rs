@@ -500,7 +500,8 @@ fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f6
         // standard errors.
         let scale = cost / (problem.measurement.observations() - m).max(1) as f64;
         if let Some(newton) = normal.clone().cholesky().map(|c| c.solve(&(-&gradient))) {
-            let clamped = DVector::from_iterator(m, (0..m).map(|j| (u[j] + newton[j]).clamp(lower[j], upper[j]) - u[j]));
+            let clamped =
+                DVector::from_iterator(m, (0..m).map(|j| (u[j] + newton[j]).clamp(lower[j], upper[j]) - u[j]));
             let decrease = -(2.0 * gradient.dot(&clamped) + (&normal * &clamped).dot(&clamped));
             if decrease <= 1e-6 * scale {
                 return Ok((u, FitStatus::Converged, iteration - 1));

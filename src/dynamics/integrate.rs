@@ -522,15 +522,10 @@ impl<P: Plant> Driver<'_, P> {
                     &mut ws,
                     &mut switches_before,
                 )?;
-                // Just past the crossing: each switched function keeps its new side.
-                for &k in &switched {
-                    switches_before[k] = switches_now[k];
-                }
                 s_previous = s_switch;
                 previous_speed = speed_sum(solver.state().y);
                 continue;
             }
-            switches_before.copy_from_slice(&switches_now);
             // Every accepted step too: the steps resolve the fastest mode, a fixed grid may alias
             // it. A long run thins them (the stride doubles every STEP_SAMPLE_CHUNK samples), so
             // memory grows with the logarithm of the steps, not the steps.
@@ -568,6 +563,12 @@ impl<P: Plant> Driver<'_, P> {
                     state_mut.y.copy_from(&fresh);
                     state_mut.dy.copy_from(&derivative);
                 }
+            }
+            if switch_count > 0 {
+                // At the step's end as the plant now holds it (projected, its sides updated).
+                let y = solver.state().y.clone();
+                split(&y, &mut angles, &mut rates, &mut accumulated);
+                plant.switch_values(s_now_time, &angles, &rates, &mut ws, &mut switches_before)?;
             }
             if matches!(reason, OdeSolverStopReason::TstopReached) {
                 next_stop += 1;

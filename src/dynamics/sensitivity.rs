@@ -24,6 +24,9 @@ use super::scene::{Scene, System};
 use super::strip::{StripChain, StripPlant};
 use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, DVector};
+use sides::{held_accelerations, Side, SideScratch};
+
+mod sides;
 
 /// The motion and its sensitivities at the requested times.
 #[derive(Debug, Clone)]
@@ -146,7 +149,7 @@ fn run<P: Plant>(
         epsilon,
         time_unit: 1.0 / base.slowest_omega()?,
         switch_count: base.switches(&base.workspace()).len(),
-        mode: std::cell::RefCell::new(vec![0.0; base.switches(&base.workspace()).len()]),
+        mode: std::cell::RefCell::new(vec![Side::Free; base.switches(&base.workspace()).len()]),
         initial: std::cell::OnceCell::new(),
     };
     let mut grid = Vec::with_capacity(times.len() + 1);
@@ -193,10 +196,10 @@ struct Augmented<'p, P: Plant> {
     time_unit: f64,
     /// The base plant's drag switches.
     switch_count: usize,
-    /// The drag's side on each plate, locked between located switches (0: not yet moving,
-    /// its own): the motion's right-hand side is then smooth within every step, and each
+    /// The drag's side on each plate (`sides`): locked between located switches, or
+    /// sliding; the motion's right-hand side is then smooth within every step, and each
     /// switch is taken where it is crossed.
-    mode: std::cell::RefCell<Vec<f64>>,
+    mode: std::cell::RefCell<Vec<Side>>,
     /// The start, found once.
     initial: std::cell::OnceCell<InitialState>,
 }
@@ -209,10 +212,11 @@ struct AugmentedWorkspace<W> {
     shifted_rates: Vec<f64>,
     /// The accelerations at the four offsets.
     stencil: [Vec<f64>; 4],
-    /// The drag's signs held while differencing.
-    signs: Vec<f64>,
-    /// Accelerations on either side of a switch, and a direction.
-    before: Vec<f64>,
+    /// The signs of the free plates' drag at the motion's state, held while differencing.
+    free_signs: Vec<f64>,
+    /// Scratch of the held evaluations.
+    scratch: SideScratch,
+    /// The base's held accelerations, and a direction.
     after: Vec<f64>,
     direction: Vec<f64>,
 }
@@ -232,30 +236,27 @@ impl<P: Plant> Augmented<'_, P> {
             .map_or(0, |s| s.angles.len())
     }
 
-    /// Holds the drag's signs of the base and every perturbed plant: at the locked mode
-    /// (`effective` false), or at the signs the base's last evaluation used (`effective`).
-    fn freeze(&self, ws: &mut AugmentedWorkspace<P::Workspace>, effective: bool) {
-        let mode = self.mode.borrow();
-        for (p, sign) in ws.signs.iter_mut().enumerate() {
-            let speed = self.base.switches(&ws.base).get(p).copied().unwrap_or(0.0);
-            *sign = match (mode[p], effective) {
-                (locked, _) if locked != 0.0 => locked,
-                (_, true) if speed != 0.0 => speed.signum(),
-                _ => 0.0,
-            };
-        }
-        let signs = Some(ws.signs.as_slice());
-        self.base.freeze_switches(&mut ws.base, signs);
-        for (four, plants) in ws.perturbed.iter_mut().zip(self.perturbed) {
-            for (w, plant) in four.iter_mut().zip(plants) {
-                plant.freeze_switches(w, signs);
-            }
-        }
+    /// The base's accelerations (into `after`), speeds and equivalent signs (into the
+    /// scratch) at (q, q̇) under the current sides.
+    fn held_base(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut AugmentedWorkspace<P::Workspace>) -> Result<()> {
+        let sides = self.mode.borrow();
+        held_accelerations(
+            self.base,
+            &sides,
+            None,
+            t,
+            q,
+            q_dot,
+            &mut ws.base,
+            &mut ws.scratch,
+            &mut ws.after,
+        )
     }
 
     /// Each column's acceleration with the signs held: along the parameter, then the state.
     fn column_accelerations(
         &self,
+        sides: &[Side],
         t: f64,
         q: &[f64],
         q_dot: &[f64],
@@ -266,7 +267,17 @@ impl<P: Plant> Augmented<'_, P> {
         for (j, four) in self.perturbed.iter().enumerate() {
             let column = &mut out[n * (1 + j)..n * (2 + j)];
             for (k, plant) in four.iter().enumerate() {
-                plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
+                held_accelerations(
+                    plant,
+                    sides,
+                    Some(&ws.free_signs),
+                    t,
+                    &q[..n],
+                    &q_dot[..n],
+                    &mut ws.perturbed[j][k],
+                    &mut ws.scratch,
+                    &mut ws.stencil[k],
+                )?;
             }
             for (i, c) in column.iter_mut().enumerate() {
                 *c = stencil(std::array::from_fn(|k| ws.stencil[k][i]), self.epsilon);
@@ -274,8 +285,17 @@ impl<P: Plant> Augmented<'_, P> {
             if let Some(h) = self.state_step(j, q_dot, q) {
                 for (k, offset) in STENCIL.iter().enumerate() {
                     self.shift(j, offset * h, q, q_dot, &mut ws.shifted_q, &mut ws.shifted_rates);
-                    self.base
-                        .accelerations(t, &ws.shifted_q, &ws.shifted_rates, &mut ws.base, &mut ws.stencil[k])?;
+                    held_accelerations(
+                        self.base,
+                        sides,
+                        Some(&ws.free_signs),
+                        t,
+                        &ws.shifted_q,
+                        &ws.shifted_rates,
+                        &mut ws.base,
+                        &mut ws.scratch,
+                        &mut ws.stencil[k],
+                    )?;
                 }
                 for (i, c) in column.iter_mut().enumerate() {
                     *c += stencil(std::array::from_fn(|k| ws.stencil[k][i]), h);
@@ -355,8 +375,8 @@ impl<P: Plant> Plant for Augmented<'_, P> {
             shifted_q: vec![0.0; n],
             shifted_rates: vec![0.0; n],
             stencil: std::array::from_fn(|_| vec![0.0; n]),
-            signs: vec![0.0; self.switch_count],
-            before: vec![0.0; n],
+            free_signs: vec![0.0; self.switch_count],
+            scratch: SideScratch::new(self.switch_count, n),
             after: vec![0.0; n],
             direction: vec![0.0; n],
         }
@@ -435,16 +455,15 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         if self.switch_count == 0 {
             return Ok(projected);
         }
-        self.freeze(ws, false);
-        self.base
-            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+        self.held_base(t, &q[..n], &q_dot[..n], ws)?;
         let mut missed = Vec::new();
         {
             let mut mode = self.mode.borrow_mut();
-            for (p, (locked, speed)) in mode.iter_mut().zip(self.base.switches(&ws.base)).enumerate() {
-                if *locked == 0.0 && *speed != 0.0 {
-                    *locked = speed.signum();
-                } else if *locked * speed < 0.0 {
+            for (p, side) in mode.iter_mut().enumerate() {
+                let speed = ws.scratch.speeds[p];
+                if *side == Side::Free && speed != 0.0 {
+                    *side = Side::Locked(speed.signum());
+                } else if side.switch_value(speed, ws.scratch.sigma[p]) < 0.0 {
                     missed.push(p);
                 }
             }
@@ -458,16 +477,27 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         Ok(projected)
     }
 
-    /// The motion's accelerations, then each column's with the drag's signs held at the
-    /// motion's (a difference straddling a switch would see its jump; the integrator applies
-    /// the jump where the switch is crossed instead).
+    /// The motion's accelerations with the drag's sides held, then each column's with the
+    /// free plates' signs held at the motion's too (a difference straddling a switch would
+    /// see its jump; the integrator applies the jump where the switch is crossed instead).
     fn accelerations(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()> {
         let n = self.base.dof();
-        self.freeze(ws, false);
-        self.base
-            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut out[..n])?;
-        self.freeze(ws, true);
-        self.column_accelerations(t, q, q_dot, ws, out)
+        let sides = self.mode.borrow();
+        held_accelerations(
+            self.base,
+            &sides,
+            None,
+            t,
+            &q[..n],
+            &q_dot[..n],
+            &mut ws.base,
+            &mut ws.scratch,
+            &mut out[..n],
+        )?;
+        for (sign, speed) in ws.free_signs.iter_mut().zip(&ws.scratch.speeds) {
+            *sign = if *speed == 0.0 { 0.0 } else { speed.signum() };
+        }
+        self.column_accelerations(&sides, t, q, q_dot, ws, out)
     }
 
     fn located_switches(&self) -> usize {
@@ -476,17 +506,20 @@ impl<P: Plant> Plant for Augmented<'_, P> {
 
     fn switch_values(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()> {
         let n = self.base.dof();
-        self.freeze(ws, false);
-        self.base
-            .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
-        out.copy_from_slice(self.base.switches(&ws.base));
+        self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+        let sides = self.mode.borrow();
+        for (p, value) in out.iter_mut().enumerate() {
+            *value = sides[p].switch_value(ws.scratch.speeds[p], ws.scratch.sigma[p]);
+        }
         Ok(())
     }
 
-    /// Each column's jump where drag switch i is crossed (Hiskens & Pai 2000): the crossing
-    /// time moves by τⱼ = −(∇g·Xⱼ + ∂g/∂uⱼ) / (∇g·f⁻), and Ṡⱼ jumps by (a⁻ − a⁺) τⱼ, a⁻ and
-    /// a⁺ the accelerations with the drag on the old and the new side (the angles are
-    /// continuous, so Sⱼ does not jump).
+    /// Where plate i's switching function crosses zero. Leaving a sliding stretch (σ
+    /// reaching ±1) the field is continuous: the side is locked and nothing jumps. Crossing
+    /// g = 0 the plate slides on if its equivalent sign lies in [−1, 1], else it locks to the
+    /// other side; each column then jumps (Hiskens & Pai 2000): the crossing time moves by
+    /// τⱼ = −(∇g·Xⱼ + ∂g/∂uⱼ) / (∇g·f⁻), and Ṡⱼ by (a⁻ − a⁺) τⱼ, a⁻ and a⁺ the accelerations
+    /// before and after (the angles are continuous, so Sⱼ does not jump).
     fn jump(
         &self,
         t: f64,
@@ -497,34 +530,35 @@ impl<P: Plant> Plant for Augmented<'_, P> {
     ) -> Result<()> {
         let n = self.base.dof();
         for &i in switched {
-            // The side it crosses to: the speed's sign just past the crossing.
-            self.freeze(ws, false);
-            self.base
-                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
-            let speed = self.base.switches(&ws.base)[i];
-            let old_side = self.mode.borrow()[i];
-            // Just past the crossing the speed may round to zero: the side is then the other.
-            let new_side = match (speed, old_side) {
-                (0.0, 0.0) => continue,
-                (0.0, old) => -old,
-                (speed, _) => speed.signum(),
+            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            let (speed, sigma) = (ws.scratch.speeds[i], ws.scratch.sigma[i]);
+            let side = self.mode.borrow()[i];
+            let old_side = match side {
+                Side::Sliding => {
+                    self.mode.borrow_mut()[i] = Side::Locked(if sigma < 0.0 { -1.0 } else { 1.0 });
+                    continue;
+                }
+                Side::Locked(sign) => sign,
+                Side::Free if speed != 0.0 => -speed.signum(),
+                Side::Free => continue,
             };
-            self.mode.borrow_mut()[i] = -new_side;
-            self.freeze(ws, true);
-            self.base
-                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.before)?;
-            self.mode.borrow_mut()[i] = new_side;
-            self.freeze(ws, true);
-            self.base
-                .accelerations(t, &q[..n], &q_dot[..n], &mut ws.base, &mut ws.after)?;
+            self.mode.borrow_mut()[i] = Side::Locked(old_side);
+            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            let before = ws.after.clone();
+            self.mode.borrow_mut()[i] = Side::Sliding;
+            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            let sigma = ws.scratch.sigma[i];
+            if !(sigma.is_finite() && sigma.abs() <= 1.0) {
+                self.mode.borrow_mut()[i] = Side::Locked(-old_side);
+                self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            }
+            let after = ws.after.clone();
             ws.direction.copy_from_slice(&q_dot[..n]);
-            let before = std::mem::take(&mut ws.before);
             let direction = std::mem::take(&mut ws.direction);
             let along_motion = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&direction, &before), ws);
             ws.direction = direction;
             let along_motion = along_motion?;
             if along_motion == 0.0 || !along_motion.is_finite() {
-                ws.before = before;
                 continue;
             }
             for j in 0..self.columns() {
@@ -540,10 +574,9 @@ impl<P: Plant> Plant for Augmented<'_, P> {
                 }
                 let tau = -(along_column + stencil(values, self.epsilon)) / along_motion;
                 for r in 0..n {
-                    q_dot[n * (1 + j) + r] += (before[r] - ws.after[r]) * tau;
+                    q_dot[n * (1 + j) + r] += (before[r] - after[r]) * tau;
                 }
             }
-            ws.before = before;
         }
         Ok(())
     }

@@ -31,6 +31,10 @@ pub const OUTPUT_FILES: &[&str] = &[
     "snapshots.svg",
     "motion.fold",
     "modes.fold",
+    "fit.json",
+    "fit.csv",
+    "fitted.scene.json",
+    "fit.svg",
     OWNER_FILE,
 ];
 

@@ -1,0 +1,60 @@
+//! Writes patterns/measurements/bridge_step_measured.csv: the bridge's step response
+//! simulated at known parameters (drag coefficient 1.6, stress target 85°, Cr 0.1 µm), its
+//! four hinges' angles every 0.45 µs up to 90 µs with seeded Gaussian noise of 0.5°, and
+//! hinge 2 unobserved after 45 µs (a tracker that lost it). A stand-in for a tracked video
+//! until one is measured; README's "Calibrating from a measurement" fits it.
+//!
+//! `cargo run --release --example synthesize_measurement`
+
+use nanofold::calibrate::{resolve, with_values, FreeParameter, SENSITIVITY_STEP};
+use nanofold::dynamics::sensitivity::trajectory_sensitivities;
+use nanofold::dynamics::Method;
+use nanofold::read::SceneDocument;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref())?;
+    let free = |path: &str| FreeParameter {
+        path: path.into(),
+        lower: f64::MIN,
+        upper: f64::MAX,
+    };
+    let parameters = resolve(
+        &document,
+        &[free("environment.drag_coefficient"), free("hinges[*].target_angle_deg")],
+    )?;
+    let scene = with_values(&document, &parameters, &[1.6, 85.0]).spec()?.build()?;
+    let times: Vec<f64> = (1..=200).map(|k| 90e-6 * k as f64 / 200.0).collect();
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
+    let mut state = 2026_u64;
+    let mut uniform = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut normal = move || {
+        let (u, v) = (uniform().max(1e-300), uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let mut text = String::from(
+        "# The bridge's step response simulated at drag coefficient 1.6 and stress target 85 deg\n# with 0.5 deg Gaussian noise (examples/synthesize_measurement.rs); hinge 2 lost after 45 us.\ntime_s,hinge_0_deg,hinge_1_deg,hinge_2_deg,hinge_3_deg\n",
+    );
+    for (t, angles) in run.times.iter().zip(&run.angles) {
+        text += &format!("{t:e}");
+        for (k, a) in angles.iter().enumerate() {
+            if k == 2 && *t > 45e-6 {
+                text += ",";
+            } else {
+                text += &format!(",{:.4}", a.to_degrees() + 0.5 * normal());
+            }
+        }
+        text.push('\n');
+    }
+    std::fs::write("patterns/measurements/bridge_step_measured.csv", text)?;
+    println!(
+        "wrote patterns/measurements/bridge_step_measured.csv ({} rows)",
+        run.times.len()
+    );
+    Ok(())
+}
