@@ -1113,6 +1113,9 @@ fn run_fit(args: &FitArgs) -> Result<()> {
             r.name, r.observations, r.rms, r.max_abs, r.noise, r.noise_source
         );
     }
+    for warning in &report.warnings {
+        println!("  warning: {warning}");
+    }
     print_written(&dir, &files);
     Ok(())
 }

@@ -182,3 +182,49 @@ fn the_bridge_fit_recovers_its_parameters_within_their_intervals() {
         assert!((column.noise - 0.5).abs() < 0.1, "{}: σ {}", column.name, column.noise);
     }
 }
+
+#[test]
+fn a_product_the_data_fix_is_named_and_its_factors_get_no_error_bar() {
+    // Drag acts through C_D ρ: the data fix the product, not the two.
+    let document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref()).unwrap();
+    let free = vec![
+        free("environment.drag_coefficient", 0.1, 10.0),
+        free("environment.air_density_kg_m3", 0.1, 10.0),
+    ];
+    let parameters = resolve(&document, &free).unwrap();
+    let mut noise = Noise(11);
+    let t = times(3e-5, 60);
+    let measured = synthetic(
+        &document,
+        &parameters,
+        &[1.28, 1.2],
+        &t,
+        &[(3, "hinge_3_deg")],
+        0.5,
+        &mut noise,
+    );
+    let report = fit(
+        &document,
+        &measured,
+        &FitSettings {
+            free,
+            ..FitSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(report.undetermined.len(), 1, "{:?}", report.undetermined);
+    let combination = &report.undetermined[0];
+    assert!(
+        combination.description.contains("product"),
+        "{}",
+        combination.description
+    );
+    for p in &report.parameters {
+        assert!(
+            !p.determined && p.standard_error.is_none() && p.interval_95.is_none(),
+            "{p:?}"
+        );
+    }
+    // A separable pair from the same data gets its intervals.
+    assert_eq!(report.singular_values.len(), 2);
+}

@@ -1371,3 +1371,103 @@ fn many_vertex_settings_and_inputs_at_their_edges() {
     assert!(ok && stdout.contains("vertices_coords[25] on no edge"), "{stdout}{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn fit_writes_its_files_and_refuses_bad_input_by_name_writing_nothing() {
+    let dir = temp_dir("fit");
+    let measured = "patterns/measurements/bridge_step_measured.csv";
+    // A short window of one hinge keeps the run quick; the file's own values are the truth.
+    let short = dir.with_extension("short.csv");
+    let text = std::fs::read_to_string(measured).unwrap();
+    let kept: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).take(61).collect();
+    std::fs::write(&short, kept.join("\n") + "\n").unwrap();
+    let (_, json) = json_run(
+        nanofold()
+            .args(["fit", "patterns/bridge_step.scene.json"])
+            .arg(&short)
+            .args(["--free", "environment.drag_coefficient=0.2:5", "--json", "--out"])
+            .arg(&dir),
+    );
+    assert_eq!(json["status"], "converged");
+    assert_eq!(json["parameters"][0]["path"], "environment.drag_coefficient");
+    for file in ["fit.json", "fit.csv", "fitted.scene.json", "fit.svg", "response.html"] {
+        assert!(dir.join(file).is_file(), "{file} missing");
+    }
+    // The fitted scene is a scene file `simulate` reads, with the estimate in it.
+    let fitted: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fitted.scene.json")).unwrap()).unwrap();
+    assert_eq!(
+        fitted["environment"]["drag_coefficient"],
+        json["parameters"][0]["estimate"]
+    );
+    let out = nanofold()
+        .arg("simulate")
+        .arg(dir.join("fitted.scene.json"))
+        .arg("--out")
+        .arg(dir.with_extension("sim"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    let bad = |name: &str, csv: Option<&str>, free: &str, expected: &[&str]| {
+        let out_dir = temp_dir(&format!("fit-bad-{name}"));
+        let file = out_dir.with_extension("csv");
+        std::fs::write(&file, csv.unwrap_or(&(kept.join("\n") + "\n"))).unwrap();
+        let out = nanofold()
+            .args(["fit", "patterns/bridge_step.scene.json"])
+            .arg(&file)
+            .args(["--free", free, "--out"])
+            .arg(&out_dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}: succeeded");
+        for part in expected {
+            assert!(stderr.contains(part), "{name}: {stderr}");
+        }
+        assert!(!out_dir.exists(), "{name}: wrote its folder");
+        let _ = std::fs::remove_file(&file);
+    };
+    let drag = "environment.drag_coefficient=0.2:5";
+    bad(
+        "path",
+        None,
+        "environment.drag_coeficient=0.2:5",
+        &["drag_coeficient", "no key"],
+    );
+    bad(
+        "bounds",
+        None,
+        "environment.drag_coefficient=2:5",
+        &["exclude the scene's value 1.28"],
+    );
+    bad(
+        "time",
+        Some("time_s,hinge_0_deg\n0,0\n1e-6,1\n1e-6,2\n"),
+        drag,
+        &["time_s", "must increase"],
+    );
+    bad(
+        "nan",
+        Some("time_s,hinge_0_deg\n0,0\n1e-6,NaN\n"),
+        drag,
+        &["hinge_0_deg", "NaN"],
+    );
+    bad("text", Some("time_s,hinge_0_deg\n0,0\n1e-6,abc\n"), drag, &["abc"]);
+    bad(
+        "column",
+        Some("time_s,hinge_7_deg\n0,0\n1e-6,1\n"),
+        drag,
+        &["hinge_7_deg", "hinges 0 to 3"],
+    );
+    bad(
+        "few",
+        Some("time_s,hinge_0_deg\n1e-6,1\n"),
+        drag,
+        &["1 observations", "more observations than parameters"],
+    );
+    for d in [&dir, &dir.with_extension("sim")] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+    let _ = std::fs::remove_file(&short);
+}

@@ -14,8 +14,8 @@ numeric lists as numpy arrays.
 """
 
 from . import generate
-from ._core import Pattern, Scene, check, constraints, fold, modes, simulate, unfold
-from ._results import FoldResult, PatternResult, Result, SimulationResult
+from ._core import Pattern, Scene, check, constraints, fit, fold, modes, simulate, unfold
+from ._results import FitResult, FoldResult, PatternResult, Result, SimulationResult
 from ._sweep import sweep
 from .errors import (
     ClosureError,
@@ -41,12 +41,14 @@ __all__ = [
     "constraints",
     "simulate",
     "modes",
+    "fit",
     "sweep",
     "generate",
     "Result",
     "PatternResult",
     "FoldResult",
     "SimulationResult",
+    "FitResult",
     "NanofoldError",
     "InputError",
     "InvalidFieldError",

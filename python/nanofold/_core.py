@@ -17,7 +17,7 @@ T = TypeVar("T")
 PathLike = Union[str, "os.PathLike[str]"]
 
 # The library's own limits on a pattern and a scene file (io::input).
-MAX_FILE_BYTES = {"pattern": 16 << 20, "scene": 1 << 20}
+MAX_FILE_BYTES = {"pattern": 16 << 20, "scene": 1 << 20, "measurement": 64 << 20}
 
 
 def _call(function: Callable[..., T], *args: Any) -> T:
@@ -447,6 +447,55 @@ def simulate(
                     ignore_collisions=ignore_collisions, max_steps=max_steps)
     summary, rest = _call(_native.simulate, s._handle, _settings(keywords))
     return SimulationResult("simulate", summary, rest)
+
+
+def fit(
+    scene: SceneLike,
+    measured: Any,
+    *,
+    free: Any,
+    noise: Any = None,
+    rtol: Optional[float] = None,
+    max_iterations: Optional[int] = None,
+    method: Optional[str] = None,
+) -> "FitResult":
+    """Fits a scene's parameters to a measured trajectory (``nanofold fit``): ``measured`` is a
+    pandas DataFrame or a CSV file (``time_s`` and columns such as ``crease_3_deg``; NaN or
+    empty where nothing was seen); ``free`` names each parameter by its path in the scene file
+    with its bounds, ``{"environment.drag_coefficient": (0.5, 4)}`` or
+    ``["environment.drag_coefficient=0.5:4"]``; ``noise`` is one σ for every column, a dict by
+    column, or None to estimate it. The result has the estimates (``parameters``), what the
+    data cannot separate (``undetermined``), the residuals, ``fitted_scene`` (a Scene) and
+    ``table`` (measured against fitted, a DataFrame).
+
+    >>> import nanofold
+    >>> r = nanofold.fit("patterns/bridge_step.scene.json",
+    ...                  "patterns/measurements/bridge_step_measured.csv",
+    ...                  free={"environment.drag_coefficient": (0.2, 5)})
+    >>> r.status, r.parameters[0]["determined"]
+    ('converged', True)
+    """
+    s = _scene(scene)
+    if isinstance(measured, (str, os.PathLike)):
+        path = Path(measured)
+        text, source = _read_text(path, "measurement"), str(path)
+    elif hasattr(measured, "to_csv") and hasattr(measured, "columns"):  # a pandas DataFrame
+        text, source = measured.to_csv(index=False), "<DataFrame>"
+    else:
+        raise TypeError(f"measured: expected a path or a pandas DataFrame, got {type(measured).__name__}")
+    if isinstance(free, Mapping):
+        free_list = [{"path": str(k), "lower": float(v[0]), "upper": float(v[1])} for k, v in free.items()]
+    elif isinstance(free, (list, tuple)):
+        free_list = list(free)
+    else:
+        raise TypeError(f"free: expected a dict of (lower, upper) or a list of PATH=LOWER:UPPER, got {type(free).__name__}")
+    keywords = dict(free=free_list, noise=noise, rtol=rtol, max_iterations=max_iterations, method=method)
+    summary, rest = _call(
+        _native.fit, json.dumps(s._spec), s._source, s._fallback, s._base, text, source, _settings(keywords)
+    )
+    from ._results import FitResult
+
+    return FitResult("fit", summary, rest)
 
 
 def modes(scene: SceneLike) -> Result:

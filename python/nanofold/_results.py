@@ -158,3 +158,29 @@ class SimulationResult(Result):
     def angles(self) -> np.ndarray:
         """Fold angles at every sample, rad (samples × hinges)."""
         return np.asarray(self._payload["response"].get("angles_rad") or [], dtype=float)
+
+
+class FitResult(Result):
+    """``fit``: the report (``parameters``, ``correlation``, ``singular_values``,
+    ``undetermined``, ``residuals``, ...), the fitted scene and the table of measured against
+    fitted values."""
+
+    @property
+    def fitted_scene(self) -> "Any":
+        """The fitted scene (a nanofold.Scene, ready for ``simulate`` and ``modes``)."""
+        from ._core import Scene
+
+        return Scene(self._payload["fitted_scene"], name=f"{self._summary.get('scene', 'scene')}-fitted")
+
+    def fitted_scene_dict(self) -> Dict[str, Any]:
+        """The fitted scene file's JSON."""
+        return copy.deepcopy(self._payload["fitted_scene"])
+
+    @property
+    def table(self) -> "Any":
+        """Measured, fitted and residual values per time (a pandas DataFrame, as fit.csv)."""
+        import io
+
+        import pandas as pd  # type: ignore[import-untyped]
+
+        return pd.read_csv(io.StringIO(self._payload["table_csv"]))

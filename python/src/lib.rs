@@ -383,6 +383,43 @@ fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(St
     })
 }
 
+/// `fit`: a scene file's JSON (with the name, source and base folder its pattern path is
+/// relative to) fitted to measurement CSV text; the report, and the fitted scene with the
+/// table of measured against fitted values.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fit(
+    py: Python<'_>,
+    scene: &str,
+    source: String,
+    name: String,
+    base: String,
+    measured: String,
+    measured_source: String,
+    settings: &str,
+) -> PyResult<(String, String)> {
+    let settings = options::<commands::FitOptions>(settings, "settings")?
+        .settings()
+        .map_err(to_py)?;
+    let document = commands::SceneDocument {
+        value: parse_json(scene, "scene")?,
+        source,
+        fallback_name: name,
+        base: base.into(),
+    };
+    run_detached(py, move || {
+        let clock = Instant::now();
+        let measurement = commands::parse_measurement(&measured, &measured_source)?;
+        let report = commands::fit(&document, &measurement, &settings)?;
+        let summary = serde_json::to_value(&report).expect("a report is plain data");
+        Ok(payload(
+            summary,
+            json!({"fitted_scene": report.fitted_scene, "table_csv": commands::fit_table_csv(&report.table)}),
+            clock,
+        ))
+    })
+}
+
 /// `modes`: the summary and a network's modes.fold.
 #[pyfunction]
 fn modes(py: Python<'_>, scene: &SceneHandle) -> PyResult<(String, String)> {
@@ -437,6 +474,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(parse_scene, m)?,
         wrap_pyfunction!(simulate, m)?,
         wrap_pyfunction!(modes, m)?,
+        wrap_pyfunction!(fit, m)?,
         wrap_pyfunction!(noop, m)?,
         wrap_pyfunction!(wait, m)?,
         wrap_pyfunction!(version, m)?,

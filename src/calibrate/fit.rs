@@ -198,6 +198,9 @@ pub struct FitReport {
     pub undetermined: Vec<Combination>,
     /// Per column.
     pub residuals: Vec<ColumnResiduals>,
+    /// What the numbers above do not say by themselves: a fit that stopped early, a given
+    /// noise the residuals contradict, an estimate on a bound.
+    pub warnings: Vec<String>,
     /// Wall time, s.
     pub seconds: f64,
     /// Measured against fitted, per time (not in `--json`: fit.csv holds it).
@@ -430,7 +433,27 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
     let report = statistics(&problem, &u, &at, given, n, m)?;
     let values = problem.values(&u);
     let fitted = with_values(document, &problem.parameters, &values);
+    let mut warnings = Vec::new();
+    if status != FitStatus::Converged {
+        warnings.push(format!(
+            "the fit stopped before converging ({status:?} after {iterations} iterations): the estimates and intervals are of the last point"
+        ));
+    }
+    let dof = report.degrees_of_freedom as f64;
+    if given && report.reduced_chi_square > 1.0 + 3.0 * (2.0 / dof).sqrt() {
+        warnings.push(format!(
+            "reduced χ² {:.3} with the given noise: the model does not fit the data as well as the noise allows (a local minimum from this start, or a model error), and the intervals assume it does",
+            report.reduced_chi_square
+        ));
+    }
+    for p in report.parameters.iter().filter(|p| p.at_bound) {
+        warnings.push(format!(
+            "{} = {} sits on a bound: its interval is not a confidence interval",
+            p.path, p.estimate
+        ));
+    }
     Ok(FitReport {
+        warnings,
         scene: document.source.clone(),
         measurement: measurement.source.clone(),
         status,
@@ -667,6 +690,7 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
         singular_values,
         undetermined,
         residuals,
+        warnings: Vec::new(),
         seconds: 0.0,
         table: FitTable {
             times: measurement.times.clone(),

@@ -148,10 +148,18 @@ fn parse_path(path: &str) -> std::result::Result<Vec<Step>, String> {
             Some(at) => (&segment[..at], &segment[at..]),
             None => (segment, ""),
         };
-        if key.is_empty() {
+        if key.is_empty() && (steps.is_empty() || rest.is_empty()) {
             return Err(format!("an empty key in `{segment}`: write a.b[2].c"));
         }
-        steps.push(Step::Key(key.to_string()));
+        // `hinges.3.layers` (as Scene.replace in Python writes it) is `hinges[3].layers`.
+        match key {
+            "" => {}
+            "*" => steps.push(Step::Every),
+            digits if digits.bytes().all(|b| b.is_ascii_digit()) => steps.push(Step::Index(
+                digits.parse().map_err(|_| format!("`{digits}` is not an index"))?,
+            )),
+            _ => steps.push(Step::Key(key.to_string())),
+        }
         while !rest.is_empty() {
             let close = rest
                 .find(']')
@@ -188,7 +196,10 @@ fn collect(value: &Value, steps: &[Step], out: &mut Vec<f64>) -> std::result::Re
             Some(inner) => collect(inner, rest, out),
             None => {
                 let keys: Vec<&str> = map.keys().map(String::as_str).collect();
-                Err(format!("no key `{key}` (there are {})", keys.join(", ")))
+                Err(format!(
+                    "no key `{key}` (there are {}; a value the file leaves to its default must be written in the file to be fitted)",
+                    keys.join(", ")
+                ))
             }
         },
         (Step::Index(i), Value::Array(items)) => match items.get(*i) {
@@ -275,6 +286,9 @@ mod tests {
         assert_eq!(changed.value["hinges"][1]["target_angle_deg"], 80.0);
         assert_eq!(changed.value["hinges"][1]["layers"][0]["thickness_um"], 0.15);
         assert_eq!(changed.value["hinges"][0]["layers"][0]["thickness_um"], 0.2);
+        // The dotted spelling names the same places.
+        let dotted = resolve(&doc, &[free("hinges.1.layers.0.thickness_um", 0.05, 0.3)]).unwrap();
+        assert_eq!(dotted[0].start, 0.1);
         assert_eq!(
             FreeParameter::parse("environment.drag_coefficient=0.5:4").unwrap(),
             free("environment.drag_coefficient", 0.5, 4.0)
