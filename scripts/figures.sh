@@ -22,6 +22,9 @@ for scene in bridge_step bridge_ramp corner_cube_step1 corner_cube_step1_ramp co
     cp "$out/$scene/snapshots.svg" "docs/${scene}_snapshots.svg"
   fi
 done
+$bin fit patterns/bridge_step.scene.json patterns/measurements/bridge_step_measured.csv \
+  --free environment.drag_coefficient=0.2:5 --free hinges.*.target_angle_deg=45:135 --out "$out/fit" > /dev/null
+cp "$out/fit/fit.svg" docs/fit_bridge_step.svg
 for scene in cube_closes cube_jams miura_sheet; do
   $bin simulate "patterns/devices/$scene.scene.json" --out "$out/$scene" > /dev/null
 done

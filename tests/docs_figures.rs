@@ -121,6 +121,19 @@ fn the_docs_figures_are_current() {
             same_figure(&dir.join(scene).join("snapshots.svg"), &snapshots);
         }
     }
+    run(
+        &[
+            "fit",
+            "patterns/bridge_step.scene.json",
+            "patterns/measurements/bridge_step_measured.csv",
+            "--free",
+            "environment.drag_coefficient=0.2:5",
+            "--free",
+            "hinges.*.target_angle_deg=45:135",
+        ],
+        "fit",
+    );
+    same_figure(&dir.join("fit/fit.svg"), "docs/fit_bridge_step.svg");
     // Devices of many panels.
     for (scene, figure) in [
         ("cube_closes", "snapshots"),

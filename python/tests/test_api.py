@@ -237,3 +237,25 @@ def test_the_known_length_call_refuses_a_length_out_of_range():
     for seconds in (-1.0, 61.0):
         with pytest.raises(nanofold._native.NativeError, match="seconds"):
             nanofold._native.wait(seconds)
+
+
+def test_fit_takes_a_dataframe_with_gaps_and_gives_the_estimate_its_interval_and_the_fitted_scene():
+    import pandas as pd
+
+    measured = pd.read_csv("patterns/measurements/bridge_step_measured.csv", comment="#")
+    window = measured[measured.time_s <= 30e-6][["time_s", "hinge_0_deg", "hinge_2_deg"]].copy()
+    window.loc[window.index[::3], "hinge_0_deg"] = float("nan")  # every third sample missed
+    scene = nanofold.Scene.open("patterns/bridge_step.scene.json").replace({"hinges.0.target_angle_deg": 85})
+    scene = scene.replace({k: 85 for k in ("hinges.1.target_angle_deg", "hinges.2.target_angle_deg",
+                                           "hinges.3.target_angle_deg")})
+    r = nanofold.fit(scene, window, free={"environment.drag_coefficient": (0.2, 5)}, noise=0.5)
+    (p,) = r.parameters
+    assert r.status == "converged" and p["determined"]
+    low, high = p["interval_95"]
+    assert low <= 1.6 <= high  # the value the measurement was simulated with
+    assert r.observations == int(window[["hinge_0_deg", "hinge_2_deg"]].notna().sum().sum())
+    table = r.table
+    assert list(table.columns[:4]) == ["time_s", "hinge_0_deg", "hinge_0_deg_fitted", "hinge_0_deg_residual"]
+    assert r.fitted_scene.to_dict()["environment"]["drag_coefficient"] == p["estimate"]
+    with pytest.raises(nanofold.InvalidFieldError, match="drag_coeficient"):
+        nanofold.fit(scene, window, free={"environment.drag_coeficient": (0.2, 5)})

@@ -519,13 +519,20 @@ fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f6
             return Ok((u, FitStatus::Converged, iteration - 1));
         }
         // Converged once the Gauss–Newton step would lower S by less than 1e-6 of its mean
-        // square per degree of freedom: the estimates would move by under 1e-3 of their
-        // standard errors.
+        // square per degree of freedom (the estimates would move by under 1e-3 of their
+        // standard errors), counting only the directions the data determine: along one they
+        // do not, the objective is flat and the step says nothing.
         let scale = cost / (problem.measurement.observations() - m).max(1) as f64;
-        if let Some(newton) = normal.clone().cholesky().map(|c| c.solve(&(-&gradient))) {
-            let clamped =
-                DVector::from_iterator(m, (0..m).map(|j| (u[j] + newton[j]).clamp(lower[j], upper[j]) - u[j]));
-            let decrease = -(2.0 * gradient.dot(&clamped) + (&normal * &clamped).dot(&clamped));
+        let svd = jacobian.clone().svd(true, false);
+        if let Some(left) = &svd.u {
+            let largest = svd.singular_values.max();
+            let decrease: f64 = (0..svd.singular_values.len())
+                .filter(|&k| {
+                    let sigma = svd.singular_values[k];
+                    sigma > DEGENERATE_FRACTION * largest && scale.sqrt() / sigma <= UNDETERMINED_RELATIVE_ERROR
+                })
+                .map(|k| left.column(k).dot(&current.residuals).powi(2))
+                .sum();
             if decrease <= 1e-6 * scale {
                 return Ok((u, FitStatus::Converged, iteration - 1));
             }
@@ -615,7 +622,13 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
             undetermined.push(Combination {
                 singular_value: sigma,
                 relative_standard_error: relative_error,
-                description: describe(&loadings),
+                description: describe(&loadings, &|path: &str| {
+                    problem
+                        .parameters
+                        .iter()
+                        .position(|p| p.path == path)
+                        .map_or(f64::NAN, |j| problem.values(u)[j])
+                }),
                 loadings,
             });
             continue;
@@ -710,19 +723,20 @@ pub fn t_quantile(dof: usize) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// An undetermined direction in words.
-fn describe(loadings: &[(String, f64)]) -> String {
+/// An undetermined direction in words, with the value of what the data do fix.
+fn describe(loadings: &[(String, f64)], value: &dyn Fn(&str) -> f64) -> String {
     match loadings {
         [(a, wa), (b, wb)] => {
-            // Moving along (wa Δln a + wb Δln b) leaves the fit unchanged: a^wb · b^(−wa) is
+            // Moving along (wa Δln a + wb Δln b) leaves the fit unchanged: a · b^(−wa/wb) is
             // what the data fix.
-            let ratio = wb / wa;
-            if (ratio + 1.0).abs() < 0.2 {
-                format!("only the product {a} × {b} is determined")
-            } else if (ratio - 1.0).abs() < 0.2 {
-                format!("only the ratio {a} / {b} is determined")
+            let exponent = -wa / wb;
+            let fixed = value(a) * value(b).powf(exponent);
+            if (exponent - 1.0).abs() < 0.2 {
+                format!("only the product {a} × {b} is determined ({:.6e})", value(a) * value(b))
+            } else if (exponent + 1.0).abs() < 0.2 {
+                format!("only the ratio {a} / {b} is determined ({:.6e})", value(a) / value(b))
             } else {
-                format!("only {a} × {b}^({:.3}) is determined", -1.0 / ratio)
+                format!("only {a} × {b}^({exponent:.3}) is determined ({fixed:.6e})")
             }
         }
         [(a, _)] => format!("{a} does not change the fitted trajectory"),

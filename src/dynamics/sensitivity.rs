@@ -157,7 +157,15 @@ fn run<P: Plant>(
         grid.push(0.0);
     }
     grid.extend_from_slice(times);
-    let method = method.resolve(&base.time_scales()?);
+    let scales = base.time_scales()?;
+    if scales.ratio >= super::simulate::QUASI_STATIC_RATIO {
+        return Err(NanofoldError::invalid(
+            "actuation",
+            format!("a forcing of {:.1e} fastest periods", scales.ratio),
+            "sensitivities are integrated with the dynamics, and this scene's slow forcing takes the quasi-static path, whose sensitivities are not built: fit a step response",
+        ));
+    }
+    let method = method.resolve(&scales);
     let options = IntegrationOptions {
         rtol,
         progress: None,
