@@ -12,23 +12,9 @@ use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
 use nanofold::read::SceneDocument;
 use std::time::Instant;
 
-/// splitmix64 and Box–Muller: seeded standard normal samples.
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn sample(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
+#[path = "common/normal.rs"]
+mod normal;
+use normal::Normal;
 
 struct Study<'a> {
     name: &'a str,

@@ -11,6 +11,10 @@ use nanofold::dynamics::sensitivity::trajectory_sensitivities;
 use nanofold::dynamics::Method;
 use nanofold::read::SceneDocument;
 
+#[path = "common/normal.rs"]
+mod normal;
+use normal::Normal;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref())?;
     let free = |path: &str| FreeParameter {
@@ -25,18 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene = with_values(&document, &parameters, &[1.6, 85.0]).spec()?.build()?;
     let times: Vec<f64> = (1..=200).map(|k| 90e-6 * k as f64 / 200.0).collect();
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
-    let mut state = 2026_u64;
-    let mut uniform = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let mut normal = move || {
-        let (u, v) = (uniform().max(1e-300), uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    };
+    let mut normal = Normal(2026);
     let mut text = String::from(
         "# The bridge's step response simulated at drag coefficient 1.6 and stress target 85 deg\n# with 0.5 deg Gaussian noise (examples/synthesize_measurement.rs); hinge 2 lost after 45 us.\ntime_s,hinge_0_deg,hinge_1_deg,hinge_2_deg,hinge_3_deg\n",
     );
@@ -46,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if k == 2 && *t > 45e-6 {
                 text += ",";
             } else {
-                text += &format!(",{:.4}", a.to_degrees() + 0.5 * normal());
+                text += &format!(",{:.4}", a.to_degrees() + 0.5 * normal.sample());
             }
         }
         text.push('\n');

@@ -1072,12 +1072,13 @@ fn run_fit(args: &FitArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "{} fitted to {}: {:?} after {} iterations ({} simulations, {:.2} s); {} observations, {} degrees of freedom, reduced χ² {:.3}",
+        "{} fitted to {}: {:?} after {} iterations ({} simulations, {} with sensitivities, {:.2} s); {} observations, {} degrees of freedom, reduced χ² {:.3}",
         args.scene.display(),
         args.measured.display(),
         report.status,
         report.iterations,
         report.simulations,
+        report.sensitivity_runs,
         report.seconds,
         report.observations,
         report.degrees_of_freedom,

@@ -7,6 +7,10 @@ use nanofold::dynamics::Method;
 use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
 use nanofold::read::SceneDocument;
 
+#[path = "../examples/common/normal.rs"]
+mod normal;
+use normal::Normal as Noise;
+
 fn free(path: &str, lower: f64, upper: f64) -> FreeParameter {
     FreeParameter {
         path: path.into(),
@@ -85,24 +89,6 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
     }
 }
 
-/// A deterministic normal sample (splitmix64 and Box–Muller): the tests' noise.
-struct Noise(u64);
-
-impl Noise {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn normal(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
-
 /// A measurement of `columns` (output index, name) of `document` simulated at `values` of
 /// `parameters`, with Gaussian noise of `sigma` degrees.
 fn synthetic(
@@ -131,7 +117,7 @@ fn synthetic(
                 values: run
                     .angles
                     .iter()
-                    .map(|a| Some(a[k].to_degrees() + sigma * noise.normal()))
+                    .map(|a| Some(a[k].to_degrees() + sigma * noise.sample()))
                     .collect(),
             })
             .collect(),

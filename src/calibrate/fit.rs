@@ -178,6 +178,8 @@ pub struct FitReport {
     pub iterations: usize,
     /// Simulations run (with sensitivities, and of trial steps).
     pub simulations: usize,
+    /// Of those, the simulations with the sensitivities (each costs about 1 + 8m plain ones).
+    pub sensitivity_runs: usize,
     /// Observations n and parameters m.
     pub observations: usize,
     /// Degrees of freedom n − m.
@@ -250,6 +252,7 @@ struct Problem<'a> {
     sigma: Vec<f64>,
     settings: &'a FitSettings,
     simulations: usize,
+    sensitivity_runs: usize,
 }
 
 impl Problem<'_> {
@@ -277,6 +280,7 @@ impl Problem<'_> {
             }
         }
         self.simulations += 1;
+        self.sensitivity_runs += usize::from(jacobian);
         let run = trajectory_sensitivities(
             &base,
             &perturbed,
@@ -414,22 +418,23 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
         sigma,
         settings,
         simulations: 0,
+        sensitivity_runs: 0,
     };
     let start: Vec<f64> = problem.parameters.iter().map(|p| p.start / p.scale).collect();
-    let (mut u, mut status, mut iterations) = levenberg_marquardt(&mut problem, start)?;
+    let (mut u, mut status, mut iterations, mut at) = levenberg_marquardt(&mut problem, start, None)?;
     if !given && measurement.columns.len() > 1 {
-        // Columns of different noise: weigh each by its estimated σ and fit again from here.
-        let at = problem.evaluate(&u, false)?;
-        problem.sigma = column_noise(&problem, &at.residuals, n, m);
-        let (again, again_status, more) = levenberg_marquardt(&mut problem, u)?;
-        (u, status, iterations) = (again, again_status, iterations + more);
+        // Columns of different noise: weigh each by its estimated σ and fit again from here
+        // (new weights only rescale the rows of the residuals and the Jacobian).
+        let sigma = column_noise(&problem, &at.residuals, n, m);
+        reweigh(&mut problem, &mut at, sigma);
+        let (again, again_status, more, again_at) = levenberg_marquardt(&mut problem, u, Some(at))?;
+        (u, status, iterations, at) = (again, again_status, iterations + more, again_at);
     }
     if !given {
         // σ of each column from its residuals, so the residuals below are in units of it.
-        let at = problem.evaluate(&u, false)?;
-        problem.sigma = column_noise(&problem, &at.residuals, n, m);
+        let sigma = column_noise(&problem, &at.residuals, n, m);
+        reweigh(&mut problem, &mut at, sigma);
     }
-    let at = problem.evaluate(&u, true)?;
     let report = statistics(&problem, &u, &at, given, n, m)?;
     let values = problem.values(&u);
     let fitted = with_values(document, &problem.parameters, &values);
@@ -459,10 +464,27 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
         status,
         iterations,
         simulations: problem.simulations,
+        sensitivity_runs: problem.sensitivity_runs,
         seconds: started.elapsed().as_secs_f64(),
         fitted_scene: absolute_pattern(&fitted),
         ..report
     })
+}
+
+/// Sets the columns' σ and rescales an evaluation's weighted rows to it.
+fn reweigh(problem: &mut Problem, at: &mut Evaluation, sigma: Vec<f64>) {
+    let mut e = 0;
+    for (c, column) in problem.measurement.columns.iter().enumerate() {
+        let factor = problem.sigma[c] / sigma[c];
+        for _ in column.values.iter().flatten() {
+            at.residuals[e] *= factor;
+            if let Some(j) = &mut at.jacobian {
+                j.row_mut(e).scale_mut(factor);
+            }
+            e += 1;
+        }
+    }
+    problem.sigma = sigma;
 }
 
 /// Each column's σ from its residuals (weighted by the current σ), with the n − m correction.
@@ -489,14 +511,25 @@ fn column_noise(problem: &Problem, residuals: &DVector<f64>, n: usize, m: usize)
 }
 
 /// Levenberg–Marquardt (Marquardt's diagonal scaling, Nielsen's damping update) within the
-/// bounds: trial points are clamped to them. Returns the estimate in scaled units, how it
-/// ended and the iterations.
-fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f64>, FitStatus, usize)> {
+/// bounds: trial points are clamped to them. Between exact Jacobians (a simulation with the
+/// sensitivities, ~(1 + 8m) plain ones) the Jacobian is carried by Broyden's rank-one update
+/// from each accepted step's residuals; an exact one is computed again after a rejected
+/// step and before convergence is declared, so the estimate and the statistics rest on it.
+/// Returns the estimate in scaled units, how it ended and the iterations.
+fn levenberg_marquardt(
+    problem: &mut Problem,
+    start: Vec<f64>,
+    at_start: Option<Evaluation>,
+) -> Result<(Vec<f64>, FitStatus, usize, Evaluation)> {
     let lower: Vec<f64> = problem.parameters.iter().map(|p| p.lower / p.scale).collect();
     let upper: Vec<f64> = problem.parameters.iter().map(|p| p.upper / p.scale).collect();
     let m = start.len();
     let mut u = start;
-    let mut current = problem.evaluate(&u, true)?;
+    let mut current = match at_start {
+        Some(at) if at.jacobian.is_some() => at,
+        _ => problem.evaluate(&u, true)?,
+    };
+    let mut exact = true;
     let mut cost = current.residuals.norm_squared();
     let mut lambda: Option<f64> = None;
     let mut nu = 2.0;
@@ -504,38 +537,21 @@ fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f6
         let jacobian = current.jacobian.as_ref().expect("evaluated with its Jacobian");
         let normal = jacobian.transpose() * jacobian;
         let gradient = jacobian.transpose() * &current.residuals;
-        // Projected gradient: a component pushing out through an active bound is no descent.
-        let projected = (0..m)
-            .map(|j| {
-                let g = gradient[j];
-                if (u[j] <= lower[j] && g > 0.0) || (u[j] >= upper[j] && g < 0.0) {
-                    0.0
-                } else {
-                    g.abs()
-                }
-            })
-            .fold(0.0, f64::max);
-        if projected <= 1e-12 * (1.0 + cost) {
-            return Ok((u, FitStatus::Converged, iteration - 1));
-        }
-        // Converged once the Gauss–Newton step would lower S by less than 1e-6 of its mean
-        // square per degree of freedom (the estimates would move by under 1e-3 of their
-        // standard errors), counting only the directions the data determine: along one they
-        // do not, the objective is flat and the step says nothing.
-        let scale = cost / (problem.measurement.observations() - m).max(1) as f64;
-        let svd = jacobian.clone().svd(true, false);
-        if let Some(left) = &svd.u {
-            let largest = svd.singular_values.max();
-            let decrease: f64 = (0..svd.singular_values.len())
-                .filter(|&k| {
-                    let sigma = svd.singular_values[k];
-                    sigma > DEGENERATE_FRACTION * largest && scale.sqrt() / sigma <= UNDETERMINED_RELATIVE_ERROR
-                })
-                .map(|k| left.column(k).dot(&current.residuals).powi(2))
-                .sum();
-            if decrease <= 1e-6 * scale {
-                return Ok((u, FitStatus::Converged, iteration - 1));
+        if converged(
+            problem,
+            jacobian,
+            &current.residuals,
+            &gradient,
+            &u,
+            (&lower, &upper),
+            cost,
+        ) {
+            if exact {
+                return Ok((u, FitStatus::Converged, iteration - 1, current));
             }
+            current = problem.evaluate(&u, true)?;
+            exact = true;
+            continue;
         }
         let diagonal: Vec<f64> = (0..m).map(|j| normal[(j, j)].max(1e-12 * normal.max())).collect();
         let mut damping = *lambda.get_or_insert(1e-3);
@@ -553,37 +569,104 @@ fn levenberg_marquardt(problem: &mut Problem, start: Vec<f64>) -> Result<(Vec<f6
             let taken = DVector::from_iterator(m, (0..m).map(|j| trial[j] - u[j]));
             let predicted = -(2.0 * gradient.dot(&taken) + (&normal * &taken).dot(&taken));
             let small_step = (0..m).all(|j| taken[j].abs() <= 1e-10 * (u[j].abs() + 1e-10));
-            if small_step {
-                return Ok((u, FitStatus::Converged, iteration));
+            if small_step && exact {
+                return Ok((u, FitStatus::Converged, iteration, current));
             }
-            let outcome = problem.evaluate(&trial, false).ok();
+            let outcome = if small_step {
+                None
+            } else {
+                problem.evaluate(&trial, false).ok()
+            };
             let trial_cost = outcome.as_ref().map_or(f64::INFINITY, |e| e.residuals.norm_squared());
             let rho = if predicted > 0.0 {
                 (cost - trial_cost) / predicted
             } else {
                 -1.0
             };
-            if rho > 0.0 && trial_cost < cost {
-                let relative_decrease = (cost - trial_cost) / cost.max(f64::MIN_POSITIVE);
+            if let (true, Some(outcome)) = (rho > 0.0 && trial_cost < cost, outcome) {
+                // Broyden: J += (Δr − J δ) δᵀ / δᵀδ.
+                let mut updated = jacobian.clone();
+                let change = &outcome.residuals - &current.residuals - &updated * &taken;
+                updated += change * taken.transpose() / taken.norm_squared();
                 u = trial;
-                current = problem.evaluate(&u, true)?;
-                cost = current.residuals.norm_squared();
+                current = Evaluation {
+                    jacobian: Some(updated),
+                    ..outcome
+                };
+                exact = false;
+                cost = trial_cost;
                 damping *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                 nu = 2.0;
                 lambda = Some(damping);
-                if relative_decrease < 1e-12 {
-                    return Ok((u, FitStatus::Converged, iteration));
-                }
+                break;
+            }
+            if !exact {
+                // A carried Jacobian that led astray: compute the exact one here and try again.
+                current = problem.evaluate(&u, true)?;
+                exact = true;
                 break;
             }
             damping *= nu;
             nu *= 2.0;
             if damping > 1e16 {
-                return Ok((u, FitStatus::Stalled, iteration));
+                let at = exact_at(problem, &u, current, exact)?;
+                return Ok((u, FitStatus::Stalled, iteration, at));
             }
         }
     }
-    Ok((u, FitStatus::MaxIterations, problem.settings.max_iterations))
+    let at = exact_at(problem, &u, current, exact)?;
+    Ok((u, FitStatus::MaxIterations, problem.settings.max_iterations, at))
+}
+
+/// The evaluation at u with its exact Jacobian (computed unless `current` has it).
+fn exact_at(problem: &mut Problem, u: &[f64], current: Evaluation, exact: bool) -> Result<Evaluation> {
+    if exact {
+        Ok(current)
+    } else {
+        problem.evaluate(u, true)
+    }
+}
+
+/// Whether the fit has converged at u: no descent left through the bounds, or the
+/// Gauss–Newton step would lower S by less than 1e-6 of its mean square per degree of
+/// freedom (the estimates would move by under 1e-3 of their standard errors), counting only
+/// the directions the data determine (along one they do not, S is flat and the step says
+/// nothing).
+fn converged(
+    problem: &Problem,
+    jacobian: &DMatrix<f64>,
+    residuals: &DVector<f64>,
+    gradient: &DVector<f64>,
+    u: &[f64],
+    (lower, upper): (&[f64], &[f64]),
+    cost: f64,
+) -> bool {
+    let m = u.len();
+    let projected = (0..m)
+        .map(|j| {
+            let g = gradient[j];
+            if (u[j] <= lower[j] && g > 0.0) || (u[j] >= upper[j] && g < 0.0) {
+                0.0
+            } else {
+                g.abs()
+            }
+        })
+        .fold(0.0, f64::max);
+    if projected <= 1e-12 * (1.0 + cost) {
+        return true;
+    }
+    let scale = cost / (problem.measurement.observations() - m).max(1) as f64;
+    let svd = jacobian.clone().svd(true, false);
+    let Some(left) = &svd.u else { return false };
+    let largest = svd.singular_values.max();
+    let decrease: f64 = (0..svd.singular_values.len())
+        .filter(|&k| {
+            let sigma = svd.singular_values[k];
+            sigma > DEGENERATE_FRACTION * largest && scale.sqrt() / sigma <= UNDETERMINED_RELATIVE_ERROR
+        })
+        .map(|k| left.column(k).dot(residuals).powi(2))
+        .sum();
+    decrease <= 1e-6 * scale
 }
 
 /// Covariance, intervals, correlations and identifiability at the estimate.
@@ -693,6 +776,7 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
         status: FitStatus::Converged,
         iterations: 0,
         simulations: 0,
+        sensitivity_runs: 0,
         observations: n,
         degrees_of_freedom: dof,
         weighted_sum_of_squares: sum_of_squares,
