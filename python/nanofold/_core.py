@@ -10,7 +10,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _native
-from ._results import FoldResult, PatternResult, Result, SimulationResult
+from ._results import FitResult, FoldResult, PatternResult, Result, SimulationResult
 from .errors import from_native
 
 T = TypeVar("T")
@@ -458,7 +458,7 @@ def fit(
     rtol: Optional[float] = None,
     max_iterations: Optional[int] = None,
     method: Optional[str] = None,
-) -> "FitResult":
+) -> FitResult:
     """Fits a scene's parameters to a measured trajectory (``nanofold fit``): ``measured`` is a
     pandas DataFrame or a CSV file (``time_s`` and columns such as ``crease_3_deg``; NaN or
     empty where nothing was seen); ``free`` names each parameter by its path in the scene file
@@ -493,8 +493,6 @@ def fit(
     summary, rest = _call(
         _native.fit, json.dumps(s._spec), s._source, s._fallback, s._base, text, source, _settings(keywords)
     )
-    from ._results import FitResult
-
     return FitResult("fit", summary, rest)
 
 

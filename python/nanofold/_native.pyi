@@ -16,6 +16,7 @@ __all__ = [
     "parse_scene",
     "simulate",
     "modes",
+    "fit",
     "noop",
     "wait",
     "version",

@@ -244,6 +244,37 @@ impl<P: Plant> Augmented<'_, P> {
             .map_or(0, |s| s.angles.len())
     }
 
+    /// Each column moved onto the tangent of the plant's constraints at the projected
+    /// state, as the motion is moved onto them: the difference of the plant's own projection
+    /// along the column (a network's closures hold for every parameter, so ∂q/∂u is tangent
+    /// to them, and the rates' columns satisfy the differentiated closures; unprojected,
+    /// the columns drift off as the motion would).
+    fn project_columns(
+        &self,
+        t: f64,
+        q: &mut [f64],
+        q_dot: &mut [f64],
+        ws: &mut AugmentedWorkspace<P::Workspace>,
+    ) -> Result<()> {
+        let n = self.base.dof();
+        let mut angles = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut rates = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        for j in 0..self.columns() {
+            let Some(h) = self.state_step(j, q_dot, q) else {
+                continue;
+            };
+            for (k, offset) in STENCIL.iter().enumerate() {
+                self.shift(j, offset * h, q, q_dot, &mut angles[k], &mut rates[k]);
+                self.base.project(t, &mut angles[k], &mut rates[k], &mut ws.base)?;
+            }
+            for i in 0..n {
+                q[n * (1 + j) + i] = stencil(std::array::from_fn(|k| angles[k][i]), h);
+                q_dot[n * (1 + j) + i] = stencil(std::array::from_fn(|k| rates[k][i]), h);
+            }
+        }
+        Ok(())
+    }
+
     /// The base's accelerations (into `after`), speeds and equivalent signs (into the
     /// scratch) at (q, q̇) under the current sides.
     fn held_base(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut AugmentedWorkspace<P::Workspace>) -> Result<()> {
@@ -460,6 +491,9 @@ impl<P: Plant> Plant for Augmented<'_, P> {
     fn project(&self, t: f64, q: &mut [f64], q_dot: &mut [f64], ws: &mut Self::Workspace) -> Result<bool> {
         let n = self.base.dof();
         let projected = self.base.project(t, &mut q[..n], &mut q_dot[..n], &mut ws.base)?;
+        if projected {
+            self.project_columns(t, q, q_dot, ws)?;
+        }
         if self.switch_count == 0 {
             return Ok(projected);
         }
