@@ -33,7 +33,8 @@
 //! | [`folding`] | many vertices: closures and their Jacobian, rank, panel poses and contact, folding paths, verdicts |
 //! | [`unfold`] | unfolding by energy descent on the sphere (one vertex) and on the closures (many) |
 //! | [`constraints`] | the constraint curves: exact sweeps, polynomial fits, their errors |
-//! | [`dynamics`] | plates on hinges: models, mass matrices, forcing, contact, integration, modes |
+//! | [`dynamics`] | plates on hinges: models, mass matrices, forcing, contact, integration, modes, sensitivities |
+//! | [`calibrate`] | a scene's numbers fitted to a measured folding, with intervals and identifiability |
 //! | [`write`](mod@write) | the writers: JSON reports, FOLD animations, MuJoCo models, output folders |
 //! | [`commands`] | the front door over all of the above |
 //! | `plot` | SVG figures and 3D pages (feature `plot`) |
@@ -89,7 +90,7 @@
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
 //! [`read`] (the file readers) → [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`]
-//! → [`write`](mod@write) (the file writers) → `plot` (the figures and pages, feature
+//! → [`calibrate`] → [`write`](mod@write) (the file writers) → `plot` (the figures and pages, feature
 //! `plot`) → [`commands`] (the front door, which renders each command's files) → the
 //! `nanofold` binary (feature `cli`) and the Python package. [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.
