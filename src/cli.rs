@@ -181,7 +181,8 @@ pub struct FitArgs {
     /// The scene file (.scene.json) whose parameters are fitted.
     pub scene: PathBuf,
     /// The measured trajectory: CSV with time_s and columns crease_<i>_deg (FOLD edge i; a
-    /// strip's hinge i) or hinge_<i>_deg; empty cells are missing observations.
+    /// strip's hinge i), hinge_<i>_deg, or panel_<p>_<u>_<v>_<x|y|z>_um (a tracked mark drawn
+    /// at (u, v) µm on panel p); empty cells are missing observations.
     pub measured: PathBuf,
     /// A parameter to fit, PATH=LOWER:UPPER, its path into the scene file (e.g.
     /// environment.drag_coefficient=0.5:4, hinges[*].target_angle_deg=60:120); repeat it.

@@ -21,6 +21,7 @@ pub mod model;
 pub mod modes;
 pub mod network;
 pub(crate) mod plant;
+pub mod points;
 pub(crate) mod quasi_static;
 pub mod scene;
 pub mod sensitivity;

@@ -254,3 +254,143 @@ fn sensitivities_of_a_miura_sheet_stay_on_its_closures_and_match_central_differe
     eprintln!("miura: max |S| {largest:.4e}, max |S - FD| {worst:.3e}");
     assert!(worst <= 1e-6 * largest, "{worst:e} against {largest:e}");
 }
+
+#[test]
+fn tracked_marks_on_two_plates_give_the_bridge_back_and_sit_where_the_kinematics_put_them() {
+    use nanofold::dynamics::points::PanelPoints;
+    let document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref()).unwrap();
+    let free = vec![
+        free("environment.drag_coefficient", 0.2, 5.0),
+        free("hinges[*].target_angle_deg", 45.0, 135.0),
+    ];
+    let parameters = resolve(&document, &free).unwrap();
+    let truth = [1.6, 85.0];
+    let scene = with_values(&document, &parameters, &truth)
+        .spec()
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut points = PanelPoints::new(&scene).unwrap();
+    // Plate 0 turns about the substrate's edge (y = 0): a mark 50 µm up it at θ is at
+    // (0, 50 cos θ, 50 sin θ) up to the turn's sense.
+    for theta in [0.0_f64, 0.3, 1.2, -0.7] {
+        let [x, y, z] = points.position(&[theta, 0.0, 0.0, 0.0], 0, [0.0, 50.0]);
+        assert!(
+            x.abs() < 1e-9
+                && (y - 50.0 * theta.cos()).abs() < 1e-9
+                && (z.abs() - 50.0 * theta.sin().abs()).abs() < 1e-9
+        );
+    }
+    // Marks at the middle of plate 1 (x, y, z) and at the tip of plate 3 (z), 0.5 µm noise.
+    let marks = [
+        (1, [0.0, 300.0], 0),
+        (1, [0.0, 300.0], 1),
+        (1, [0.0, 300.0], 2),
+        (3, [20.0, 615.0], 2),
+    ];
+    let t = times(3e-5, 80);
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &t, Method::Auto, 1e-10).unwrap();
+    let mut noise = Noise(5);
+    let axes = ["x", "y", "z"];
+    let measured = Measurement {
+        source: "tracked.csv".into(),
+        times: t.clone(),
+        columns: marks
+            .iter()
+            .map(|&(panel, at, axis)| MeasuredColumn {
+                name: format!("panel_{panel}_{}_{}_{}_um", at[0], at[1], axes[axis]),
+                observed: Observed::Point { panel, at, axis },
+                values: run
+                    .angles
+                    .iter()
+                    .map(|a| Some(points.position(a.as_slice(), panel, at)[axis] + 0.5 * noise.sample()))
+                    .collect(),
+            })
+            .collect(),
+    };
+    let report = fit(
+        &document,
+        &measured,
+        &FitSettings {
+            free,
+            ..FitSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(report.status, FitStatus::Converged);
+    for (p, truth) in report.parameters.iter().zip(truth) {
+        let [lo, hi] = p.interval_95.unwrap();
+        assert!(lo <= truth && truth <= hi, "{}: {truth} outside [{lo}, {hi}]", p.path);
+    }
+    for column in &report.residuals {
+        assert!(
+            (column.noise - 0.5).abs() < 0.15,
+            "{}: σ {} µm",
+            column.name,
+            column.noise
+        );
+    }
+}
+
+#[test]
+fn marks_on_a_miura_sheet_stay_on_their_panels_as_it_folds() {
+    use nanofold::dynamics::points::PanelPoints;
+    let scene = SceneDocument::load("patterns/devices/miura_sheet.scene.json".as_ref())
+        .unwrap()
+        .spec()
+        .unwrap()
+        .build()
+        .unwrap();
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &[3e-4], Method::Auto, 1e-8).unwrap();
+    let folded = run.angles[0].as_slice();
+    let model = scene.network().unwrap();
+    let mut points = PanelPoints::new(&scene).unwrap();
+    let flat = vec![0.0; folded.len()];
+    let unit = model.unit * 1e6;
+    let faces = &model.folding.pattern.faces;
+    let vertices = &model.folding.pattern.vertices;
+    let mut moved = 0;
+    for (face, corners) in faces.iter().enumerate() {
+        let panel = points.panel(face).unwrap();
+        let at: Vec<[f64; 2]> = corners
+            .iter()
+            .map(|&v| [vertices[v][0] * unit, vertices[v][1] * unit])
+            .collect();
+        // Flat, a mark is where it was drawn; folded, its panel's marks keep their distances.
+        for a in &at {
+            let p = points.position(&flat, panel, *a);
+            assert!((p[0] - a[0]).abs() < 1e-9 && (p[1] - a[1]).abs() < 1e-9 && p[2].abs() < 1e-9);
+        }
+        let placed: Vec<[f64; 3]> = at.iter().map(|a| points.position(folded, panel, *a)).collect();
+        for i in 0..at.len() {
+            for j in 0..i {
+                let drawn = ((at[i][0] - at[j][0]).powi(2) + (at[i][1] - at[j][1]).powi(2)).sqrt();
+                let now = (0..3)
+                    .map(|k| (placed[i][k] - placed[j][k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(
+                    (now - drawn).abs() < 1e-9 * drawn.max(1.0),
+                    "face {face}: {drawn} became {now}"
+                );
+            }
+        }
+        // The same corner placed from either of two faces that share it is one point.
+        moved += usize::from(placed.iter().any(|p| p[2].abs() > 1.0));
+    }
+    assert!(moved > 0, "the sheet folded out of its plane");
+    for (f, g) in [(0usize, 1usize)] {
+        let shared: Vec<usize> = faces[f].iter().copied().filter(|v| faces[g].contains(v)).collect();
+        for v in shared {
+            let at = [vertices[v][0] * unit, vertices[v][1] * unit];
+            let (a, b) = (
+                points.position(folded, points.panel(f).unwrap(), at),
+                points.position(folded, points.panel(g).unwrap(), at),
+            );
+            assert!(
+                (0..3).all(|k| (a[k] - b[k]).abs() < 1e-6),
+                "vertex {v}: {a:?} and {b:?}"
+            );
+        }
+    }
+}

@@ -4,6 +4,7 @@
 //! data cannot separate.
 
 use super::parameters::{resolve, with_values, FreeParameter, ResolvedParameter};
+use crate::dynamics::points::PanelPoints;
 use crate::dynamics::scene::Scene;
 use crate::dynamics::sensitivity::{trajectory_sensitivities, STENCIL};
 use crate::dynamics::Method;
@@ -231,7 +232,12 @@ pub struct FitTable {
 enum Output {
     /// Output angle k, reported in degrees.
     Angle(usize),
+    /// A mark at `at` (flat µm) on internal panel `panel`: its coordinate `axis`, µm.
+    Point { panel: usize, at: [f64; 2], axis: usize },
 }
+
+/// Step of the differences of a mark's position in the fold angles, rad.
+const MARK_STEP: f64 = 1e-6;
 
 /// One evaluation of the model at a parameter vector.
 struct Evaluation {
@@ -302,16 +308,36 @@ impl Problem<'_> {
         let rows: usize = self.measurement.observations();
         let mut residuals = DVector::zeros(rows);
         let mut matrix = jacobian.then(|| DMatrix::zeros(rows, u.len()));
+        let mut points = match self.outputs.iter().any(|o| matches!(o, Output::Point { .. })) {
+            true => Some(PanelPoints::new(&base)?),
+            false => None,
+        };
         let mut e = 0;
         for (c, column) in columns.iter().enumerate() {
-            let Output::Angle(k) = self.outputs[c];
             for (i, measured) in column.values.iter().enumerate() {
-                predicted[c][i] = run.angles[i][k].to_degrees();
+                let angles = run.angles[i].as_slice();
+                predicted[c][i] = match self.outputs[c] {
+                    Output::Angle(k) => angles[k].to_degrees(),
+                    Output::Point { panel, at, axis } => points
+                        .as_mut()
+                        .expect("made for the points")
+                        .position(angles, panel, at)[axis],
+                };
                 if let Some(y) = measured {
                     residuals[e] = (predicted[c][i] - y) / self.sigma[c];
                     if let Some(m) = &mut matrix {
+                        // A mark moves with the angles: its columns are the angles' columns
+                        // through its kinematics.
+                        let slope: Vec<(usize, f64)> = match self.outputs[c] {
+                            Output::Angle(k) => vec![(k, 180.0 / std::f64::consts::PI)],
+                            Output::Point { panel, at, axis } => {
+                                let points = points.as_mut().expect("made for the points");
+                                mark_slopes(points, angles, panel, at, axis)
+                            }
+                        };
                         for j in 0..u.len() {
-                            m[(e, j)] = run.sensitivities[i][(k, j)].to_degrees() / self.sigma[c];
+                            let total: f64 = slope.iter().map(|&(k, d)| d * run.sensitivities[i][(k, j)]).sum();
+                            m[(e, j)] = total / self.sigma[c];
                         }
                     }
                     e += 1;
@@ -324,6 +350,22 @@ impl Problem<'_> {
             jacobian: matrix,
         })
     }
+}
+
+/// ∂(coordinate `axis` of the mark)/∂θₖ for every angle k that moves it, µm per rad.
+fn mark_slopes(points: &mut PanelPoints, angles: &[f64], panel: usize, at: [f64; 2], axis: usize) -> Vec<(usize, f64)> {
+    let mut shifted = angles.to_vec();
+    (0..angles.len())
+        .filter_map(|k| {
+            shifted[k] = angles[k] + MARK_STEP;
+            let plus = points.position(&shifted, panel, at)[axis];
+            shifted[k] = angles[k] - MARK_STEP;
+            let minus = points.position(&shifted, panel, at)[axis];
+            shifted[k] = angles[k];
+            let slope = (plus - minus) / (2.0 * MARK_STEP);
+            (slope != 0.0).then_some((k, slope))
+        })
+        .collect()
 }
 
 /// Which output each measured column reads, or an error naming the column.
@@ -355,11 +397,18 @@ fn map_columns(scene: &Scene, measurement: &Measurement) -> Result<Vec<Output>> 
                         format!("edge {index} is not one of the scene's creases (edges {edges:?})"),
                     )),
                 },
-                (Observed::Point { .. }, _) => Err(NanofoldError::invalid(
-                    field,
-                    &column.name,
-                    "tracked points are not fitted yet: give fold angles (crease_<i>_deg)",
-                )),
+                (Observed::Point { panel, at, axis }, _) => {
+                    let points = PanelPoints::new(scene)
+                        .map_err(|e| NanofoldError::invalid(field.clone(), &column.name, e.to_string()))?;
+                    let internal = points
+                        .panel(*panel)
+                        .map_err(|reason| NanofoldError::invalid(field.clone(), panel, reason))?;
+                    Ok(Output::Point {
+                        panel: internal,
+                        at: *at,
+                        axis: *axis,
+                    })
+                }
             }
         })
         .collect()
