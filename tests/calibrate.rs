@@ -215,12 +215,12 @@ fn a_product_the_data_fix_is_named_and_its_factors_get_no_error_bar() {
     assert_eq!(report.singular_values.len(), 2);
 }
 
-#[test]
-fn sensitivities_of_a_miura_sheet_stay_on_its_closures_and_match_central_differences() {
-    // A network of 16 panels: its closures hold for every parameter, so the columns are
-    // projected with the motion; unprojected they drifted to 1e-4 of their size by 0.3 ms.
-    let document = SceneDocument::load("patterns/devices/miura_sheet.scene.json".as_ref()).unwrap();
-    let parameters = resolve(&document, &[free("hinge_defaults.layers[1].thickness_um", 0.05, 0.2)]).unwrap();
+/// The largest difference between one parameter's sensitivities (at rtol 1e-8) and
+/// Richardson-extrapolated central differences of whole runs at rtol 1e-11, and the largest
+/// sensitivity.
+fn against_differences(scene: &str, path: &str, lower: f64, upper: f64, t: &[f64]) -> (f64, f64) {
+    let document = SceneDocument::load(scene.as_ref()).unwrap();
+    let parameters = resolve(&document, &[free(path, lower, upper)]).unwrap();
     let start = parameters[0].start;
     let build = |value: f64| {
         with_values(&document, &parameters, &[value])
@@ -229,13 +229,12 @@ fn sensitivities_of_a_miura_sheet_stay_on_its_closures_and_match_central_differe
             .build()
             .unwrap()
     };
-    let t = times(3.2e-4, 16);
     let perturbed = [std::array::from_fn(|k| {
         build(start * (1.0 + STENCIL[k] * SENSITIVITY_STEP))
     })];
-    let run = trajectory_sensitivities(&build(start), &perturbed, SENSITIVITY_STEP, &t, Method::Auto, 1e-8).unwrap();
+    let run = trajectory_sensitivities(&build(start), &perturbed, SENSITIVITY_STEP, t, Method::Auto, 1e-8).unwrap();
     let plain =
-        |value: f64| trajectory_sensitivities(&build(value), &[], SENSITIVITY_STEP, &t, Method::Auto, 1e-11).unwrap();
+        |value: f64| trajectory_sensitivities(&build(value), &[], SENSITIVITY_STEP, t, Method::Auto, 1e-11).unwrap();
     let difference = |step: f64| {
         let (plus, minus) = (plain(start * (1.0 + step)), plain(start * (1.0 - step)));
         (0..t.len())
@@ -251,7 +250,34 @@ fn sensitivities_of_a_miura_sheet_stay_on_its_closures_and_match_central_differe
             largest = largest.max(fd.abs());
         }
     }
-    eprintln!("miura: max |S| {largest:.4e}, max |S - FD| {worst:.3e}");
+    eprintln!("{scene} {path}: max |S| {largest:.4e}, max |S - FD| {worst:.3e}");
+    (worst, largest)
+}
+
+#[test]
+fn sensitivities_of_a_miura_sheet_stay_on_its_closures_and_match_central_differences() {
+    // A network of 16 panels: its closures hold for every parameter, so the columns are
+    // projected with the motion; unprojected they drifted to 1e-4 of their size by 0.3 ms.
+    let (worst, largest) = against_differences(
+        "patterns/devices/miura_sheet.scene.json",
+        "hinge_defaults.layers[1].thickness_um",
+        0.05,
+        0.2,
+        &times(3.2e-4, 16),
+    );
+    assert!(worst <= 1e-6 * largest, "{worst:e} against {largest:e}");
+}
+
+#[test]
+fn sensitivities_of_the_corner_cube_match_central_differences() {
+    // A closed vertex on its fitted curves, crease 0 driven to 180° by its stressed hinge.
+    let (worst, largest) = against_differences(
+        "patterns/corner_cube_step1.scene.json",
+        "hinges[0].layers[1].thickness_um",
+        0.02,
+        0.5,
+        &times(2.5e-5, 40),
+    );
     assert!(worst <= 1e-6 * largest, "{worst:e} against {largest:e}");
 }
 
