@@ -430,35 +430,7 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
             format!("fitting {m} parameters needs more observations than parameters"),
         ));
     }
-    let (given, sigma) = match &settings.noise {
-        Noise::Estimated => (false, vec![1.0; measurement.columns.len()]),
-        Noise::Given { default, columns } => {
-            if let Some(unknown) = columns
-                .keys()
-                .find(|k| !measurement.columns.iter().any(|c| &c.name == *k))
-            {
-                return Err(NanofoldError::invalid(
-                    format!("noise.{unknown}"),
-                    columns[unknown],
-                    format!("{} has no column {unknown}", measurement.source),
-                ));
-            }
-            let sigma = measurement
-                .columns
-                .iter()
-                .map(|c| {
-                    columns.get(&c.name).copied().or(*default).ok_or_else(|| {
-                        NanofoldError::invalid(
-                            format!("noise.{}", c.name),
-                            "missing",
-                            "give every column's noise (or a default), or let it be estimated",
-                        )
-                    })
-                })
-                .collect::<Result<Vec<f64>>>()?;
-            (true, sigma)
-        }
-    };
+    let (given, sigma) = column_sigma(&settings.noise, measurement)?;
     let mut problem = Problem {
         document,
         parameters,
@@ -487,6 +459,23 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
     let report = statistics(&problem, &u, &at, given, n, m)?;
     let values = problem.values(&u);
     let fitted = with_values(document, &problem.parameters, &values);
+    let warnings = warnings(status, iterations, given, &report);
+    Ok(FitReport {
+        warnings,
+        scene: document.source.clone(),
+        measurement: measurement.source.clone(),
+        status,
+        iterations,
+        simulations: problem.simulations,
+        sensitivity_runs: problem.sensitivity_runs,
+        seconds: started.elapsed().as_secs_f64(),
+        fitted_scene: absolute_pattern(&fitted),
+        ..report
+    })
+}
+
+/// What the report's numbers do not say by themselves.
+fn warnings(status: FitStatus, iterations: usize, given: bool, report: &FitReport) -> Vec<String> {
     let mut warnings = Vec::new();
     if status != FitStatus::Converged {
         warnings.push(format!(
@@ -506,18 +495,65 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
             p.path, p.estimate
         ));
     }
-    Ok(FitReport {
-        warnings,
-        scene: document.source.clone(),
-        measurement: measurement.source.clone(),
-        status,
-        iterations,
-        simulations: problem.simulations,
-        sensitivity_runs: problem.sensitivity_runs,
-        seconds: started.elapsed().as_secs_f64(),
-        fitted_scene: absolute_pattern(&fitted),
-        ..report
+    warnings
+}
+
+/// Each column's σ as given (true), or 1 until it is estimated (false); a noise named for a
+/// column the measurement lacks, or a column without one, is refused by name.
+fn column_sigma(noise: &Noise, measurement: &Measurement) -> Result<(bool, Vec<f64>)> {
+    Ok(match noise {
+        Noise::Estimated => (false, vec![1.0; measurement.columns.len()]),
+        Noise::Given { default, columns } => {
+            if let Some(unknown) = columns
+                .keys()
+                .find(|k| !measurement.columns.iter().any(|c| &c.name == *k))
+            {
+                return Err(NanofoldError::invalid(
+                    format!("noise.{unknown}"),
+                    columns[unknown],
+                    format!("{} has no column {unknown}", measurement.source),
+                ));
+            }
+            let sigma = measurement
+                .columns
+                .iter()
+                .map(|c| {
+                    columns.get(&c.name).copied().or(*default).ok_or_else(|| {
+                        NanofoldError::invalid(
+                            format!("noise.{}", c.name),
+                            "missing",
+                            "give every column's noise (or a default), or let it be estimated",
+                        )
+                    })
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            (true, sigma)
+        }
     })
+}
+
+/// Each column's residual summary, in its unit.
+fn column_residuals(problem: &Problem, at: &Evaluation, given: bool) -> Vec<ColumnResiduals> {
+    let mut e = 0;
+    problem
+        .measurement
+        .columns
+        .iter()
+        .enumerate()
+        .map(|(c, column)| {
+            let count = column.values.iter().flatten().count();
+            let values: Vec<f64> = (e..e + count).map(|k| at.residuals[k] * problem.sigma[c]).collect();
+            e += count;
+            ColumnResiduals {
+                name: column.name.clone(),
+                observations: count,
+                noise: problem.sigma[c],
+                noise_source: if given { "given" } else { "estimated" },
+                rms: (values.iter().map(|r| r * r).sum::<f64>() / count.max(1) as f64).sqrt(),
+                max_abs: values.iter().fold(0.0, |a, r| a.max(r.abs())),
+            }
+        })
+        .collect()
 }
 
 /// Sets the columns' σ and rescales an evaluation's weighted rows to it.
@@ -633,10 +669,7 @@ fn levenberg_marquardt(
                 -1.0
             };
             if let (true, Some(outcome)) = (rho > 0.0 && trial_cost < cost, outcome) {
-                // Broyden: J += (Δr − J δ) δᵀ / δᵀδ.
-                let mut updated = jacobian.clone();
-                let change = &outcome.residuals - &current.residuals - &updated * &taken;
-                updated += change * taken.transpose() / taken.norm_squared();
+                let updated = broyden(jacobian, &current.residuals, &outcome.residuals, &taken);
                 u = trial;
                 current = Evaluation {
                     jacobian: Some(updated),
@@ -674,6 +707,13 @@ fn exact_at(problem: &mut Problem, u: &[f64], current: Evaluation, exact: bool) 
     } else {
         problem.evaluate(u, true)
     }
+}
+
+/// Broyden's rank-one update of the Jacobian by a step δ and the residuals' change:
+/// J + (Δr − J δ) δᵀ / δᵀδ.
+fn broyden(jacobian: &DMatrix<f64>, before: &DVector<f64>, after: &DVector<f64>, step: &DVector<f64>) -> DMatrix<f64> {
+    let change = after - before - jacobian * step;
+    jacobian + change * step.transpose() / step.norm_squared()
 }
 
 /// Whether the fit has converged at u: no descent left through the bounds, or the
@@ -804,21 +844,7 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
     let mut singular_values: Vec<f64> = order.iter().map(|&k| svd.singular_values[k]).collect();
     singular_values.iter_mut().for_each(|s| *s = s.max(0.0));
     let measurement = problem.measurement;
-    let mut residuals = Vec::new();
-    let mut e = 0;
-    for (c, column) in measurement.columns.iter().enumerate() {
-        let count = column.values.iter().flatten().count();
-        let values: Vec<f64> = (e..e + count).map(|k| at.residuals[k] * problem.sigma[c]).collect();
-        e += count;
-        residuals.push(ColumnResiduals {
-            name: column.name.clone(),
-            observations: count,
-            noise: problem.sigma[c],
-            noise_source: if given { "given" } else { "estimated" },
-            rms: (values.iter().map(|r| r * r).sum::<f64>() / count.max(1) as f64).sqrt(),
-            max_abs: values.iter().fold(0.0, |a, r| a.max(r.abs())),
-        });
-    }
+    let residuals = column_residuals(problem, at, given);
     Ok(FitReport {
         scene: String::new(),
         measurement: String::new(),

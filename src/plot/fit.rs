@@ -79,59 +79,72 @@ pub fn fit_svg(report: &FitReport) -> Result<String> {
         }
         draw_side_legend(&top, 44, &entries)?;
 
-        let residuals: Vec<Vec<(f64, f64)>> = (0..table.columns.len())
-            .map(|c| {
-                table
-                    .times
-                    .iter()
-                    .zip(&table.measured[c])
-                    .zip(&table.fitted[c])
-                    .filter_map(|((t, y), f)| y.map(|y| (t / scale, y - f)))
-                    .collect()
-            })
-            .collect();
-        let largest = residuals.iter().flatten().fold(0.0_f64, |a, (_, r)| a.max(r.abs()));
-        let mut chart = ChartBuilder::on(&bottom)
-            .caption(
-                format!(
-                    "residuals (reduced χ² {:.3}, {} degrees of freedom)",
-                    report.reduced_chi_square, report.degrees_of_freedom
-                ),
-                ("sans-serif", 16),
-            )
-            .margin(px(12))
-            .margin_right(px(LEGEND_MARGIN))
-            .x_label_area_size(px(36))
-            .y_label_area_size(px(56))
-            .build_cartesian_2d(x_range, axis_range(-largest, largest, 0.06))
-            .map_err(plot_error)?;
-        chart
-            .configure_mesh()
-            .set_all_tick_mark_size(px(5))
-            .x_desc(format!("time ({unit})"))
-            .y_desc("measured − fitted")
-            .draw()
-            .map_err(plot_error)?;
-        let mut noise = Vec::new();
-        for (c, points) in residuals.into_iter().enumerate() {
-            let (colour, _) = series_line(c);
-            chart
-                .draw_series(points.into_iter().map(|p| Circle::new(p, px(2), colour.filled())))
-                .map_err(plot_error)?;
-            let column = &report.residuals[c];
-            noise.push((
-                format!("{}: σ {:.4}", column.name, column.noise),
-                colour,
-                LineKind::Note,
-            ));
-        }
-        if let Some(first) = report.residuals.first() {
-            noise.push((format!("(σ {})", first.noise_source), BLACK, LineKind::Note));
-        }
-        draw_side_legend(&bottom, 44, &noise)?;
+        draw_residuals(&bottom, report, scale, unit, x_range)?;
         root.present().map_err(plot_error)?;
     }
     Ok(shown_at(svg))
+}
+
+/// The lower panel: measured − fitted per column, with each column's σ.
+fn draw_residuals<DB: DrawingBackend>(
+    bottom: &DrawingArea<DB, plotters::coord::Shift>,
+    report: &FitReport,
+    scale: f64,
+    unit: &str,
+    x_range: std::ops::Range<f64>,
+) -> Result<()> {
+    let table = &report.table;
+    let residuals: Vec<Vec<(f64, f64)>> = (0..table.columns.len())
+        .map(|c| {
+            table
+                .times
+                .iter()
+                .zip(&table.measured[c])
+                .zip(&table.fitted[c])
+                .filter_map(|((t, y), f)| y.map(|y| (t / scale, y - f)))
+                .collect()
+        })
+        .collect();
+    let largest = residuals.iter().flatten().fold(0.0_f64, |a, (_, r)| a.max(r.abs()));
+    let mut chart = ChartBuilder::on(bottom)
+        .caption(
+            format!(
+                "residuals (reduced χ² {:.3}, {} degrees of freedom)",
+                report.reduced_chi_square, report.degrees_of_freedom
+            ),
+            ("sans-serif", 16),
+        )
+        .margin(px(12))
+        .margin_right(px(LEGEND_MARGIN))
+        .x_label_area_size(px(36))
+        .y_label_area_size(px(56))
+        .build_cartesian_2d(x_range, axis_range(-largest, largest, 0.06))
+        .map_err(plot_error)?;
+    chart
+        .configure_mesh()
+        .set_all_tick_mark_size(px(5))
+        .x_desc(format!("time ({unit})"))
+        .y_desc("measured − fitted")
+        .draw()
+        .map_err(plot_error)?;
+    let mut noise = Vec::new();
+    for (c, points) in residuals.into_iter().enumerate() {
+        let (colour, _) = series_line(c);
+        chart
+            .draw_series(points.into_iter().map(|p| Circle::new(p, px(2), colour.filled())))
+            .map_err(plot_error)?;
+        let column = &report.residuals[c];
+        noise.push((
+            format!("{}: σ {:.4}", column.name, column.noise),
+            colour,
+            LineKind::Note,
+        ));
+    }
+    if let Some(first) = report.residuals.first() {
+        noise.push((format!("(σ {})", first.noise_source), BLACK, LineKind::Note));
+    }
+    draw_side_legend(bottom, 44, &noise)?;
+    Ok(())
 }
 
 /// A path's file name, for a title.

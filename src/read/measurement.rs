@@ -83,49 +83,7 @@ pub fn parse_measurement(text: &str, source: &str) -> Result<Measurement> {
             "a measurement needs a header row and data rows",
         ));
     };
-    let names: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
-    if names.len() > MAX_MEASUREMENT_COLUMNS + 1 {
-        return Err(NanofoldError::invalid(
-            format!("{source}: header"),
-            format!("{} columns", names.len()),
-            format!("at most {MAX_MEASUREMENT_COLUMNS} observed columns and time_s"),
-        ));
-    }
-    let time_column = match names.iter().position(|n| n == "time_s") {
-        Some(k) => k,
-        None => {
-            return Err(NanofoldError::missing(format!("{source}: column time_s")));
-        }
-    };
-    let mut columns = Vec::new();
-    for (k, name) in names.iter().enumerate() {
-        if k == time_column {
-            continue;
-        }
-        if names[..k].contains(name) {
-            return Err(NanofoldError::invalid(
-                format!("{source}: column {}", k + 1),
-                name,
-                "this column name appears twice",
-            ));
-        }
-        columns.push((
-            k,
-            MeasuredColumn {
-                name: name.clone(),
-                observed: observed(name)
-                    .map_err(|reason| NanofoldError::invalid(format!("{source}: column {}", k + 1), name, reason))?,
-                values: Vec::new(),
-            },
-        ));
-    }
-    if columns.is_empty() {
-        return Err(NanofoldError::invalid(
-            format!("{source}: header"),
-            header.trim(),
-            "no observed column besides time_s",
-        ));
-    }
+    let (names, time_column, mut columns) = read_header(header, source)?;
     let mut times: Vec<f64> = Vec::new();
     for (line_index, line) in lines {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -185,6 +143,56 @@ pub fn parse_measurement(text: &str, source: &str) -> Result<Measurement> {
         times,
         columns: columns.into_iter().map(|(_, c)| c).collect(),
     })
+}
+
+/// The header's names, the time column's place, and each observed column (its place and an
+/// empty column), or an error naming the column.
+#[allow(clippy::type_complexity)]
+fn read_header(header: &str, source: &str) -> Result<(Vec<String>, usize, Vec<(usize, MeasuredColumn)>)> {
+    let names: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
+    if names.len() > MAX_MEASUREMENT_COLUMNS + 1 {
+        return Err(NanofoldError::invalid(
+            format!("{source}: header"),
+            format!("{} columns", names.len()),
+            format!("at most {MAX_MEASUREMENT_COLUMNS} observed columns and time_s"),
+        ));
+    }
+    let time_column = match names.iter().position(|n| n == "time_s") {
+        Some(k) => k,
+        None => {
+            return Err(NanofoldError::missing(format!("{source}: column time_s")));
+        }
+    };
+    let mut columns = Vec::new();
+    for (k, name) in names.iter().enumerate() {
+        if k == time_column {
+            continue;
+        }
+        if names[..k].contains(name) {
+            return Err(NanofoldError::invalid(
+                format!("{source}: column {}", k + 1),
+                name,
+                "this column name appears twice",
+            ));
+        }
+        columns.push((
+            k,
+            MeasuredColumn {
+                name: name.clone(),
+                observed: observed(name)
+                    .map_err(|reason| NanofoldError::invalid(format!("{source}: column {}", k + 1), name, reason))?,
+                values: Vec::new(),
+            },
+        ));
+    }
+    if columns.is_empty() {
+        return Err(NanofoldError::invalid(
+            format!("{source}: header"),
+            header.trim(),
+            "no observed column besides time_s",
+        ));
+    }
+    Ok((names, time_column, columns))
 }
 
 /// What a column name observes, or why the name is not understood.

@@ -137,22 +137,7 @@ pub(crate) fn held_accelerations<P: Plant>(
             Ok(sliding.iter().map(|&p| plant.switches(ws)[p]).collect())
         };
     let mut buffer = vec![0.0; n];
-    let q_dot_size = q_dot.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-    let mut along_motion = vec![0.0; k_count];
-    if q_dot_size > 0.0 {
-        let h = SHIFT / q_dot_size;
-        let mut values = [vec![], vec![], vec![], vec![]];
-        for (slot, offset) in [-2.0, -1.0, 1.0, 2.0].iter().enumerate() {
-            for i in 0..n {
-                scratch.shifted[i] = q[i] + offset * h * q_dot[i];
-            }
-            let shifted = scratch.shifted.clone();
-            values[slot] = speed_at(plant, ws, &shifted, q_dot, &mut buffer)?;
-        }
-        for k in 0..k_count {
-            along_motion[k] = (8.0 * (values[2][k] - values[1][k]) - (values[3][k] - values[0][k])) / (12.0 * h);
-        }
-    }
+    let along_motion = speeds_along_motion(plant, &sliding, t, q, q_dot, ws, &mut scratch.shifted)?;
     let at_a0 = speed_at(plant, ws, q, &a0, &mut buffer)?;
     let mut matrix = DMatrix::zeros(k_count, k_count);
     for (k, column) in b.iter().enumerate() {
@@ -180,4 +165,34 @@ pub(crate) fn held_accelerations<P: Plant>(
                 .sum::<f64>();
     }
     Ok(())
+}
+
+/// ∂g/∂q q̇ of each sliding plate's normal speed g at (q, q̇): the fourth-order difference of
+/// g along the motion, the angles shifted by at most [`SHIFT`].
+fn speeds_along_motion<P: Plant>(
+    plant: &P,
+    sliding: &[usize],
+    t: f64,
+    q: &[f64],
+    q_dot: &[f64],
+    ws: &mut P::Workspace,
+    shifted: &mut [f64],
+) -> Result<Vec<f64>> {
+    let size = q_dot.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    if size == 0.0 {
+        return Ok(vec![0.0; sliding.len()]);
+    }
+    let h = SHIFT / size;
+    let mut buffer = vec![0.0; q.len()];
+    let mut values = [vec![], vec![], vec![], vec![]];
+    for (slot, offset) in [-2.0, -1.0, 1.0, 2.0].iter().enumerate() {
+        for i in 0..q.len() {
+            shifted[i] = q[i] + offset * h * q_dot[i];
+        }
+        plant.accelerations(t, shifted, q_dot, ws, &mut buffer)?;
+        values[slot] = sliding.iter().map(|&p| plant.switches(ws)[p]).collect::<Vec<f64>>();
+    }
+    Ok((0..sliding.len())
+        .map(|k| (8.0 * (values[2][k] - values[1][k]) - (values[3][k] - values[0][k])) / (12.0 * h))
+        .collect())
 }
