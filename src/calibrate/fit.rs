@@ -446,14 +446,14 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
     if !given && measurement.columns.len() > 1 {
         // Columns of different noise: weigh each by its estimated σ and fit again from here
         // (new weights only rescale the rows of the residuals and the Jacobian).
-        let sigma = column_noise(&problem, &at.residuals, n, m);
+        let sigma = column_noise(&problem, &at, n, m);
         reweigh(&mut problem, &mut at, sigma);
         let (again, again_status, more, again_at) = levenberg_marquardt(&mut problem, u, Some(at))?;
         (u, status, iterations, at) = (again, again_status, iterations + more, again_at);
     }
     if !given {
         // σ of each column from its residuals, so the residuals below are in units of it.
-        let sigma = column_noise(&problem, &at.residuals, n, m);
+        let sigma = column_noise(&problem, &at, n, m);
         reweigh(&mut problem, &mut at, sigma);
     }
     let report = statistics(&problem, &u, &at, given, n, m)?;
@@ -573,19 +573,12 @@ fn reweigh(problem: &mut Problem, at: &mut Evaluation, sigma: Vec<f64>) {
 }
 
 /// Each column's σ from its residuals (weighted by the current σ), with the n − m correction.
-fn column_noise(problem: &Problem, residuals: &DVector<f64>, n: usize, m: usize) -> Vec<f64> {
-    let correction = n as f64 / (n - m) as f64;
-    let mut e = 0;
-    problem
-        .measurement
-        .columns
+fn column_noise(problem: &Problem, at: &Evaluation, n: usize, m: usize) -> Vec<f64> {
+    let correction = (n as f64 / (n - m) as f64).sqrt();
+    column_residuals(problem, at, false)
         .iter()
-        .enumerate()
-        .map(|(c, column)| {
-            let count = column.values.iter().flatten().count();
-            let sum: f64 = (e..e + count).map(|k| (residuals[k] * problem.sigma[c]).powi(2)).sum();
-            e += count;
-            let sigma = (correction * sum / count.max(1) as f64).sqrt();
+        .map(|column| {
+            let sigma = correction * column.rms;
             if sigma > 0.0 {
                 sigma
             } else {
@@ -916,4 +909,41 @@ fn absolute_pattern(document: &SceneDocument) -> serde_json::Value {
         value["pattern"] = serde_json::Value::String(absolute.display().to_string());
     }
     value
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_are_refused_by_name() {
+        let error = |settings: FitSettings| settings.validate().unwrap_err().to_string();
+        let given = |default: Option<f64>, column: f64| Noise::Given {
+            default,
+            columns: BTreeMap::from([("hinge_0_deg".to_string(), column)]),
+        };
+        let base = FitSettings::default;
+        assert!(error(FitSettings { rtol: 0.0, ..base() }).contains("rtol"));
+        assert!(error(FitSettings {
+            max_iterations: 0,
+            ..base()
+        })
+        .contains("max_iterations"));
+        let noise = FitSettings {
+            noise: given(None, -0.5),
+            ..base()
+        };
+        assert!(error(noise).contains("noise.hinge_0_deg"));
+        let noise = FitSettings {
+            noise: given(Some(f64::NAN), 0.5),
+            ..base()
+        };
+        assert!(error(noise).contains("noise.default"));
+        assert!(FitSettings {
+            noise: given(Some(0.5), 0.5),
+            ..base()
+        }
+        .validate()
+        .is_ok());
+    }
 }
