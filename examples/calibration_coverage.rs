@@ -3,68 +3,81 @@
 //! intervals should contain the truth in about 95 of 100 fits (90 to 99 is the binomial
 //! range). Prints each study's coverage per parameter and the time per fit.
 //!
-//! `cargo run --release --example calibration_coverage [RUNS]` (default 100)
+//! `cargo run --release --example calibration_coverage [RUNS] [STUDY]` (default 100, every
+//! study; STUDY is `bridge`, `corner` or `miura`)
 
 use nanofold::calibrate::{fit, resolve, with_values, FitSettings, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::sensitivity::trajectory_sensitivities;
 use nanofold::dynamics::Method;
-use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
+use nanofold::read::measurement::{MeasuredColumn, Observed};
 use nanofold::read::SceneDocument;
 use std::time::Instant;
 
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;
+#[path = "common/miura.rs"]
+mod miura;
 
-struct Study<'a> {
-    name: &'a str,
-    scene: &'a str,
+type Failure = Box<dyn std::error::Error>;
+
+struct Study {
+    name: &'static str,
+    document: SceneDocument,
     free: Vec<FreeParameter>,
-    /// Output angles observed.
-    outputs: Vec<usize>,
-    t_end: f64,
-    samples: usize,
-    sigma_deg: f64,
+    truth: Vec<f64>,
+    times: Vec<f64>,
+    /// The observed columns at the truth, each with its σ.
+    exact: Vec<(MeasuredColumn, f64)>,
 }
 
-fn run(study: &Study, runs: usize) -> Result<(), Box<dyn std::error::Error>> {
-    let document = SceneDocument::load(study.scene.as_ref())?;
-    let parameters = resolve(&document, &study.free)?;
+/// A study observing output angles `outputs` of `scene` at `samples` times to `t_end`, with
+/// noise of `sigma_deg`.
+fn angles_study(
+    name: &'static str,
+    scene: &str,
+    free: Vec<FreeParameter>,
+    (outputs, t_end, samples, sigma_deg): (&[usize], f64, usize, f64),
+) -> Result<Study, Failure> {
+    let document = SceneDocument::load(scene.as_ref())?;
+    let parameters = resolve(&document, &free)?;
     let truth: Vec<f64> = parameters.iter().map(|p| p.start).collect();
     let scene = with_values(&document, &parameters, &truth).spec()?.build()?;
     let edges = scene.output_edges().map(<[usize]>::to_vec);
-    let times: Vec<f64> = (1..=study.samples)
-        .map(|k| study.t_end * k as f64 / study.samples as f64)
+    let times: Vec<f64> = (1..=samples).map(|k| t_end * k as f64 / samples as f64).collect();
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-11)?;
+    let exact = outputs
+        .iter()
+        .map(|&k| {
+            let index = edges.as_ref().map_or(k, |e| e[k]);
+            let column = MeasuredColumn {
+                name: format!("crease_{index}_deg"),
+                observed: Observed::Angle { index, hinge: false },
+                values: run.angles.iter().map(|a| Some(a[k].to_degrees())).collect(),
+            };
+            (column, sigma_deg)
+        })
         .collect();
-    let exact = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-11)?;
+    Ok(Study {
+        name,
+        document,
+        free,
+        truth,
+        times: run.times,
+        exact,
+    })
+}
+
+fn run(study: &Study, runs: usize) -> Result<(), Failure> {
     let mut normal = Normal(1);
-    let mut covered = vec![0usize; parameters.len()];
-    let mut determined = vec![0usize; parameters.len()];
-    let (mut seconds, mut simulations) = (0.0, 0);
+    let m = study.truth.len();
+    let (mut covered, mut determined) = (vec![0usize; m], vec![0usize; m]);
+    let (mut seconds, mut simulations, mut exact_runs) = (0.0, 0, 0);
     for _ in 0..runs {
-        let measured = Measurement {
-            source: format!("{} synthetic", study.name),
-            times: times.clone(),
-            columns: study
-                .outputs
-                .iter()
-                .map(|&k| {
-                    let index = edges.as_ref().map_or(k, |e| e[k]);
-                    MeasuredColumn {
-                        name: format!("crease_{index}_deg"),
-                        observed: Observed::Angle { index, hinge: false },
-                        values: exact
-                            .angles
-                            .iter()
-                            .map(|a| Some(a[k].to_degrees() + study.sigma_deg * normal.sample()))
-                            .collect(),
-                    }
-                })
-                .collect(),
-        };
+        let measured = miura::noisy(&study.times, &study.exact, &mut normal);
         let clock = Instant::now();
         let report = fit(
-            &document,
+            &study.document,
             &measured,
             &FitSettings {
                 free: study.free.clone(),
@@ -73,65 +86,76 @@ fn run(study: &Study, runs: usize) -> Result<(), Box<dyn std::error::Error>> {
         )?;
         seconds += clock.elapsed().as_secs_f64();
         simulations += report.simulations;
+        exact_runs += report.sensitivity_runs;
         for (j, p) in report.parameters.iter().enumerate() {
             if let Some([lo, hi]) = p.interval_95 {
                 determined[j] += 1;
-                if lo <= truth[j] && truth[j] <= hi {
+                if lo <= study.truth[j] && study.truth[j] <= hi {
                     covered[j] += 1;
                 }
             }
         }
     }
     println!(
-        "{}: {runs} fits of {} samples × {} angles (σ {}°), {:.2} s and {:.1} simulations per fit",
+        "{}: {runs} fits of {} samples × {} columns, {:.2} s, {:.1} simulations ({:.1} with sensitivities) per fit",
         study.name,
-        study.samples,
-        study.outputs.len(),
-        study.sigma_deg,
+        study.times.len(),
+        study.exact.len(),
         seconds / runs as f64,
-        simulations as f64 / runs as f64
+        simulations as f64 / runs as f64,
+        exact_runs as f64 / runs as f64
     );
-    for (j, p) in parameters.iter().enumerate() {
+    for (j, p) in study.free.iter().enumerate() {
         println!(
             "  {} = {}: covered in {}/{} ({} determined)",
-            p.path, truth[j], covered[j], runs, determined[j]
+            p.path, study.truth[j], covered[j], runs, determined[j]
         );
     }
     Ok(())
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> Result<(), Failure> {
     let runs: usize = std::env::args().nth(1).map_or(Ok(100), |a| a.parse())?;
+    let only = std::env::args().nth(2);
     let free = |path: &str, lower: f64, upper: f64| FreeParameter {
         path: path.into(),
         lower,
         upper,
     };
-    let studies = [
-        Study {
-            name: "bridge step",
-            scene: "patterns/bridge_step.scene.json",
-            free: vec![
+    let wanted = |key: &str| only.as_deref().is_none_or(|o| o == key);
+    if wanted("bridge") {
+        let bridge = angles_study(
+            "bridge step",
+            "patterns/bridge_step.scene.json",
+            vec![
                 free("environment.drag_coefficient", 0.2, 5.0),
                 free("hinges[*].target_angle_deg", 45.0, 135.0),
             ],
-            outputs: vec![0, 3],
-            t_end: 45e-6,
-            samples: 100,
-            sigma_deg: 0.5,
-        },
-        Study {
-            name: "corner cube step 1",
-            scene: "patterns/corner_cube_step1.scene.json",
-            free: vec![free("hinges[0].layers[1].thickness_um", 0.02, 0.5)],
-            outputs: vec![0, 2],
-            t_end: 2.5e-5,
-            samples: 100,
-            sigma_deg: 0.5,
-        },
-    ];
-    for study in &studies {
-        run(study, runs)?;
+            (&[0, 3], 45e-6, 100, 0.5),
+        )?;
+        run(&bridge, runs)?;
+    }
+    if wanted("corner") {
+        let corner = angles_study(
+            "corner cube step 1",
+            "patterns/corner_cube_step1.scene.json",
+            vec![free("hinges[0].layers[1].thickness_um", 0.02, 0.5)],
+            (&[0, 2], 2.5e-5, 100, 0.5),
+        )?;
+        run(&corner, runs)?;
+    }
+    if wanted("miura") {
+        let document = miura::document()?;
+        let (times, exact) = miura::exact_columns(&document)?;
+        let sheet = Study {
+            name: "Miura-ori 4 x 4 (2 creases, marks on 2 panels)",
+            document,
+            free: miura::free(),
+            truth: miura::TRUTH.to_vec(),
+            times,
+            exact,
+        };
+        run(&sheet, runs)?;
     }
     Ok(())
 }

@@ -6,7 +6,7 @@
 use super::parameters::{resolve, with_values, FreeParameter, ResolvedParameter};
 use crate::dynamics::points::PanelPoints;
 use crate::dynamics::scene::Scene;
-use crate::dynamics::sensitivity::{trajectory_sensitivities, STENCIL};
+use crate::dynamics::sensitivity::{trajectory_sensitivities, TrajectorySensitivity, STENCIL};
 use crate::dynamics::Method;
 use crate::error::{NanofoldError, Result};
 use crate::read::measurement::{Measurement, Observed};
@@ -18,7 +18,7 @@ use std::time::Instant;
 
 /// Each parameter's step ε in the differences of the sensitivity equations, in the
 /// parameter's scale (|start|).
-pub const SENSITIVITY_STEP: f64 = 1e-3;
+pub const SENSITIVITY_STEP: f64 = 1e-4;
 /// A combination of parameters is undetermined when the data fix it no better than this
 /// relative standard error (100 %), or when its singular value is below this fraction of the
 /// largest (numerically degenerate).
@@ -239,14 +239,58 @@ enum Output {
 /// Step of the differences of a mark's position in the fold angles, rad.
 const MARK_STEP: f64 = 1e-6;
 
+/// Step of the forward differences that give the iterations their Jacobian, in scaled
+/// units: large against the plain runs' noise (their rtol), small against the curvature.
+const DIFFERENCE_STEP: f64 = 1e-4;
+
+/// Where an evaluation's Jacobian came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Jacobian {
+    /// Carried by Broyden's update.
+    Carried,
+    /// Forward differences of plain runs.
+    Differences,
+    /// The sensitivity equations.
+    Exact,
+}
+
 /// One evaluation of the model at a parameter vector.
 struct Evaluation {
     /// Fitted values per column per time.
     predicted: Vec<Vec<f64>>,
     /// Weighted residuals (ŷ − y)/σ of every observation.
     residuals: DVector<f64>,
-    /// ∂residuals/∂u, when asked.
-    jacobian: Option<DMatrix<f64>>,
+    /// ∂residuals/∂u and where it came from, when asked.
+    jacobian: Option<(DMatrix<f64>, Jacobian)>,
+}
+
+/// `job(i)` for i in 0..count on the machine's cores, in order.
+fn on_cores<T: Send>(count: usize, job: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
+    let threads = std::thread::available_parallelism().map_or(1, usize::from).min(count);
+    if threads <= 1 {
+        return (0..count).map(job).collect();
+    }
+    let mut results: Vec<Option<T>> = (0..count).map(|_| None).collect();
+    std::thread::scope(|scope| {
+        let chunks: Vec<_> = results
+            .chunks_mut(count.div_ceil(threads))
+            .enumerate()
+            .map(|(c, chunk)| {
+                let first = c * count.div_ceil(threads);
+                scope.spawn(move || {
+                    for (k, slot) in chunk.iter_mut().enumerate() {
+                        *slot = Some(job(first + k));
+                    }
+                })
+            })
+            .collect();
+        for chunk in chunks {
+            if let Err(panic) = chunk.join() {
+                std::panic::resume_unwind(panic);
+            }
+        }
+    });
+    results.into_iter().map(|r| r.expect("every job ran")).collect()
 }
 
 /// The problem: the document, its parameters, the measurement and how columns map.
@@ -270,31 +314,102 @@ impl Problem<'_> {
         with_values(self.document, &self.parameters, values).spec()?.build()
     }
 
-    fn evaluate(&mut self, u: &[f64], jacobian: bool) -> Result<Evaluation> {
-        let values = self.values(u);
-        let base = self.scene(&values)?;
-        let mut perturbed = Vec::new();
-        if jacobian {
-            for j in 0..u.len() {
-                let mut at = values.clone();
-                let mut four = Vec::with_capacity(4);
-                for k in STENCIL {
-                    at[j] = values[j] + k * SENSITIVITY_STEP * self.parameters[j].scale;
-                    four.push(self.scene(&at)?);
-                }
-                perturbed.push(four.try_into().expect("four offsets"));
-            }
-        }
+    /// A plain run at u.
+    fn evaluate(&mut self, u: &[f64]) -> Result<Evaluation> {
         self.simulations += 1;
-        self.sensitivity_runs += usize::from(jacobian);
-        let run = trajectory_sensitivities(
+        self.run(u, false)
+    }
+
+    /// A run at u with the sensitivities.
+    fn exact(&mut self, u: &[f64]) -> Result<Evaluation> {
+        self.simulations += 1;
+        self.sensitivity_runs += 1;
+        self.run(u, true)
+    }
+
+    /// At `at` (a plain run at u), the Jacobian from forward differences of plain runs, one
+    /// per parameter, on the machine's cores; a step that would leave the bounds goes the
+    /// other way.
+    fn differences(&mut self, u: &[f64], at: Evaluation, (lower, upper): (&[f64], &[f64])) -> Result<Evaluation> {
+        let m = u.len();
+        self.simulations += m;
+        let this: &Problem = self;
+        let columns = on_cores(m, &|j| {
+            let h = if u[j] + DIFFERENCE_STEP <= upper[j] || u[j] - DIFFERENCE_STEP < lower[j] {
+                DIFFERENCE_STEP
+            } else {
+                -DIFFERENCE_STEP
+            };
+            let mut shifted = u.to_vec();
+            shifted[j] += h;
+            this.run(&shifted, false).map(|e| (e.residuals - &at.residuals) / h)
+        });
+        let mut jacobian = DMatrix::zeros(at.residuals.len(), m);
+        for (j, column) in columns.into_iter().enumerate() {
+            jacobian.set_column(j, &column?);
+        }
+        Ok(Evaluation {
+            jacobian: Some((jacobian, Jacobian::Differences)),
+            ..at
+        })
+    }
+
+    /// The motion at `values` and its sensitivities to the parameters `columns`.
+    fn sensitivities(&self, values: &[f64], columns: std::ops::Range<usize>) -> Result<TrajectorySensitivity> {
+        let base = self.scene(values)?;
+        let mut perturbed = Vec::with_capacity(columns.len());
+        for j in columns {
+            let mut at = values.to_vec();
+            let mut pair = Vec::with_capacity(STENCIL.len());
+            for k in STENCIL {
+                at[j] = values[j] + k * SENSITIVITY_STEP * self.parameters[j].scale;
+                pair.push(self.scene(&at)?);
+            }
+            perturbed.push(pair.try_into().expect("one scene per offset"));
+        }
+        trajectory_sensitivities(
             &base,
             &perturbed,
             SENSITIVITY_STEP,
             &self.measurement.times,
             self.settings.method,
             self.settings.rtol,
-        )?;
+        )
+    }
+
+    /// The residuals at u, and their exact Jacobian if asked: the parameters' columns in
+    /// groups, one run per core.
+    fn run(&self, u: &[f64], jacobian: bool) -> Result<Evaluation> {
+        let values = self.values(u);
+        let base = self.scene(&values)?;
+        let run = if jacobian {
+            let m = u.len();
+            let groups = std::thread::available_parallelism().map_or(1, usize::from).clamp(1, m);
+            let size = m.div_ceil(groups);
+            let runs = on_cores(m.div_ceil(size), &|g| {
+                self.sensitivities(&values, g * size..((g + 1) * size).min(m))
+            });
+            let mut runs = runs.into_iter();
+            let mut run = runs.next().expect("one group at least")?;
+            for other in runs {
+                let other = other?;
+                for (mine, theirs) in run.sensitivities.iter_mut().zip(&other.sensitivities) {
+                    let (rows, have) = mine.shape();
+                    let joined = DMatrix::from_fn(rows, have + theirs.ncols(), |i, j| {
+                        if j < have {
+                            mine[(i, j)]
+                        } else {
+                            theirs[(i, j - have)]
+                        }
+                    });
+                    *mine = joined;
+                }
+                run.times.truncate(other.times.len());
+            }
+            run
+        } else {
+            self.sensitivities(&values, 0..0)?
+        };
         if run.times.len() != self.measurement.times.len() {
             let missing = self.measurement.times[run.times.len().min(self.measurement.times.len() - 1)];
             return Err(NanofoldError::invalid(
@@ -347,7 +462,7 @@ impl Problem<'_> {
         Ok(Evaluation {
             predicted,
             residuals,
-            jacobian: matrix,
+            jacobian: matrix.map(|m| (m, Jacobian::Exact)),
         })
     }
 }
@@ -563,7 +678,7 @@ fn reweigh(problem: &mut Problem, at: &mut Evaluation, sigma: Vec<f64>) {
         let factor = problem.sigma[c] / sigma[c];
         for _ in column.values.iter().flatten() {
             at.residuals[e] *= factor;
-            if let Some(j) = &mut at.jacobian {
+            if let Some((j, _)) = &mut at.jacobian {
                 j.row_mut(e).scale_mut(factor);
             }
             e += 1;
@@ -589,11 +704,12 @@ fn column_noise(problem: &Problem, at: &Evaluation, n: usize, m: usize) -> Vec<f
 }
 
 /// Levenberg–Marquardt (Marquardt's diagonal scaling, Nielsen's damping update) within the
-/// bounds: trial points are clamped to them. Between exact Jacobians (a simulation with the
-/// sensitivities, ~(1 + 8m) plain ones) the Jacobian is carried by Broyden's rank-one update
-/// from each accepted step's residuals; an exact one is computed again after a rejected
-/// step and before convergence is declared, so the estimate and the statistics rest on it.
-/// Returns the estimate in scaled units, how it ended and the iterations.
+/// bounds: trial points are clamped to them. The iterations' Jacobian comes from forward
+/// differences of plain runs (m of them, on the machine's cores) and is carried between
+/// them by Broyden's rank-one update from each accepted step's residuals; the differences
+/// are taken again after a step the carried one led astray. Convergence is confirmed with
+/// the exact Jacobian (a run with the sensitivities), so the estimate and the statistics
+/// rest on it. Returns the estimate in scaled units, how it ended and the iterations.
 fn levenberg_marquardt(
     problem: &mut Problem,
     start: Vec<f64>,
@@ -601,34 +717,31 @@ fn levenberg_marquardt(
 ) -> Result<(Vec<f64>, FitStatus, usize, Evaluation)> {
     let lower: Vec<f64> = problem.parameters.iter().map(|p| p.lower / p.scale).collect();
     let upper: Vec<f64> = problem.parameters.iter().map(|p| p.upper / p.scale).collect();
+    let bounds = (lower.as_slice(), upper.as_slice());
     let m = start.len();
     let mut u = start;
     let mut current = match at_start {
         Some(at) if at.jacobian.is_some() => at,
-        _ => problem.evaluate(&u, true)?,
+        _ => {
+            let at = problem.evaluate(&u)?;
+            problem.differences(&u, at, bounds)?
+        }
     };
-    let mut exact = true;
+    let mut exact_taken = matches!(current.jacobian, Some((_, Jacobian::Exact)));
     let mut cost = current.residuals.norm_squared();
     let mut lambda: Option<f64> = None;
     let mut nu = 2.0;
     for iteration in 1..=problem.settings.max_iterations {
-        let jacobian = current.jacobian.as_ref().expect("evaluated with its Jacobian");
+        let (jacobian, kind) = current.jacobian.as_ref().expect("evaluated with its Jacobian");
+        let kind = *kind;
         let normal = jacobian.transpose() * jacobian;
         let gradient = jacobian.transpose() * &current.residuals;
-        if converged(
-            problem,
-            jacobian,
-            &current.residuals,
-            &gradient,
-            &u,
-            (&lower, &upper),
-            cost,
-        ) {
-            if exact {
+        if converged(problem, jacobian, &current.residuals, &gradient, &u, bounds, cost) {
+            if kind == Jacobian::Exact {
                 return Ok((u, FitStatus::Converged, iteration - 1, current));
             }
-            current = problem.evaluate(&u, true)?;
-            exact = true;
+            current = problem.exact(&u)?;
+            exact_taken = true;
             continue;
         }
         let diagonal: Vec<f64> = (0..m).map(|j| normal[(j, j)].max(1e-12 * normal.max())).collect();
@@ -647,14 +760,15 @@ fn levenberg_marquardt(
             let taken = DVector::from_iterator(m, (0..m).map(|j| trial[j] - u[j]));
             let predicted = -(2.0 * gradient.dot(&taken) + (&normal * &taken).dot(&taken));
             let small_step = (0..m).all(|j| taken[j].abs() <= 1e-10 * (u[j].abs() + 1e-10));
-            if small_step && exact {
-                return Ok((u, FitStatus::Converged, iteration, current));
+            if small_step {
+                if kind == Jacobian::Exact {
+                    return Ok((u, FitStatus::Converged, iteration, current));
+                }
+                current = problem.exact(&u)?;
+                exact_taken = true;
+                break;
             }
-            let outcome = if small_step {
-                None
-            } else {
-                problem.evaluate(&trial, false).ok()
-            };
+            let outcome = problem.evaluate(&trial).ok();
             let trial_cost = outcome.as_ref().map_or(f64::INFINITY, |e| e.residuals.norm_squared());
             let rho = if predicted > 0.0 {
                 (cost - trial_cost) / predicted
@@ -665,40 +779,47 @@ fn levenberg_marquardt(
                 let updated = broyden(jacobian, &current.residuals, &outcome.residuals, &taken);
                 u = trial;
                 current = Evaluation {
-                    jacobian: Some(updated),
+                    jacobian: Some((updated, Jacobian::Carried)),
                     ..outcome
                 };
-                exact = false;
                 cost = trial_cost;
                 damping *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                 nu = 2.0;
                 lambda = Some(damping);
                 break;
             }
-            if !exact {
-                // A carried Jacobian that led astray: compute the exact one here and try again.
-                current = problem.evaluate(&u, true)?;
-                exact = true;
+            if kind == Jacobian::Carried {
+                // A carried Jacobian that led astray: take the differences here and try again;
+                // once the exact one has been needed (near the estimate, where the
+                // differences' noise matters), the exact one.
+                current = if exact_taken {
+                    problem.exact(&u)?
+                } else {
+                    let at = Evaluation {
+                        jacobian: None,
+                        ..current
+                    };
+                    problem.differences(&u, at, bounds)?
+                };
                 break;
             }
             damping *= nu;
             nu *= 2.0;
             if damping > 1e16 {
-                let at = exact_at(problem, &u, current, exact)?;
+                let at = exact_at(problem, &u, current)?;
                 return Ok((u, FitStatus::Stalled, iteration, at));
             }
         }
     }
-    let at = exact_at(problem, &u, current, exact)?;
+    let at = exact_at(problem, &u, current)?;
     Ok((u, FitStatus::MaxIterations, problem.settings.max_iterations, at))
 }
 
 /// The evaluation at u with its exact Jacobian (computed unless `current` has it).
-fn exact_at(problem: &mut Problem, u: &[f64], current: Evaluation, exact: bool) -> Result<Evaluation> {
-    if exact {
-        Ok(current)
-    } else {
-        problem.evaluate(u, true)
+fn exact_at(problem: &mut Problem, u: &[f64], current: Evaluation) -> Result<Evaluation> {
+    match current.jacobian {
+        Some((_, Jacobian::Exact)) => Ok(current),
+        _ => problem.exact(u),
     }
 }
 
@@ -710,8 +831,8 @@ fn broyden(jacobian: &DMatrix<f64>, before: &DVector<f64>, after: &DVector<f64>,
 }
 
 /// Whether the fit has converged at u: no descent left through the bounds, or the
-/// Gauss–Newton step would lower S by less than 1e-6 of its mean square per degree of
-/// freedom (the estimates would move by under 1e-3 of their standard errors), counting only
+/// Gauss–Newton step would lower S by less than 1e-4 of its mean square per degree of
+/// freedom (the estimates would move by under 1e-2 of their standard errors), counting only
 /// the directions the data determine (along one they do not, S is flat and the step says
 /// nothing).
 fn converged(
@@ -748,12 +869,12 @@ fn converged(
         })
         .map(|k| left.column(k).dot(residuals).powi(2))
         .sum();
-    decrease <= 1e-6 * scale
+    decrease <= 1e-4 * scale
 }
 
 /// Covariance, intervals, correlations and identifiability at the estimate.
 fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usize, m: usize) -> Result<FitReport> {
-    let jacobian = at.jacobian.as_ref().expect("evaluated with its Jacobian");
+    let (jacobian, _) = at.jacobian.as_ref().expect("evaluated with its Jacobian");
     let sum_of_squares = at.residuals.norm_squared();
     let dof = n - m;
     let reduced = sum_of_squares / dof as f64;
@@ -763,14 +884,28 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
     let mut order: Vec<usize> = (0..m).collect();
     order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
     let largest = svd.singular_values[order[0]];
+    let lower: Vec<f64> = problem.parameters.iter().map(|p| p.lower / p.scale).collect();
+    let upper: Vec<f64> = problem.parameters.iter().map(|p| p.upper / p.scale).collect();
     let mut covariance = DMatrix::<f64>::zeros(m, m);
     let mut undetermined = Vec::new();
     let mut loose = vec![false; m];
+    // The spread along the undetermined directions: how far, within the bounds, the
+    // combinations the data do not fix move the parameters.
+    let mut spread = DMatrix::<f64>::zeros(m, m);
     for &k in &order {
         let sigma = svd.singular_values[k];
         let direction: Vec<f64> = (0..m).map(|j| v_t[(k, j)]).collect();
         let relative_error = s2.sqrt() / sigma;
         if sigma <= DEGENERATE_FRACTION * largest || relative_error > UNDETERMINED_RELATIVE_ERROR {
+            let extent = relative_error.min(span(u, &direction, (&lower, &upper)));
+            for (j, w) in direction.iter().enumerate() {
+                for (i, v) in direction.iter().enumerate() {
+                    spread[(i, j)] += v * w * extent * extent;
+                }
+                if w.abs() >= LOADING {
+                    loose[j] = true;
+                }
+            }
             let mut loadings: Vec<(String, f64)> = problem
                 .parameters
                 .iter()
@@ -779,11 +914,6 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
                 .map(|(p, &w)| (p.path.clone(), w))
                 .collect();
             loadings.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-            for (j, w) in direction.iter().enumerate() {
-                if w.abs() >= LOADING {
-                    loose[j] = true;
-                }
-            }
             undetermined.push(Combination {
                 singular_value: sigma,
                 relative_standard_error: relative_error,
@@ -804,6 +934,15 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
             }
         }
     }
+    // A parameter the undetermined combinations move by more than the data's error on it
+    // is undetermined too, however small its loading; otherwise its error includes that
+    // spread.
+    for j in 0..m {
+        if spread[(j, j)] > covariance[(j, j)] {
+            loose[j] = true;
+        }
+    }
+    covariance += spread;
     let t = t_quantile(dof);
     let values = problem.values(u);
     let parameters: Vec<FittedParameter> = problem
@@ -865,6 +1004,21 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
         },
         fitted_scene: serde_json::Value::Null,
     })
+}
+
+/// The length, in scaled units, of the line through u along `direction` within the bounds.
+fn span(u: &[f64], direction: &[f64], (lower, upper): (&[f64], &[f64])) -> f64 {
+    let (mut below, mut above) = (f64::NEG_INFINITY, f64::INFINITY);
+    for j in 0..u.len() {
+        let w = direction[j];
+        if w.abs() < f64::EPSILON {
+            continue;
+        }
+        let (a, b) = ((lower[j] - u[j]) / w, (upper[j] - u[j]) / w);
+        below = below.max(a.min(b));
+        above = above.min(a.max(b));
+    }
+    (above - below).max(0.0)
 }
 
 /// The 0.975 quantile of Student's t with `dof` degrees of freedom.

@@ -272,55 +272,68 @@ impl<P: Plant> Driver<'_, P> {
         S: OdeSolverMethod<'a, Eqn>,
     {
         let n = self.plant.dof();
-        let mut earliest: Option<(f64, Vec<usize>)> = None;
-        for k in (0..before.len()).filter(|&k| before[k] * now[k] < 0.0) {
-            let side = before[k].signum();
-            // Regula falsi with the Illinois modification (an end kept twice has its value
-            // halved), to rounding: far fewer evaluations than bisection's fifty. (Stopping at
-            // 1e-13 of the step instead moved the Miura-ori sheet's sensitivities by 1e-6.)
-            let (mut lo, mut hi) = (s_before, s_now);
-            let (mut f_lo, mut f_hi) = (before[k] * side, now[k] * side);
-            let mut kept = 0_i8;
-            loop {
-                let secant = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-                let mid = if secant > lo && secant < hi && secant.is_finite() {
-                    secant
-                } else {
-                    0.5 * (lo + hi)
-                };
-                if mid <= lo || mid >= hi {
-                    break;
-                }
-                solver.interpolate_inplace(mid, state)?;
-                for i in 0..n {
-                    angles[i] = state[i];
-                    rates[i] = state[n + i] / self.time_unit;
-                }
-                accumulated.iter_mut().for_each(|a| *a = 0.0);
-                self.plant
-                    .switch_values(mid * self.time_unit, angles, rates, ws, scratch)?;
-                let f_mid = scratch[k] * side;
-                if f_mid > 0.0 {
-                    (lo, f_lo) = (mid, f_mid);
-                    if kept == -1 {
-                        f_hi *= 0.5;
-                    }
-                    kept = -1;
-                } else {
-                    (hi, f_hi) = (mid, f_mid);
-                    if kept == 1 {
-                        f_lo *= 0.5;
-                    }
-                    kept = 1;
-                }
+        // Every function that changes sign in the step, bracketed together: each evaluation
+        // gives all of them, and the bracket closes on the earliest crossing.
+        let mut crossing: Vec<(usize, f64, f64, f64)> = (0..before.len())
+            .filter(|&k| before[k] * now[k] < 0.0)
+            .map(|k| {
+                let side = before[k].signum();
+                (k, side, before[k] * side, now[k] * side)
+            })
+            .collect();
+        if crossing.is_empty() {
+            return Ok(None);
+        }
+        // Regula falsi with the Illinois modification (an end kept twice has its values
+        // halved), to rounding: far fewer evaluations than bisection's fifty. (Stopping at
+        // 1e-13 of the step instead moved the Miura-ori sheet's sensitivities by 1e-6.)
+        let (mut lo, mut hi) = (s_before, s_now);
+        let mut kept = 0_i8;
+        loop {
+            let secant = crossing
+                .iter()
+                .map(|&(_, _, f_lo, f_hi)| (lo * f_hi - hi * f_lo) / (f_hi - f_lo))
+                .fold(f64::INFINITY, f64::min);
+            let mid = if secant > lo && secant < hi && secant.is_finite() {
+                secant
+            } else {
+                0.5 * (lo + hi)
+            };
+            if mid <= lo || mid >= hi {
+                break;
             }
-            match &mut earliest {
-                Some((s, switched)) if hi == *s => switched.push(k),
-                Some((s, _)) if hi > *s => {}
-                _ => earliest = Some((hi, vec![k])),
+            solver.interpolate_inplace(mid, state)?;
+            for i in 0..n {
+                angles[i] = state[i];
+                rates[i] = state[n + i] / self.time_unit;
+            }
+            accumulated.iter_mut().for_each(|a| *a = 0.0);
+            self.plant
+                .switch_values(mid * self.time_unit, angles, rates, ws, scratch)?;
+            if crossing.iter().any(|&(k, side, _, _)| scratch[k] * side <= 0.0) {
+                // Something crosses by mid: the earliest is before it; those that have not
+                // crossed yet cross later, found again after the jump.
+                hi = mid;
+                crossing.retain(|&(k, side, _, _)| scratch[k] * side <= 0.0);
+                for entry in &mut crossing {
+                    entry.3 = scratch[entry.0] * entry.1;
+                    if kept == 1 {
+                        entry.2 *= 0.5;
+                    }
+                }
+                kept = 1;
+            } else {
+                lo = mid;
+                for entry in &mut crossing {
+                    entry.2 = scratch[entry.0] * entry.1;
+                    if kept == -1 {
+                        entry.3 *= 0.5;
+                    }
+                }
+                kept = -1;
             }
         }
-        Ok(earliest)
+        Ok(Some((hi, crossing.into_iter().map(|(k, ..)| k).collect())))
     }
 
     fn run<'a, Eqn, S>(&self, mut solver: S) -> Result<(Vec<Sample>, Option<Collision>, usize, usize)>

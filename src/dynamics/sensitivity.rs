@@ -2,17 +2,15 @@
 //! (`docs/model.md#calibration`): the variational equations S̈ = ∂a/∂q S + ∂a/∂q̇ Ṡ + ∂a/∂u
 //! integrated with the motion under one error control, for any plant.
 //!
-//! The caller hands the scene at the parameters u and at u + kε eⱼ, k = −2, −1, 1, 2, for
-//! each parameter j (one scene per perturbation, built from the scene file, so any number
-//! the file holds can be a parameter). Each column's right-hand side is two fourth-order
-//! central differences, [8(f₊₁ − f₋₁) − (f₊₂ − f₋₂)] / 12h: along the state,
-//! ∂a/∂q Sⱼ + ∂a/∂q̇ Ṡⱼ from the base plant at (q + khSⱼ, q̇ + khṠⱼ) with h sized so the
-//! shift is [`STATE_SHIFT`] rad whatever |Sⱼ| is; along the parameter, ∂a/∂uⱼ from the
-//! perturbed plants at (q, q̇). Fourth order lets both steps be large enough that rounding in
-//! a (a stiff strip's accelerations carry ~1e-14 of it) stays far below the tolerance, and a
-//! small state shift keeps the error where the right-hand side is only once differentiable
-//! (quadratic drag at a turning point) small. The adaptive integrator never differentiates
-//! its own step choices, so the columns are as accurate as the motion.
+//! The caller hands the scene at the parameters u and at u ± ε eⱼ for each parameter j (one
+//! scene per perturbation, built from the scene file, so any number the file holds can be a
+//! parameter). Each column's right-hand side is two central differences (f₊ − f₋)/2h: along
+//! the state, ∂a/∂q Sⱼ + ∂a/∂q̇ Ṡⱼ from the base plant at (q ± hSⱼ, q̇ ± hṠⱼ) with h sized so
+//! the shift is [`STATE_SHIFT`] rad whatever |Sⱼ| is; along the parameter, ∂a/∂uⱼ from the
+//! perturbed plants at (q, q̇). With the drag's sides held the right-hand side is smooth, so
+//! steps of 1e-4 leave a truncation error near 1e-9 while rounding in a (a stiff strip's
+//! accelerations carry ~1e-14 of it) adds 1e-10. The adaptive integrator never
+//! differentiates its own step choices, so the columns are as accurate as the motion.
 
 use super::closed::{ClosedChain, ClosedPlant};
 use super::contact::{Collision, ContactProbe};
@@ -42,15 +40,19 @@ pub struct TrajectorySensitivity {
     pub steps: usize,
 }
 
-/// The offsets, in steps ε, of the four perturbed scenes of each parameter.
-pub const STENCIL: [f64; 4] = [-2.0, -1.0, 1.0, 2.0];
+/// How many perturbed scenes each parameter has.
+pub const POINTS: usize = 2;
+/// The offsets, in steps ε, of each parameter's perturbed scenes.
+pub const STENCIL: [f64; POINTS] = [-1.0, 1.0];
+/// The central difference's weights at the [`STENCIL`] offsets.
+const WEIGHTS: [f64; POINTS] = [-0.5, 0.5];
 /// The largest shift of an angle (rad) or a rate (rad per unit of scaled time) in the
 /// differences along the state.
 pub const STATE_SHIFT: f64 = 1e-4;
 
-/// The fourth-order central difference from values at the [`STENCIL`] offsets.
-fn stencil(values: [f64; 4], epsilon: f64) -> f64 {
-    (8.0 * (values[2] - values[1]) - (values[3] - values[0])) / (12.0 * epsilon)
+/// The central difference from values at the [`STENCIL`] offsets.
+fn stencil(values: [f64; POINTS], epsilon: f64) -> f64 {
+    values.iter().zip(WEIGHTS).map(|(v, w)| v * w).sum::<f64>() / epsilon
 }
 
 /// Integrates `base` and the sensitivity of its output angles to each parameter whose
@@ -59,7 +61,7 @@ fn stencil(values: [f64; 4], epsilon: f64) -> f64 {
 /// time scales) at relative tolerance `rtol`.
 pub fn trajectory_sensitivities(
     base: &Scene,
-    perturbed: &[[Scene; 4]],
+    perturbed: &[[Scene; POINTS]],
     epsilon: f64,
     times: &[f64],
     method: Method,
@@ -79,15 +81,15 @@ pub fn trajectory_sensitivities(
         ($kind:ident, $make:expr) => {{
             let mut plants = Vec::with_capacity(perturbed.len());
             for (j, scenes) in perturbed.iter().enumerate() {
-                let mut four = Vec::with_capacity(4);
+                let mut pair = Vec::with_capacity(POINTS);
                 for scene in scenes {
                     match &scene.system {
-                        System::$kind(inner) => four.push($make(inner)?),
+                        System::$kind(inner) => pair.push($make(inner)?),
                         _ => return Err(mismatch(j)),
                     }
                 }
-                let four: [_; 4] = four.try_into().map_err(|_| mismatch(j))?;
-                plants.push(four);
+                let pair: [_; POINTS] = pair.try_into().map_err(|_| mismatch(j))?;
+                plants.push(pair);
             }
             plants
         }};
@@ -95,19 +97,19 @@ pub fn trajectory_sensitivities(
     match &base.system {
         System::Strip(chain) => {
             let plants = pairs!(Strip, strip_plant);
-            run(&strip_plant(chain)?, &plants, epsilon, times, method, rtol)
+            run(&strip_plant(chain)?, &plants, epsilon, times, (method, rtol, true))
         }
         System::Closed(chain) => {
             let plants = pairs!(Closed, closed_plant);
-            run(&closed_plant(chain)?, &plants, epsilon, times, method, rtol)
+            run(&closed_plant(chain)?, &plants, epsilon, times, (method, rtol, true))
         }
         System::Network(model) if model.reduction.is_some() => {
             let plants = pairs!(Network, reduced_plant);
-            run(&reduced_plant(model)?, &plants, epsilon, times, method, rtol)
+            run(&reduced_plant(model)?, &plants, epsilon, times, (method, rtol, true))
         }
         System::Network(model) => {
             let plants = pairs!(Network, network_plant);
-            run(&network_plant(model)?, &plants, epsilon, times, method, rtol)
+            run(&network_plant(model)?, &plants, epsilon, times, (method, rtol, true))
         }
     }
 }
@@ -137,16 +139,16 @@ fn reduced_plant(model: &NetworkModel) -> Result<ReducedPlant<'_>> {
 
 fn run<P: Plant>(
     base: &P,
-    perturbed: &[[P; 4]],
+    perturbed: &[[P; POINTS]],
     epsilon: f64,
     times: &[f64],
-    method: Method,
-    rtol: f64,
+    (method, rtol, locate): (Method, f64, bool),
 ) -> Result<TrajectorySensitivity> {
     let plant = Augmented {
         base,
         perturbed,
         epsilon,
+        locate,
         time_unit: 1.0 / base.slowest_omega()?,
         switch_count: base.switches(&base.workspace()).len(),
         mode: std::cell::RefCell::new(vec![Side::Free; base.switches(&base.workspace()).len()]),
@@ -198,8 +200,10 @@ fn run<P: Plant>(
 /// The plant of the motion and its m sensitivity columns: coordinates (q, S₁ … Sₘ).
 struct Augmented<'p, P: Plant> {
     base: &'p P,
-    perturbed: &'p [[P; 4]],
+    perturbed: &'p [[P; POINTS]],
     epsilon: f64,
+    /// Whether the drag's switches are located (and the columns jump there).
+    locate: bool,
     /// 1/ω_slow, s: rates times it are rad per unit of scaled time.
     time_unit: f64,
     /// The base plant's drag switches.
@@ -215,11 +219,11 @@ struct Augmented<'p, P: Plant> {
 /// Scratch of the augmented plant: the base's and each perturbed plant's.
 struct AugmentedWorkspace<W> {
     base: W,
-    perturbed: Vec<[W; 4]>,
+    perturbed: Vec<[W; POINTS]>,
     shifted_q: Vec<f64>,
     shifted_rates: Vec<f64>,
-    /// The accelerations at the four offsets.
-    stencil: [Vec<f64>; 4],
+    /// The accelerations at the stencil's offsets.
+    stencil: [Vec<f64>; POINTS],
     /// The signs of the free plates' drag at the motion's state, held while differencing.
     free_signs: Vec<f64>,
     /// Scratch of the held evaluations.
@@ -257,8 +261,8 @@ impl<P: Plant> Augmented<'_, P> {
         ws: &mut AugmentedWorkspace<P::Workspace>,
     ) -> Result<()> {
         let n = self.base.dof();
-        let mut angles = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let mut rates = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut angles: [Vec<f64>; POINTS] = std::array::from_fn(|_| vec![0.0; n]);
+        let mut rates: [Vec<f64>; POINTS] = std::array::from_fn(|_| vec![0.0; n]);
         for j in 0..self.columns() {
             let Some(h) = self.state_step(j, q_dot, q) else {
                 continue;
@@ -303,9 +307,9 @@ impl<P: Plant> Augmented<'_, P> {
         out: &mut [f64],
     ) -> Result<()> {
         let n = self.base.dof();
-        for (j, four) in self.perturbed.iter().enumerate() {
+        for (j, pair) in self.perturbed.iter().enumerate() {
             let column = &mut out[n * (1 + j)..n * (2 + j)];
-            for (k, plant) in four.iter().enumerate() {
+            for (k, plant) in pair.iter().enumerate() {
                 held_accelerations(
                     plant,
                     sides,
@@ -344,7 +348,7 @@ impl<P: Plant> Augmented<'_, P> {
         Ok(())
     }
 
-    /// ∇gᵢ·(dq, dq̇) at (q, q̇): the fourth-order difference of drag switch i of the base.
+    /// ∇gᵢ·(dq, dq̇) at (q, q̇): the central difference of drag switch i of the base.
     fn switch_derivative(
         &self,
         t: f64,
@@ -362,7 +366,7 @@ impl<P: Plant> Augmented<'_, P> {
             return Ok(0.0);
         }
         let h = STATE_SHIFT / size;
-        let mut values = [0.0; 4];
+        let mut values = [0.0; POINTS];
         for (k, offset) in STENCIL.iter().enumerate() {
             for r in 0..q.len() {
                 ws.shifted_q[r] = q[r] + offset * h * dq[r];
@@ -409,7 +413,7 @@ impl<P: Plant> Plant for Augmented<'_, P> {
             perturbed: self
                 .perturbed
                 .iter()
-                .map(|four| four.each_ref().map(P::workspace))
+                .map(|pair| pair.each_ref().map(P::workspace))
                 .collect(),
             shifted_q: vec![0.0; n],
             shifted_rates: vec![0.0; n],
@@ -463,13 +467,14 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         let mut coordinates = start.coordinates.clone();
         let mut rates = start.rates.clone();
         let eps = self.epsilon;
-        for four in self.perturbed {
-            let states = [
-                four[0].initial_state()?,
-                four[1].initial_state()?,
-                four[2].initial_state()?,
-                four[3].initial_state()?,
-            ];
+        for pair in self.perturbed {
+            let mut states = Vec::with_capacity(POINTS);
+            for plant in pair {
+                states.push(plant.initial_state()?);
+            }
+            let states: [InitialState; POINTS] = states
+                .try_into()
+                .map_err(|_| NanofoldError::invalid("perturbed", "a pair of scenes", "one scene per stencil offset"))?;
             let dt = stencil(states.each_ref().map(|s| s.time), eps);
             for (i, (rate, accel)) in start.rates.iter().zip(&acceleration).enumerate() {
                 coordinates.push(stencil(states.each_ref().map(|s| s.coordinates[i]), eps) - rate * dt);
@@ -494,7 +499,8 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         if projected {
             self.project_columns(t, q, q_dot, ws)?;
         }
-        if self.switch_count == 0 {
+        // Unlocated, the drag keeps its natural sign, as in `simulate`.
+        if self.switch_count == 0 || !self.locate {
             return Ok(projected);
         }
         self.held_base(t, &q[..n], &q_dot[..n], ws)?;
@@ -543,7 +549,11 @@ impl<P: Plant> Plant for Augmented<'_, P> {
     }
 
     fn located_switches(&self) -> usize {
-        self.switch_count
+        if self.locate {
+            self.switch_count
+        } else {
+            0
+        }
     }
 
     fn switch_values(&self, t: f64, q: &[f64], q_dot: &[f64], ws: &mut Self::Workspace, out: &mut [f64]) -> Result<()> {
@@ -609,7 +619,7 @@ impl<P: Plant> Plant for Augmented<'_, P> {
                     q_dot[n * (1 + j)..n * (2 + j)].to_vec(),
                 );
                 let along_column = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&s, &s_dot), ws)?;
-                let mut values = [0.0; 4];
+                let mut values = [0.0; POINTS];
                 for (k, plant) in self.perturbed[j].iter().enumerate() {
                     plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
                     values[k] = plant.switches(&ws.perturbed[j][k])[i];
@@ -638,12 +648,12 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         let outputs = sample.angles.len();
         let mut angles = sample.angles.as_slice().to_vec();
         let mut rates = sample.rates.as_slice().to_vec();
-        for (j, four) in self.perturbed.iter().enumerate() {
-            let mut along_parameter = Vec::with_capacity(4);
-            for (k, plant) in four.iter().enumerate() {
+        for (j, pair) in self.perturbed.iter().enumerate() {
+            let mut along_parameter = Vec::with_capacity(POINTS);
+            for (k, plant) in pair.iter().enumerate() {
                 along_parameter.push(plant.sample(t, &q[..n], &q_dot[..n], &[], &mut ws.perturbed[j][k])?);
             }
-            let mut along_state = Vec::with_capacity(4);
+            let mut along_state = Vec::with_capacity(POINTS);
             let h = self.state_step(j, q_dot, q);
             for offset in STENCIL {
                 self.shift(
