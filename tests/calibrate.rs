@@ -453,3 +453,91 @@ fn a_parameter_that_a_degenerate_direction_moves_gets_no_error_bar_however_small
     assert!(report.undetermined[0].loadings.len() < 3, "{:?}", report.undetermined);
     without_error_bars(&report.parameters);
 }
+
+#[test]
+fn marks_on_a_closed_vertex_ride_their_sectors_in_the_files_frame() {
+    use nanofold::dynamics::points::PanelPoints;
+    // The corner cube, and the same paper moved by (2, 3) units in its plane: a mark at the
+    // same place on the same face must land at the same place, moved by the same amount.
+    let original = "patterns/corner_cube_step1.scene.json";
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("closed_marks");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/corner_cube_plates.fold").unwrap()).unwrap();
+    let shift = [2.0, 3.0];
+    for point in fold["vertices_coords"].as_array_mut().unwrap() {
+        for (k, x) in point.as_array_mut().unwrap().iter_mut().enumerate() {
+            *x = (x.as_f64().unwrap() + shift[k]).into();
+        }
+    }
+    std::fs::write(dir.join("moved.fold"), fold.to_string()).unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(original).unwrap()).unwrap();
+    scene["pattern"] = "moved.fold".into();
+    std::fs::write(dir.join("moved.scene.json"), scene.to_string()).unwrap();
+    let build = |path: &std::path::Path| SceneDocument::load(path).unwrap().spec().unwrap().build().unwrap();
+    let (here, moved) = (build(original.as_ref()), build(&dir.join("moved.scene.json")));
+    let run = trajectory_sensitivities(&here, &[], SENSITIVITY_STEP, &[2e-5], Method::Auto, 1e-8).unwrap();
+    let folded = run.angles[0].as_slice();
+    let unit = 300.0;
+    let faces: Vec<Vec<usize>> = serde_json::from_value(fold["faces_vertices"].clone()).unwrap();
+    let corners: Vec<[f64; 2]> = serde_json::from_value(fold["vertices_coords"].clone()).unwrap();
+    let (mut a, mut b) = (PanelPoints::new(&here).unwrap(), PanelPoints::new(&moved).unwrap());
+    let mut lifted = 0;
+    for (face, outline) in faces.iter().enumerate() {
+        let (pa, pb) = (a.panel(face).unwrap(), b.panel(face).unwrap());
+        let at_moved: Vec<[f64; 2]> = outline
+            .iter()
+            .map(|&v| [corners[v][0] * unit, corners[v][1] * unit])
+            .collect();
+        let at_here: Vec<[f64; 2]> = at_moved
+            .iter()
+            .map(|p| [p[0] - shift[0] * unit, p[1] - shift[1] * unit])
+            .collect();
+        let mut placed = Vec::new();
+        for (p, q) in at_here.iter().zip(&at_moved) {
+            // Flat, a mark is where it was drawn.
+            let flat = b.position(&vec![0.0; folded.len()], pb, *q);
+            assert!((flat[0] - q[0]).abs() < 1e-9 && (flat[1] - q[1]).abs() < 1e-9 && flat[2].abs() < 1e-9);
+            let (x, y) = (a.position(folded, pa, *p), b.position(folded, pb, *q));
+            assert!(
+                (x[0] + shift[0] * unit - y[0]).abs() < 1e-6
+                    && (x[1] + shift[1] * unit - y[1]).abs() < 1e-6
+                    && (x[2] - y[2]).abs() < 1e-6,
+                "face {face}: {x:?} moved is not {y:?}"
+            );
+            placed.push(x);
+        }
+        // Folded, a face's marks keep their distances.
+        for i in 0..placed.len() {
+            for j in 0..i {
+                let drawn = (at_here[i][0] - at_here[j][0]).hypot(at_here[i][1] - at_here[j][1]);
+                let now = (0..3)
+                    .map(|k| (placed[i][k] - placed[j][k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(
+                    (now - drawn).abs() < 1e-9 * drawn.max(1.0),
+                    "face {face}: {drawn} became {now}"
+                );
+            }
+        }
+        lifted += usize::from(placed.iter().any(|p| p[2].abs() > 1.0));
+    }
+    assert!(lifted >= 2, "the vertex folded out of its plane");
+    // A crease's far end, placed from either face beside it, is one point; across the cut
+    // crease, to the loop's closure on the fitted constraint (its residual times the length).
+    let chain = here.closed().unwrap();
+    let cut_edge = chain.crease_user_indices[chain.cut_crease];
+    let edges: Vec<[usize; 2]> = serde_json::from_value(fold["edges_vertices"].clone()).unwrap();
+    for (edge, &[_, v]) in edges.iter().enumerate().take(5) {
+        let beside: Vec<usize> = (0..faces.len()).filter(|&f| faces[f].contains(&v)).collect();
+        let at = [(corners[v][0] - shift[0]) * unit, (corners[v][1] - shift[1]) * unit];
+        let (x, y) = (
+            a.position(folded, a.panel(beside[0]).unwrap(), at),
+            a.position(folded, a.panel(beside[1]).unwrap(), at),
+        );
+        let gap = (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
+        let allowed = if edge == cut_edge { 1e-5 * unit } else { 1e-9 * unit };
+        assert!(gap < allowed, "crease {edge}: {x:?} and {y:?} ({gap:e} µm apart)");
+    }
+}

@@ -3,6 +3,7 @@
 //! `hinges[*].target_angle_deg` for every hinge at once), each with bounds.
 
 use crate::error::{NanofoldError, Result};
+use crate::read::scene_spec::default_number;
 use crate::read::SceneDocument;
 use serde_json::Value;
 
@@ -82,7 +83,7 @@ pub fn resolve(document: &SceneDocument, free: &[FreeParameter]) -> Result<Vec<R
         let steps = parse_path(&parameter.path)
             .map_err(|reason| NanofoldError::invalid(format!("{field}.path"), &parameter.path, reason))?;
         let mut values = Vec::new();
-        collect(&document.value, &steps, &mut values).map_err(|reason| {
+        collect(&document.value, &steps, "", &mut values).map_err(|reason| {
             NanofoldError::invalid(
                 format!("{field}.path"),
                 &parameter.path,
@@ -180,8 +181,9 @@ fn parse_path(path: &str) -> std::result::Result<Vec<Step>, String> {
     Ok(steps)
 }
 
-/// Every number the steps reach, or where the path leaves the file.
-fn collect(value: &Value, steps: &[Step], out: &mut Vec<f64>) -> std::result::Result<(), String> {
+/// Every number the steps reach, or where the path leaves the file; a last key the file
+/// leaves out counts with its default, if it has one (`parent`: the key above the object).
+fn collect(value: &Value, steps: &[Step], parent: &str, out: &mut Vec<f64>) -> std::result::Result<(), String> {
     let Some((step, rest)) = steps.split_first() else {
         return match value.as_f64() {
             Some(x) => {
@@ -193,21 +195,24 @@ fn collect(value: &Value, steps: &[Step], out: &mut Vec<f64>) -> std::result::Re
     };
     match (step, value) {
         (Step::Key(key), Value::Object(map)) => match map.get(key) {
-            Some(inner) => collect(inner, rest, out),
-            None => {
-                let keys: Vec<&str> = map.keys().map(String::as_str).collect();
-                Err(format!(
-                    "no key `{key}` (there are {}; a value the file leaves to its default must be written in the file to be fitted)",
-                    keys.join(", ")
-                ))
-            }
+            Some(inner) => collect(inner, rest, key, out),
+            None => match default_number(parent, key).filter(|_| rest.is_empty()) {
+                Some(default) => {
+                    out.push(default);
+                    Ok(())
+                }
+                None => {
+                    let keys: Vec<&str> = map.keys().map(String::as_str).collect();
+                    Err(format!("no key `{key}` (there are {})", keys.join(", ")))
+                }
+            },
         },
         (Step::Index(i), Value::Array(items)) => match items.get(*i) {
-            Some(inner) => collect(inner, rest, out),
+            Some(inner) => collect(inner, rest, parent, out),
             None => Err(format!("index [{i}] past the {} entries", items.len())),
         },
         (Step::Every, Value::Array(items)) if !items.is_empty() => {
-            items.iter().try_for_each(|inner| collect(inner, rest, out))
+            items.iter().try_for_each(|inner| collect(inner, rest, parent, out))
         }
         (Step::Key(key), _) => Err(format!("`{key}` is asked of something that is not an object")),
         _ => Err("an index is asked of something that is not a list of entries".to_string()),
@@ -220,11 +225,14 @@ fn assign(value: &mut Value, steps: &[Step], x: f64) {
         return;
     };
     match (step, value) {
-        (Step::Key(key), Value::Object(map)) => {
-            if let Some(inner) = map.get_mut(key) {
-                assign(inner, rest, x);
+        (Step::Key(key), Value::Object(map)) => match map.get_mut(key) {
+            Some(inner) => assign(inner, rest, x),
+            // A number left to its default (resolve checked it has one) is written in.
+            None if rest.is_empty() => {
+                map.insert(key.clone(), serde_json::json!(x));
             }
-        }
+            None => {}
+        },
         (Step::Index(i), Value::Array(items)) => {
             if let Some(inner) = items.get_mut(*i) {
                 assign(inner, rest, x);
@@ -293,6 +301,27 @@ mod tests {
             FreeParameter::parse("environment.drag_coefficient=0.5:4").unwrap(),
             free("environment.drag_coefficient", 0.5, 4.0)
         );
+    }
+
+    #[test]
+    fn a_number_left_to_its_default_is_fitted_from_it_and_written_in() {
+        let doc = document();
+        let parameters = resolve(
+            &doc,
+            &[
+                free("environment.air_density_kg_m3", 0.5, 3.0),
+                free("hinges[*].stiffness_scale", 0.1, 10.0),
+            ],
+        )
+        .unwrap();
+        assert_eq!((parameters[0].start, parameters[1].start), (1.2, 1.0));
+        let changed = with_values(&doc, &parameters, &[1.1, 2.0]);
+        assert_eq!(changed.value["environment"]["air_density_kg_m3"], 1.1);
+        assert_eq!(changed.value["hinges"][0]["stiffness_scale"], 2.0);
+        assert_eq!(changed.value["hinges"][1]["stiffness_scale"], 2.0);
+        // A key without a default is still refused, and so is one under a missing object.
+        assert!(resolve(&doc, &[free("environment.viscosity", 0.5, 3.0)]).is_err());
+        assert!(resolve(&doc, &[free("hinge_defaults.stiffness_scale", 0.5, 3.0)]).is_err());
     }
 
     #[test]

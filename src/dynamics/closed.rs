@@ -128,6 +128,11 @@ pub struct ClosedChain {
     pub crease_user_indices: Vec<usize>,
     /// FOLD face index of the anchored sector.
     pub anchored_face: usize,
+    /// The FOLD face of every sector (its plate), if it has one.
+    pub sector_faces: Vec<Option<usize>>,
+    /// The vertex in the file's flat coordinates times the length unit, m: the chain's world
+    /// frame is the flat sheet about it.
+    pub vertex: [f64; 2],
     /// What drives every crease: only the driver is actuated.
     pub forcing: Forcing,
 }

@@ -102,6 +102,19 @@ pub enum ActuationSpec {
 fn default_drag_coefficient() -> f64 {
     1.28
 }
+
+/// The value a scene file's number takes when its key is left out, for the numbers that
+/// have one: `key` in an object listed under (or named) `parent` — C_D and ρ_air of the
+/// environment, a hinge's stiffness scale. (What a fit needs to free a number the file does
+/// not write.)
+pub fn default_number(parent: &str, key: &str) -> Option<f64> {
+    match (parent, key) {
+        ("environment", "drag_coefficient") => Some(default_drag_coefficient()),
+        ("environment", "air_density_kg_m3") => Some(default_air_density()),
+        ("hinges" | "hinge_defaults", "stiffness_scale") => Some(1.0),
+        _ => None,
+    }
+}
 fn default_air_density() -> f64 {
     1.2
 }

@@ -105,6 +105,11 @@ pub fn closed_chain(spec: &ClosedSpec<VertexPattern>) -> Result<ClosedChain> {
         start: step.start,
         crease_user_indices: pattern.user_indices(),
         anchored_face,
+        sector_faces: geometry.outlines.iter().map(|o| o.as_ref().map(|(_, f)| *f)).collect(),
+        vertex: {
+            let [x, y] = mesh.vertices_coords[mesh.center];
+            [x * unit, y * unit]
+        },
         forcing: Forcing {
             actuation,
             hinges: drives,
