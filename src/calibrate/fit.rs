@@ -243,6 +243,11 @@ const MARK_STEP: f64 = 1e-6;
 /// units: large against the plain runs' noise (their rtol), small against the curvature.
 const DIFFERENCE_STEP: f64 = 1e-4;
 
+/// Sensitivity columns integrated in one run. Fixed, not the machine's core count, so that
+/// a fit gives the same numbers on every machine (each run's error control sees its own
+/// columns); two keeps both cores of a small machine busy for two or more parameters.
+const COLUMNS_PER_RUN: usize = 2;
+
 /// Where an evaluation's Jacobian came from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Jacobian {
@@ -378,14 +383,12 @@ impl Problem<'_> {
     }
 
     /// The residuals at u, and their exact Jacobian if asked: the parameters' columns in
-    /// groups, one run per core.
+    /// groups of [`COLUMNS_PER_RUN`], the runs on the machine's cores.
     fn run(&self, u: &[f64], jacobian: bool) -> Result<Evaluation> {
         let values = self.values(u);
         let base = self.scene(&values)?;
         let run = if jacobian {
-            let m = u.len();
-            let groups = std::thread::available_parallelism().map_or(1, usize::from).clamp(1, m);
-            let size = m.div_ceil(groups);
+            let (m, size) = (u.len(), COLUMNS_PER_RUN);
             let runs = on_cores(m.div_ceil(size), &|g| {
                 self.sensitivities(&values, g * size..((g + 1) * size).min(m))
             });
