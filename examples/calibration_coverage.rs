@@ -146,7 +146,7 @@ fn main() -> Result<(), Failure> {
     }
     if wanted("miura") {
         let document = miura::document()?;
-        let (times, exact) = miura::exact_columns(&document)?;
+        let (times, exact) = miura::exact_columns(&document, true)?;
         let sheet = Study {
             name: "Miura-ori 4 x 4 (2 creases, marks on 2 panels)",
             document,

@@ -1,7 +1,7 @@
 //! The Miura-ori study of the calibration examples: the 4 × 4 sheet with its mountain
 //! hinges deposited apart from its valley ones (each mountain crease its own hinge), four
-//! free parameters, and what a camera sees of it: two creases' angles (0.5°) and marks at
-//! the centres of two panels tracked in x, y, z (0.5 µm), 100 times over 0.5 ms.
+//! free parameters, and what a camera sees of it: marks at the centres of two panels tracked
+//! in x, y, z (0.5 µm), and two creases' angles (0.5°), 100 times over 0.5 ms.
 
 use nanofold::calibrate::{resolve, with_values, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::points::PanelPoints;
@@ -60,8 +60,9 @@ pub fn document() -> Result<SceneDocument, Failure> {
     Ok(file.with_value(value))
 }
 
-/// The observed columns without noise, each with its σ: the sheet simulated at [`TRUTH`].
-pub fn exact_columns(document: &SceneDocument) -> Result<(Vec<f64>, ExactColumns), Failure> {
+/// The observed columns without noise, each with its σ: the sheet simulated at [`TRUTH`],
+/// the marks and, if `angles`, the two creases.
+pub fn exact_columns(document: &SceneDocument, angles: bool) -> Result<(Vec<f64>, ExactColumns), Failure> {
     let parameters = resolve(document, &free())?;
     let scene = with_values(document, &parameters, &TRUTH).spec()?.build()?;
     let times: Vec<f64> = (1..=100).map(|k| 5e-4 * k as f64 / 100.0).collect();
@@ -72,7 +73,7 @@ pub fn exact_columns(document: &SceneDocument) -> Result<(Vec<f64>, ExactColumns
     let mut points = PanelPoints::new(&scene)?;
     let mut columns = Vec::new();
     let edges = scene.output_edges().ok_or("a pattern's creases")?.to_vec();
-    for k in [0, edges.len() / 2] {
+    for k in [0, edges.len() / 2].into_iter().filter(|_| angles) {
         let values = run.angles.iter().map(|a| Some(a[k].to_degrees())).collect();
         let observed = Observed::Angle {
             index: edges[k],
