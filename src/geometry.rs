@@ -1,9 +1,12 @@
 //! The geometry layer: points on the unit sphere around a vertex (geodesics, fold angles
 //! measured from nodes) and the kinematics of one vertex (fold angles ↔ ray directions,
-//! loop closure), and which boxes overlap (the broad phase of planarity and contact tests).
+//! loop closure), which boxes overlap (the broad phase of planarity and contact tests), and
+//! the closed solids a net is designed for (their dual graphs, spanning trees, symmetries).
 
 pub(crate) mod broad_phase;
 pub mod kinematics;
+pub mod polyhedron;
+pub mod solids;
 pub mod sphere;
 pub use broad_phase::overlapping_pairs;
 

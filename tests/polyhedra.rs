@@ -1,0 +1,128 @@
+//! The solids a net is designed for: the generated solids against their known counts (faces,
+//! Euler's formula, spanning trees of the dual graph, symmetry groups), and a surface that is
+//! not a closed solid refused by name.
+
+use nalgebra::Point3;
+use nanofold::geometry::polyhedron::Polyhedron;
+use nanofold::geometry::solids;
+
+/// (faces, edges, vertices, spanning trees, symmetries).
+fn counts(solid: &Polyhedron) -> (usize, usize, usize, f64, usize) {
+    (
+        solid.faces.len(),
+        solid.dual_edges().len(),
+        solid.vertices.len(),
+        solid.spanning_tree_count(),
+        solid.symmetries().len(),
+    )
+}
+
+#[test]
+fn the_platonic_solids_have_their_known_trees_and_symmetry_groups() {
+    // Trees and group orders as tabulated for edge unfoldings (tetrahedron 16 / 24, cube and
+    // octahedron 384 / 48, dodecahedron and icosahedron 5 184 000 / 120).
+    let cases = [
+        ("tetrahedron", solids::tetrahedron().unwrap(), (4, 6, 4, 16.0, 24)),
+        ("cube", solids::cube().unwrap(), (6, 12, 8, 384.0, 48)),
+        ("octahedron", solids::octahedron().unwrap(), (8, 12, 6, 384.0, 48)),
+        (
+            "dodecahedron",
+            solids::dodecahedron().unwrap(),
+            (12, 30, 20, 5_184_000.0, 120),
+        ),
+        (
+            "icosahedron",
+            solids::icosahedron().unwrap(),
+            (20, 30, 12, 5_184_000.0, 120),
+        ),
+    ];
+    for (name, solid, expected) in cases {
+        assert_eq!(counts(&solid), expected, "{name}");
+        let rotations = solid.symmetries().iter().filter(|s| s.is_rotation()).count();
+        assert_eq!(2 * rotations, expected.4, "{name}: half the group are rotations");
+    }
+}
+
+#[test]
+fn generated_solids_obey_euler_and_their_symmetry_groups() {
+    // Euler: V − E + F = 2. Groups: a box of three different sides D2h (8), a cube Oh (48);
+    // over an n-gon (n ≠ 4, where a prism of the right height is a cube) a prism D_nh (4n),
+    // an antiprism D_nd (4n), a pyramid C_nv (2n); the truncated tetrahedron Td (24), the
+    // cuboctahedron and the truncated octahedron Oh (48).
+    let mut cases = vec![
+        ("box 1 × 2 × 3", solids::cuboid(1.0, 2.0, 3.0).unwrap(), 8),
+        ("box 2 × 2 × 2", solids::cuboid(2.0, 2.0, 2.0).unwrap(), 48),
+        ("truncated tetrahedron", solids::truncated_tetrahedron().unwrap(), 24),
+        ("cuboctahedron", solids::cuboctahedron().unwrap(), 48),
+        ("truncated octahedron", solids::truncated_octahedron().unwrap(), 48),
+    ];
+    for n in [3, 5, 6, 7, 12] {
+        cases.push(("prism", solids::prism(n, 0.7).unwrap(), 4 * n));
+        cases.push(("antiprism", solids::antiprism(n, 0.7).unwrap(), 4 * n));
+        cases.push(("pyramid", solids::pyramid(n, 0.7).unwrap(), 2 * n));
+    }
+    for (name, solid, group) in cases {
+        let (f, e, v, trees, symmetries) = counts(&solid);
+        assert_eq!(v + f, e + 2, "{name}: Euler");
+        assert_eq!(symmetries, group, "{name} ({f} faces)");
+        assert!(trees >= f as f64, "{name}: {trees} trees");
+    }
+    // Faces of the Archimedean solids by their sides.
+    let sides = |solid: &Polyhedron| {
+        let mut s: Vec<usize> = solid.faces.iter().map(Vec::len).collect();
+        s.sort_unstable();
+        s
+    };
+    assert_eq!(
+        sides(&solids::truncated_tetrahedron().unwrap()),
+        [[3; 4].as_slice(), &[6; 4]].concat()
+    );
+    assert_eq!(
+        sides(&solids::cuboctahedron().unwrap()),
+        [[3; 8].as_slice(), &[4; 6]].concat()
+    );
+    assert_eq!(
+        sides(&solids::truncated_octahedron().unwrap()),
+        [[4; 6].as_slice(), &[6; 8]].concat()
+    );
+}
+
+#[test]
+fn a_surface_that_is_not_a_closed_solid_is_refused_by_name() {
+    let cube = solids::cube().unwrap();
+    let refused = |vertices: Vec<Point3<f64>>, faces: Vec<Vec<usize>>, expected: &[&str]| {
+        let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
+        for part in expected {
+            assert!(message.contains(part), "{message:?} lacks {part:?}");
+        }
+    };
+    // A face missing: the surface is open along that face's edges.
+    refused(cube.vertices.clone(), cube.faces[1..].to_vec(), &["edge", "not closed"]);
+    // One face wound the wrong way.
+    let mut faces = cube.faces.clone();
+    faces[2].reverse();
+    refused(cube.vertices.clone(), faces, &["faces[", "wound"]);
+    // Every face wound the wrong way: inside out.
+    let inside_out: Vec<Vec<usize>> = cube.faces.iter().map(|f| f.iter().rev().copied().collect()).collect();
+    refused(cube.vertices.clone(), inside_out, &["volume", "inside out"]);
+    // A vertex moved off its faces' planes.
+    let mut vertices = cube.vertices.clone();
+    vertices[0].z += 0.1;
+    refused(vertices, cube.faces.clone(), &["faces[", "off its plane"]);
+    // An index past the vertices, and a repeated vertex.
+    let mut faces = cube.faces.clone();
+    faces[0][0] = 99;
+    refused(cube.vertices.clone(), faces, &["faces[0]", "vertex 99 does not exist"]);
+    let mut faces = cube.faces.clone();
+    faces[0][1] = faces[0][0];
+    refused(cube.vertices.clone(), faces, &["faces[0]", "repeats"]);
+    // Two separate cubes are two surfaces.
+    let mut vertices = cube.vertices.clone();
+    vertices.extend(cube.vertices.iter().map(|p| Point3::new(p.x + 10.0, p.y, p.z)));
+    let mut faces = cube.faces.clone();
+    faces.extend(cube.faces.iter().map(|f| f.iter().map(|v| v + 8).collect::<Vec<_>>()));
+    refused(vertices, faces, &["separate surfaces"]);
+    // Bad generator arguments.
+    assert!(solids::prism(2, 1.0).unwrap_err().to_string().contains("sides"));
+    assert!(solids::cuboid(1.0, -1.0, 1.0).unwrap_err().to_string().contains('b'));
+}
