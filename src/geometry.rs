@@ -8,6 +8,7 @@ pub mod kinematics;
 pub mod polyhedron;
 pub mod solids;
 pub mod sphere;
+pub mod unfoldings;
 pub use broad_phase::overlapping_pairs;
 
 /// Uniform draws in [0, 1) from a fixed seed (xorshift): the deterministic random inputs of

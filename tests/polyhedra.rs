@@ -126,3 +126,28 @@ fn a_surface_that_is_not_a_closed_solid_is_refused_by_name() {
     assert!(solids::prism(2, 1.0).unwrap_err().to_string().contains("sides"));
     assert!(solids::cuboid(1.0, -1.0, 1.0).unwrap_err().to_string().contains('b'));
 }
+
+#[test]
+fn the_nets_of_the_tetrahedron_cube_and_octahedron_are_2_11_and_11() {
+    use nanofold::geometry::unfoldings::{burnside_nets, distinct_nets, edge_map, spanning_trees};
+    for (name, solid, nets) in [
+        ("tetrahedron", solids::tetrahedron().unwrap(), 2),
+        ("cube", solids::cube().unwrap(), 11),
+        ("octahedron", solids::octahedron().unwrap(), 11),
+    ] {
+        let trees = spanning_trees(&solid, 10_000).unwrap();
+        // As many as the matrix-tree theorem says, all different, each F − 1 folds.
+        assert_eq!(trees.len() as f64, solid.spanning_tree_count(), "{name}");
+        let unique: std::collections::HashSet<_> = trees.iter().collect();
+        assert_eq!(unique.len(), trees.len(), "{name}");
+        assert!(trees.iter().all(|t| t.count_ones() as usize == solid.faces.len() - 1));
+        let maps: Vec<Vec<usize>> = solid.symmetries().iter().map(|s| edge_map(&solid, s)).collect();
+        assert_eq!(distinct_nets(&trees, &maps), nets, "{name}: orbits");
+        assert_eq!(burnside_nets(&trees, &maps), nets as f64, "{name}: Burnside");
+    }
+    // More trees than the limit: refused, naming the count.
+    let message = spanning_trees(&solids::dodecahedron().unwrap(), 1000)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("5184000"), "{message}");
+}

@@ -1,0 +1,145 @@
+//! Edge unfoldings of a solid (`docs/model.md#nets-of-polyhedra`): the spanning trees of its
+//! dual graph, enumerated as sets of dual edges (bit k: dual edge k is a fold), and their
+//! classes under the solid's symmetry group (the distinct nets).
+
+use super::polyhedron::{Polyhedron, Symmetry};
+use crate::error::{NanofoldError, Result};
+use std::collections::HashSet;
+
+/// A spanning tree of the dual graph: bit k set when dual edge k is a fold (a hinge).
+pub type Tree = u64;
+
+/// Most dual edges for enumeration (a tree is one 64-bit word).
+pub const MAX_DUAL_EDGES: usize = 64;
+
+/// Every spanning tree of the solid's dual graph, or an error naming the count when there
+/// are more than `limit` (the caller samples instead).
+pub fn spanning_trees(solid: &Polyhedron, limit: usize) -> Result<Vec<Tree>> {
+    let edges: Vec<[usize; 2]> = solid.dual_edges().iter().map(|e| e.faces).collect();
+    if edges.len() > MAX_DUAL_EDGES {
+        return Err(NanofoldError::invalid(
+            "faces",
+            format!("{} edges", edges.len()),
+            format!("trees are enumerated for solids of at most {MAX_DUAL_EDGES} edges"),
+        ));
+    }
+    let count = solid.spanning_tree_count();
+    if count > limit as f64 {
+        return Err(NanofoldError::invalid(
+            "limit",
+            limit,
+            format!("the solid has {count} spanning trees: sample them instead"),
+        ));
+    }
+    let faces = solid.faces.len();
+    let mut trees = Vec::with_capacity(count as usize);
+    let mut search = Search {
+        edges: &edges,
+        faces,
+        trees: &mut trees,
+    };
+    search.extend(0, 0, &mut (0..faces).collect::<Vec<_>>(), faces - 1);
+    Ok(trees)
+}
+
+/// Depth-first choice of each dual edge in turn: in (when it joins two components) or out
+/// (when the edges left can still connect everything).
+struct Search<'a> {
+    edges: &'a [[usize; 2]],
+    faces: usize,
+    trees: &'a mut Vec<Tree>,
+}
+
+impl Search<'_> {
+    fn extend(&mut self, next: usize, chosen: Tree, component: &mut Vec<usize>, missing: usize) {
+        if missing == 0 {
+            self.trees.push(chosen);
+            return;
+        }
+        if next == self.edges.len() || self.edges.len() - next < missing {
+            return;
+        }
+        let [a, b] = self.edges[next];
+        let (ca, cb) = (component[a], component[b]);
+        if ca != cb {
+            let saved = component.clone();
+            for c in component.iter_mut() {
+                if *c == cb {
+                    *c = ca;
+                }
+            }
+            self.extend(next + 1, chosen | 1 << next, component, missing - 1);
+            *component = saved;
+        }
+        if self.still_connectable(next + 1, component) {
+            self.extend(next + 1, chosen, component, missing);
+        }
+    }
+
+    /// Whether the components joined by the edges from `from` on make one.
+    fn still_connectable(&self, from: usize, component: &[usize]) -> bool {
+        let find = |parent: &mut Vec<usize>, mut x: usize| {
+            while parent[x] != x {
+                parent[x] = parent[parent[x]];
+                x = parent[x];
+            }
+            x
+        };
+        // Components are labelled by a member face; union them along the remaining edges.
+        let mut parent: Vec<usize> = (0..self.faces).collect();
+        for (f, &root) in component.iter().enumerate() {
+            let (rf, rr) = (find(&mut parent, f), find(&mut parent, root));
+            parent[rf] = rr;
+        }
+        for &[a, b] in &self.edges[from..] {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            parent[ra] = rb;
+        }
+        let root = find(&mut parent, 0);
+        (0..self.faces).all(|f| find(&mut parent, f) == root)
+    }
+}
+
+/// Where each dual edge goes under a symmetry.
+pub fn edge_map(solid: &Polyhedron, symmetry: &Symmetry) -> Vec<usize> {
+    let edges = solid.dual_edges();
+    let key = |a: usize, b: usize| if a < b { [a, b] } else { [b, a] };
+    edges
+        .iter()
+        .map(|e| {
+            let image = key(symmetry.vertex_map[e.vertices[0]], symmetry.vertex_map[e.vertices[1]]);
+            edges
+                .iter()
+                .position(|f| key(f.vertices[0], f.vertices[1]) == image)
+                .expect("a symmetry maps edges onto edges")
+        })
+        .collect()
+}
+
+/// A tree's image under a symmetry's edge map.
+pub fn image(tree: Tree, map: &[usize]) -> Tree {
+    map.iter()
+        .enumerate()
+        .filter(|&(k, _)| tree >> k & 1 == 1)
+        .fold(0, |image, (_, &to)| image | 1 << to)
+}
+
+/// The number of distinct nets among `trees` (all of a solid's): the orbits under the
+/// symmetries' edge maps, each tree counted by its smallest image.
+pub fn distinct_nets(trees: &[Tree], maps: &[Vec<usize>]) -> usize {
+    let canonical: HashSet<Tree> = trees
+        .iter()
+        .map(|&t| maps.iter().map(|m| image(t, m)).min().unwrap_or(t))
+        .collect();
+    canonical.len()
+}
+
+/// Burnside's count of the same orbits: the mean, over the group, of the trees each
+/// symmetry fixes.
+pub fn burnside_nets(trees: &[Tree], maps: &[Vec<usize>]) -> f64 {
+    let fixed: usize = maps
+        .iter()
+        .map(|m| trees.iter().filter(|&&t| image(t, m) == t).count())
+        .sum();
+    fixed as f64 / maps.len() as f64
+}
