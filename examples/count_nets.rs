@@ -1,9 +1,12 @@
 //! Counts every edge unfolding of the Platonic solids and the distinct nets among them
 //! (orbits under the solid's symmetry group, found from its geometry), with the time each
 //! took; the tabulated counts are 2, 11, 11, 43 380 and 43 380 (`docs/model.md#nets-of-polyhedra`).
+//! Then lays every hundredth tree flat (every tree of the small three) and counts those
+//! whose faces overlap (none, for these solids).
 //!
 //! `cargo run --release --example count_nets`
 
+use nanofold::geometry::nets::lay_flat;
 use nanofold::geometry::solids;
 use nanofold::geometry::unfoldings::{distinct_nets, edge_map, spanning_trees};
 use std::time::Instant;
@@ -29,6 +32,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             solid.spanning_tree_count(),
             symmetries.len(),
             clock.elapsed().as_secs_f64() - enumerated
+        );
+        let clock = Instant::now();
+        let stride = if trees.len() > 1_000 { 100 } else { 1 };
+        let laid: Vec<_> = trees.iter().step_by(stride).map(|&t| lay_flat(&solid, t)).collect();
+        let overlapping = laid.iter().filter(|net| !net.overlapping_pairs().is_empty()).count();
+        let which = if stride == 1 {
+            "every tree".to_string()
+        } else {
+            format!("every {stride}th tree")
+        };
+        println!(
+            "  laid flat: {overlapping} of {} ({which}) overlap ({:.2} s)",
+            laid.len(),
+            clock.elapsed().as_secs_f64()
         );
     }
     Ok(())

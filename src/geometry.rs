@@ -5,6 +5,7 @@
 
 pub(crate) mod broad_phase;
 pub mod kinematics;
+pub mod nets;
 pub mod polyhedron;
 pub mod solids;
 pub mod sphere;

@@ -151,3 +151,126 @@ fn the_nets_of_the_tetrahedron_cube_and_octahedron_are_2_11_and_11() {
         .to_string();
     assert!(message.contains("5184000"), "{message}");
 }
+
+#[test]
+fn nets_lay_flat_true_to_their_faces_and_the_platonic_ones_never_overlap() {
+    use nanofold::geometry::nets::{lay_flat, leaves, seam_length};
+    use nanofold::geometry::unfoldings::spanning_trees;
+    // (The dodecahedron's and icosahedron's millions: examples/count_nets.)
+    for (name, solid) in [
+        ("tetrahedron", solids::tetrahedron().unwrap()),
+        ("cube", solids::cube().unwrap()),
+        ("octahedron", solids::octahedron().unwrap()),
+    ] {
+        let trees = spanning_trees(&solid, 1_000).unwrap();
+        let edges = solid.dual_edges();
+        let length = |e: &nanofold::geometry::polyhedron::DualEdge| {
+            (solid.vertices[e.vertices[0]] - solid.vertices[e.vertices[1]]).norm()
+        };
+        let surface: f64 = (0..solid.faces.len()).map(|f| solid.face_normal(f).norm() / 2.0).sum();
+        for &tree in &trees {
+            let net = lay_flat(&solid, tree);
+            let at = |f: usize, v: usize| net.faces[f][solid.faces[f].iter().position(|&w| w == v).unwrap()];
+            // Every face keeps its edges' lengths, its winding (not mirrored) and its area.
+            let mut area = 0.0;
+            for (f, corners) in net.faces.iter().enumerate() {
+                let face = &solid.faces[f];
+                let mut twice = 0.0;
+                for k in 0..face.len() {
+                    let (a, b) = (corners[k], corners[(k + 1) % face.len()]);
+                    let real = (solid.vertices[face[k]] - solid.vertices[face[(k + 1) % face.len()]]).norm();
+                    assert!(((b - a).norm() - real).abs() < 1e-12 * real, "{name}: face {f}");
+                    twice += a.x * b.y - a.y * b.x;
+                }
+                assert!(twice > 0.0, "{name}: face {f} mirrored");
+                area += twice / 2.0;
+            }
+            assert!((area - surface).abs() < 1e-12 * surface, "{name}: area");
+            // Faces across a fold share its edge in the plane.
+            for &k in &net.folds {
+                let e = &edges[k];
+                for v in e.vertices {
+                    assert!(
+                        (at(e.faces[0], v) - at(e.faces[1], v)).norm() < 1e-9,
+                        "{name}: fold {k}"
+                    );
+                }
+            }
+            // Horiyama & Shoji: no edge unfolding of a Platonic solid overlaps.
+            assert!(net.overlapping_pairs().is_empty(), "{name}: tree {tree:b} overlaps");
+            // The seams are the cut edges: E − (F − 1) of them, the rest of the edges' length.
+            assert_eq!(net.seams.len(), edges.len() + 1 - solid.faces.len());
+            let total: f64 = edges.iter().map(length).sum();
+            let folded: f64 = net.folds.iter().map(|&k| length(&edges[k])).sum();
+            assert!((seam_length(&solid, tree) - (total - folded)).abs() < 1e-12 * total);
+        }
+        if name == "tetrahedron" {
+            // K4's 16 spanning trees: 4 stars (3 leaves) and 12 paths (2).
+            let mut by_leaves = [0usize; 4];
+            for &tree in &trees {
+                by_leaves[leaves(&solid, tree)] += 1;
+            }
+            assert_eq!(by_leaves, [0, 0, 12, 4]);
+        }
+    }
+}
+
+#[test]
+fn a_cube_nets_radius_of_gyration_is_its_squares_own() {
+    use nanofold::geometry::nets::lay_flat;
+    use nanofold::geometry::unfoldings::spanning_trees;
+    // Six squares of side s: Rg² = (1/6) Σ |c_f − c|² + s²/6 (a square's polar moment about
+    // its centre is A s²/6), with c_f the squares' centres.
+    let cube = solids::cube().unwrap();
+    let side = 2.0;
+    let mut seen = Vec::new();
+    for tree in spanning_trees(&cube, 1000).unwrap() {
+        let net = lay_flat(&cube, tree);
+        let centres: Vec<_> = net
+            .faces
+            .iter()
+            .map(|f| f.iter().fold(nalgebra::Vector2::zeros(), |s, p| s + p.coords) / 4.0)
+            .collect();
+        let c = centres.iter().fold(nalgebra::Vector2::zeros(), |s, x| s + x) / 6.0;
+        let expected = (centres.iter().map(|x| (x - c).norm_squared()).sum::<f64>() / 6.0 + side * side / 6.0).sqrt();
+        let rg = net.radius_of_gyration();
+        assert!((rg - expected).abs() < 1e-12 * expected, "{rg} against {expected}");
+        if !seen.iter().any(|&x: &f64| (x - rg).abs() < 1e-9) {
+            seen.push(rg);
+        }
+    }
+    // The 11 nets are not all equally compact.
+    assert!(seen.len() > 3, "{seen:?}");
+}
+
+#[test]
+fn convex_faces_overlap_only_through_their_interiors() {
+    use nalgebra::Point2;
+    use nanofold::geometry::nets::convex_overlap;
+    let square = |x: f64, y: f64| {
+        vec![
+            Point2::new(x, y),
+            Point2::new(x + 1.0, y),
+            Point2::new(x + 1.0, y + 1.0),
+            Point2::new(x, y + 1.0),
+        ]
+    };
+    assert!(
+        !convex_overlap(&square(0.0, 0.0), &square(1.0, 0.0), 1e-12),
+        "a shared edge"
+    );
+    assert!(
+        !convex_overlap(&square(0.0, 0.0), &square(1.0, 1.0), 1e-12),
+        "a shared corner"
+    );
+    assert!(convex_overlap(&square(0.0, 0.0), &square(0.5, 0.0), 1e-12), "half over");
+    assert!(
+        convex_overlap(&square(0.0, 0.0), &square(0.999, 0.999), 1e-12),
+        "a corner over"
+    );
+    let triangle = vec![Point2::new(1.5, -1.0), Point2::new(3.0, 0.5), Point2::new(1.5, 0.5)];
+    assert!(
+        !convex_overlap(&square(0.0, 0.0), &triangle, 1e-12),
+        "apart along a diagonal"
+    );
+}
