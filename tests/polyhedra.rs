@@ -274,3 +274,66 @@ fn convex_faces_overlap_only_through_their_interiors() {
         "apart along a diagonal"
     );
 }
+
+#[test]
+fn sampled_trees_are_uniform_over_the_cubes_384() {
+    use nanofold::geometry::unfoldings::{sample_trees, spanning_trees};
+    let cube = solids::cube().unwrap();
+    let all = spanning_trees(&cube, 1_000).unwrap();
+    let draws = 38_400;
+    let sampled = sample_trees(&cube, draws, 42).unwrap();
+    let mut seen = std::collections::HashMap::new();
+    for t in &sampled {
+        *seen.entry(*t).or_insert(0usize) += 1;
+    }
+    // Every draw a spanning tree; all 384 drawn; Pearson's χ² against uniform (383 degrees of
+    // freedom: mean 383, sd 27.7) below 520, which a uniform sampler exceeds with p < 1e-6.
+    assert!(seen.keys().all(|t| all.contains(t)));
+    assert_eq!(seen.len(), all.len());
+    let expected = draws as f64 / all.len() as f64;
+    let chi2: f64 = seen.values().map(|&n| (n as f64 - expected).powi(2) / expected).sum();
+    assert!(chi2 < 520.0, "χ² {chi2}");
+}
+
+#[test]
+fn the_l_tromino_has_its_trees_and_overlaps_in_about_two_unfoldings_of_five() {
+    use nanofold::geometry::nets::lay_flat;
+    use nanofold::geometry::unfoldings::sample_trees;
+    let tromino = solids::polycube(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]]).unwrap();
+    assert_eq!(tromino.faces.len(), 14);
+    assert!((tromino.volume() - 3.0).abs() < 1e-12);
+    assert_eq!(tromino.spanning_tree_count(), 2_488_976.0);
+    // A uniform sample of 5 000 gave 0.394 (the issue); 4 000 draws here have a standard
+    // error of 0.008.
+    let trees = sample_trees(&tromino, 4_000, 7).unwrap();
+    let overlapping = trees
+        .iter()
+        .filter(|&&t| !lay_flat(&tromino, t).overlapping_pairs().is_empty())
+        .count() as f64
+        / trees.len() as f64;
+    eprintln!("L-tromino: {overlapping} of its sampled unfoldings overlap");
+    assert!((overlapping - 0.394).abs() < 0.04, "{overlapping}");
+    // Cubes that touch only along an edge, or only at a corner, or that repeat, are refused.
+    let refused = |cubes: &[[i64; 3]], part: &str| {
+        let message = solids::polycube(cubes).unwrap_err().to_string();
+        assert!(message.contains(part), "{cubes:?}: {message}");
+    };
+    refused(&[[0, 0, 0], [1, 1, 0]], "more than two faces");
+    refused(&[[0, 0, 0], [1, 1, 1]], "separate surfaces");
+    // Joined by faces the long way round, the first and last cube still meet at the corner
+    // (1, 1, 1) only, and no other cube has that corner.
+    refused(
+        &[
+            [0, 0, 0],
+            [0, 0, -1],
+            [1, 0, -1],
+            [2, 0, -1],
+            [2, 0, 0],
+            [2, 0, 1],
+            [2, 1, 1],
+            [1, 1, 1],
+        ],
+        "pinched",
+    );
+    refused(&[[0, 0, 0], [0, 0, 0]], "repeats");
+}

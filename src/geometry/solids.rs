@@ -191,3 +191,108 @@ fn positive(name: &str, x: f64) -> Result<()> {
         Err(NanofoldError::invalid(name, x, "must be > 0 and at most 1e6"))
     }
 }
+
+/// Most unit cubes of a polycube.
+pub const MAX_CUBES: usize = 1_000;
+
+/// The surface of a polycube: unit cubes at integer positions, each square of the surface
+/// its own face (coplanar neighbours stay separate faces, as the net's panels are). Refused:
+/// a repeated or far cube, cubes in more than one piece, and cubes that touch only along an
+/// edge or at a corner (the surface would not be a manifold there).
+pub fn polycube(cubes: &[[i64; 3]]) -> Result<Polyhedron> {
+    use std::collections::{HashMap, HashSet};
+    if cubes.is_empty() || cubes.len() > MAX_CUBES {
+        return Err(NanofoldError::invalid(
+            "cubes",
+            cubes.len(),
+            format!("1 to {MAX_CUBES} unit cubes"),
+        ));
+    }
+    let mut filled = HashSet::new();
+    for (k, c) in cubes.iter().enumerate() {
+        if c.iter().any(|x| x.abs() > 1_000_000) {
+            return Err(NanofoldError::invalid(
+                format!("cubes[{k}]"),
+                format!("{c:?}"),
+                "positions within ±1e6",
+            ));
+        }
+        if !filled.insert(*c) {
+            return Err(NanofoldError::invalid(
+                format!("cubes[{k}]"),
+                format!("{c:?}"),
+                "a cube repeats",
+            ));
+        }
+    }
+    // Cubes that share an edge or a corner but not a face with a common neighbour pinch the
+    // surface; checked on the surface itself by Polyhedron::new's edge rule and a vertex-fan
+    // count below.
+    let mut index: HashMap<[i64; 3], usize> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    let mut vertex = |p: [i64; 3], vertices: &mut Vec<Point3<f64>>| {
+        *index.entry(p).or_insert_with(|| {
+            vertices.push(Point3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+            vertices.len() - 1
+        })
+    };
+    for c in cubes {
+        for axis in 0..3 {
+            for side in [0i64, 1] {
+                let mut neighbour = *c;
+                neighbour[axis] += 2 * side - 1;
+                if filled.contains(&neighbour) {
+                    continue;
+                }
+                // The square at c[axis] + side, its corners counter-clockwise seen from
+                // outside (along +axis when side is 1, −axis when 0).
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let corner = |du: i64, dv: i64| {
+                    let mut p = *c;
+                    p[axis] += side;
+                    p[u] += du;
+                    p[v] += dv;
+                    p
+                };
+                let mut square = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
+                if side == 0 {
+                    square.reverse();
+                }
+                faces.push(square.iter().map(|&p| vertex(p, &mut vertices)).collect::<Vec<_>>());
+            }
+        }
+    }
+    let solid = Polyhedron::new(vertices, faces)?;
+    // Each vertex's faces must form one fan (one cycle around it), or the cubes meet at a
+    // point only there.
+    for v in 0..solid.vertices.len() {
+        let around: Vec<usize> = (0..solid.faces.len())
+            .filter(|&f| solid.faces[f].contains(&v))
+            .collect();
+        let mut next: HashMap<usize, usize> = HashMap::new();
+        for &f in &around {
+            let face = &solid.faces[f];
+            let k = face.iter().position(|&w| w == v).expect("around v");
+            // The edge leaving v in this face, and the one entering it: faces chain by them.
+            next.insert(face[(k + face.len() - 1) % face.len()], face[(k + 1) % face.len()]);
+        }
+        let start = *next.keys().next().expect("a vertex has faces");
+        let (mut at, mut steps) = (start, 0);
+        loop {
+            at = next[&at];
+            steps += 1;
+            if at == start || steps > around.len() {
+                break;
+            }
+        }
+        if steps != around.len() {
+            return Err(NanofoldError::invalid(
+                "cubes",
+                format!("corner {:?}", solid.vertices[v].coords.as_slice()),
+                "cubes meet only at this corner or along an edge through it: the surface is pinched there",
+            ));
+        }
+    }
+    Ok(solid)
+}

@@ -143,3 +143,60 @@ pub fn burnside_nets(trees: &[Tree], maps: &[Vec<usize>]) -> f64 {
         .sum();
     fixed as f64 / maps.len() as f64
 }
+
+/// `count` spanning trees drawn uniformly at random (Wilson's algorithm: loop-erased random
+/// walks on the dual graph, each step along a dual edge chosen uniformly, so parallel edges
+/// count as they should), from `seed`: for solids with too many trees to enumerate.
+pub fn sample_trees(solid: &Polyhedron, count: usize, seed: u64) -> Result<Vec<Tree>> {
+    let edges: Vec<[usize; 2]> = solid.dual_edges().iter().map(|e| e.faces).collect();
+    if edges.len() > MAX_DUAL_EDGES {
+        return Err(NanofoldError::invalid(
+            "faces",
+            format!("{} edges", edges.len()),
+            format!("trees are sampled for solids of at most {MAX_DUAL_EDGES} edges"),
+        ));
+    }
+    let faces = solid.faces.len();
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); faces];
+    for (k, &[a, b]) in edges.iter().enumerate() {
+        incident[a].push(k);
+        incident[b].push(k);
+    }
+    let mut state = seed;
+    let mut draw = |n: usize| {
+        // splitmix64
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) % n as u64) as usize
+    };
+    let mut trees = Vec::with_capacity(count);
+    for _ in 0..count {
+        let mut in_tree = vec![false; faces];
+        let mut leave: Vec<usize> = vec![usize::MAX; faces];
+        in_tree[0] = true;
+        let mut tree: Tree = 0;
+        for start in 1..faces {
+            // Walk until the tree, remembering only the last exit from each face (which
+            // erases the loops).
+            let mut at = start;
+            while !in_tree[at] {
+                let k = incident[at][draw(incident[at].len())];
+                leave[at] = k;
+                let [a, b] = edges[k];
+                at = if a == at { b } else { a };
+            }
+            let mut at = start;
+            while !in_tree[at] {
+                in_tree[at] = true;
+                let k = leave[at];
+                tree |= 1 << k;
+                let [a, b] = edges[k];
+                at = if a == at { b } else { a };
+            }
+        }
+        trees.push(tree);
+    }
+    Ok(trees)
+}
