@@ -89,6 +89,75 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
     }
 }
 
+/// At a drag of 1.6 and a target of 85° the bridge's third plate grazes the edge of sliding
+/// at 54.9 µs (its normal speed crosses zero twice within 5 ns, then slides): the columns
+/// computed in one run must equal each computed alone, and follow whole-run differences.
+#[test]
+fn columns_sharing_a_run_through_a_grazed_drag_switch_equal_each_run_alone() {
+    let document = SceneDocument::load("patterns/bridge_step.scene.json".as_ref()).unwrap();
+    let free = [
+        free("environment.drag_coefficient", 0.2, 5.0),
+        free("hinges[*].target_angle_deg", 45.0, 135.0),
+    ];
+    let parameters = resolve(&document, &free).unwrap();
+    let values = [1.6, 85.0];
+    let build = |values: &[f64]| {
+        with_values(&document, &parameters, values)
+            .spec()
+            .unwrap()
+            .build()
+            .unwrap()
+    };
+    let t = times(9e-5, 60);
+    let eps = SENSITIVITY_STEP;
+    let perturbed = |j: usize| -> [_; STENCIL.len()] {
+        std::array::from_fn(|k| {
+            let mut at = values.to_vec();
+            at[j] += STENCIL[k] * eps * parameters[j].scale;
+            build(&at)
+        })
+    };
+    let base = build(&values);
+    // At rtol 1e-9: what is compared is the runs' switches, not their error control.
+    let together = trajectory_sensitivities(&base, &[perturbed(0), perturbed(1)], eps, &t, Method::Auto, 1e-9).unwrap();
+    // The motion changes its sequence of switches within 2e-4 of the target, so the
+    // differences take steps of 1e-6, extrapolated from 2h and h.
+    let plain = |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, &t, Method::Auto, 1e-12).unwrap();
+    for j in 0..2 {
+        let alone = trajectory_sensitivities(&base, &[perturbed(j)], eps, &t, Method::Auto, 1e-9).unwrap();
+        let difference = |step: f64| {
+            let mut at = values.to_vec();
+            at[j] += step * parameters[j].scale;
+            let plus = plain(&at);
+            at[j] -= 2.0 * step * parameters[j].scale;
+            let minus = plain(&at);
+            (0..t.len())
+                .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
+                .collect::<Vec<_>>()
+        };
+        let (wide, narrow) = (difference(2e-6), difference(1e-6));
+        let (mut apart, mut off, mut largest) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for i in 0..t.len() {
+            for k in 0..4 {
+                let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
+                let (shared, single) = (together.sensitivities[i][(k, j)], alone.sensitivities[i][(k, 0)]);
+                apart = apart.max((shared - single).abs());
+                off = off.max((single - fd).abs());
+                largest = largest.max(fd.abs());
+            }
+        }
+        eprintln!("column {j}: max |S| {largest:.4e}, together - alone {apart:.2e}, alone - FD {off:.2e}");
+        assert!(
+            apart <= 1e-6 * largest,
+            "column {j} together and alone differ by {apart:e} of {largest:e}"
+        );
+        assert!(
+            off <= 1e-6 * largest,
+            "column {j} differs from whole runs by {off:e} of {largest:e}"
+        );
+    }
+}
+
 /// A measurement of `columns` (output index, name) of `document` simulated at `values` of
 /// `parameters`, with Gaussian noise of `sigma` degrees.
 fn synthetic(

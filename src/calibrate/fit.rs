@@ -243,13 +243,9 @@ const MARK_STEP: f64 = 1e-6;
 /// units: large against the plain runs' noise (their rtol), small against the curvature.
 const DIFFERENCE_STEP: f64 = 1e-4;
 
-/// Sensitivity columns integrated in one run: one. Several in one run share its step
-/// sequence, and on the bridge at drag 1.6 and target 85° the target's column, run beside
-/// the drag's, left its own value by 4 % after 55 µs (a drag switch crossed in and out
-/// within one step is taken at the step's end, and whether that happens depends on the
-/// steps); alone it follows the whole-run differences. Fixed, not the core count, so a fit
-/// gives the same numbers on every machine.
-const COLUMNS_PER_RUN: usize = 1;
+/// Sensitivity columns integrated in one run (the runs on the machine's cores). Fixed, not
+/// the core count, so a fit gives the same numbers on every machine.
+const COLUMNS_PER_RUN: usize = 2;
 
 /// Where an evaluation's Jacobian came from.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -20,6 +20,9 @@ const CONTACT_SUBDIVISIONS: usize = 4;
 /// A run stops with an error once Newton has failed more than this many times and on more
 /// than every other step (diffsol's own cap counts failures over the whole run; see `integrate`).
 const NEWTON_FAILURE_FLOOR: usize = 1000;
+/// The step after a jump is searched at this many equal parts for where the just-switched
+/// function has risen from zero (a crossing in and out within it would leave no sign change).
+const AFTER_JUMP_PARTS: usize = 8;
 /// `auto` integrates with ESDIRK34 rather than Tsit45 when the forcing lasts at least this many
 /// fastest periods: the response is then smooth on the fast time scale and an L-stable
 /// implicit method takes long steps. A step keeps the modes ringing (quadratic drag damps
@@ -275,7 +278,7 @@ impl<P: Plant> Driver<'_, P> {
         // Every function that changes sign in the step, bracketed together: each evaluation
         // gives all of them, and the bracket closes on the earliest crossing.
         let mut crossing: Vec<(usize, f64, f64, f64)> = (0..before.len())
-            .filter(|&k| before[k] * now[k] < 0.0)
+            .filter(|&k| before[k] > 0.0 && now[k] < 0.0)
             .map(|k| {
                 let side = before[k].signum();
                 (k, side, before[k] * side, now[k] * side)
@@ -391,6 +394,7 @@ impl<P: Plant> Driver<'_, P> {
         let mut switches_before = vec![0.0; switch_count];
         let mut switches_now = vec![0.0; switch_count];
         let mut switches_scratch = vec![0.0; switch_count];
+        let mut just_switched: Vec<usize> = Vec::new();
         if switch_count > 0 {
             plant.switch_values(t_start, &angles, &rates, &mut ws, &mut switches_before)?;
         }
@@ -493,14 +497,48 @@ impl<P: Plant> Driver<'_, P> {
                 solver.interpolate_inplace(s_now, &mut state)?;
                 split(&state, &mut angles, &mut rates, &mut accumulated);
                 plant.switch_values(s_now * self.time_unit, &angles, &rates, &mut ws, &mut switches_now)?;
+                // A function just switched starts this step at zero, so its sign there cannot
+                // show a crossing within the step: the step is split where it is positive.
+                let (mut s_from, mut s_to) = (s_previous, s_now);
+                let mut interior = None;
+                if just_switched
+                    .iter()
+                    .any(|&k| switches_before[k] <= 0.0 && switches_now[k] < 0.0)
+                {
+                    for part in 1..AFTER_JUMP_PARTS {
+                        let s = s_previous + (s_now - s_previous) * part as f64 / AFTER_JUMP_PARTS as f64;
+                        solver.interpolate_inplace(s, &mut state)?;
+                        split(&state, &mut angles, &mut rates, &mut accumulated);
+                        plant.switch_values(s * self.time_unit, &angles, &rates, &mut ws, &mut switches_scratch)?;
+                        if just_switched.iter().any(|&k| switches_scratch[k] > 0.0) {
+                            interior = Some(s);
+                            break;
+                        }
+                    }
+                }
+                let mut at_interior = Vec::new();
+                if let Some(s) = interior {
+                    at_interior.clone_from(&switches_scratch);
+                    if (0..switch_count).any(|k| switches_before[k] > 0.0 && at_interior[k] < 0.0) {
+                        s_to = s;
+                    } else {
+                        s_from = s;
+                    }
+                }
+                let (values_from, values_to) = match interior {
+                    Some(s) if s == s_to => (&switches_before, &at_interior),
+                    Some(_) => (&at_interior, &switches_now),
+                    None => (&switches_before, &switches_now),
+                };
                 switch = self.first_switch(
                     &solver,
-                    (s_previous, s_now),
-                    (&switches_before, &switches_now),
+                    (s_from, s_to),
+                    (values_from, values_to),
                     (&mut state, &mut angles, &mut rates, &mut accumulated),
                     &mut switches_scratch,
                     &mut ws,
                 )?;
+                just_switched.clear();
                 // A contact after the switch is found again after the jump.
                 if let (Some((s_switch, _)), Some(c)) = (&switch, &collision) {
                     if *s_switch < c.time / self.time_unit {
@@ -532,6 +570,7 @@ impl<P: Plant> Driver<'_, P> {
                 ));
             }
             if let Some((s_switch, switched)) = switch {
+                just_switched.clone_from(&switched);
                 // Back to the crossing, the jump applied, and on from there.
                 solver.state_mut_back(s_switch)?;
                 let y = solver.state().y.clone();
@@ -554,6 +593,10 @@ impl<P: Plant> Driver<'_, P> {
                     &mut ws,
                     &mut switches_before,
                 )?;
+                // Zero at the crossing, up to rounding whose sign means nothing.
+                for &k in &just_switched {
+                    switches_before[k] = 0.0;
+                }
                 s_previous = s_switch;
                 previous_speed = speed_sum(solver.state().y);
                 continue;

@@ -152,7 +152,8 @@ pub trait Plant {
     fn located_switches(&self) -> usize {
         0
     }
-    /// The located switching functions at (t, q, q̇).
+    /// The located switching functions at (t, q, q̇): each positive until its switch is
+    /// crossed; the integrator locates a fall through zero, not a rise.
     fn switch_values(
         &self,
         _t: f64,

@@ -49,6 +49,9 @@ const WEIGHTS: [f64; POINTS] = [-0.5, 0.5];
 /// The largest shift of an angle (rad) or a rate (rad per unit of scaled time) in the
 /// differences along the state.
 pub const STATE_SHIFT: f64 = 1e-4;
+/// The state and the parameter are differenced together while ε(Sⱼ, Ṡⱼ) shifts no angle or
+/// rate by more than this many [`STATE_SHIFT`]s.
+const TOGETHER_RATIO: f64 = 2.0;
 
 /// The central difference from values at the [`STENCIL`] offsets.
 fn stencil(values: [f64; POINTS], epsilon: f64) -> f64 {
@@ -308,24 +311,34 @@ impl<P: Plant> Augmented<'_, P> {
     ) -> Result<()> {
         let n = self.base.dof();
         for (j, pair) in self.perturbed.iter().enumerate() {
-            let column = &mut out[n * (1 + j)..n * (2 + j)];
+            // One difference along (Sⱼ, Ṡⱼ, eⱼ) together, on the perturbed plants at the state
+            // shifted by ±ε(Sⱼ, Ṡⱼ), where that shift is small enough; else the parameter's
+            // and the state's differences apart.
+            let h = self.state_step(j, q_dot, q);
+            let together = h.is_none_or(|h| self.epsilon <= TOGETHER_RATIO * h);
             for (k, plant) in pair.iter().enumerate() {
+                let shift = if together { STENCIL[k] * self.epsilon } else { 0.0 };
+                self.shift(j, shift, q, q_dot, &mut ws.shifted_q, &mut ws.shifted_rates);
                 held_accelerations(
                     plant,
                     sides,
                     Some(&ws.free_signs),
                     t,
-                    &q[..n],
-                    &q_dot[..n],
+                    &ws.shifted_q,
+                    &ws.shifted_rates,
                     &mut ws.perturbed[j][k],
                     &mut ws.scratch,
                     &mut ws.stencil[k],
                 )?;
             }
+            let column = &mut out[n * (1 + j)..n * (2 + j)];
             for (i, c) in column.iter_mut().enumerate() {
                 *c = stencil(std::array::from_fn(|k| ws.stencil[k][i]), self.epsilon);
             }
-            if let Some(h) = self.state_step(j, q_dot, q) {
+            if together {
+                continue;
+            }
+            if let Some(h) = h {
                 for (k, offset) in STENCIL.iter().enumerate() {
                     self.shift(j, offset * h, q, q_dot, &mut ws.shifted_q, &mut ws.shifted_rates);
                     held_accelerations(
@@ -377,6 +390,74 @@ impl<P: Plant> Augmented<'_, P> {
             values[k] = self.base.switches(&ws.base)[i];
         }
         Ok(stencil(values, h))
+    }
+
+    /// Each plate in `switched` to its side past the switch, and each column's jump there
+    /// (`docs/model.md#calibration`). `at_crossing`: on g = 0, where the plate may slide on;
+    /// otherwise (a crossing found only at a step's end) a locked plate takes the other side.
+    fn switch_sides(
+        &self,
+        t: f64,
+        q: &mut [f64],
+        q_dot: &mut [f64],
+        switched: &[usize],
+        at_crossing: bool,
+        ws: &mut AugmentedWorkspace<P::Workspace>,
+    ) -> Result<()> {
+        let n = self.base.dof();
+        for &i in switched {
+            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            let (speed, sigma) = (ws.scratch.speeds[i], ws.scratch.sigma[i]);
+            let side = self.mode.borrow()[i];
+            let old_side = match side {
+                Side::Sliding => {
+                    self.mode.borrow_mut()[i] = Side::Locked(if sigma < 0.0 { -1.0 } else { 1.0 });
+                    continue;
+                }
+                Side::Locked(sign) => sign,
+                Side::Free if speed != 0.0 => -speed.signum(),
+                Side::Free => continue,
+            };
+            self.mode.borrow_mut()[i] = Side::Locked(old_side);
+            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            let before = ws.after.clone();
+            let mut sigma = f64::NAN;
+            if at_crossing {
+                self.mode.borrow_mut()[i] = Side::Sliding;
+                self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+                sigma = ws.scratch.sigma[i];
+            }
+            if !(sigma.is_finite() && sigma.abs() <= 1.0) {
+                self.mode.borrow_mut()[i] = Side::Locked(-old_side);
+                self.held_base(t, &q[..n], &q_dot[..n], ws)?;
+            }
+            let after = ws.after.clone();
+            ws.direction.copy_from_slice(&q_dot[..n]);
+            let direction = std::mem::take(&mut ws.direction);
+            let along_motion = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&direction, &before), ws);
+            ws.direction = direction;
+            let along_motion = along_motion?;
+            if along_motion == 0.0 || !along_motion.is_finite() {
+                continue;
+            }
+            for j in 0..self.columns() {
+                let (s, s_dot) = (
+                    q[n * (1 + j)..n * (2 + j)].to_vec(),
+                    q_dot[n * (1 + j)..n * (2 + j)].to_vec(),
+                );
+                let along_column = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&s, &s_dot), ws)?;
+                let mut values = [0.0; POINTS];
+                for (k, plant) in self.perturbed[j].iter().enumerate() {
+                    plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
+                    values[k] = plant.switches(&ws.perturbed[j][k])[i];
+                }
+                let tau = -(along_column + stencil(values, self.epsilon)) / along_motion;
+                for r in 0..n {
+                    q_dot[n * (1 + j) + r] += (before[r] - after[r]) * tau;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The step h along column j's (Sⱼ, Ṡⱼ) that shifts no angle or scaled rate by more than
@@ -516,10 +597,10 @@ impl<P: Plant> Plant for Augmented<'_, P> {
                 }
             }
         }
-        // A crossing the integrator did not locate (one in and out within a step leaves
-        // none to see): taken here, at the end of the step.
+        // A crossing the integrator did not locate: taken here, at the end of the step, where
+        // the plate is plainly on the other side (it cannot slide there).
         if !missed.is_empty() {
-            self.jump(t, q, q_dot, &missed, ws)?;
+            self.switch_sides(t, q, q_dot, &missed, false, ws)?;
             return Ok(true);
         }
         Ok(projected)
@@ -580,57 +661,7 @@ impl<P: Plant> Plant for Augmented<'_, P> {
         switched: &[usize],
         ws: &mut Self::Workspace,
     ) -> Result<()> {
-        let n = self.base.dof();
-        for &i in switched {
-            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
-            let (speed, sigma) = (ws.scratch.speeds[i], ws.scratch.sigma[i]);
-            let side = self.mode.borrow()[i];
-            let old_side = match side {
-                Side::Sliding => {
-                    self.mode.borrow_mut()[i] = Side::Locked(if sigma < 0.0 { -1.0 } else { 1.0 });
-                    continue;
-                }
-                Side::Locked(sign) => sign,
-                Side::Free if speed != 0.0 => -speed.signum(),
-                Side::Free => continue,
-            };
-            self.mode.borrow_mut()[i] = Side::Locked(old_side);
-            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
-            let before = ws.after.clone();
-            self.mode.borrow_mut()[i] = Side::Sliding;
-            self.held_base(t, &q[..n], &q_dot[..n], ws)?;
-            let sigma = ws.scratch.sigma[i];
-            if !(sigma.is_finite() && sigma.abs() <= 1.0) {
-                self.mode.borrow_mut()[i] = Side::Locked(-old_side);
-                self.held_base(t, &q[..n], &q_dot[..n], ws)?;
-            }
-            let after = ws.after.clone();
-            ws.direction.copy_from_slice(&q_dot[..n]);
-            let direction = std::mem::take(&mut ws.direction);
-            let along_motion = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&direction, &before), ws);
-            ws.direction = direction;
-            let along_motion = along_motion?;
-            if along_motion == 0.0 || !along_motion.is_finite() {
-                continue;
-            }
-            for j in 0..self.columns() {
-                let (s, s_dot) = (
-                    q[n * (1 + j)..n * (2 + j)].to_vec(),
-                    q_dot[n * (1 + j)..n * (2 + j)].to_vec(),
-                );
-                let along_column = self.switch_derivative(t, i, (&q[..n], &q_dot[..n]), (&s, &s_dot), ws)?;
-                let mut values = [0.0; POINTS];
-                for (k, plant) in self.perturbed[j].iter().enumerate() {
-                    plant.accelerations(t, &q[..n], &q_dot[..n], &mut ws.perturbed[j][k], &mut ws.stencil[k])?;
-                    values[k] = plant.switches(&ws.perturbed[j][k])[i];
-                }
-                let tau = -(along_column + stencil(values, self.epsilon)) / along_motion;
-                for r in 0..n {
-                    q_dot[n * (1 + j) + r] += (before[r] - after[r]) * tau;
-                }
-            }
-        }
-        Ok(())
+        self.switch_sides(t, q, q_dot, switched, true, ws)
     }
 
     /// The base's sample, its angles followed by each column's output sensitivities (the
