@@ -19,6 +19,19 @@ fn free(path: &str, lower: f64, upper: f64) -> FreeParameter {
     }
 }
 
+/// The scene of `document` with `parameters` at `values`, built.
+fn scene_at(
+    document: &SceneDocument,
+    parameters: &[nanofold::calibrate::ResolvedParameter],
+    values: &[f64],
+) -> nanofold::dynamics::scene::Scene {
+    with_values(document, parameters, values)
+        .spec()
+        .unwrap()
+        .build()
+        .unwrap()
+}
+
 fn times(t_end: f64, samples: usize) -> Vec<f64> {
     (1..=samples).map(|k| t_end * k as f64 / samples as f64).collect()
 }
@@ -33,13 +46,7 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
     ];
     let parameters = resolve(&document, &free).unwrap();
     let start: Vec<f64> = parameters.iter().map(|p| p.start).collect();
-    let build = |values: &[f64]| {
-        with_values(&document, &parameters, values)
-            .spec()
-            .unwrap()
-            .build()
-            .unwrap()
-    };
+    let build = |values: &[f64]| scene_at(&document, &parameters, values);
     let t = times(9e-5, 60);
     let (eps, rtol) = (SENSITIVITY_STEP, 1e-8);
     let perturbed: Vec<[_; STENCIL.len()]> = (0..3)
@@ -101,13 +108,7 @@ fn columns_sharing_a_run_through_a_grazed_drag_switch_equal_each_run_alone() {
     ];
     let parameters = resolve(&document, &free).unwrap();
     let values = [1.6, 85.0];
-    let build = |values: &[f64]| {
-        with_values(&document, &parameters, values)
-            .spec()
-            .unwrap()
-            .build()
-            .unwrap()
-    };
+    let build = |values: &[f64]| scene_at(&document, &parameters, values);
     let t = times(9e-5, 60);
     let eps = SENSITIVITY_STEP;
     let perturbed = |j: usize| -> [_; STENCIL.len()] {
@@ -327,13 +328,7 @@ fn against_differences(scene: &str, path: &str, lower: f64, upper: f64, t: &[f64
     let document = SceneDocument::load(scene.as_ref()).unwrap();
     let parameters = resolve(&document, &[free(path, lower, upper)]).unwrap();
     let start = parameters[0].start;
-    let build = |value: f64| {
-        with_values(&document, &parameters, &[value])
-            .spec()
-            .unwrap()
-            .build()
-            .unwrap()
-    };
+    let build = |value: f64| scene_at(&document, &parameters, &[value]);
     let perturbed = [std::array::from_fn(|k| {
         build(start * (1.0 + STENCIL[k] * SENSITIVITY_STEP))
     })];
