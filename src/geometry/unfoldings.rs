@@ -4,7 +4,6 @@
 
 use super::polyhedron::{Polyhedron, Symmetry};
 use crate::error::{NanofoldError, Result};
-use std::collections::HashSet;
 
 /// A spanning tree of the dual graph: bit k set when dual edge k is a fold (a hinge).
 pub type Tree = u64;
@@ -118,20 +117,39 @@ pub fn edge_map(solid: &Polyhedron, symmetry: &Symmetry) -> Vec<usize> {
 
 /// A tree's image under a symmetry's edge map.
 pub fn image(tree: Tree, map: &[usize]) -> Tree {
-    map.iter()
-        .enumerate()
-        .filter(|&(k, _)| tree >> k & 1 == 1)
-        .fold(0, |image, (_, &to)| image | 1 << to)
+    let mut rest = tree;
+    let mut image: Tree = 0;
+    while rest != 0 {
+        let k = rest.trailing_zeros() as usize;
+        image |= 1 << map[k];
+        rest &= rest - 1;
+    }
+    image
 }
 
-/// The number of distinct nets among `trees` (all of a solid's): the orbits under the
-/// symmetries' edge maps, each tree counted by its smallest image.
-pub fn distinct_nets(trees: &[Tree], maps: &[Vec<usize>]) -> usize {
-    let canonical: HashSet<Tree> = trees
-        .iter()
-        .map(|&t| maps.iter().map(|m| image(t, m)).min().unwrap_or(t))
-        .collect();
-    canonical.len()
+/// One tree of each distinct net among `trees` (all of a solid's): the orbits under the
+/// symmetries' edge maps, each represented by its smallest member. The trees
+/// are sorted once and each orbit's images struck off by binary search, so the work is one
+/// orbit's images per net, not per tree.
+pub fn distinct_nets(trees: &[Tree], maps: &[Vec<usize>]) -> Vec<Tree> {
+    let mut sorted = trees.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let mut seen = vec![false; sorted.len()];
+    let mut representatives = Vec::new();
+    for at in 0..sorted.len() {
+        if seen[at] {
+            continue;
+        }
+        let tree = sorted[at];
+        representatives.push(tree);
+        for map in maps {
+            if let Ok(other) = sorted.binary_search(&image(tree, map)) {
+                seen[other] = true;
+            }
+        }
+    }
+    representatives
 }
 
 /// Burnside's count of the same orbits: the mean, over the group, of the trees each
