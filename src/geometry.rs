@@ -9,6 +9,7 @@ pub mod nets;
 pub mod polyhedron;
 pub mod solids;
 pub mod sphere;
+pub mod surface_intersection;
 pub mod unfoldings;
 pub use broad_phase::overlapping_pairs;
 

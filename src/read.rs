@@ -9,6 +9,7 @@ pub mod measurement;
 pub(crate) mod native;
 pub(crate) mod scene;
 pub mod scene_spec;
+pub mod solid;
 pub use input::MAX_PATTERN_BYTES;
 
 pub use scene::{load_scene, parse_scene, scene_from_value, SceneDocument};

@@ -369,7 +369,7 @@ fn the_l_tromino_has_its_trees_and_overlaps_in_about_two_unfoldings_of_five() {
         assert!(message.contains(part), "{cubes:?}: {message}");
     };
     refused(&[[0, 0, 0], [1, 1, 0]], "more than two faces");
-    refused(&[[0, 0, 0], [1, 1, 1]], "separate surfaces");
+    refused(&[[0, 0, 0], [1, 1, 1]], "pinched");
     // Joined by faces the long way round, the first and last cube still meet at the corner
     // (1, 1, 1) only, and no other cube has that corner.
     refused(
@@ -386,4 +386,199 @@ fn the_l_tromino_has_its_trees_and_overlaps_in_about_two_unfoldings_of_five() {
         "pinched",
     );
     refused(&[[0, 0, 0], [0, 0, 0]], "repeats");
+}
+
+/// `solid` as OFF text.
+fn off_text(solid: &Polyhedron) -> String {
+    let mut text = format!(
+        "OFF\n# written by the test\n{} {} 0\n",
+        solid.vertices.len(),
+        solid.faces.len()
+    );
+    for p in &solid.vertices {
+        text += &format!("{} {} {}\n", p.x, p.y, p.z);
+    }
+    for f in &solid.faces {
+        text += &format!(
+            "{} {} 0.5 0.5 0.5\n",
+            f.len(),
+            f.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(" ")
+        );
+    }
+    text
+}
+
+#[test]
+fn solids_read_from_off_obj_and_fold_files_are_the_generated_ones() {
+    use nanofold::read::solid::{load_solid, parse_fold_solid, parse_obj, parse_off};
+    for solid in [
+        solids::cube().unwrap(),
+        solids::icosahedron().unwrap(),
+        solids::pyramid(5, 1.0).unwrap(),
+    ] {
+        let off = parse_off(&off_text(&solid), "test.off").unwrap();
+        // OBJ: 1-based, the faces in v/t/n form, the last face by negative indices.
+        let mut obj = String::from("# test\no solid\n");
+        for p in &solid.vertices {
+            obj += &format!("v {} {} {}\nvn 0 0 1\n", p.x, p.y, p.z);
+        }
+        let n = solid.vertices.len();
+        for (k, f) in solid.faces.iter().enumerate() {
+            let corners: Vec<String> = if k + 1 == solid.faces.len() {
+                f.iter().map(|&v| format!("{}", v as i64 - n as i64)).collect()
+            } else {
+                f.iter().map(|&v| format!("{}/1/1", v + 1)).collect()
+            };
+            obj += &format!("f {}\n", corners.join(" "));
+        }
+        let obj = parse_obj(&obj, "test.obj").unwrap();
+        let fold = serde_json::json!({
+            "file_spec": 1.1,
+            "vertices_coords": solid.vertices.iter().map(|p| vec![p.x, p.y, p.z]).collect::<Vec<_>>(),
+            "faces_vertices": solid.faces,
+        });
+        let fold = parse_fold_solid(&fold.to_string(), "test.fold").unwrap();
+        for read in [&off, &obj, &fold] {
+            assert_eq!(read, &solid);
+        }
+    }
+    // Through a file, the format from its extension.
+    let folder = std::env::temp_dir().join(format!("nanofold-solids-{}", std::process::id()));
+    std::fs::create_dir_all(&folder).unwrap();
+    let path = folder.join("cube.off");
+    std::fs::write(&path, off_text(&solids::cube().unwrap())).unwrap();
+    assert_eq!(load_solid(&path).unwrap().faces.len(), 6);
+    let wrong = folder.join("cube.stl");
+    std::fs::write(&wrong, "solid").unwrap();
+    assert!(load_solid(&wrong)
+        .unwrap_err()
+        .to_string()
+        .contains(".off, .obj or .fold"));
+    std::fs::remove_dir_all(&folder).unwrap();
+    // Bad files, each refused where the fault is.
+    let refused = |text: &str, parse: fn(&str, &str) -> nanofold::Result<Polyhedron>, expected: &[&str]| {
+        let message = parse(text, "bad").unwrap_err().to_string();
+        for part in expected {
+            assert!(message.contains(part), "{message:?} lacks {part:?}");
+        }
+    };
+    let cube_off = off_text(&solids::cube().unwrap());
+    refused(
+        &cube_off.replace("OFF", "PLY"),
+        parse_off,
+        &["line 1", "starts with OFF"],
+    );
+    refused(
+        &cube_off.replacen("-1 ", "x ", 1),
+        parse_off,
+        &["line", ": x (", "three coordinates"],
+    );
+    refused(&cube_off.replace("8 6 0", "8 7 0"), parse_off, &["faces[6]", "missing"]);
+    refused(
+        &cube_off.replace("8 6 0", "900000 6 0"),
+        parse_off,
+        &["vertices", "at most 4096"],
+    );
+    refused(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 5\n",
+        parse_obj,
+        &["line 5", ": 5 (", "vertex index"],
+    );
+    refused("v 0 0 nan\n", parse_obj, &["line 1", "finite"]);
+    refused(
+        r#"{"vertices_coords": [[0, 0]], "faces_vertices": []}"#,
+        parse_fold_solid,
+        &["vertices_coords[0]", "three coordinates"],
+    );
+    refused(
+        r#"{"vertices_coords": []}"#,
+        parse_fold_solid,
+        &["faces_vertices", "missing"],
+    );
+}
+
+/// A bar of square section (side 2w, height 1) along a path in the plane z = 0..1, mitred at
+/// its corners: planar convex faces, wound outwards.
+fn bar(path: &[[f64; 2]], w: f64) -> (Vec<Point3<f64>>, Vec<Vec<usize>>) {
+    use nalgebra::Vector2;
+    let n = path.len();
+    let p = |i: usize| Vector2::new(path[i][0], path[i][1]);
+    let left = |d: Vector2<f64>| Vector2::new(-d.y, d.x).normalize();
+    let mut vertices = Vec::new();
+    for i in 0..n {
+        let offset = if i == 0 {
+            left(p(1) - p(0))
+        } else if i == n - 1 {
+            left(p(n - 1) - p(n - 2))
+        } else {
+            let (a, b) = (left(p(i) - p(i - 1)), left(p(i + 1) - p(i)));
+            (a + b) / (1.0 + a.dot(&b))
+        };
+        // Per section: right bottom, left bottom, left top, right top.
+        for (side, z) in [(-1.0, 0.0), (1.0, 0.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let q = p(i) + offset * (side * w);
+            vertices.push(Point3::new(q.x, q.y, z));
+        }
+    }
+    let mut faces = Vec::new();
+    for i in 0..n - 1 {
+        let (a, b) = (4 * i, 4 * (i + 1));
+        faces.push(vec![a, b, b + 3, a + 3]); // right
+        faces.push(vec![a + 1, a + 2, b + 2, b + 1]); // left
+        faces.push(vec![a + 3, b + 3, b + 2, a + 2]); // top
+        faces.push(vec![a, a + 1, b + 1, b]); // bottom
+    }
+    let last = 4 * (n - 1);
+    faces.push(vec![0, 3, 2, 1]);
+    faces.push(vec![last, last + 1, last + 2, last + 3]);
+    (vertices, faces)
+}
+
+#[test]
+fn pinched_concave_and_self_crossing_surfaces_are_refused_by_name() {
+    // A bar bent round a square is a solid; bent on until it crosses itself it is refused,
+    // naming the two faces that meet.
+    let (vertices, faces) = bar(&[[0.0, 0.0], [6.0, 0.0], [6.0, 3.0], [3.0, 3.0], [3.0, 1.5]], 0.5);
+    let solid = Polyhedron::new(vertices, faces).unwrap();
+    assert_eq!(solid.faces.len(), 18);
+    let (vertices, faces) = bar(&[[0.0, 0.0], [6.0, 0.0], [6.0, 3.0], [3.0, 3.0], [3.0, -3.0]], 0.5);
+    let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
+    assert!(
+        message.contains("passes through itself") && message.contains("meets faces["),
+        "{message}"
+    );
+    // Two tetrahedra tip to tip share one vertex: pinched there.
+    let tetra = solids::tetrahedron().unwrap();
+    let mut vertices = tetra.vertices.clone();
+    let tip = tetra.vertices[0];
+    vertices.extend(
+        tetra.vertices[1..]
+            .iter()
+            .map(|p| Point3::from(2.0 * tip.coords - p.coords)),
+    );
+    let map = |v: usize| if v == 0 { 0 } else { v + 3 };
+    let mut faces = tetra.faces.clone();
+    // The mirror image through the tip turns the winding inside out; reverse it back.
+    faces.extend(
+        tetra
+            .faces
+            .iter()
+            .map(|f| f.iter().rev().map(|&v| map(v)).collect::<Vec<_>>()),
+    );
+    let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
+    assert!(
+        message.contains("vertices[0]") && message.contains("pinched"),
+        "{message}"
+    );
+    // A concave face: an L-shaped prism whose L faces are single faces.
+    let l = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]];
+    let mut vertices: Vec<Point3<f64>> = l.iter().map(|q| Point3::new(q[0], q[1], 0.0)).collect();
+    vertices.extend(l.iter().map(|q| Point3::new(q[0], q[1], 1.0)));
+    let mut faces = vec![(0..6).rev().collect::<Vec<_>>(), (6..12).collect()];
+    for k in 0..6 {
+        let j = (k + 1) % 6;
+        faces.push(vec![k, j, j + 6, k + 6]);
+    }
+    let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
+    assert!(message.contains("faces[") && message.contains("convex"), "{message}");
 }

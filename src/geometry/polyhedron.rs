@@ -3,6 +3,7 @@
 //! generated solids, the face-adjacency (dual) graph, its number of spanning trees (the edge
 //! unfoldings) and the solid's symmetry group found from its geometry.
 
+use super::surface_intersection::first_self_intersection;
 use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, Matrix3, Point3, Vector3};
 use std::collections::HashMap;
@@ -79,6 +80,7 @@ impl Polyhedron {
         let solid = Polyhedron { vertices, faces };
         solid.check_faces()?;
         solid.check_edges()?;
+        solid.check_pinched()?;
         solid.check_planar()?;
         let volume = solid.volume();
         if volume <= 0.0 {
@@ -93,6 +95,13 @@ impl Polyhedron {
                 "faces",
                 "two or more separate surfaces",
                 "a solid is one closed surface",
+            ));
+        }
+        if let Some((f, g)) = first_self_intersection(&solid, 1e-9 * solid.size()) {
+            return Err(NanofoldError::invalid(
+                format!("faces[{f}]"),
+                format!("meets faces[{g}]"),
+                "the surface passes through itself (faces may meet only along their shared edges and corners)",
             ));
         }
         Ok(solid)
@@ -151,6 +160,51 @@ impl Polyhedron {
         Ok(())
     }
 
+    /// Around every vertex its faces form one fan (a surface pinched at a vertex, two
+    /// cones tip to tip, is not a solid's).
+    fn check_pinched(&self) -> Result<()> {
+        // For each corner (face f at vertex v), the next face around v: the one across the
+        // edge that enters v in f.
+        let mut outgoing: HashMap<(usize, usize), usize> = HashMap::new();
+        let mut corners = vec![0usize; self.vertices.len()];
+        for (f, face) in self.faces.iter().enumerate() {
+            for k in 0..face.len() {
+                outgoing.insert((face[k], face[(k + 1) % face.len()]), f);
+                corners[face[k]] += 1;
+            }
+        }
+        let mut walked = vec![false; self.vertices.len()];
+        for (f, face) in self.faces.iter().enumerate() {
+            for k in 0..face.len() {
+                let v = face[k];
+                if walked[v] {
+                    continue;
+                }
+                walked[v] = true;
+                let mut previous = face[(k + face.len() - 1) % face.len()];
+                let mut fan = 0;
+                loop {
+                    fan += 1;
+                    let next = outgoing[&(v, previous)];
+                    if next == f || fan > corners[v] {
+                        break;
+                    }
+                    let around = &self.faces[next];
+                    let i = around.iter().position(|&w| w == v).expect("v on the face");
+                    previous = around[(i + around.len() - 1) % around.len()];
+                }
+                if fan != corners[v] {
+                    return Err(NanofoldError::invalid(
+                        format!("vertices[{v}]"),
+                        format!("{} faces in a fan of {fan}", corners[v]),
+                        "the surface is pinched there: its faces around a vertex must form one fan",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The size the tolerances are relative to: the largest distance from the centroid.
     fn size(&self) -> f64 {
         let c = self.centroid();
@@ -179,6 +233,21 @@ impl Polyhedron {
                     format!("a vertex {off:e} off its plane"),
                     format!("faces must be planar (to 1e-9 of the solid's size, {size:e})"),
                 ));
+            }
+            let face = &self.faces[f];
+            for k in 0..face.len() {
+                let [a, b, c] = [0, 1, 2].map(|i| self.vertices[face[(k + i) % face.len()]]);
+                let turn = (b - a).cross(&(c - b)).dot(&unit);
+                if turn < -1e-9 * size * size {
+                    return Err(NanofoldError::invalid(
+                        format!("faces[{f}]"),
+                        format!(
+                            "corner at vertex {} turns {turn:e} the wrong way",
+                            face[(k + 1) % face.len()]
+                        ),
+                        "faces must be convex (split a concave face into convex ones)",
+                    ));
+                }
             }
         }
         Ok(())
