@@ -4,6 +4,7 @@
 
 pub mod crease_pattern;
 pub mod generate;
+pub mod net;
 
 use crate::error::{NanofoldError, Result};
 use crate::geometry::kinematics;

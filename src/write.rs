@@ -5,6 +5,7 @@
 pub(crate) mod folder;
 pub(crate) mod folding_output;
 pub(crate) mod mujoco;
+pub mod net_output;
 pub(crate) mod output;
 pub(crate) mod summary;
 pub use folding_output::{

@@ -582,3 +582,135 @@ fn pinched_concave_and_self_crossing_surfaces_are_refused_by_name() {
     let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
     assert!(message.contains("faces[") && message.contains("convex"), "{message}");
 }
+
+/// The largest distance, after the one rigid motion that fits them best (Kabsch), between
+/// `moved` and `fixed`, point for point.
+fn fitted_distance(moved: &[Point3<f64>], fixed: &[Point3<f64>]) -> f64 {
+    use nalgebra::{Matrix3, Vector3};
+    let centre =
+        |points: &[Point3<f64>]| points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
+    let (cm, cf) = (centre(moved), centre(fixed));
+    let h = moved.iter().zip(fixed).fold(Matrix3::zeros(), |h, (m, f)| {
+        h + (m.coords - cm) * (f.coords - cf).transpose()
+    });
+    let svd = h.svd(true, true);
+    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let mut d = Matrix3::identity();
+    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let rotation = v_t.transpose() * d * u.transpose();
+    moved
+        .iter()
+        .zip(fixed)
+        .map(|(m, f)| (rotation * (m.coords - cm) + cf - f.coords).norm())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn every_net_folded_by_the_crease_pattern_kinematics_lands_on_its_solid() {
+    use nanofold::folding::{panel_poses, vertex_positions, FoldingModel};
+    use nanofold::geometry::nets::NetLayout;
+    use nanofold::geometry::unfoldings::{distinct_nets, edge_map, sample_trees, spanning_trees};
+    use nanofold::pattern::net::net_pattern;
+    let mut cases: Vec<(&str, Polyhedron, Vec<u64>)> = Vec::new();
+    for (name, solid) in [
+        ("tetrahedron", solids::tetrahedron().unwrap()),
+        ("cube", solids::cube().unwrap()),
+        ("octahedron", solids::octahedron().unwrap()),
+        ("box 1 x 2 x 3", solids::cuboid(1.0, 2.0, 3.0).unwrap()),
+    ] {
+        let maps: Vec<Vec<usize>> = solid.symmetries().iter().map(|s| edge_map(&solid, s)).collect();
+        let nets = distinct_nets(&spanning_trees(&solid, 100_000).unwrap(), &maps);
+        cases.push((name, solid, nets));
+    }
+    for (name, solid) in [
+        ("dodecahedron", solids::dodecahedron().unwrap()),
+        ("icosahedron", solids::icosahedron().unwrap()),
+        ("truncated octahedron", solids::truncated_octahedron().unwrap()),
+        ("pentagonal antiprism", solids::antiprism(5, 1.0).unwrap()),
+        (
+            "L tromino",
+            solids::polycube(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]]).unwrap(),
+        ),
+    ] {
+        let trees = sample_trees(&solid, 60, 11).unwrap();
+        cases.push((name, solid, trees));
+    }
+    for (name, solid, trees) in &cases {
+        let layout = NetLayout::new(solid);
+        let size = solid.vertices.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
+        let (mut folded_nets, mut touching) = (0, 0);
+        let mut worst: f64 = 0.0;
+        for &tree in trees {
+            let net = layout.lay_flat(tree);
+            if !net.overlapping_pairs().is_empty() {
+                continue;
+            }
+            let made = match net_pattern(solid, &net, name) {
+                Ok(made) => made,
+                Err(e) if e.to_string().contains("touches itself") => {
+                    touching += 1;
+                    continue;
+                }
+                Err(e) => panic!("{name}: {e}"),
+            };
+            assert_eq!(made.seams.len(), solid.dual_edges().len() - solid.faces.len() + 1);
+            let targets = made.pattern.target_angles.clone().unwrap();
+            let model = FoldingModel::new(made.pattern.clone()).unwrap();
+            let fold_angles: Vec<f64> = model.pattern.creases.iter().map(|&e| targets[e]).collect();
+            let mut poses = Vec::new();
+            panel_poses(&model, &fold_angles, &mut poses);
+            let folded: Vec<Point3<f64>> = vertex_positions(&model, &poses).into_iter().map(Point3::from).collect();
+            let on_solid: Vec<Point3<f64>> = made.solid_vertex.iter().map(|&v| solid.vertices[v]).collect();
+            let distance = fitted_distance(&folded, &on_solid);
+            assert!(
+                distance <= 1e-12 * size,
+                "{name}: a net lands {distance:e} off its solid"
+            );
+            // Each seam's two edges meet: their ends are copies of the same solid vertices,
+            // now at the same places.
+            for [a, b] in &made.seams {
+                let ends = |e: usize| model.pattern.edges[e].map(|v| made.solid_vertex[v]);
+                let (mut x, mut y) = (ends(*a), ends(*b));
+                x.sort_unstable();
+                y.sort_unstable();
+                assert_eq!(x, y, "{name}: a seam's edges are one edge of the solid");
+            }
+            worst = worst.max(distance / size);
+            folded_nets += 1;
+        }
+        eprintln!("{name}: {folded_nets} nets folded onto the solid, worst {worst:.1e} of its size; {touching} touch themselves");
+        // A convex solid's nets never touch themselves; the L tromino's flat sides may.
+        assert!(folded_nets > 0 && (touching == 0 || *name == "L tromino"));
+    }
+}
+
+#[test]
+fn a_nets_fold_file_reads_back_with_its_targets_and_seams() {
+    use nanofold::geometry::nets::lay_flat;
+    use nanofold::geometry::unfoldings::spanning_trees;
+    use nanofold::pattern::net::net_pattern;
+    use nanofold::read::parse_crease_pattern;
+    use nanofold::write::net_output::{net_fold, SEAMS_KEY, SOLID_VERTEX_KEY};
+    let octahedron = solids::octahedron().unwrap();
+    let tree = spanning_trees(&octahedron, 1000).unwrap()[17];
+    let made = net_pattern(&octahedron, &lay_flat(&octahedron, tree), "octahedron").unwrap();
+    let fold = net_fold(&made, "a net of the octahedron");
+    let read = parse_crease_pattern(&fold.to_string(), "octahedron", "octahedron.fold").unwrap();
+    // The octahedron's dihedral is acos(-1/3): each fold turns by its supplement, a valley.
+    let turn = std::f64::consts::PI - (-1.0_f64 / 3.0).acos();
+    // A tree of panels closes no vertex, so its angles read as a state: the closed solid.
+    let angles = read.target_angles.clone().unwrap_or_else(|| read.fold_angles.clone());
+    assert_eq!(read.creases.len(), 7);
+    for &e in &read.creases {
+        assert!((angles[e] - turn).abs() < 1e-12, "{} against {turn}", angles[e]);
+    }
+    assert_eq!(fold[SEAMS_KEY].as_array().unwrap().len(), 12 - 8 + 1);
+    assert_eq!(fold[SOLID_VERTEX_KEY].as_array().unwrap().len(), read.vertices.len());
+    for pair in fold[SEAMS_KEY].as_array().unwrap() {
+        for e in pair.as_array().unwrap() {
+            assert_eq!(fold["edges_assignment"][e.as_u64().unwrap() as usize], "B");
+        }
+    }
+}

@@ -3,7 +3,7 @@
 //! generated solids, the face-adjacency (dual) graph, its number of spanning trees (the edge
 //! unfoldings) and the solid's symmetry group found from its geometry.
 
-use super::surface_intersection::first_self_intersection;
+use super::surface_intersection::{first_self_intersection, newell_normal};
 use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, Matrix3, Point3, Vector3};
 use std::collections::HashMap;
@@ -97,7 +97,7 @@ impl Polyhedron {
                 "a solid is one closed surface",
             ));
         }
-        if let Some((f, g)) = first_self_intersection(&solid, 1e-9 * solid.size()) {
+        if let Some((f, g)) = first_self_intersection(&solid.vertices, &solid.faces, 1e-9 * solid.size()) {
             return Err(NanofoldError::invalid(
                 format!("faces[{f}]"),
                 format!("meets faces[{g}]"),
@@ -282,11 +282,8 @@ impl Polyhedron {
 
     /// Newell's normal of a face: outward, its length twice the face's area.
     pub fn face_normal(&self, f: usize) -> Vector3<f64> {
-        let face = &self.faces[f];
-        (0..face.len()).fold(Vector3::zeros(), |n, k| {
-            let (a, b) = (self.vertices[face[k]], self.vertices[face[(k + 1) % face.len()]]);
-            n + a.coords.cross(&b.coords)
-        })
+        let points: Vec<Point3<f64>> = self.faces[f].iter().map(|&v| self.vertices[v]).collect();
+        newell_normal(&points)
     }
 
     /// A face's vertex centroid.

@@ -2,7 +2,6 @@
 //! convex faces tested in pairs, each pair along the line where their planes meet.
 
 use super::broad_phase::overlapping_pairs;
-use super::polyhedron::Polyhedron;
 use nalgebra::{Point3, Vector3};
 
 /// The interval of the line (origin + s·direction) that a convex face covers, or None when
@@ -33,15 +32,26 @@ fn cut(
     (interval.0 <= interval.1).then_some(interval)
 }
 
-/// The first pair of faces (f < g) whose interiors meet: faces that share an edge or a corner
-/// may touch there, nowhere else. Faces must be planar and convex. `tolerance` is a length.
-pub fn first_self_intersection(solid: &Polyhedron, tolerance: f64) -> Option<(usize, usize)> {
-    let faces: Vec<Vec<Point3<f64>>> = solid
-        .faces
+/// A polygon's area vector (Newell): its normal, as long as twice its area.
+pub fn newell_normal(points: &[Point3<f64>]) -> Vector3<f64> {
+    (0..points.len()).fold(Vector3::zeros(), |n, k| {
+        n + points[k].coords.cross(&points[(k + 1) % points.len()].coords)
+    })
+}
+
+/// The first pair of faces (f < g) of the surface (`vertices`, `faces`) whose interiors
+/// meet: faces that share an edge or a corner may touch there, nowhere else. Faces must be
+/// planar and convex. `tolerance` is a length.
+pub fn first_self_intersection(
+    vertices: &[Point3<f64>],
+    faces: &[Vec<usize>],
+    tolerance: f64,
+) -> Option<(usize, usize)> {
+    let corners: Vec<Vec<Point3<f64>>> = faces
         .iter()
-        .map(|face| face.iter().map(|&v| solid.vertices[v]).collect())
+        .map(|face| face.iter().map(|&v| vertices[v]).collect())
         .collect();
-    let boxes: Vec<([f64; 3], [f64; 3])> = faces
+    let boxes: Vec<([f64; 3], [f64; 3])> = corners
         .iter()
         .map(|points| {
             let mut bounds = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -54,15 +64,17 @@ pub fn first_self_intersection(solid: &Polyhedron, tolerance: f64) -> Option<(us
             bounds
         })
         .collect();
-    let planes: Vec<(Vector3<f64>, f64)> = (0..faces.len())
-        .map(|f| {
-            let normal = solid.face_normal(f).normalize();
-            (normal, normal.dot(&solid.face_centroid(f).coords))
+    let planes: Vec<(Vector3<f64>, f64)> = corners
+        .iter()
+        .map(|points| {
+            let normal = newell_normal(points).normalize();
+            let centre = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
+            (normal, normal.dot(&centre))
         })
         .collect();
     overlapping_pairs(&boxes).into_iter().find(|&(f, g)| {
-        let shared = solid.faces[f].iter().filter(|v| solid.faces[g].contains(v)).count();
-        faces_meet((&faces[f], &planes[f]), (&faces[g], &planes[g]), shared, tolerance)
+        let shared = faces[f].iter().filter(|v| faces[g].contains(v)).count();
+        faces_meet((&corners[f], &planes[f]), (&corners[g], &planes[g]), shared, tolerance)
     })
 }
 

@@ -1,0 +1,199 @@
+//! A solid's flat net as a crease pattern (`docs/model.md#nets-of-polyhedra`): laid with its
+//! inside up, so every convex fold is a valley, its target the turn between the two faces'
+//! outward normals; each cut edge a pair of boundary edges (a seam) that must meet again.
+
+use super::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
+use super::Assignment;
+use crate::error::{NanofoldError, Result};
+use crate::geometry::nets::FlatNet;
+use crate::geometry::polyhedron::Polyhedron;
+use std::collections::HashMap;
+
+/// A net's crease pattern and what ties it back to its solid.
+#[derive(Debug, Clone)]
+pub struct NetPattern {
+    /// The flat sheet: faces in the solid's order, folds as creases (or facet edges between
+    /// faces in one plane), the cut boundary; its `target_angles` fold it onto the solid.
+    pub pattern: CreasePattern,
+    /// Each seam: the pattern's two boundary edges that are one edge of the solid.
+    pub seams: Vec<[usize; 2]>,
+    /// The solid's vertex each pattern vertex is a copy of.
+    pub solid_vertex: Vec<usize>,
+}
+
+/// Union–find over the faces' corners.
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// The fold angle that takes face `b` to its place beside face `a` on the solid, seen with
+/// the inside up: the turn between their outward normals, positive where the edge is convex.
+fn fold_angle(solid: &Polyhedron, a: usize, b: usize) -> f64 {
+    let (na, nb) = (solid.face_normal(a).normalize(), solid.face_normal(b).normalize());
+    let turn = na.cross(&nb).norm().atan2(na.dot(&nb));
+    let towards_b = solid.face_centroid(b) - solid.face_centroid(a);
+    if towards_b.dot(&na) > 0.0 {
+        -turn
+    } else {
+        turn
+    }
+}
+
+/// Two copies of solid vertices at one place: the net touches itself there (at a point, or
+/// along a seam whose two sides lie on each other), which a crease pattern cannot hold.
+fn touching_copies(vertices: &[[f64; 2]], solid_vertex: &[usize]) -> Result<()> {
+    let size = vertices.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let tolerance = 1e-9 * size.max(f64::MIN_POSITIVE);
+    let mut order: Vec<usize> = (0..vertices.len()).collect();
+    order.sort_by(|&a, &b| vertices[a][0].total_cmp(&vertices[b][0]));
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if vertices[b][0] - vertices[a][0] > tolerance {
+                break;
+            }
+            if (vertices[b][1] - vertices[a][1]).abs() <= tolerance {
+                return Err(NanofoldError::invalid(
+                    "net",
+                    format!("copies of the solid's vertices {} and {} at one point", solid_vertex[a], solid_vertex[b]),
+                    "the net touches itself there (a point, or a seam whose sides lie on each other): no crease pattern holds it",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `net` of `solid` as a crease pattern named `name`; a net that touches itself is refused.
+pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetPattern> {
+    let edges = solid.dual_edges();
+    // Corners as (face, position in the face), numbered by their face's offset.
+    let offsets: Vec<usize> = solid
+        .faces
+        .iter()
+        .scan(0, |total, face| {
+            let start = *total;
+            *total += face.len();
+            Some(start)
+        })
+        .collect();
+    let corner_count: usize = solid.faces.iter().map(Vec::len).sum();
+    let corner = |f: usize, v: usize| -> usize {
+        offsets[f]
+            + solid.faces[f]
+                .iter()
+                .position(|&w| w == v)
+                .expect("the edge's vertex is on its face")
+    };
+    let mut parent: Vec<usize> = (0..corner_count).collect();
+    for &k in &net.folds {
+        let e = &edges[k];
+        for v in e.vertices {
+            let (a, b) = (
+                root(&mut parent, corner(e.faces[0], v)),
+                root(&mut parent, corner(e.faces[1], v)),
+            );
+            parent[a] = b;
+        }
+    }
+    // Each class of corners is one vertex of the sheet, mirrored (x → −x) so the inside is up.
+    let mut vertex_of_root: HashMap<usize, usize> = HashMap::new();
+    let mut vertices: Vec<[f64; 2]> = Vec::new();
+    let mut solid_vertex = Vec::new();
+    let mut vertex_of_corner = vec![0; corner_count];
+    for (f, face) in solid.faces.iter().enumerate() {
+        for (i, &v) in face.iter().enumerate() {
+            let r = root(&mut parent, offsets[f] + i);
+            let index = *vertex_of_root.entry(r).or_insert_with(|| {
+                let p = net.faces[f][i];
+                vertices.push([-p.x, p.y]);
+                solid_vertex.push(v);
+                vertices.len() - 1
+            });
+            vertex_of_corner[offsets[f] + i] = index;
+        }
+    }
+    touching_copies(&vertices, &solid_vertex)?;
+    // Faces reversed by the mirror, so counter-clockwise again.
+    let faces: Vec<Vec<usize>> = solid
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            (0..face.len())
+                .rev()
+                .map(|i| vertex_of_corner[offsets[f] + i])
+                .collect()
+        })
+        .collect();
+    let mut edge_vertices: Vec<[usize; 2]> = Vec::new();
+    let mut kinds = Vec::new();
+    let mut targets = Vec::new();
+    let mut index_of: HashMap<[usize; 2], usize> = HashMap::new();
+    let mut add = |pair: [usize; 2], kind: EdgeKind, target: f64| -> usize {
+        let key = [pair[0].min(pair[1]), pair[0].max(pair[1])];
+        *index_of.entry(key).or_insert_with(|| {
+            edge_vertices.push(pair);
+            kinds.push(kind);
+            targets.push(target);
+            edge_vertices.len() - 1
+        })
+    };
+    let mut seams = Vec::new();
+    for (k, e) in edges.iter().enumerate() {
+        let side = |f: usize| {
+            [
+                vertex_of_corner[corner(f, e.vertices[0])],
+                vertex_of_corner[corner(f, e.vertices[1])],
+            ]
+        };
+        if net.folds.contains(&k) {
+            let rho = fold_angle(solid, e.faces[0], e.faces[1]);
+            let kind = if rho.abs() < 1e-12 {
+                EdgeKind::Facet
+            } else if rho > 0.0 {
+                EdgeKind::Crease(Assignment::Valley)
+            } else {
+                EdgeKind::Crease(Assignment::Mountain)
+            };
+            add(side(e.faces[0]), kind, if rho.abs() < 1e-12 { 0.0 } else { rho });
+        } else {
+            let pair = [
+                add(side(e.faces[0]), EdgeKind::Boundary, 0.0),
+                add(side(e.faces[1]), EdgeKind::Boundary, 0.0),
+            ];
+            if pair[0] == pair[1] {
+                return Err(NanofoldError::invalid(
+                    format!("seam {k}"),
+                    format!("edge {}–{}", e.vertices[0], e.vertices[1]),
+                    "both sides of a cut landed on one edge of the net",
+                ));
+            }
+            seams.push(pair);
+        }
+    }
+    let edge_count = edge_vertices.len();
+    let pattern = CreasePatternBuilder {
+        name: name.to_string(),
+        vertices,
+        edges: edge_vertices,
+        kinds,
+        fold_angles: vec![0.0; edge_count],
+        faces: Some(faces),
+        angle_field: "edges_foldAngle".into(),
+        ..Default::default()
+    }
+    .with_reading(
+        "a net of a solid: its fold angles are the targets that close it".into(),
+        Some(targets),
+    )
+    .build()?;
+    Ok(NetPattern {
+        pattern,
+        seams,
+        solid_vertex,
+    })
+}
