@@ -92,6 +92,11 @@ pub enum Command {
     /// separate, residuals; writes fit.json, fit.csv, fitted.scene.json, fit.svg and the fitted
     /// motion's page response.html.
     Fit(FitArgs),
+    /// The distinct nets of a solid (a .off, .obj or .fold file, or a generated one such as
+    /// cube, box:1x2x3, prism:6, polycube:0,0,0;1,0,0), each laid flat, tested for overlap,
+    /// scored and ranked (`docs/model.md#nets-of-polyhedra`); writes nets.json, nets.csv,
+    /// the best nets as FOLD crease patterns (net_<rank>.fold) and gallery.svg.
+    Nets(NetsArgs),
     /// Write a scene in another tool's format: `export mujoco SCENE` writes one complete MJCF
     /// model (`docs/model.md#mujoco-scenes`).
     Export {
@@ -207,6 +212,47 @@ pub struct FitArgs {
     /// Print the report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Arguments of `nanofold nets`.
+#[derive(Args)]
+pub struct NetsArgs {
+    /// The solid: a .off, .obj or .fold file, or tetrahedron, cube, octahedron,
+    /// dodecahedron, icosahedron, truncated_tetrahedron, cuboctahedron,
+    /// truncated_octahedron, box:AxBxC, prism:N[:H], antiprism:N[:H], pyramid:N[:H],
+    /// polycube:X,Y,Z;X,Y,Z;...
+    pub shape: String,
+    /// Enumerate every spanning tree when there are at most this many; else sample.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().max_trees)]
+    pub max_trees: usize,
+    /// Trees drawn uniformly (Wilson's algorithm) when they are too many to enumerate.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().samples)]
+    pub samples: usize,
+    /// The sampler's seed.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().seed)]
+    pub seed: u64,
+    /// The score the nets are ranked by, smallest first (nets that can be made come first).
+    #[arg(long, value_enum, default_value_t = RankByArg::RadiusOfGyration)]
+    pub rank_by: RankByArg,
+    /// How many of the best nets are written as FOLD and drawn.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().top)]
+    pub top: usize,
+    /// The length of the solid's unit in µm.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().unit_um, allow_negative_numbers = true)]
+    pub unit_um: f64,
+    /// Output folder (default: output/<shape>-nets/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RankByArg {
+    RadiusOfGyration,
+    SeamLength,
+    Footprint,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -1027,6 +1073,83 @@ const FIT_FLAGS: &[(&str, &str)] = &[
     ("free", "--free"),
 ];
 
+const NETS_FLAGS: &[(&str, &str)] = &[
+    ("max_trees", "--max-trees"),
+    ("samples", "--samples"),
+    ("top", "--top"),
+    ("unit_um", "--unit-um"),
+];
+
+fn run_nets(args: &NetsArgs) -> Result<()> {
+    use nanofold::commands::nets::{nets, nets_files, open_solid, NetsOptions, RankBy, Search};
+    let options = NetsOptions {
+        max_trees: args.max_trees,
+        samples: args.samples,
+        seed: args.seed,
+        rank_by: match args.rank_by {
+            RankByArg::RadiusOfGyration => RankBy::RadiusOfGyration,
+            RankByArg::SeamLength => RankBy::SeamLength,
+            RankByArg::Footprint => RankBy::Footprint,
+        },
+        top: args.top,
+        unit_um: args.unit_um,
+    };
+    let flags = |e| with_flags(e, NETS_FLAGS);
+    options.validate().map_err(flags)?;
+    let (name, solid) = open_solid(&args.shape).map_err(|e| anyhow::anyhow!("reading {}: {e}", args.shape))?;
+    let report = nets(&name, &solid, &options).map_err(flags)?;
+    let files = nets_files(&solid, &report, options.top)?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(folder_name(&format!("{name}-nets"), &name)));
+    let named: Vec<(&str, String)> = files.iter().map(|(n, t)| (n.as_str(), t.clone())).collect();
+    write_outputs(&dir, Path::new(&args.shape), &named)?;
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    let how = match report.search {
+        Search::Enumerated => format!("all {} spanning trees enumerated", report.trees_considered),
+        Search::Sampled => format!(
+            "{} of its {:.3e} spanning trees sampled uniformly",
+            report.trees_considered, report.spanning_trees
+        ),
+    };
+    println!(
+        "{}: {} faces, {} edges, {} vertices, symmetry group of order {} ({} rotations); {how}: {} distinct nets, {} overlapping ({:.2} s)",
+        report.solid,
+        report.faces,
+        report.edges,
+        report.vertices,
+        report.symmetry_order,
+        report.rotations,
+        report.distinct_nets,
+        report.overlapping,
+        report.seconds
+    );
+    for row in report.nets.iter().take(options.top) {
+        println!(
+            "  #{}: Rg {:.4} µm, {} leaves, seams {:.4} µm, footprint {:.4} × {:.4} µm{}",
+            row.rank,
+            row.radius_of_gyration_um,
+            row.leaves,
+            row.seam_length_um,
+            row.footprint_um[0],
+            row.footprint_um[1],
+            if row.overlapping {
+                ", overlaps"
+            } else if row.touching == Some(true) {
+                ", touches itself"
+            } else {
+                ""
+            }
+        );
+    }
+    println!("wrote {}", dir.display());
+    Ok(())
+}
+
 fn run_fit(args: &FitArgs) -> Result<()> {
     use nanofold::commands::{FitOptions, FreeOption, NoiseOption};
     let noise = match args.noise.as_slice() {
@@ -1580,6 +1703,7 @@ pub fn run(cli: Cli) -> Result<bool> {
         Command::Generate { kind } => folding::run_generate(&kind).map(|_| true),
         Command::Simulate(args) => run_simulate(&args).map(|_| true),
         Command::Fit(args) => run_fit(&args).map(|_| true),
+        Command::Nets(args) => run_nets(&args).map(|_| true),
         Command::Modes { scene, json, out } => run_modes(&scene, json, out.as_deref()).map(|_| true),
         Command::Export { format } => run_export(&format).map(|_| true),
     }

@@ -43,6 +43,7 @@ use std::time::Instant;
 mod constraints;
 mod fit;
 mod generate;
+pub mod nets;
 pub mod options;
 pub mod outputs;
 mod scene;

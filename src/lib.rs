@@ -98,6 +98,7 @@
 pub mod calibrate;
 pub mod commands;
 pub mod constraints;
+pub mod design;
 pub mod dynamics;
 pub mod error;
 pub mod folding;

@@ -4,6 +4,7 @@
 mod canvas;
 pub(crate) mod fit;
 pub(crate) mod folding;
+pub(crate) mod nets;
 pub(crate) mod page;
 pub(crate) mod response;
 pub(crate) mod scene_page;

@@ -1471,3 +1471,51 @@ fn fit_writes_its_files_and_refuses_bad_input_by_name_writing_nothing() {
     }
     let _ = std::fs::remove_file(&short);
 }
+
+#[test]
+fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
+    let dir = temp_dir("nets-cube");
+    let (out, report) = json_run(
+        nanofold()
+            .args(["nets", "cube", "--top", "3", "--json", "--out"])
+            .arg(&dir),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report["distinct_nets"], 11);
+    assert_eq!(report["symmetry_order"], 48);
+    assert_eq!(report["search"], "enumerated");
+    let rg: Vec<f64> = report["nets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["radius_of_gyration_um"].as_f64().unwrap())
+        .collect();
+    assert!(rg.windows(2).all(|w| w[0] <= w[1]), "ranked by Rg: {rg:?}");
+    for k in 1..=3 {
+        let fold = std::fs::read_to_string(dir.join(format!("net_{k:03}.fold"))).unwrap();
+        let pattern = nanofold::read::parse_crease_pattern(&fold, "net", "net.fold").unwrap();
+        assert_eq!((pattern.faces.len(), pattern.creases.len()), (6, 5));
+    }
+    assert!(!dir.join("net_004.fold").exists());
+    for name in ["nets.json", "nets.csv", "gallery.svg"] {
+        assert!(dir.join(name).exists(), "{name}");
+    }
+    let csv = std::fs::read_to_string(dir.join("nets.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 12);
+    // A bad shape or setting is refused by name, with nothing written.
+    let bad_dir = temp_dir("nets-bad");
+    for (args, part) in [
+        (vec!["nets", "box:1x2"], "box:AxBxC"),
+        (vec!["nets", "prism:2"], "sides"),
+        (vec!["nets", "cube", "--top", "500"], "--top"),
+        (vec!["nets", "cube", "--unit-um", "-1"], "--unit-um"),
+        (vec!["nets", "sphere"], "shape"),
+    ] {
+        let out = nanofold().args(&args).arg("--out").arg(&bad_dir).output().unwrap();
+        assert!(!out.status.success());
+        let message = String::from_utf8_lossy(&out.stderr);
+        assert!(message.contains(part), "{args:?}: {message}");
+        assert!(!bad_dir.exists(), "{args:?} wrote its folder");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -19,7 +19,7 @@ fn rank(module: &str) -> Option<usize> {
         "folding" => 4,
         "unfold" | "constraints" => 5,
         "dynamics" => 6,
-        "calibrate" => 7,
+        "calibrate" | "design" => 7,
         "write" => 8,
         "plot" => 9,
         "commands" => 10,

@@ -152,6 +152,20 @@ pub fn distinct_nets(trees: &[Tree], maps: &[Vec<usize>]) -> Vec<Tree> {
     representatives
 }
 
+/// One tree of each distinct net among some of a solid's trees (a sample): each tree's
+/// class is its smallest image, the classes in the order first met.
+pub fn distinct_among(trees: &[Tree], maps: &[Vec<usize>]) -> Vec<Tree> {
+    let mut seen = std::collections::HashSet::new();
+    let mut representatives = Vec::new();
+    for &tree in trees {
+        let smallest = maps.iter().map(|m| image(tree, m)).min().unwrap_or(tree).min(tree);
+        if seen.insert(smallest) {
+            representatives.push(smallest);
+        }
+    }
+    representatives
+}
+
 /// Burnside's count of the same orbits: the mean, over the group, of the trees each
 /// symmetry fixes.
 pub fn burnside_nets(trees: &[Tree], maps: &[Vec<usize>]) -> f64 {

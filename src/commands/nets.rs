@@ -1,0 +1,147 @@
+//! Nets of a solid behind the door (`docs/model.md#nets-of-polyhedra`): a shape in (a file
+//! or a generated solid), its ranked nets out ([`crate::design::nets`]), and the files
+//! `nanofold nets` writes (nets.json, nets.csv, the best nets as FOLD crease patterns,
+//! gallery.svg).
+
+pub use crate::design::nets::{
+    best_net_patterns, nets, NetRow, NetsOptions, NetsReport, RankBy, Search, MAX_ENUMERATED_TREES, MAX_SAMPLED_TREES,
+    MAX_WRITTEN_NETS,
+};
+use crate::error::{NanofoldError, Result};
+use crate::geometry::polyhedron::Polyhedron;
+use crate::geometry::solids;
+use crate::pattern::net::NetPattern;
+use std::path::Path;
+
+/// A solid from a file (`.off`, `.obj`, `.fold`) or a generator's name: `tetrahedron`,
+/// `cube`, `octahedron`, `dodecahedron`, `icosahedron`, `truncated_tetrahedron`,
+/// `cuboctahedron`, `truncated_octahedron`, `box:AxBxC`, `prism:N[:H]`, `antiprism:N[:H]`,
+/// `pyramid:N[:H]`, `polycube:X,Y,Z;X,Y,Z;…`. Returns its name and the solid.
+pub fn open_solid(shape: &str) -> Result<(String, Polyhedron)> {
+    let path = Path::new(shape);
+    let is_file = matches!(
+        path.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref(),
+        Some("off" | "obj" | "fold")
+    );
+    if is_file {
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("solid").to_string();
+        return Ok((name, crate::read::solid::load_solid(path)?));
+    }
+    let (kind, rest) = shape.split_once(':').unwrap_or((shape, ""));
+    let bad = |why: &str| NanofoldError::invalid("shape", shape, why.to_string());
+    let number = |text: &str| -> Result<f64> {
+        text.trim()
+            .parse::<f64>()
+            .map_err(|_| bad("a number was expected after the solid's name"))
+    };
+    let sides_and_height = || -> Result<(usize, f64)> {
+        let mut parts = rest.split(':');
+        let sides = parts
+            .next()
+            .and_then(|n| n.trim().parse::<usize>().ok())
+            .ok_or_else(|| bad("give the number of sides, e.g. prism:6 or prism:6:2.5"))?;
+        let height = parts.next().map(number).transpose()?.unwrap_or(1.0);
+        Ok((sides, height))
+    };
+    let solid = match kind {
+        "tetrahedron" => solids::tetrahedron()?,
+        "cube" => solids::cube()?,
+        "octahedron" => solids::octahedron()?,
+        "dodecahedron" => solids::dodecahedron()?,
+        "icosahedron" => solids::icosahedron()?,
+        "truncated_tetrahedron" => solids::truncated_tetrahedron()?,
+        "cuboctahedron" => solids::cuboctahedron()?,
+        "truncated_octahedron" => solids::truncated_octahedron()?,
+        "box" => {
+            let sides: Vec<f64> = rest.split('x').map(number).collect::<Result<_>>()?;
+            let [a, b, c] = sides[..] else {
+                return Err(bad("a box is box:AxBxC"));
+            };
+            solids::cuboid(a, b, c)?
+        }
+        "prism" => {
+            let (n, h) = sides_and_height()?;
+            solids::prism(n, h)?
+        }
+        "antiprism" => {
+            let (n, h) = sides_and_height()?;
+            solids::antiprism(n, h)?
+        }
+        "pyramid" => {
+            let (n, h) = sides_and_height()?;
+            solids::pyramid(n, h)?
+        }
+        "polycube" => {
+            let mut cubes = Vec::new();
+            for cell in rest.split(';').filter(|c| !c.trim().is_empty()) {
+                let xyz: Vec<i64> = cell
+                    .split(',')
+                    .map(|x| x.trim().parse::<i64>())
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| bad("a polycube is polycube:X,Y,Z;X,Y,Z;… of integer cube positions"))?;
+                let [x, y, z] = xyz[..] else {
+                    return Err(bad("each cube has three integer coordinates"));
+                };
+                cubes.push([x, y, z]);
+            }
+            solids::polycube(&cubes)?
+        }
+        _ => return Err(bad(
+            "a .off, .obj or .fold file, or one of tetrahedron, cube, octahedron, dodecahedron, icosahedron, truncated_tetrahedron, cuboctahedron, truncated_octahedron, box:AxBxC, prism:N[:H], antiprism:N[:H], pyramid:N[:H], polycube:X,Y,Z;…",
+        )),
+    };
+    Ok((shape.replace([':', ';', ',', '/'], "_"), solid))
+}
+
+/// The ranked table as CSV.
+pub fn nets_csv(report: &NetsReport) -> String {
+    let mut csv = String::from(
+        "rank,radius_of_gyration_um,leaves,seam_length_um,footprint_long_um,footprint_short_um,overlapping,touching,folds\n",
+    );
+    for row in &report.nets {
+        csv += &format!(
+            "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{},{},{}\n",
+            row.rank,
+            row.radius_of_gyration_um,
+            row.leaves,
+            row.seam_length_um,
+            row.footprint_um[0],
+            row.footprint_um[1],
+            row.overlapping,
+            row.touching.map_or(String::new(), |t| t.to_string()),
+            row.folds.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(" ")
+        );
+    }
+    csv
+}
+
+/// The files `nanofold nets` writes: nets.json, nets.csv, net_<rank>.fold for the best
+/// `top` that can be made, and gallery.svg of them drawn to one scale.
+pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result<Vec<(String, String)>> {
+    let best = best_net_patterns(solid, report, top)?;
+    let mut files = vec![
+        (
+            "nets.json".to_string(),
+            serde_json::to_string_pretty(report).expect("a report is plain data"),
+        ),
+        ("nets.csv".to_string(), nets_csv(report)),
+    ];
+    for (rank, made) in &best {
+        let description = format!("net ranked {rank} of {} by {:?}", report.solid, report.rank_by);
+        let fold = crate::write::net_output::net_fold(made, &description);
+        files.push((
+            format!("net_{rank:03}.fold"),
+            serde_json::to_string_pretty(&fold).expect("FOLD is plain data"),
+        ));
+    }
+    let rows: Vec<&NetRow> = best.iter().map(|(rank, _)| &report.nets[rank - 1]).collect();
+    let patterns: Vec<&NetPattern> = best.iter().map(|(_, made)| made).collect();
+    files.push((
+        "gallery.svg".to_string(),
+        crate::plot::nets::gallery_svg(&report.solid, &patterns, &rows, report.rank_by, report.unit_um)?,
+    ));
+    Ok(files)
+}

@@ -1,0 +1,270 @@
+//! Ranking a solid's nets (`docs/model.md#nets-of-polyhedra`): every distinct edge
+//! unfolding (or those met in a uniform sample), laid flat, tested for overlap, scored and
+//! ranked, the best that can be made checked for touching themselves.
+
+use crate::error::{NanofoldError, Result};
+use crate::geometry::nets::NetLayout;
+use crate::geometry::polyhedron::Polyhedron;
+use crate::geometry::unfoldings::{distinct_among, distinct_nets, edge_map, sample_trees, spanning_trees, Tree};
+use crate::pattern::net::{net_pattern, NetPattern};
+use serde::{Deserialize, Serialize};
+
+/// The most trees enumerated; above it the trees are sampled.
+pub const MAX_ENUMERATED_TREES: usize = 10_000_000;
+/// The most trees sampled.
+pub const MAX_SAMPLED_TREES: usize = 1_000_000;
+/// The most nets written as files.
+pub const MAX_WRITTEN_NETS: usize = 100;
+
+/// The score nets are ranked by (smallest first); every ranking puts the nets that can be
+/// made (no overlap, not touching themselves) first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum RankBy {
+    /// Compactness: the flat net's radius of gyration.
+    #[default]
+    RadiusOfGyration,
+    /// The total length of the seams that must meet again.
+    SeamLength,
+    /// The area of the smallest rectangle holding the net.
+    Footprint,
+}
+
+/// `nets`' options, as the command line and Python give them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NetsOptions {
+    /// Enumerate every tree when the solid has at most this many; else sample.
+    pub max_trees: usize,
+    /// Trees drawn uniformly when they are too many to enumerate.
+    pub samples: usize,
+    /// The sampler's seed.
+    pub seed: u64,
+    /// The ranking.
+    pub rank_by: RankBy,
+    /// How many of the best nets are written as crease patterns and drawn.
+    pub top: usize,
+    /// The length of the solid's unit in µm (scales the lengths reported).
+    pub unit_um: f64,
+}
+
+impl Default for NetsOptions {
+    fn default() -> Self {
+        NetsOptions {
+            max_trees: MAX_ENUMERATED_TREES,
+            samples: 20_000,
+            seed: 1,
+            rank_by: RankBy::RadiusOfGyration,
+            top: 10,
+            unit_um: 1.0,
+        }
+    }
+}
+
+impl NetsOptions {
+    /// Refuses options out of range by name.
+    pub fn validate(&self) -> Result<()> {
+        if self.max_trees == 0 || self.max_trees > MAX_ENUMERATED_TREES {
+            return Err(NanofoldError::invalid(
+                "max_trees",
+                self.max_trees,
+                format!("from 1 to {MAX_ENUMERATED_TREES}"),
+            ));
+        }
+        if self.samples == 0 || self.samples > MAX_SAMPLED_TREES {
+            return Err(NanofoldError::invalid(
+                "samples",
+                self.samples,
+                format!("from 1 to {MAX_SAMPLED_TREES}"),
+            ));
+        }
+        if self.top > MAX_WRITTEN_NETS {
+            return Err(NanofoldError::invalid(
+                "top",
+                self.top,
+                format!("at most {MAX_WRITTEN_NETS}"),
+            ));
+        }
+        if !(self.unit_um.is_finite() && self.unit_um > 0.0) {
+            return Err(NanofoldError::invalid("unit_um", self.unit_um, "a length > 0"));
+        }
+        Ok(())
+    }
+}
+
+/// What was done to find the nets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Search {
+    /// Every spanning tree enumerated: every net is here.
+    Enumerated,
+    /// Trees drawn uniformly (Wilson's algorithm): the nets met among them.
+    Sampled,
+}
+
+/// One distinct net and its scores, lengths in µm.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NetRow {
+    /// 1 for the best.
+    pub rank: usize,
+    /// The solid's edges (dual edges) that are folds.
+    pub folds: Vec<usize>,
+    /// The flat net's radius of gyration.
+    pub radius_of_gyration_um: f64,
+    /// Faces with one fold.
+    pub leaves: usize,
+    /// Total length of the cut edges.
+    pub seam_length_um: f64,
+    /// The smallest rectangle holding the net: (long side, short side).
+    pub footprint_um: [f64; 2],
+    /// Two faces of the flat net overlap: it cannot be made.
+    pub overlapping: bool,
+    /// The net touches itself at a point or along a seam (checked for the nets written).
+    pub touching: Option<bool>,
+}
+
+/// The solid and its nets.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NetsReport {
+    /// The solid's name.
+    pub solid: String,
+    /// Faces, edges, vertices.
+    pub faces: usize,
+    /// Edges of the solid (of its dual graph).
+    pub edges: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Order of the symmetry group (rotations and reflections).
+    pub symmetry_order: usize,
+    /// Rotations among them.
+    pub rotations: usize,
+    /// Spanning trees by the matrix-tree theorem.
+    pub spanning_trees: f64,
+    /// Enumerated or sampled.
+    pub search: Search,
+    /// Trees looked at.
+    pub trees_considered: usize,
+    /// Distinct nets found (all of them when enumerated).
+    pub distinct_nets: usize,
+    /// Of those, how many overlap.
+    pub overlapping: usize,
+    /// The ranking.
+    pub rank_by: RankBy,
+    /// The length of the solid's unit in µm.
+    pub unit_um: f64,
+    /// The nets, best first.
+    pub nets: Vec<NetRow>,
+    /// Seconds taken.
+    pub seconds: f64,
+}
+
+/// Finds, lays flat, tests and ranks the distinct nets of `solid`.
+pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<NetsReport> {
+    options.validate()?;
+    let started = std::time::Instant::now();
+    let symmetries = solid.symmetries();
+    let maps: Vec<Vec<usize>> = symmetries.iter().map(|s| edge_map(solid, s)).collect();
+    let count = solid.spanning_tree_count();
+    let (search, trees) = if count <= options.max_trees as f64 {
+        (Search::Enumerated, spanning_trees(solid, options.max_trees)?)
+    } else {
+        (Search::Sampled, sample_trees(solid, options.samples, options.seed)?)
+    };
+    let distinct = match search {
+        Search::Enumerated => distinct_nets(&trees, &maps),
+        Search::Sampled => distinct_among(&trees, &maps),
+    };
+    let layout = NetLayout::new(solid);
+    let unit = options.unit_um;
+    let mut rows: Vec<(Tree, NetRow)> = distinct
+        .iter()
+        .map(|&tree| {
+            let net = layout.lay_flat(tree);
+            let (long, short) = net.footprint();
+            let row = NetRow {
+                rank: 0,
+                folds: net.folds.clone(),
+                radius_of_gyration_um: net.radius_of_gyration() * unit,
+                leaves: layout.leaves(tree),
+                seam_length_um: layout.seam_length(tree) * unit,
+                footprint_um: [long * unit, short * unit],
+                overlapping: !net.overlapping_pairs().is_empty(),
+                touching: None,
+            };
+            (tree, row)
+        })
+        .collect();
+    let key = |row: &NetRow| match options.rank_by {
+        RankBy::RadiusOfGyration => row.radius_of_gyration_um,
+        RankBy::SeamLength => row.seam_length_um,
+        RankBy::Footprint => row.footprint_um[0] * row.footprint_um[1],
+    };
+    rows.sort_by(|(ta, a), (tb, b)| {
+        a.overlapping
+            .cmp(&b.overlapping)
+            .then(key(a).total_cmp(&key(b)))
+            .then(ta.cmp(tb))
+    });
+    // The best nets that can be made: those touching themselves move down among the
+    // overlapping ones.
+    let mut checked = 0;
+    for (tree, row) in rows.iter_mut() {
+        if checked >= options.top || row.overlapping {
+            break;
+        }
+        let touching = net_pattern(solid, &layout.lay_flat(*tree), name).is_err();
+        row.touching = Some(touching);
+        if !touching {
+            checked += 1;
+        }
+    }
+    rows.sort_by_key(|(_, row)| row.overlapping || row.touching == Some(true));
+    let overlapping = rows.iter().filter(|(_, r)| r.overlapping).count();
+    let nets: Vec<NetRow> = rows
+        .into_iter()
+        .enumerate()
+        .map(|(k, (_, mut row))| {
+            row.rank = k + 1;
+            row
+        })
+        .collect();
+    Ok(NetsReport {
+        solid: name.to_string(),
+        faces: solid.faces.len(),
+        edges: solid.dual_edges().len(),
+        vertices: solid.vertices.len(),
+        symmetry_order: symmetries.len(),
+        rotations: symmetries.iter().filter(|s| s.is_rotation()).count(),
+        spanning_trees: count,
+        search,
+        trees_considered: trees.len(),
+        distinct_nets: nets.len(),
+        overlapping,
+        rank_by: options.rank_by,
+        unit_um: unit,
+        nets,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The tree of a ranked net.
+fn tree_of(row: &NetRow) -> Tree {
+    row.folds.iter().fold(0, |t, &k| t | 1 << k)
+}
+
+/// The best `top` nets that can be made, as crease patterns.
+pub fn best_net_patterns(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result<Vec<(usize, NetPattern)>> {
+    let layout = NetLayout::new(solid);
+    report
+        .nets
+        .iter()
+        .filter(|row| !row.overlapping && row.touching == Some(false))
+        .take(top)
+        .map(|row| {
+            Ok((
+                row.rank,
+                net_pattern(solid, &layout.lay_flat(tree_of(row)), &report.solid)?,
+            ))
+        })
+        .collect()
+}
