@@ -14,8 +14,8 @@ numeric lists as numpy arrays.
 """
 
 from . import generate
-from ._core import Pattern, Scene, check, constraints, fit, fold, modes, simulate, unfold
-from ._results import FitResult, FoldResult, PatternResult, Result, SimulationResult
+from ._core import Pattern, Scene, check, constraints, fit, fold, modes, nets, simulate, unfold
+from ._results import FitResult, FoldResult, NetsResult, PatternResult, Result, SimulationResult
 from ._sweep import sweep
 from .errors import (
     ClosureError,
@@ -42,6 +42,7 @@ __all__ = [
     "simulate",
     "modes",
     "fit",
+    "nets",
     "sweep",
     "generate",
     "Result",
@@ -49,6 +50,7 @@ __all__ = [
     "FoldResult",
     "SimulationResult",
     "FitResult",
+    "NetsResult",
     "NanofoldError",
     "InputError",
     "InvalidFieldError",

@@ -10,7 +10,7 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 import numpy as np
 
 from . import _native
-from ._results import FitResult, FoldResult, PatternResult, Result, SimulationResult
+from ._results import FitResult, FoldResult, NetsResult, PatternResult, Result, SimulationResult
 from .errors import from_native
 
 T = TypeVar("T")
@@ -494,6 +494,33 @@ def fit(
         _native.fit, json.dumps(s._spec), s._source, s._fallback, s._base, text, source, _settings(keywords)
     )
     return FitResult("fit", summary, rest)
+
+
+def nets(
+    shape: Union[str, "os.PathLike[str]"],
+    *,
+    max_trees: Optional[int] = None,
+    samples: Optional[int] = None,
+    seed: Optional[int] = None,
+    rank_by: Optional[str] = None,
+    top: Optional[int] = None,
+    unit_um: Optional[float] = None,
+) -> NetsResult:
+    """The distinct nets of a solid (``nanofold nets``): ``shape`` is a .off, .obj or .fold
+    file, or a generated solid (``"cube"``, ``"box:1x2x3"``, ``"prism:6"``,
+    ``"polycube:0,0,0;1,0,0"``, ...). Every net is laid flat, tested for overlap and scored
+    (radius of gyration, leaves, seam length, footprint); ``rank_by`` is
+    ``"radius_of_gyration"`` (default), ``"seam_length"`` or ``"footprint"``; the ``top``
+    best that can be made come back as FOLD crease patterns.
+
+    >>> import nanofold
+    >>> r = nanofold.nets("cube", top=3)
+    >>> r.distinct_nets, r.symmetry_order, len(r.folds)
+    (11, 48, 3)
+    """
+    keywords = dict(max_trees=max_trees, samples=samples, seed=seed, rank_by=rank_by, top=top, unit_um=unit_um)
+    summary, rest = _call(_native.nets, os.fspath(shape), _settings(keywords))
+    return NetsResult("nets", summary, rest)
 
 
 def modes(scene: SceneLike) -> Result:

@@ -184,3 +184,27 @@ class FitResult(Result):
         import pandas as pd  # type: ignore[import-untyped]
 
         return pd.read_csv(io.StringIO(self._payload["table_csv"]))
+
+
+class NetsResult(Result):
+    """``nets``: the report (``solid``, ``symmetry_order``, ``distinct_nets``, ``overlapping``,
+    ``nets`` ranked best first, ...), the ranked table, the best nets as FOLD and the gallery."""
+
+    @property
+    def table(self) -> "Any":
+        """The ranked nets with their scores (a pandas DataFrame, as nets.csv)."""
+        import io
+
+        import pandas as pd  # type: ignore[import-untyped]
+
+        return pd.read_csv(io.StringIO(self._payload["table_csv"]))
+
+    @property
+    def folds(self) -> List[Dict[str, Any]]:
+        """The best nets that can be made, as FOLD crease patterns (net_<rank>.fold)."""
+        return copy.deepcopy(self._payload["folds"])
+
+    @property
+    def gallery_svg(self) -> str:
+        """The best nets drawn to one scale (gallery.svg)."""
+        return str(self._payload["gallery_svg"])

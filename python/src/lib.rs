@@ -383,6 +383,37 @@ fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(St
     })
 }
 
+/// `nets`: a solid (a file path or a generated solid's name) and its ranked nets; the
+/// report, and the ranked table (CSV), the best nets as FOLD and the gallery.
+#[pyfunction]
+fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, String)> {
+    let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
+    options.validate().map_err(to_py)?;
+    run_detached(py, move || {
+        let clock = Instant::now();
+        let (name, solid) = commands::nets::open_solid(&shape)?;
+        let report = commands::nets::nets(&name, &solid, &options)?;
+        let summary = serde_json::to_value(&report).expect("a report is plain data");
+        let files = commands::nets::nets_files(&solid, &report, options.top)?;
+        let mut folds = Vec::new();
+        let mut rest = serde_json::Map::new();
+        for (file, text) in files {
+            if file.ends_with(".fold") {
+                folds.push(
+                    serde_json::from_str::<Value>(&text)
+                        .map_err(|e| NanofoldError::invalid("fold", file.clone(), e.to_string()))?,
+                );
+            } else if file == "nets.csv" {
+                rest.insert("table_csv".into(), Value::String(text));
+            } else if file == "gallery.svg" {
+                rest.insert("gallery_svg".into(), Value::String(text));
+            }
+        }
+        rest.insert("folds".into(), Value::Array(folds));
+        Ok(payload(summary, Value::Object(rest), clock))
+    })
+}
+
 /// `fit`: a scene file's JSON (with the name, source and base folder its pattern path is
 /// relative to) fitted to measurement CSV text; the report, and the fitted scene with the
 /// table of measured against fitted values.
@@ -475,6 +506,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(simulate, m)?,
         wrap_pyfunction!(modes, m)?,
         wrap_pyfunction!(fit, m)?,
+        wrap_pyfunction!(nets, m)?,
         wrap_pyfunction!(noop, m)?,
         wrap_pyfunction!(wait, m)?,
         wrap_pyfunction!(version, m)?,

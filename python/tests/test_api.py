@@ -259,3 +259,18 @@ def test_fit_takes_a_dataframe_with_gaps_and_gives_the_estimate_its_interval_and
     assert r.fitted_scene.to_dict()["environment"]["drag_coefficient"] == p["estimate"]
     with pytest.raises(nanofold.InvalidFieldError, match="drag_coeficient"):
         nanofold.fit(scene, window, free={"environment.drag_coeficient": (0.2, 5)})
+
+
+def test_nets_rank_a_solids_nets_and_give_the_best_as_fold():
+    r = nanofold.nets("box:1x2x3", top=5, unit_um=50)
+    # A box of three different sides has 54 distinct nets (and a symmetry group of order 8).
+    assert (r.distinct_nets, r.symmetry_order, r.search) == (54, 8, "enumerated")
+    table = r.table
+    assert list(table["rank"]) == list(range(1, 55))
+    assert table["radius_of_gyration_um"].is_monotonic_increasing
+    assert len(r.folds) == 5 and all(f["nanofold:seams"] for f in r.folds)
+    assert r.gallery_svg.startswith("<svg")
+    with pytest.raises(nanofold.InvalidFieldError, match="top"):
+        nanofold.nets("cube", top=1000)
+    with pytest.raises(nanofold.InvalidFieldError, match="shape"):
+        nanofold.nets("sphere")

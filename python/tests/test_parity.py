@@ -84,3 +84,10 @@ def test_constraints_equal_the_command_line(tmp_path):
 def _first_crease(path):
     label = nanofold.Pattern.open(path).crease_labels[0]
     return int(label.split("[")[1].rstrip("]"))
+
+
+@pytest.mark.parametrize("shape", ["cube", "box:1x2x3", "pyramid:5:1.5"])
+def test_nets_equal_the_command_line(shape, tmp_path):
+    result = nanofold.nets(shape, top=4, rank_by="seam_length")
+    expected = cli_json("nets", shape, "--top", "4", "--rank-by", "seam-length", "--out", str(tmp_path / "n"))
+    assert comparable(result.to_dict()) == comparable(expected)
