@@ -35,6 +35,7 @@
 //! | [`constraints`] | the constraint curves: exact sweeps, polynomial fits, their errors |
 //! | [`dynamics`] | plates on hinges: models, mass matrices, forcing, contact, integration, modes, sensitivities |
 //! | [`calibrate`] | a scene's numbers fitted to a measured folding, with intervals and identifiability |
+//! | [`design`] | from a solid to its nets: every distinct edge unfolding, laid flat, scored and ranked |
 //! | [`write`](mod@write) | the writers: JSON reports, FOLD animations, MuJoCo models, output folders |
 //! | [`commands`] | the front door over all of the above |
 //! | `plot` | SVG figures and 3D pages (feature `plot`) |
@@ -90,7 +91,7 @@
 //!
 //! Each depends only on those before it (a test checks): [`geometry`] → [`pattern`] →
 //! [`read`] (the file readers) → [`folding`] → [`unfold`] and [`constraints`] → [`dynamics`]
-//! → [`calibrate`] → [`write`](mod@write) (the file writers) → `plot` (the figures and pages, feature
+//! → [`calibrate`] and [`design`] → [`write`](mod@write) (the file writers) → `plot` (the figures and pages, feature
 //! `plot`) → [`commands`] (the front door, which renders each command's files) → the
 //! `nanofold` binary (feature `cli`) and the Python package. [`error`]
 //! sits beneath them all; [`prelude`] gathers the names most programs need.

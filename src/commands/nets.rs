@@ -130,7 +130,7 @@ pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result
         ("nets.csv".to_string(), nets_csv(report)),
     ];
     for (rank, made) in &best {
-        let description = format!("net ranked {rank} of {} by {:?}", report.solid, report.rank_by);
+        let description = format!("net ranked {rank} of {} by {}", report.solid, report.rank_by.label());
         let fold = crate::write::net_output::net_fold(made, &description);
         files.push((
             format!("net_{rank:03}.fold"),

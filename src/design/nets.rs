@@ -30,6 +30,17 @@ pub enum RankBy {
     Footprint,
 }
 
+impl RankBy {
+    /// The score's name in words.
+    pub fn label(self) -> &'static str {
+        match self {
+            RankBy::RadiusOfGyration => "radius of gyration",
+            RankBy::SeamLength => "seam length",
+            RankBy::Footprint => "footprint",
+        }
+    }
+}
+
 /// `nets`' options, as the command line and Python give them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -48,8 +48,9 @@ pub fn gallery_svg(
         title
             .titled(
                 &format!(
-                    "{solid}: the {} best nets by {rank_by:?}, one scale (a cell is {:.3} µm across)",
+                    "{solid}: the {} best nets by {}, one scale (a cell is {:.3} µm across)",
                     nets.len(),
+                    rank_by.label(),
                     1.1 * extent * unit_um
                 ),
                 ("sans-serif", 16),
@@ -63,7 +64,7 @@ pub fn gallery_svg(
             let mut chart = ChartBuilder::on(area)
                 .caption(
                     format!(
-                        "#{}: Rg {:.3}, {} leaves, seams {:.2}, {:.2} × {:.2}",
+                        "#{}: Rg {:.3} µm, {} leaves, seams {:.2} µm, {:.2} × {:.2} µm",
                         row.rank,
                         row.radius_of_gyration_um,
                         row.leaves,
