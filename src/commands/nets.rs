@@ -118,7 +118,7 @@ pub fn nets_csv(report: &NetsReport) -> String {
     csv
 }
 
-/// The files `nanofold nets` writes: nets.json, nets.csv, net_<rank>.fold for the best
+/// The files `nanofold nets` writes: nets.json, nets.csv, `net_<rank>.fold` for the best
 /// `top` that can be made, and gallery.svg of them drawn to one scale.
 pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result<Vec<(String, String)>> {
     let best = best_net_patterns(solid, report, top)?;
