@@ -227,7 +227,7 @@ pub fn crease_pattern_of_value(value: &serde_json::Value, name: &str, origin: &s
     let mut pattern = fold::read_crease_pattern(unflattened.as_ref().unwrap_or(value), name)?.build()?;
     // A flat-folded form (fold-convert's) states its fold: its ±180° are the state.
     if unflattened.is_none() {
-        angles_as_targets(&mut pattern)?;
+        angles_as_targets(&mut pattern, value.get(NET_SEAMS_KEY).is_some())?;
     }
     if !pattern.ignored_vertices.is_empty() {
         let shown: Vec<String> = pattern.ignored_vertices.iter().map(|v| v.to_string()).collect();
@@ -247,7 +247,7 @@ const STATE_CLOSURE: f64 = 1e-6;
 /// Simulator's and other solvers' exports), or angles that close no vertex of three or more
 /// creases (a state closes at least where it is not bent). A state that closes somewhere
 /// stays a state.
-fn angles_as_targets(pattern: &mut CreasePattern) -> Result<()> {
+fn angles_as_targets(pattern: &mut CreasePattern, net: bool) -> Result<()> {
     if pattern.folded_form.is_some() || !pattern.reading.is_empty() {
         return Ok(());
     }
@@ -256,7 +256,9 @@ fn angles_as_targets(pattern: &mut CreasePattern) -> Result<()> {
         return Ok(());
     }
     let full = angles.iter().all(|a| (a.abs().to_degrees() - 180.0).abs() <= 1e-9);
-    let why = if full {
+    let why = if net {
+        format!("a net of a solid ({NET_SEAMS_KEY} given): its angles close the solid")
+    } else if full {
         "every crease at ±180° (the targets' convention of Origami Simulator and other solvers)".to_string()
     } else {
         let residuals = pattern.given_closure_residuals();
@@ -282,6 +284,10 @@ fn angles_as_targets(pattern: &mut CreasePattern) -> Result<()> {
     ));
     Ok(())
 }
+
+/// The FOLD key a net's seams go under (`docs/model.md#nets-of-polyhedra`): a file with it
+/// is read flat, its `edges_foldAngle` the targets that close the solid.
+pub const NET_SEAMS_KEY: &str = "nanofold:seams";
 
 /// Does this JSON object look like a scene file (keys only scenes have)?
 pub(crate) fn is_scene_object(value: &serde_json::Value) -> bool {

@@ -1497,7 +1497,31 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         assert_eq!((pattern.faces.len(), pattern.creases.len()), (6, 5));
     }
     assert!(!dir.join("net_004.fold").exists());
-    for name in ["nets.json", "nets.csv", "gallery.svg"] {
+    // The best net's ready scene, released at once: its walls rise and first meet where its
+    // seams are, each pair of faces that touches meeting along a seam's two edges.
+    let (_, run) = json_run(
+        nanofold()
+            .args(["simulate", "--json", "--out"])
+            .arg(dir.join("simulated"))
+            .arg(dir.join("net_001.scene.json")),
+    );
+    let fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("net_001.fold")).unwrap()).unwrap();
+    let seams: Vec<[u64; 2]> = serde_json::from_value(fold["nanofold:seams"].clone()).unwrap();
+    let edge_of = |text: &str| -> u64 {
+        let start = text.find("edges[").expect("an edge named") + 6;
+        text[start..].split(']').next().unwrap().parse().unwrap()
+    };
+    let meeting = run["meeting_at_contact"].as_array().unwrap();
+    assert!(!meeting.is_empty(), "{run}");
+    for pair in meeting {
+        let (a, b) = (edge_of(pair[0].as_str().unwrap()), edge_of(pair[1].as_str().unwrap()));
+        assert!(
+            seams.iter().any(|s| s == &[a.min(b), a.max(b)]),
+            "edges {a} and {b} meet but are no seam: {seams:?}"
+        );
+    }
+    for name in ["nets.json", "nets.csv", "gallery.svg", "net_001.scene.json"] {
         assert!(dir.join(name).exists(), "{name}");
     }
     let csv = std::fs::read_to_string(dir.join("nets.csv")).unwrap();

@@ -700,8 +700,14 @@ fn a_nets_fold_file_reads_back_with_its_targets_and_seams() {
     let read = parse_crease_pattern(&fold.to_string(), "octahedron", "octahedron.fold").unwrap();
     // The octahedron's dihedral is acos(-1/3): each fold turns by its supplement, a valley.
     let turn = std::f64::consts::PI - (-1.0_f64 / 3.0).acos();
-    // A tree of panels closes no vertex, so its angles read as a state: the closed solid.
-    let angles = read.target_angles.clone().unwrap_or_else(|| read.fold_angles.clone());
+    // Read flat, its angles the targets that close the solid.
+    assert!(read.fold_angles.iter().all(|&a| a == 0.0));
+    assert!(
+        read.reading.iter().any(|r| r.contains("a net of a solid")),
+        "{:?}",
+        read.reading
+    );
+    let angles = read.target_angles.clone().expect("read as targets");
     assert_eq!(read.creases.len(), 7);
     for &e in &read.creases {
         assert!((angles[e] - turn).abs() < 1e-12, "{} against {turn}", angles[e]);

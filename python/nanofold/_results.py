@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import copy
 import json
-from typing import Any, Dict, List, Optional
+import os
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
@@ -203,6 +205,21 @@ class NetsResult(Result):
     def folds(self) -> List[Dict[str, Any]]:
         """The best nets that can be made, as FOLD crease patterns (net_<rank>.fold)."""
         return copy.deepcopy(self._payload["folds"])
+
+    def write_scenes(self, folder: Union[str, "os.PathLike[str]"]) -> List[Path]:
+        """Writes each best net's crease pattern (net_<rank>.fold) and ready device scene
+        (net_<rank>.scene.json: every fold released at once towards its target, the centre
+        face anchored) into ``folder`` (made if missing); returns the scenes' paths, for
+        ``nanofold.simulate``."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        written = []
+        for fold, scene in zip(self._payload["folds"], self._payload["scenes"]):
+            (out / str(scene["pattern"])).write_text(json.dumps(fold, indent=1))
+            path = out / (str(scene["pattern"])[: -len(".fold")] + ".scene.json")
+            path.write_text(json.dumps(scene, indent=1))
+            written.append(path)
+        return written
 
     @property
     def gallery_svg(self) -> str:

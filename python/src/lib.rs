@@ -395,10 +395,15 @@ fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, Stri
         let report = commands::nets::nets(&name, &solid, &options)?;
         let summary = serde_json::to_value(&report).expect("a report is plain data");
         let files = commands::nets::nets_files(&solid, &report, options.top)?;
-        let mut folds = Vec::new();
+        let (mut folds, mut scenes) = (Vec::new(), Vec::new());
         let mut rest = serde_json::Map::new();
         for (file, text) in files {
-            if file.ends_with(".fold") {
+            if file.ends_with(".scene.json") {
+                scenes.push(
+                    serde_json::from_str::<Value>(&text)
+                        .map_err(|e| NanofoldError::invalid("scene", file.clone(), e.to_string()))?,
+                );
+            } else if file.ends_with(".fold") {
                 folds.push(
                     serde_json::from_str::<Value>(&text)
                         .map_err(|e| NanofoldError::invalid("fold", file.clone(), e.to_string()))?,
@@ -410,6 +415,7 @@ fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, Stri
             }
         }
         rest.insert("folds".into(), Value::Array(folds));
+        rest.insert("scenes".into(), Value::Array(scenes));
         Ok(payload(summary, Value::Object(rest), clock))
     })
 }

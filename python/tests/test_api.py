@@ -270,6 +270,20 @@ def test_nets_rank_a_solids_nets_and_give_the_best_as_fold():
     assert table["radius_of_gyration_um"].is_monotonic_increasing
     assert len(r.folds) == 5 and all(f["nanofold:seams"] for f in r.folds)
     assert r.gallery_svg.startswith("<svg")
+
+
+
+def test_a_best_nets_scene_simulates_and_its_walls_meet_along_seams(tmp_path):
+    r = nanofold.nets("cube", top=1)
+    (scene,) = r.write_scenes(tmp_path)
+    run = nanofold.simulate(scene)
+    seams = {tuple(s) for s in r.folds[0]["nanofold:seams"]}
+    edges = lambda text: int(text.split("edges[")[1].split("]")[0])
+    met = [tuple(sorted((edges(a), edges(b)))) for a, b in run.meeting_at_contact]
+    assert met and all(m in seams for m in met), (met, seams)
+
+
+def test_nets_refuse_bad_shapes_and_settings_by_name():
     with pytest.raises(nanofold.InvalidFieldError, match="top"):
         nanofold.nets("cube", top=1000)
     with pytest.raises(nanofold.InvalidFieldError, match="shape"):

@@ -96,6 +96,66 @@ pub fn open_solid(shape: &str) -> Result<(String, Polyhedron)> {
     Ok((shape.replace([':', ';', ',', '/'], "_"), solid))
 }
 
+/// A ready device scene for a net whose crease pattern is the file `pattern_file` beside
+/// it: 0.2 µm SiN plates on SiN/Cr bilayer hinges (as the bundled cube's), every fold
+/// actuated towards its target (the turn that closes the solid), released at once (a
+/// step), the face at the centre of the net's tree anchored. `unit_um` is the solid's unit.
+pub fn net_scene(made: &NetPattern, name: &str, pattern_file: &str, unit_um: f64) -> serde_json::Value {
+    let pattern = &made.pattern;
+    let targets = pattern
+        .target_angles
+        .clone()
+        .unwrap_or_else(|| vec![0.0; pattern.edges.len()]);
+    let degrees: Vec<(usize, f64)> = pattern.creases.iter().map(|&e| (e, targets[e].to_degrees())).collect();
+    // The commonest magnitude is the default; the others get entries of their own.
+    let mut magnitudes: Vec<f64> = degrees.iter().map(|(_, d)| d.abs()).collect();
+    magnitudes.sort_by(f64::total_cmp);
+    let common = magnitudes
+        .chunk_by(|a, b| (a - b).abs() <= 1e-9)
+        .max_by_key(|run| run.len())
+        .map_or(90.0, |run| run[0]);
+    let hinge = |target: Option<f64>| {
+        let mut entry = serde_json::json!({
+            "hinge_length_um": 20,
+            "layers": [{"material": "SiN", "thickness_um": 0.2}, {"material": "Cr", "thickness_um": 0.1}],
+            "actuated": true,
+            "radius_of_curvature_um": 20
+        });
+        if let Some(t) = target {
+            entry["target_angle_deg"] = serde_json::json!(t);
+        }
+        entry
+    };
+    let mut defaults = hinge(Some(common));
+    defaults["target_angle_deg"] = serde_json::json!(common);
+    let hinges: Vec<serde_json::Value> = degrees
+        .iter()
+        .filter(|(_, d)| (d.abs() - common).abs() > 1e-9)
+        .map(|&(e, d)| {
+            let mut entry = hinge(Some(d));
+            entry["crease"] = serde_json::json!(e);
+            entry
+        })
+        .collect();
+    serde_json::json!({
+        "name": name,
+        "description": format!("{name}: a net folded by stressed SiN/Cr hinges, all released at once"),
+        "pattern": pattern_file,
+        "length_unit_um": unit_um,
+        "materials": {
+            "SiN": {"youngs_modulus_gpa": 300, "poisson_ratio": 0.28, "density_g_cm3": 3.27},
+            "Cr": {"youngs_modulus_gpa": 140, "poisson_ratio": 0.21, "density_g_cm3": 7.19}
+        },
+        "plates": {"thickness_um": 0.2, "material": "SiN"},
+        "hinge_defaults": defaults,
+        "hinges": hinges,
+        "anchored_face": made.centre_face,
+        "actuation": {"kind": "step"},
+        "environment": {"drag": true},
+        "time": {"t_end_s": 0.01}
+    })
+}
+
 /// The ranked table as CSV.
 pub fn nets_csv(report: &NetsReport) -> String {
     let mut csv = String::from(
@@ -132,9 +192,20 @@ pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result
     for (rank, made) in &best {
         let description = format!("net ranked {rank} of {} by {}", report.solid, report.rank_by.label());
         let fold = crate::write::net_output::net_fold(made, &description);
+        let fold_name = format!("net_{rank:03}.fold");
+        let scene = net_scene(
+            made,
+            &format!("{}_net_{rank:03}", report.solid),
+            &fold_name,
+            report.unit_um,
+        );
         files.push((
-            format!("net_{rank:03}.fold"),
+            fold_name,
             serde_json::to_string_pretty(&fold).expect("FOLD is plain data"),
+        ));
+        files.push((
+            format!("net_{rank:03}.scene.json"),
+            serde_json::to_string_pretty(&scene).expect("a scene is plain data"),
         ));
     }
     let rows: Vec<&NetRow> = best.iter().map(|(rank, _)| &report.nets[rank - 1]).collect();

@@ -19,6 +19,36 @@ pub struct NetPattern {
     pub seams: Vec<[usize; 2]>,
     /// The solid's vertex each pattern vertex is a copy of.
     pub solid_vertex: Vec<usize>,
+    /// The pattern's face at the centre of the net's tree (fewest folds to the farthest
+    /// face; the lowest index among equals): the face to anchor.
+    pub centre_face: usize,
+}
+
+/// The face of the tree of folds `folds` (pairs of faces) from which the farthest face is
+/// fewest folds away.
+fn centre_of_tree(faces: usize, folds: &[[usize; 2]]) -> usize {
+    let mut neighbours = vec![Vec::new(); faces];
+    for &[a, b] in folds {
+        neighbours[a].push(b);
+        neighbours[b].push(a);
+    }
+    let eccentricity = |start: usize| {
+        let mut depth = vec![usize::MAX; faces];
+        depth[start] = 0;
+        let mut queue = std::collections::VecDeque::from([start]);
+        let mut farthest = 0;
+        while let Some(f) = queue.pop_front() {
+            farthest = farthest.max(depth[f]);
+            for &g in &neighbours[f] {
+                if depth[g] == usize::MAX {
+                    depth[g] = depth[f] + 1;
+                    queue.push_back(g);
+                }
+            }
+        }
+        farthest
+    };
+    (0..faces).min_by_key(|&f| (eccentricity(f), f)).unwrap_or(0)
 }
 
 /// Union–find over the faces' corners.
@@ -191,9 +221,13 @@ pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetP
         Some(targets),
     )
     .build()?;
+    let fold_faces: Vec<[usize; 2]> = net.folds.iter().map(|&k| edges[k].faces).collect();
+    let centre = centre_of_tree(solid.faces.len(), &fold_faces);
+    let centre_face = pattern.file_face.iter().position(|&f| f == centre).unwrap_or(0);
     Ok(NetPattern {
         pattern,
         seams,
         solid_vertex,
+        centre_face,
     })
 }

@@ -7,7 +7,7 @@ use crate::write::folding_output::crease_pattern_fold;
 use serde_json::{json, Value};
 
 /// The FOLD key of the seams: pairs of boundary edges that are one edge of the solid.
-pub const SEAMS_KEY: &str = "nanofold:seams";
+pub const SEAMS_KEY: &str = crate::read::NET_SEAMS_KEY;
 /// The FOLD key of each vertex's solid vertex.
 pub const SOLID_VERTEX_KEY: &str = "nanofold:solid_vertex";
 
