@@ -240,6 +240,21 @@ pub struct NetsArgs {
     /// The length of the solid's unit in µm.
     #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().unit_um, allow_negative_numbers = true)]
     pub unit_um: f64,
+    /// The written scenes' hinges drive this many degrees past the turn that closes the
+    /// solid, so the faces press shut (0 to 45).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub overdrive_deg: f64,
+    /// Release the written scenes' hinges by an etch front crossing the wafer along this
+    /// direction (degrees; 0 along +x, 90 along +y) instead of all at once.
+    #[arg(long, allow_negative_numbers = true)]
+    pub front_deg: Option<f64>,
+    /// The etch front's speed, µm per minute.
+    #[arg(long = "etch-rate", default_value_t = 1.5, allow_negative_numbers = true)]
+    pub etch_rate_um_per_min: f64,
+    /// The face the written scenes anchor (a face index of the net's FOLD; default: the face
+    /// at the centre of the net's tree).
+    #[arg(long)]
+    pub anchor: Option<usize>,
     /// Output folder (default: output/<shape>-nets/).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -1078,6 +1093,10 @@ const NETS_FLAGS: &[(&str, &str)] = &[
     ("samples", "--samples"),
     ("top", "--top"),
     ("unit_um", "--unit-um"),
+    ("overdrive_deg", "--overdrive-deg"),
+    ("front_deg", "--front-deg"),
+    ("etch_rate_um_per_min", "--etch-rate"),
+    ("anchored_face", "--anchor"),
 ];
 
 fn run_nets(args: &NetsArgs) -> Result<()> {
@@ -1093,12 +1112,16 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         },
         top: args.top,
         unit_um: args.unit_um,
+        overdrive_deg: args.overdrive_deg,
+        front_deg: args.front_deg,
+        etch_rate_um_per_min: args.etch_rate_um_per_min,
+        anchored_face: args.anchor,
     };
     let flags = |e| with_flags(e, NETS_FLAGS);
     options.validate().map_err(flags)?;
     let (name, solid) = open_solid(&args.shape).map_err(|e| anyhow::anyhow!("reading {}: {e}", args.shape))?;
     let report = nets(&name, &solid, &options).map_err(flags)?;
-    let files = nets_files(&solid, &report, options.top)?;
+    let files = nets_files(&solid, &report, &options).map_err(flags)?;
     let dir = args
         .out
         .clone()

@@ -1502,7 +1502,7 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
     let (_, run) = json_run(
         nanofold()
             .args(["simulate", "--json", "--out"])
-            .arg(dir.join("simulated"))
+            .arg(temp_dir("nets-cube-simulated"))
             .arg(dir.join("net_001.scene.json")),
     );
     let fold: serde_json::Value =
@@ -1526,6 +1526,14 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
     }
     let csv = std::fs::read_to_string(dir.join("nets.csv")).unwrap();
     assert_eq!(csv.lines().count(), 12);
+    // Run again with fewer nets into the same folder: the old third net does not stay.
+    let again = nanofold()
+        .args(["nets", "cube", "--top", "2", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
+    assert!(dir.join("net_002.scene.json").exists() && !dir.join("net_003.fold").exists());
     // A bad shape or setting is refused by name, with nothing written.
     let bad_dir = temp_dir("nets-bad");
     for (args, part) in [
@@ -1534,6 +1542,9 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         (vec!["nets", "cube", "--top", "500"], "--top"),
         (vec!["nets", "cube", "--unit-um", "-1"], "--unit-um"),
         (vec!["nets", "sphere"], "shape"),
+        (vec!["nets", "cube", "--overdrive-deg", "50"], "--overdrive-deg"),
+        (vec!["nets", "cube", "--etch-rate", "0"], "--etch-rate"),
+        (vec!["nets", "cube", "--anchor", "9"], "--anchor"),
     ] {
         let out = nanofold().args(&args).arg("--out").arg(&bad_dir).output().unwrap();
         assert!(!out.status.success());
@@ -1542,4 +1553,59 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         assert!(!bad_dir.exists(), "{args:?} wrote its folder");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_bundled_cubes_closing_and_jam_come_back_through_the_nets_path() {
+    // The cube's most compact net is the Latin cross; laid by `nets` its hub-to-lid arm runs
+    // along −x where the bundled cube_net.fold's runs along +y, so the bundled front along
+    // +y (closes) is 180° here and −y (jams) is 0°. Squares of 100 µm, hinges to 95°.
+    for (bundled, front) in [("cube_closes", "180"), ("cube_jams", "0")] {
+        let dir = temp_dir(&format!("nets-{bundled}"));
+        let made = nanofold()
+            .args([
+                "nets",
+                "cube",
+                "--top",
+                "1",
+                "--unit-um",
+                "50",
+                "--overdrive-deg",
+                "5",
+                "--front-deg",
+                front,
+            ])
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+        let (_, ours) = json_run(
+            nanofold()
+                .args(["simulate", "--json", "--out"])
+                .arg(dir.join("run"))
+                .arg(dir.join("net_001.scene.json")),
+        );
+        let (_, theirs) = json_run(
+            nanofold()
+                .args(["simulate", "--json", "--out"])
+                .arg(dir.join("bundled"))
+                .arg(format!("patterns/devices/{bundled}.scene.json")),
+        );
+        let time = |run: &serde_json::Value| run["collision"]["time_s"].as_f64().unwrap();
+        assert!(
+            (time(&ours) - time(&theirs)).abs() <= 1e-9 * time(&theirs),
+            "{bundled}: first contact at {} s through nets, {} s bundled",
+            time(&ours),
+            time(&theirs)
+        );
+        // The same number of pairs meeting at that moment: all four corners and the lid on two
+        // walls where it closes, the lid alone on a wall where it jams.
+        assert_eq!(
+            ours["meeting_at_contact"].as_array().map(Vec::len),
+            theirs["meeting_at_contact"].as_array().map(Vec::len),
+            "{bundled}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -505,20 +505,28 @@ def nets(
     rank_by: Optional[str] = None,
     top: Optional[int] = None,
     unit_um: Optional[float] = None,
+    overdrive_deg: Optional[float] = None,
+    front_deg: Optional[float] = None,
+    etch_rate_um_per_min: Optional[float] = None,
+    anchored_face: Optional[int] = None,
 ) -> NetsResult:
     """The distinct nets of a solid (``nanofold nets``): ``shape`` is a .off, .obj or .fold
     file, or a generated solid (``"cube"``, ``"box:1x2x3"``, ``"prism:6"``,
     ``"polycube:0,0,0;1,0,0"``, ...). Every net is laid flat, tested for overlap and scored
     (radius of gyration, leaves, seam length, footprint); ``rank_by`` is
     ``"radius_of_gyration"`` (default), ``"seam_length"`` or ``"footprint"``; the ``top``
-    best that can be made come back as FOLD crease patterns.
+    best that can be made come back as FOLD crease patterns with ready device scenes, their
+    hinges driven ``overdrive_deg`` past closing, released at once or by an etch front along
+    ``front_deg`` (``etch_rate_um_per_min``), ``anchored_face`` (default: the centre face) held.
 
     >>> import nanofold
     >>> r = nanofold.nets("cube", top=3)
     >>> r.distinct_nets, r.symmetry_order, len(r.folds)
     (11, 48, 3)
     """
-    keywords = dict(max_trees=max_trees, samples=samples, seed=seed, rank_by=rank_by, top=top, unit_um=unit_um)
+    keywords = dict(max_trees=max_trees, samples=samples, seed=seed, rank_by=rank_by, top=top, unit_um=unit_um,
+                    overdrive_deg=overdrive_deg, front_deg=front_deg, etch_rate_um_per_min=etch_rate_um_per_min,
+                    anchored_face=anchored_face)
     summary, rest = _call(_native.nets, os.fspath(shape), _settings(keywords))
     return NetsResult("nets", summary, rest)
 

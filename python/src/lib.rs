@@ -394,7 +394,7 @@ fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, Stri
         let (name, solid) = commands::nets::open_solid(&shape)?;
         let report = commands::nets::nets(&name, &solid, &options)?;
         let summary = serde_json::to_value(&report).expect("a report is plain data");
-        let files = commands::nets::nets_files(&solid, &report, options.top)?;
+        let files = commands::nets::nets_files(&solid, &report, &options)?;
         let (mut folds, mut scenes) = (Vec::new(), Vec::new());
         let mut rest = serde_json::Map::new();
         for (file, text) in files {

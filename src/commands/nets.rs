@@ -98,15 +98,36 @@ pub fn open_solid(shape: &str) -> Result<(String, Polyhedron)> {
 
 /// A ready device scene for a net whose crease pattern is the file `pattern_file` beside
 /// it: 0.2 µm SiN plates on SiN/Cr bilayer hinges (as the bundled cube's), every fold
-/// actuated towards its target (the turn that closes the solid), released at once (a
-/// step), the face at the centre of the net's tree anchored. `unit_um` is the solid's unit.
-pub fn net_scene(made: &NetPattern, name: &str, pattern_file: &str, unit_um: f64) -> serde_json::Value {
+/// actuated towards its target (the turn that closes the solid) plus `options.overdrive_deg`,
+/// released at once or by an etch front (`options.front_deg`), the chosen face (or the one
+/// at the centre of the net's tree) anchored; lengths in `options.unit_um`.
+pub fn net_scene(
+    made: &NetPattern,
+    name: &str,
+    pattern_file: &str,
+    options: &NetsOptions,
+) -> Result<serde_json::Value> {
+    let faces = made.pattern.faces.len();
+    let anchored = options.anchored_face.unwrap_or(made.centre_face);
+    if anchored >= faces {
+        return Err(NanofoldError::invalid(
+            "anchored_face",
+            anchored,
+            format!("the net has faces 0 to {}", faces - 1),
+        ));
+    }
+    let unit_um = options.unit_um;
     let pattern = &made.pattern;
     let targets = pattern
         .target_angles
         .clone()
         .unwrap_or_else(|| vec![0.0; pattern.edges.len()]);
-    let degrees: Vec<(usize, f64)> = pattern.creases.iter().map(|&e| (e, targets[e].to_degrees())).collect();
+    let over = options.overdrive_deg;
+    let degrees: Vec<(usize, f64)> = pattern
+        .creases
+        .iter()
+        .map(|&e| (e, targets[e].to_degrees() + over * targets[e].signum()))
+        .collect();
     // The commonest magnitude is the default; the others get entries of their own.
     let mut magnitudes: Vec<f64> = degrees.iter().map(|(_, d)| d.abs()).collect();
     magnitudes.sort_by(f64::total_cmp);
@@ -137,9 +158,26 @@ pub fn net_scene(made: &NetPattern, name: &str, pattern_file: &str, unit_um: f64
             entry
         })
         .collect();
-    serde_json::json!({
+    // A front runs until it has crossed the whole net (1.2 times, for the last hinges to
+    // fold); a step's hinges fold in microseconds.
+    let (actuation, t_end_s) = match options.front_deg {
+        None => (serde_json::json!({"kind": "step"}), 0.01),
+        Some(phi) => {
+            let direction = nalgebra::Vector2::new(phi.to_radians().cos(), phi.to_radians().sin());
+            let along = pattern
+                .vertices
+                .iter()
+                .map(|p| direction.dot(&nalgebra::Vector2::new(p[0], p[1])));
+            let extent = along.clone().fold(f64::NEG_INFINITY, f64::max) - along.fold(f64::INFINITY, f64::min);
+            (
+                serde_json::json!({"kind": "front", "etch_rate_um_per_min": options.etch_rate_um_per_min, "direction_deg": phi}),
+                1.2 * extent * unit_um / (options.etch_rate_um_per_min / 60.0),
+            )
+        }
+    };
+    Ok(serde_json::json!({
         "name": name,
-        "description": format!("{name}: a net folded by stressed SiN/Cr hinges, all released at once"),
+        "description": format!("{name}: a net folded by stressed SiN/Cr hinges"),
         "pattern": pattern_file,
         "length_unit_um": unit_um,
         "materials": {
@@ -149,11 +187,11 @@ pub fn net_scene(made: &NetPattern, name: &str, pattern_file: &str, unit_um: f64
         "plates": {"thickness_um": 0.2, "material": "SiN"},
         "hinge_defaults": defaults,
         "hinges": hinges,
-        "anchored_face": made.centre_face,
-        "actuation": {"kind": "step"},
+        "anchored_face": anchored,
+        "actuation": actuation,
         "environment": {"drag": true},
-        "time": {"t_end_s": 0.01}
-    })
+        "time": {"t_end_s": t_end_s}
+    }))
 }
 
 /// The ranked table as CSV.
@@ -179,9 +217,9 @@ pub fn nets_csv(report: &NetsReport) -> String {
 }
 
 /// The files `nanofold nets` writes: nets.json, nets.csv, `net_<rank>.fold` for the best
-/// `top` that can be made, and gallery.svg of them drawn to one scale.
-pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result<Vec<(String, String)>> {
-    let best = best_net_patterns(solid, report, top)?;
+/// `options.top` that can be made with their scenes, and gallery.svg of them drawn to one scale.
+pub fn nets_files(solid: &Polyhedron, report: &NetsReport, options: &NetsOptions) -> Result<Vec<(String, String)>> {
+    let best = best_net_patterns(solid, report, options.top)?;
     let mut files = vec![
         (
             "nets.json".to_string(),
@@ -193,12 +231,7 @@ pub fn nets_files(solid: &Polyhedron, report: &NetsReport, top: usize) -> Result
         let description = format!("net ranked {rank} of {} by {}", report.solid, report.rank_by.label());
         let fold = crate::write::net_output::net_fold(made, &description);
         let fold_name = format!("net_{rank:03}.fold");
-        let scene = net_scene(
-            made,
-            &format!("{}_net_{rank:03}", report.solid),
-            &fold_name,
-            report.unit_um,
-        );
+        let scene = net_scene(made, &format!("{}_net_{rank:03}", report.solid), &fold_name, options)?;
         files.push((
             fold_name,
             serde_json::to_string_pretty(&fold).expect("FOLD is plain data"),

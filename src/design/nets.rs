@@ -57,6 +57,18 @@ pub struct NetsOptions {
     pub top: usize,
     /// The length of the solid's unit in µm (scales the lengths reported).
     pub unit_um: f64,
+    /// Each written scene's hinges drive this far past the turn that closes the solid, so
+    /// the faces press shut (degrees, 0 to 45).
+    pub overdrive_deg: f64,
+    /// The written scenes' release: None for every hinge at once (a step); Some(φ) for an
+    /// etch front crossing the wafer along φ degrees (0 along +x, 90 along +y), freeing each
+    /// hinge once it has passed its crease.
+    pub front_deg: Option<f64>,
+    /// The etch front's speed.
+    pub etch_rate_um_per_min: f64,
+    /// The face each written scene anchors (a FOLD face index of the net; None: the face at
+    /// the centre of the net's tree).
+    pub anchored_face: Option<usize>,
 }
 
 impl Default for NetsOptions {
@@ -68,6 +80,10 @@ impl Default for NetsOptions {
             rank_by: RankBy::RadiusOfGyration,
             top: 10,
             unit_um: 1.0,
+            overdrive_deg: 0.0,
+            front_deg: None,
+            etch_rate_um_per_min: 1.5,
+            anchored_face: None,
         }
     }
 }
@@ -98,6 +114,27 @@ impl NetsOptions {
         }
         if !(self.unit_um.is_finite() && self.unit_um > 0.0) {
             return Err(NanofoldError::invalid("unit_um", self.unit_um, "a length > 0"));
+        }
+        if !(0.0..=45.0).contains(&self.overdrive_deg) {
+            return Err(NanofoldError::invalid(
+                "overdrive_deg",
+                self.overdrive_deg,
+                "from 0 to 45 degrees",
+            ));
+        }
+        if let Some(phi) = self.front_deg.filter(|phi| !phi.is_finite()) {
+            return Err(NanofoldError::invalid(
+                "front_deg",
+                phi,
+                "a finite direction in degrees",
+            ));
+        }
+        if !(self.etch_rate_um_per_min.is_finite() && self.etch_rate_um_per_min > 0.0) {
+            return Err(NanofoldError::invalid(
+                "etch_rate_um_per_min",
+                self.etch_rate_um_per_min,
+                "a speed > 0",
+            ));
         }
         Ok(())
     }

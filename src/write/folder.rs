@@ -35,8 +35,19 @@ pub const OUTPUT_FILES: &[&str] = &[
     "fit.csv",
     "fitted.scene.json",
     "fit.svg",
+    "nets.json",
+    "nets.csv",
+    "gallery.svg",
     OWNER_FILE,
 ];
+
+/// A net `nets` writes: `net_<rank>.fold` or `net_<rank>.scene.json`, the rank in digits.
+/// Numbered, they are not in [`OUTPUT_FILES`]: a run never keeps another run's nets.
+fn is_net_file(name: &str) -> bool {
+    name.strip_prefix("net_")
+        .and_then(|rest| rest.strip_suffix(".fold").or_else(|| rest.strip_suffix(".scene.json")))
+        .is_some_and(|rank| !rank.is_empty() && rank.bytes().all(|b| b.is_ascii_digit()))
+}
 
 /// The file in every output folder that names the input its results are of.
 pub const OWNER_FILE: &str = "nanofold.json";
@@ -93,7 +104,7 @@ fn check_target(dir: &Path) -> Result<()> {
     let foreign: Vec<String> = entries
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| !OUTPUT_FILES.contains(&n.as_str()))
+        .filter(|n| !OUTPUT_FILES.contains(&n.as_str()) && !is_net_file(n))
         .take(5)
         .collect();
     if !foreign.is_empty() {
