@@ -41,6 +41,8 @@ section "crease_pattern_speed (patterns of many vertices)" target/release/exampl
 section "work_precision (every engine; its report.json)" target/release/examples/work_precision
 section "closed_chain_timing (fitted against exact closure)" target/release/examples/closed_chain_timing
 section "executor_overhead (argmin's executor against a bare loop, both engines)" target/release/examples/executor_overhead
+section "fit_speed (calibration: the bridge and the Miura-ori sheet, estimates beside time)" target/release/examples/fit_speed
+section "count_nets (nets of the Platonic solids: counts, overlap, scores, each stage timed)" target/release/examples/count_nets
 # The Python layer and Dask sweeps, where the package is installed (scripts/python.sh).
 if [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import nanofold" 2>/dev/null; then
   section "python/examples/overhead.py (the Python layer, Dask sweeps)" "$venv/bin/python" python/examples/overhead.py
