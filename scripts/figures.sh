@@ -25,6 +25,8 @@ done
 $bin fit patterns/bridge_step.scene.json patterns/measurements/bridge_step_measured.csv \
   --free environment.drag_coefficient=0.2:5 --free hinges.*.target_angle_deg=45:135 --out "$out/fit" > /dev/null
 cp "$out/fit/fit.svg" docs/fit_bridge_step.svg
+$bin nets octahedron --top 11 --unit-um 50 --out "$out/nets" > /dev/null
+cp "$out/nets/gallery.svg" docs/nets_octahedron_gallery.svg
 for scene in cube_closes cube_jams miura_sheet; do
   $bin simulate "patterns/devices/$scene.scene.json" --out "$out/$scene" > /dev/null
 done

@@ -134,6 +134,8 @@ fn the_docs_figures_are_current() {
         "fit",
     );
     same_figure(&dir.join("fit/fit.svg"), "docs/fit_bridge_step.svg");
+    run(&["nets", "octahedron", "--top", "11", "--unit-um", "50"], "nets");
+    same_figure(&dir.join("nets/gallery.svg"), "docs/nets_octahedron_gallery.svg");
     // Devices of many panels.
     for (scene, figure) in [
         ("cube_closes", "snapshots"),

@@ -10,6 +10,16 @@ use crate::pattern::crease_pattern::EdgeKind;
 use crate::pattern::net::NetPattern;
 use plotters::prelude::*;
 
+/// `x` to four significant digits, without an exponent in the gallery's range.
+fn significant(x: f64) -> String {
+    let digits = if x == 0.0 {
+        0
+    } else {
+        (3 - x.abs().log10().floor() as i32).max(0) as usize
+    };
+    format!("{x:.digits$}")
+}
+
 /// Columns of the gallery.
 const COLUMNS: usize = 4;
 
@@ -64,15 +74,15 @@ pub fn gallery_svg(
             let mut chart = ChartBuilder::on(area)
                 .caption(
                     format!(
-                        "#{}: Rg {:.3} µm, {} leaves, seams {:.2} µm, {:.2} × {:.2} µm",
+                        "#{}: Rg {}, {} leaves, seams {}, {} × {} µm",
                         row.rank,
-                        row.radius_of_gyration_um,
+                        significant(row.radius_of_gyration_um),
                         row.leaves,
-                        row.seam_length_um,
-                        row.footprint_um[0],
-                        row.footprint_um[1]
+                        significant(row.seam_length_um),
+                        significant(row.footprint_um[0]),
+                        significant(row.footprint_um[1])
                     ),
-                    ("sans-serif", 12),
+                    ("sans-serif", 11),
                 )
                 .margin(px(4))
                 .build_cartesian_2d(centre[0] - half..centre[0] + half, centre[1] - half..centre[1] + half)
