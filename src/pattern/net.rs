@@ -6,7 +6,7 @@ use super::crease_pattern::{CreasePattern, CreasePatternBuilder, EdgeKind};
 use super::Assignment;
 use crate::error::{NanofoldError, Result};
 use crate::geometry::nets::FlatNet;
-use crate::geometry::polyhedron::Polyhedron;
+use crate::geometry::polyhedron::{DualEdge, Polyhedron};
 use std::collections::HashMap;
 
 /// A net's crease pattern and what ties it back to its solid.
@@ -97,9 +97,24 @@ fn touching_copies(vertices: &[[f64; 2]], solid_vertex: &[usize]) -> Result<()> 
     Ok(())
 }
 
-/// `net` of `solid` as a crease pattern named `name`; a net that touches itself is refused.
-pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetPattern> {
-    let edges = solid.dual_edges();
+/// The number of face `f`'s corner at solid vertex `v`, `offsets` each face's first.
+fn corner_number(solid: &Polyhedron, offsets: &[usize], f: usize, v: usize) -> usize {
+    offsets[f]
+        + solid.faces[f]
+            .iter()
+            .position(|&w| w == v)
+            .expect("the edge's vertex is on its face")
+}
+
+/// The sheet's vertices: the faces' corners joined across the folds (union–find), each
+/// class one vertex, placed mirrored (x → −x) so the inside is up. Returns each face's
+/// first corner's number, each corner's vertex, the vertices and their solid vertices.
+#[allow(clippy::type_complexity)]
+fn sheet_vertices(
+    solid: &Polyhedron,
+    net: &FlatNet,
+    edges: &[DualEdge],
+) -> (Vec<usize>, Vec<usize>, Vec<[f64; 2]>, Vec<usize>) {
     // Corners as (face, position in the face), numbered by their face's offset.
     let offsets: Vec<usize> = solid
         .faces
@@ -111,13 +126,7 @@ pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetP
         })
         .collect();
     let corner_count: usize = solid.faces.iter().map(Vec::len).sum();
-    let corner = |f: usize, v: usize| -> usize {
-        offsets[f]
-            + solid.faces[f]
-                .iter()
-                .position(|&w| w == v)
-                .expect("the edge's vertex is on its face")
-    };
+    let corner = |f: usize, v: usize| corner_number(solid, &offsets, f, v);
     let mut parent: Vec<usize> = (0..corner_count).collect();
     for &k in &net.folds {
         let e = &edges[k];
@@ -146,6 +155,14 @@ pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetP
             vertex_of_corner[offsets[f] + i] = index;
         }
     }
+    (offsets, vertex_of_corner, vertices, solid_vertex)
+}
+
+/// `net` of `solid` as a crease pattern named `name`; a net that touches itself is refused.
+pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetPattern> {
+    let edges = solid.dual_edges();
+    let (offsets, vertex_of_corner, vertices, solid_vertex) = sheet_vertices(solid, net, &edges);
+    let corner = |f: usize, v: usize| corner_number(solid, &offsets, f, v);
     touching_copies(&vertices, &solid_vertex)?;
     // Faces reversed by the mirror, so counter-clockwise again.
     let faces: Vec<Vec<usize>> = solid
