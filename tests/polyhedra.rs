@@ -720,3 +720,29 @@ fn a_nets_fold_file_reads_back_with_its_targets_and_seams() {
         }
     }
 }
+
+#[test]
+fn nets_met_in_a_sample_are_the_enumerated_ones_by_their_smallest_tree() {
+    use nanofold::commands::nets::{nets, NetsOptions, Search};
+    use nanofold::geometry::unfoldings::{distinct_among, distinct_nets, edge_map, sample_trees, spanning_trees};
+    // Each of the cube's 11 nets is at least 8 of its 384 trees: 2 000 uniform draws miss
+    // one with probability below 11 (1 − 8/384)^2000 ≈ 1e-17.
+    let cube = solids::cube().unwrap();
+    let maps: Vec<Vec<usize>> = cube.symmetries().iter().map(|s| edge_map(&cube, s)).collect();
+    let mut all = distinct_nets(&spanning_trees(&cube, 1000).unwrap(), &maps);
+    let mut met = distinct_among(&sample_trees(&cube, 2000, 5).unwrap(), &maps);
+    all.sort_unstable();
+    met.sort_unstable();
+    assert_eq!(met, all);
+    // The door samples when the trees are more than it may enumerate, and says so.
+    let options = NetsOptions {
+        max_trees: 100,
+        samples: 2000,
+        ..NetsOptions::default()
+    };
+    let report = nets("cube", &cube, &options).unwrap();
+    assert_eq!(
+        (report.search, report.trees_considered, report.distinct_nets),
+        (Search::Sampled, 2000, 11)
+    );
+}
