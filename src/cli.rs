@@ -249,12 +249,12 @@ pub struct NetsArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub front_deg: Option<f64>,
     /// The etch front's speed, µm per minute.
-    #[arg(long = "etch-rate", default_value_t = 1.5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
     pub etch_rate_um_per_min: f64,
     /// The face the written scenes anchor (a face index of the net's FOLD; default: the face
     /// at the centre of the net's tree).
     #[arg(long)]
-    pub anchor: Option<usize>,
+    pub anchored_face: Option<usize>,
     /// Output folder (default: output/<shape>-nets/).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -1095,8 +1095,8 @@ const NETS_FLAGS: &[(&str, &str)] = &[
     ("unit_um", "--unit-um"),
     ("overdrive_deg", "--overdrive-deg"),
     ("front_deg", "--front-deg"),
-    ("etch_rate_um_per_min", "--etch-rate"),
-    ("anchored_face", "--anchor"),
+    ("etch_rate_um_per_min", "--etch-rate-um-per-min"),
+    ("anchored_face", "--anchored-face"),
 ];
 
 fn run_nets(args: &NetsArgs) -> Result<()> {
@@ -1115,7 +1115,7 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         overdrive_deg: args.overdrive_deg,
         front_deg: args.front_deg,
         etch_rate_um_per_min: args.etch_rate_um_per_min,
-        anchored_face: args.anchor,
+        anchored_face: args.anchored_face,
     };
     let flags = |e| with_flags(e, NETS_FLAGS);
     options.validate().map_err(flags)?;

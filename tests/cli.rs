@@ -1543,8 +1543,11 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         (vec!["nets", "cube", "--unit-um", "-1"], "--unit-um"),
         (vec!["nets", "sphere"], "shape"),
         (vec!["nets", "cube", "--overdrive-deg", "50"], "--overdrive-deg"),
-        (vec!["nets", "cube", "--etch-rate", "0"], "--etch-rate"),
-        (vec!["nets", "cube", "--anchor", "9"], "--anchor"),
+        (
+            vec!["nets", "cube", "--etch-rate-um-per-min", "0"],
+            "--etch-rate-um-per-min",
+        ),
+        (vec!["nets", "cube", "--anchored-face", "9"], "--anchored-face"),
     ] {
         let out = nanofold().args(&args).arg("--out").arg(&bad_dir).output().unwrap();
         assert!(!out.status.success());

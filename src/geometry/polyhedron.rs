@@ -282,8 +282,8 @@ impl Polyhedron {
 
     /// Newell's normal of a face: outward, its length twice the face's area.
     pub fn face_normal(&self, f: usize) -> Vector3<f64> {
-        let points: Vec<Point3<f64>> = self.faces[f].iter().map(|&v| self.vertices[v]).collect();
-        newell_normal(&points)
+        let face = &self.faces[f];
+        newell_normal(face.len(), |k| self.vertices[face[k]])
     }
 
     /// A face's vertex centroid.

@@ -32,10 +32,11 @@ fn cut(
     (interval.0 <= interval.1).then_some(interval)
 }
 
-/// A polygon's area vector (Newell): its normal, as long as twice its area.
-pub fn newell_normal(points: &[Point3<f64>]) -> Vector3<f64> {
-    (0..points.len()).fold(Vector3::zeros(), |n, k| {
-        n + points[k].coords.cross(&points[(k + 1) % points.len()].coords)
+/// A polygon's area vector (Newell): its normal, as long as twice its area; `corner(k)` is
+/// its k-th of `count` corners.
+pub fn newell_normal(count: usize, corner: impl Fn(usize) -> Point3<f64>) -> Vector3<f64> {
+    (0..count).fold(Vector3::zeros(), |n, k| {
+        n + corner(k).coords.cross(&corner((k + 1) % count).coords)
     })
 }
 
@@ -67,7 +68,7 @@ pub fn first_self_intersection(
     let planes: Vec<(Vector3<f64>, f64)> = corners
         .iter()
         .map(|points| {
-            let normal = newell_normal(points).normalize();
+            let normal = newell_normal(points.len(), |k| points[k]).normalize();
             let centre = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
             (normal, normal.dot(&centre))
         })
