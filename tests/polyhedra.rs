@@ -3,6 +3,9 @@
 //! not a closed solid refused by name.
 
 use nalgebra::Point3;
+
+mod common;
+use common::fitted_distance;
 use nanofold::geometry::polyhedron::Polyhedron;
 use nanofold::geometry::solids;
 
@@ -581,30 +584,6 @@ fn pinched_concave_and_self_crossing_surfaces_are_refused_by_name() {
     }
     let message = Polyhedron::new(vertices, faces).unwrap_err().to_string();
     assert!(message.contains("faces[") && message.contains("convex"), "{message}");
-}
-
-/// The largest distance, after the one rigid motion that fits them best (Kabsch), between
-/// `moved` and `fixed`, point for point.
-fn fitted_distance(moved: &[Point3<f64>], fixed: &[Point3<f64>]) -> f64 {
-    use nalgebra::{Matrix3, Vector3};
-    let centre =
-        |points: &[Point3<f64>]| points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
-    let (cm, cf) = (centre(moved), centre(fixed));
-    let h = moved.iter().zip(fixed).fold(Matrix3::zeros(), |h, (m, f)| {
-        h + (m.coords - cm) * (f.coords - cf).transpose()
-    });
-    let svd = h.svd(true, true);
-    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
-    let mut d = Matrix3::identity();
-    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let rotation = v_t.transpose() * d * u.transpose();
-    moved
-        .iter()
-        .zip(fixed)
-        .map(|(m, f)| (rotation * (m.coords - cm) + cf - f.coords).norm())
-        .fold(0.0, f64::max)
 }
 
 #[test]

@@ -3,6 +3,7 @@
 //! `nanofold nets` writes (nets.json, nets.csv, the best nets as FOLD crease patterns,
 //! gallery.svg).
 
+pub use crate::design::closing::{ClosingReport, ClosingSettings, NetClosing, Outcome};
 pub use crate::design::nets::{
     best_net_patterns, nets, NetRow, NetsOptions, NetsReport, RankBy, Search, MAX_ENUMERATED_TREES, MAX_SAMPLED_TREES,
     MAX_WRITTEN_NETS,
@@ -192,6 +193,29 @@ pub fn net_scene(
         "environment": {"drag": true},
         "time": {"t_end_s": t_end_s}
     }))
+}
+
+/// A net's device as a scene built in memory from [`net_scene`] (what `simulate` builds from
+/// the written files).
+pub fn net_device(made: &NetPattern, name: &str, options: &NetsOptions) -> Result<crate::dynamics::scene::Scene> {
+    let value = net_scene(made, name, "net.fold", options)?;
+    let file: crate::read::scene_spec::NetworkSpec<String> = crate::read::input::from_value(&value)?;
+    let spec = crate::read::scene_spec::SceneSpec::Network(Box::new(file.with_pattern(|_| Ok(made.pattern.clone()))?));
+    spec.build()
+}
+
+/// A net's device folded quasi-statically past its first contact, its seams latching
+/// ([`crate::design::closing`]), with the scene's own drives and stiffnesses.
+pub fn net_closing(
+    made: &NetPattern,
+    name: &str,
+    options: &NetsOptions,
+    settings: &ClosingSettings,
+) -> Result<ClosingReport> {
+    let scene = net_device(made, name, options)?;
+    let model = scene.network().expect("a net's scene is a network");
+    let closing = NetClosing::new(made, model)?;
+    closing.run(model, &model.forcing, &model.stiffness(), settings)
 }
 
 /// The ranked table as CSV.

@@ -75,29 +75,43 @@ pub fn first_self_intersection(
         .collect();
     overlapping_pairs(&boxes).into_iter().find(|&(f, g)| {
         let shared = faces[f].iter().filter(|v| faces[g].contains(v)).count();
-        faces_meet((&corners[f], &planes[f]), (&corners[g], &planes[g]), shared, tolerance)
+        faces_meet((&corners[f], &planes[f]), (&corners[g], &planes[g]), shared, tolerance).is_some()
     })
 }
 
-/// Whether two convex faces' interiors meet, `shared` the corners they have in common.
+/// Where two convex, planar faces' interiors meet (a point of both), or None when they
+/// only touch: at up to `shared` corners they have in common (two: an edge), as faces of
+/// one surface do. `tolerance` is a length.
+pub fn convex_faces_meet(a: &[Point3<f64>], b: &[Point3<f64>], shared: usize, tolerance: f64) -> Option<Point3<f64>> {
+    let plane = |points: &[Point3<f64>]| {
+        let normal = newell_normal(points.len(), |k| points[k]).normalize();
+        let centre = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
+        (normal, normal.dot(&centre))
+    };
+    faces_meet((a, &plane(a)), (b, &plane(b)), shared, tolerance)
+}
+
+/// Where two convex faces' interiors meet, `shared` the corners they have in common.
 fn faces_meet(
     (a, plane_a): (&[Point3<f64>], &(Vector3<f64>, f64)),
     (b, plane_b): (&[Point3<f64>], &(Vector3<f64>, f64)),
     shared: usize,
     tolerance: f64,
-) -> bool {
+) -> Option<Point3<f64>> {
     let direction = plane_a.0.cross(&plane_b.0);
     if direction.norm() < 1e-9 {
         // Parallel planes: apart, or one plane, where the faces meet if their outlines
         // overlap with area (faces glued back to back, or folded flat onto each other).
         if (plane_a.1 - plane_a.0.dot(&plane_b.0) * plane_b.1).abs() > tolerance {
-            return false;
+            return None;
         }
-        return coplanar_overlap(a, b, &plane_a.0, tolerance);
+        let mean =
+            |points: &[Point3<f64>]| points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
+        return coplanar_overlap(a, b, &plane_a.0, tolerance).then(|| Point3::from((mean(a) + mean(b)) / 2.0));
     }
     if shared >= 2 {
         // Two faces on one edge, at an angle: they meet only along it.
-        return false;
+        return None;
     }
     let direction = direction.normalize();
     // A point on both planes: the least-norm solution of the two plane equations.
@@ -106,19 +120,18 @@ fn faces_meet(
     let det = 1.0 - c * c;
     let origin = Point3::from((n1 * (plane_a.1 - c * plane_b.1) + n2 * (plane_b.1 - c * plane_a.1)) / det);
     let line = (&origin, &direction);
-    let (Some(on_a), Some(on_b)) = (
-        cut(a, (&plane_b.0, plane_b.1), line, tolerance),
-        cut(b, (&plane_a.0, plane_a.1), line, tolerance),
-    ) else {
-        return false;
-    };
-    let overlap = on_a.1.min(on_b.1) - on_a.0.max(on_b.0);
+    let (on_a, on_b) = (
+        cut(a, (&plane_b.0, plane_b.1), line, tolerance)?,
+        cut(b, (&plane_a.0, plane_a.1), line, tolerance)?,
+    );
+    let (from, to) = (on_a.0.max(on_b.0), on_a.1.min(on_b.1));
     // A shared corner is a point both intervals hold: meeting there alone is touching.
-    if shared == 1 {
-        overlap > tolerance
+    let meets = if shared == 1 {
+        to - from > tolerance
     } else {
-        overlap >= -tolerance
-    }
+        to - from >= -tolerance
+    };
+    meets.then(|| origin + direction * (0.5 * (from + to)))
 }
 
 /// Whether two convex polygons in one plane (normal `normal`) overlap with area: separating

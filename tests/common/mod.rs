@@ -105,3 +105,27 @@ pub fn grid_fold(n: usize, jitter: f64, far: Option<f64>) -> serde_json::Value {
     }
     serde_json::json!({"file_spec": 1.1, "vertices_coords": vertices, "edges_vertices": edges, "edges_assignment": letters})
 }
+
+/// The largest distance, after the one rigid motion that fits them best (Kabsch), between
+/// `moved` and `fixed`, point for point.
+pub fn fitted_distance(moved: &[nalgebra::Point3<f64>], fixed: &[nalgebra::Point3<f64>]) -> f64 {
+    use nalgebra::{Matrix3, Point3, Vector3};
+    let centre =
+        |points: &[Point3<f64>]| points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
+    let (cm, cf) = (centre(moved), centre(fixed));
+    let h = moved.iter().zip(fixed).fold(Matrix3::zeros(), |h, (m, f)| {
+        h + (m.coords - cm) * (f.coords - cf).transpose()
+    });
+    let svd = h.svd(true, true);
+    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let mut d = Matrix3::identity();
+    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let rotation = v_t.transpose() * d * u.transpose();
+    moved
+        .iter()
+        .zip(fixed)
+        .map(|(m, f)| (rotation * (m.coords - cm) + cf - f.coords).norm())
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,702 @@
+//! Whether a net's device closes (`docs/model.md#closing-a-net`): its quasi-static folding
+//! carried past the first contact, each seam latching where its two edges meet, until every
+//! seam is shut (`closes`), faces meet where no seam is (`jams`), or the drives are spent
+//! (`stalls`).
+
+use crate::dynamics::network::algorithms::update_poses;
+use crate::dynamics::network::{NetworkData, NetworkModel};
+use crate::dynamics::Forcing;
+use crate::error::{NanofoldError, Result};
+use crate::geometry::surface_intersection::convex_faces_meet;
+use crate::pattern::net::NetPattern;
+use nalgebra::{DMatrix, DVector, Point3, Vector3};
+use serde::Serialize;
+
+/// The most any drive angle moves between two tests of the faces, rad (0.5°): a meeting
+/// that begins and ends inside a smaller turn is not seen.
+const MAX_STEP: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// A seam whose ends lie this close (a fraction of its length) has met edge to edge.
+const ALIGNED: f64 = 1e-9;
+/// Seams meeting together: within this of aligned at an event, they latch with it.
+const ALIGNED_TOGETHER: f64 = 1e-6;
+/// Faces are tested for meeting to this fraction of the net's size.
+const TOLERANCE: f64 = 1e-9;
+/// Bisection of an event's progress stops at this width.
+const LOCATE: f64 = 1e-15;
+/// The latched seams' equilibrium: Gauss–Newton steps and the step that ends them, rad.
+const SETTLE_ITERATIONS: usize = 80;
+const SETTLE_STEP: f64 = 1e-13;
+/// The largest turn of one settling step, rad.
+const SETTLE_DAMPING: f64 = 0.3;
+
+/// How seams latch.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosingSettings {
+    /// A seam latches when its faces meet with its two edges' ends at most this far apart,
+    /// in % of the seam's length (above 0, at most 50): the solder or adhesive on the seam
+    /// pulls them into line. Faces that meet farther apart jam.
+    pub capture_percent: f64,
+}
+
+impl Default for ClosingSettings {
+    fn default() -> Self {
+        ClosingSettings { capture_percent: 10.0 }
+    }
+}
+
+impl ClosingSettings {
+    /// Refuses a capture out of range by name.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.capture_percent > 0.0 && self.capture_percent <= 50.0) {
+            return Err(NanofoldError::invalid(
+                "capture_percent",
+                self.capture_percent,
+                "a share of the seam's length above 0 and at most 50 %",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// How a closing run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// Every seam latched.
+    Closes,
+    /// Two faces met where no seam joins them (or a seam's edges too far apart to latch).
+    Jams,
+    /// The drives reached their targets with seams still open.
+    Stalls,
+}
+
+impl Outcome {
+    /// The outcome's name in reports.
+    pub fn label(self) -> &'static str {
+        match self {
+            Outcome::Closes => "closes",
+            Outcome::Jams => "jams",
+            Outcome::Stalls => "stalls",
+        }
+    }
+}
+
+/// A seam latching.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Latch {
+    /// The seam (its index in the net's `nanofold:seams`).
+    pub seam: usize,
+    /// Its two faces (FOLD face indices).
+    pub faces: [usize; 2],
+    /// When, s (0 for a step, whose path is followed at t = 0⁺).
+    pub time_s: f64,
+    /// How far along the drives' path (0 to 1).
+    pub progress: f64,
+    /// How far apart its edges' ends were, a fraction of its length.
+    pub misalignment: f64,
+}
+
+/// Faces meeting where no seam latches them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Jam {
+    /// The two faces (FOLD face indices).
+    pub faces: [usize; 2],
+    /// When, s.
+    pub time_s: f64,
+    /// How far along the drives' path.
+    pub progress: f64,
+    /// A point where they meet, µm.
+    pub point_um: [f64; 3],
+    /// Their seam's misalignment when they share one that was too far out of line to latch.
+    pub seam_misalignment: Option<f64>,
+}
+
+/// The fold angles at one moment of a closing run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ClosingFrame {
+    /// s.
+    pub time_s: f64,
+    /// How far along the drives' path.
+    pub progress: f64,
+    /// One per crease column, rad.
+    pub fold_angles: Vec<f64>,
+}
+
+/// A closing run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ClosingReport {
+    /// How it ended.
+    pub outcome: Outcome,
+    /// When: the last latch (closes), the jam, or the end of the drives (stalls), s.
+    pub time_s: f64,
+    /// How far along the drives' path that was.
+    pub progress: f64,
+    /// When faces first met (a latch or a jam), s.
+    pub first_contact_time_s: Option<f64>,
+    /// Every latch in order.
+    pub latches: Vec<Latch>,
+    /// The jam.
+    pub jam: Option<Jam>,
+    /// Seams still open at the end, with their misalignment.
+    pub open_seams: Vec<(usize, f64)>,
+    /// The start, every event (before and after its latches) and the end.
+    pub frames: Vec<ClosingFrame>,
+}
+
+#[derive(Debug, Clone)]
+struct SeamEnds {
+    faces: [usize; 2],
+    /// Each end: the pattern vertex on the first face and its copy on the second.
+    ends: [[usize; 2]; 2],
+    length: f64,
+}
+
+#[derive(Debug, Clone)]
+struct FacePair {
+    faces: [usize; 2],
+    /// Corners that are copies of one solid vertex: (vertex of the first, of the second).
+    common: Vec<[usize; 2]>,
+    seam: Option<usize>,
+}
+
+/// A net's faces, seams and face pairs as a closing run tests them, for one network model
+/// of the net (built once, run for every sample).
+#[derive(Debug, Clone)]
+pub struct NetClosing {
+    faces: Vec<Vec<usize>>,
+    face_panel: Vec<usize>,
+    file_face: Vec<usize>,
+    flat: Vec<Vector3<f64>>,
+    seams: Vec<SeamEnds>,
+    pairs: Vec<FacePair>,
+    /// Each panel's tree columns to the anchored panel.
+    paths: Vec<Vec<usize>>,
+    size: f64,
+    unit: f64,
+}
+
+impl NetClosing {
+    /// The tests of `net` for `model`, a network built from `net.pattern`.
+    pub fn new(net: &NetPattern, model: &NetworkModel) -> Result<NetClosing> {
+        let pattern = &model.folding.pattern;
+        if pattern.vertices.len() != net.pattern.vertices.len() || pattern.faces.len() != net.pattern.faces.len() {
+            return Err(NanofoldError::invalid(
+                "pattern",
+                &model.folding.pattern.name,
+                "the network was not built from this net",
+            ));
+        }
+        if !model.folding.stars.is_empty() {
+            return Err(NanofoldError::invalid(
+                "pattern",
+                &pattern.name,
+                "seams latch on a net (a tree of panels); this pattern closes loops of its own",
+            ));
+        }
+        let unit = model.unit;
+        let flat: Vec<Vector3<f64>> = pattern
+            .vertices
+            .iter()
+            .map(|p| Vector3::new(p[0] * unit, p[1] * unit, 0.0))
+            .collect();
+        let face_of_edge = |e: usize| {
+            pattern.edge_faces[e]
+                .iter()
+                .flatten()
+                .copied()
+                .next()
+                .expect("a seam edge bounds a face")
+        };
+        let solid = &net.solid_vertex;
+        let seams: Vec<SeamEnds> = net
+            .seams
+            .iter()
+            .map(|&[e, f]| {
+                let ([a0, a1], [b0, b1]) = (pattern.edges[e], pattern.edges[f]);
+                let ends = if solid[a0] == solid[b0] {
+                    [[a0, b0], [a1, b1]]
+                } else {
+                    [[a0, b1], [a1, b0]]
+                };
+                SeamEnds {
+                    faces: [face_of_edge(e), face_of_edge(f)],
+                    ends,
+                    length: (flat[a1] - flat[a0]).norm(),
+                }
+            })
+            .collect();
+        let faces = pattern.faces.clone();
+        let face_panel: Vec<usize> = (0..faces.len()).map(|f| pattern.panel_of_face[f]).collect();
+        let mut pairs = Vec::new();
+        for f in 0..faces.len() {
+            for g in f + 1..faces.len() {
+                if face_panel[f] == face_panel[g] {
+                    continue;
+                }
+                let common: Vec<[usize; 2]> = faces[f]
+                    .iter()
+                    .flat_map(|&v| {
+                        faces[g]
+                            .iter()
+                            .filter(move |&&w| solid[v] == solid[w])
+                            .map(move |&w| [v, w])
+                    })
+                    .collect();
+                let seam = seams.iter().position(|s| s.faces == [f, g] || s.faces == [g, f]);
+                pairs.push(FacePair {
+                    faces: [f, g],
+                    common,
+                    seam,
+                });
+            }
+        }
+        let paths = (0..model.panels()).map(|p| model.path_columns(p).collect()).collect();
+        Ok(NetClosing {
+            faces,
+            face_panel,
+            file_face: pattern.file_face.clone(),
+            flat,
+            seams,
+            pairs,
+            paths,
+            size: model.size(),
+            unit,
+        })
+    }
+
+    /// The number of seams.
+    pub fn seam_count(&self) -> usize {
+        self.seams.len()
+    }
+
+    fn place(&self, data: &NetworkData, face: usize, v: usize) -> Vector3<f64> {
+        data.place(self.face_panel[face], &self.flat[v])
+    }
+
+    /// How far apart seam `k`'s edges' ends are, a fraction of its length.
+    fn misalignment(&self, data: &NetworkData, k: usize) -> f64 {
+        let seam = &self.seams[k];
+        seam.ends
+            .iter()
+            .map(|&[v, w]| (self.place(data, seam.faces[0], v) - self.place(data, seam.faces[1], w)).norm())
+            .fold(0.0, f64::max)
+            / seam.length
+    }
+
+    /// The face pairs whose interiors meet (with a point of each meeting), at the poses
+    /// `data` holds.
+    fn meeting_pairs(&self, data: &NetworkData) -> Vec<(usize, Point3<f64>)> {
+        let tolerance = TOLERANCE * self.size;
+        let corners: Vec<Vec<Point3<f64>>> = (0..self.faces.len())
+            .map(|f| {
+                self.faces[f]
+                    .iter()
+                    .map(|&v| Point3::from(self.place(data, f, v)))
+                    .collect()
+            })
+            .collect();
+        let boxes: Vec<([f64; 3], [f64; 3])> = corners
+            .iter()
+            .map(|points| {
+                points
+                    .iter()
+                    .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
+                        ([0, 1, 2].map(|i| lo[i].min(p[i])), [0, 1, 2].map(|i| hi[i].max(p[i])))
+                    })
+            })
+            .collect();
+        let mut meeting = Vec::new();
+        for (k, pair) in self.pairs.iter().enumerate() {
+            let [f, g] = pair.faces;
+            if (0..3).any(|i| boxes[f].0[i] > boxes[g].1[i] + tolerance || boxes[g].0[i] > boxes[f].1[i] + tolerance) {
+                continue;
+            }
+            let shared = pair
+                .common
+                .iter()
+                .filter(|&&[v, w]| (self.place(data, f, v) - self.place(data, g, w)).norm() <= tolerance)
+                .count();
+            if let Some(point) = convex_faces_meet(&corners[f], &corners[g], shared, tolerance) {
+                meeting.push((k, point));
+            }
+        }
+        meeting
+    }
+
+    /// Whether anything happens at these poses: faces meeting, or an open seam aligned.
+    fn event(&self, data: &NetworkData, latched: &[bool]) -> bool {
+        (0..self.seams.len()).any(|k| !latched[k] && self.misalignment(data, k) <= ALIGNED)
+            || !self.meeting_pairs(data).is_empty()
+    }
+
+    /// The latched seams' residual (each end's two copies' difference, over the net's size)
+    /// and its Jacobian in the fold angles, at the poses and twists `data` holds.
+    fn seam_rows(&self, data: &NetworkData, latched: &[usize], columns: usize) -> (DVector<f64>, DMatrix<f64>) {
+        let rows = 6 * latched.len();
+        let mut residual = DVector::zeros(rows);
+        let mut jacobian = DMatrix::zeros(rows, columns);
+        for (i, &k) in latched.iter().enumerate() {
+            let seam = &self.seams[k];
+            for (e, &[v, w]) in seam.ends.iter().enumerate() {
+                let row = 6 * i + 3 * e;
+                let (x, y) = (self.place(data, seam.faces[0], v), self.place(data, seam.faces[1], w));
+                residual.rows_mut(row, 3).copy_from(&((x - y) / self.size));
+                for (point, face, sign) in [(x, seam.faces[0], 1.0), (y, seam.faces[1], -1.0)] {
+                    for &c in &self.paths[self.face_panel[face]] {
+                        let twist = &data.twist[c];
+                        let velocity = twist.angular.cross(&point) + twist.linear;
+                        for j in 0..3 {
+                            jacobian[(row + j, c)] += sign * velocity[j] / self.size;
+                        }
+                    }
+                }
+            }
+        }
+        (residual, jacobian)
+    }
+
+    /// The quasi-static balance with the latched seams held: the fold angles minimising
+    /// Σ ½ K (θ − r)² on the seams' closures, from `theta` (Gauss–Newton on the closures,
+    /// the energy minimised in their null space). Returns whether it converged.
+    fn settle(
+        &self,
+        model: &NetworkModel,
+        drive: &[f64],
+        stiffness: &[f64],
+        latched: &[usize],
+        theta: &mut [f64],
+        data: &mut NetworkData,
+    ) -> bool {
+        let n = theta.len();
+        if latched.is_empty() {
+            theta.copy_from_slice(drive);
+            update_poses(model, theta, data);
+            return true;
+        }
+        let k_scale = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
+        let stiff = DVector::from_iterator(n, stiffness.iter().map(|k| k / k_scale));
+        for _ in 0..SETTLE_ITERATIONS {
+            update_poses(model, theta, data);
+            let (residual, jacobian) = self.seam_rows(data, latched, n);
+            // JᵀJ's eigenvectors: those of eigenvalue above the cut-off span J's row space,
+            // the rest its null space (redundant rows are normal: a closed corner's seams).
+            let eigen = (jacobian.transpose() * &jacobian).symmetric_eigen();
+            let largest = eigen.eigenvalues.amax();
+            // Rounding leaves JᵀJ's zero eigenvalues near 1e-16 of the largest (not its
+            // square), so the cut is well above that: singular values below 1e-6 of J's largest.
+            let cutoff = 1e-12 * largest.max(f64::MIN_POSITIVE);
+            let pulled = jacobian.transpose() * &residual;
+            // The least-norm step onto the closures: −(JᵀJ)⁺ Jᵀ c.
+            let mut step = DVector::zeros(n);
+            let mut null = Vec::new();
+            for (i, &lambda) in eigen.eigenvalues.iter().enumerate() {
+                let direction = eigen.eigenvectors.column(i);
+                if lambda > cutoff {
+                    step -= direction * (direction.dot(&pulled) / lambda);
+                } else {
+                    null.push(direction.into_owned());
+                }
+            }
+            if !null.is_empty() {
+                let z = DMatrix::from_columns(&null);
+                let moved = DVector::from_iterator(n, (0..n).map(|c| theta[c] + step[c] - drive[c]));
+                let gradient = z.transpose() * stiff.component_mul(&moved);
+                let hessian = z.transpose() * DMatrix::from_diagonal(&stiff) * &z;
+                if let Some(y) = hessian.cholesky().map(|ch| ch.solve(&gradient)) {
+                    step -= z * y;
+                }
+            }
+            let largest_turn = step.amax();
+            if largest_turn > SETTLE_DAMPING {
+                step *= SETTLE_DAMPING / largest_turn;
+            }
+            for c in 0..n {
+                theta[c] += step[c];
+            }
+            if largest_turn <= SETTLE_STEP {
+                update_poses(model, theta, data);
+                return true;
+            }
+        }
+        update_poses(model, theta, data);
+        let (residual, _) = self.seam_rows(data, latched, n);
+        residual.amax() <= 1e-10
+    }
+
+    /// Runs a net's device with `forcing` and `stiffness` (one per crease column; a sample
+    /// may vary both) from flat to its drives' end.
+    pub fn run(
+        &self,
+        model: &NetworkModel,
+        forcing: &Forcing,
+        stiffness: &[f64],
+        settings: &ClosingSettings,
+    ) -> Result<ClosingReport> {
+        settings.validate()?;
+        let n = model.columns();
+        if stiffness.len() != n || forcing.hinges.len() != n {
+            return Err(NanofoldError::invalid(
+                "hinges",
+                format!("{} stiffnesses, {} drives", stiffness.len(), forcing.hinges.len()),
+                format!("one per crease ({n})"),
+            ));
+        }
+        let path = DrivePath::new(forcing);
+        let mut data = NetworkData::new(model);
+        let mut drive = vec![0.0; n];
+        let mut theta = vec![0.0; n];
+        let mut latched = vec![false; self.seams.len()];
+        let mut latched_list: Vec<usize> = Vec::new();
+        let mut report = ClosingReport {
+            outcome: Outcome::Stalls,
+            time_s: 0.0,
+            progress: 0.0,
+            first_contact_time_s: None,
+            latches: Vec::new(),
+            jam: None,
+            open_seams: Vec::new(),
+            frames: Vec::new(),
+        };
+        let frame = |u: f64, theta: &[f64]| ClosingFrame {
+            time_s: path.time(u),
+            progress: u,
+            fold_angles: theta.to_vec(),
+        };
+        path.drive(0.0, &mut drive);
+        self.settle(model, &drive, stiffness, &latched_list, &mut theta, &mut data);
+        report.frames.push(frame(0.0, &theta));
+        let mut u = 0.0;
+        while u < 1.0 {
+            let next = path.next(u, MAX_STEP);
+            let mut trial = theta.clone();
+            path.drive(next, &mut drive);
+            let settled = self.settle(model, &drive, stiffness, &latched_list, &mut trial, &mut data);
+            if !settled {
+                return Err(NanofoldError::invalid(
+                    "seams",
+                    format!("{latched_list:?}"),
+                    format!("the latched seams hold no balance at progress {next:.6}"),
+                ));
+            }
+            if !self.event(&data, &latched) {
+                theta = trial;
+                u = next;
+                continue;
+            }
+            // Bisect for the first progress where something happens.
+            let (mut lo, mut hi, mut at_hi) = (u, next, trial);
+            while hi - lo > LOCATE * (1.0 + hi.abs()) {
+                let mid = 0.5 * (lo + hi);
+                let mut state = theta.clone();
+                path.drive(mid, &mut drive);
+                self.settle(model, &drive, stiffness, &latched_list, &mut state, &mut data);
+                if self.event(&data, &latched) {
+                    hi = mid;
+                    at_hi = state;
+                } else {
+                    lo = mid;
+                    theta = state;
+                }
+            }
+            u = hi;
+            theta = at_hi;
+            report.first_contact_time_s.get_or_insert(path.time(u));
+            report.frames.push(frame(u, &theta));
+            // Latch what meets in line; anything else is a jam. A latch moves the faces
+            // (they snap into line), so look again until nothing new meets.
+            loop {
+                path.drive(u, &mut drive);
+                update_poses(model, &theta, &mut data);
+                let mut new: Vec<(usize, f64)> = (0..self.seams.len())
+                    .filter(|&k| !latched[k])
+                    .map(|k| (k, self.misalignment(&data, k)))
+                    .filter(|&(_, m)| m <= ALIGNED_TOGETHER)
+                    .collect();
+                for (pair, point) in self.meeting_pairs(&data) {
+                    let faces = self.pairs[pair].faces;
+                    let seam = self.pairs[pair].seam.filter(|&k| !latched[k]);
+                    let misalignment = seam.map(|k| self.misalignment(&data, k));
+                    match (seam, misalignment) {
+                        (Some(k), Some(m)) if m <= settings.capture_percent / 100.0 => {
+                            if !new.iter().any(|&(j, _)| j == k) {
+                                new.push((k, m));
+                            }
+                        }
+                        _ => {
+                            report.outcome = Outcome::Jams;
+                            report.time_s = path.time(u);
+                            report.progress = u;
+                            report.jam = Some(Jam {
+                                faces: faces.map(|f| self.file_face[f]),
+                                time_s: path.time(u),
+                                progress: u,
+                                point_um: [point.x, point.y, point.z].map(|x| x * 1e6),
+                                seam_misalignment: misalignment,
+                            });
+                            report.open_seams = self.open(&data, &latched);
+                            return Ok(report);
+                        }
+                    }
+                }
+                if new.is_empty() {
+                    break;
+                }
+                new.sort_by_key(|&(k, _)| k);
+                for (k, m) in new {
+                    latched[k] = true;
+                    latched_list.push(k);
+                    report.latches.push(Latch {
+                        seam: k,
+                        faces: self.seams[k].faces.map(|f| self.file_face[f]),
+                        time_s: path.time(u),
+                        progress: u,
+                        misalignment: m,
+                    });
+                }
+                if !self.settle(model, &drive, stiffness, &latched_list, &mut theta, &mut data) {
+                    return Err(NanofoldError::invalid(
+                        "seams",
+                        format!("{latched_list:?}"),
+                        format!("the latched seams hold no balance at progress {u:.6}"),
+                    ));
+                }
+                report.frames.push(frame(u, &theta));
+                if latched.iter().all(|&l| l) {
+                    report.outcome = Outcome::Closes;
+                    report.time_s = path.time(u);
+                    report.progress = u;
+                    return Ok(report);
+                }
+            }
+        }
+        update_poses(model, &theta, &mut data);
+        report.outcome = Outcome::Stalls;
+        report.time_s = path.time(1.0);
+        report.progress = 1.0;
+        report.open_seams = self.open(&data, &latched);
+        report.frames.push(frame(1.0, &theta));
+        Ok(report)
+    }
+
+    fn open(&self, data: &NetworkData, latched: &[bool]) -> Vec<(usize, f64)> {
+        (0..self.seams.len())
+            .filter(|&k| !latched[k])
+            .map(|k| (k, self.misalignment(data, k)))
+            .collect()
+    }
+
+    /// The quasi-static balance with the seams `latched` held, from the fold angles `start`:
+    /// the angles minimising Σ ½ K (θ − r)² (r = `drive`) on the seams' closures.
+    pub fn balance(
+        &self,
+        model: &NetworkModel,
+        drive: &[f64],
+        stiffness: &[f64],
+        latched: &[usize],
+        start: &[f64],
+    ) -> Result<Vec<f64>> {
+        let n = model.columns();
+        if drive.len() != n || stiffness.len() != n || start.len() != n {
+            return Err(NanofoldError::invalid(
+                "fold_angles",
+                format!(
+                    "{} drives, {} stiffnesses, {} angles",
+                    drive.len(),
+                    stiffness.len(),
+                    start.len()
+                ),
+                format!("one per crease ({n})"),
+            ));
+        }
+        if let Some(&k) = latched.iter().find(|&&k| k >= self.seams.len()) {
+            return Err(NanofoldError::invalid(
+                "latched",
+                k,
+                format!("the net has seams 0 to {}", self.seams.len() - 1),
+            ));
+        }
+        let mut theta = start.to_vec();
+        let mut data = NetworkData::new(model);
+        if !self.settle(model, drive, stiffness, latched, &mut theta, &mut data) {
+            return Err(NanofoldError::invalid(
+                "latched",
+                format!("{latched:?}"),
+                "the latched seams hold no balance near the start",
+            ));
+        }
+        Ok(theta)
+    }
+
+    /// Every pattern vertex's place at fold angles `theta`, in units of the pattern (for
+    /// checks against the solid).
+    pub fn vertex_places(&self, model: &NetworkModel, theta: &[f64]) -> Vec<[f64; 3]> {
+        let mut data = NetworkData::new(model);
+        update_poses(model, theta, &mut data);
+        let mut places = vec![[f64::NAN; 3]; self.flat.len()];
+        for (f, face) in self.faces.iter().enumerate() {
+            for &v in face {
+                let x = self.place(&data, f, v) / self.unit;
+                places[v] = [x.x, x.y, x.z];
+            }
+        }
+        places
+    }
+}
+
+/// The drives' path as a progress u ∈ [0, 1]: a ramp's time over its whole duration, a
+/// step's straight path at t = 0⁺.
+struct DrivePath<'a> {
+    forcing: &'a Forcing,
+    duration: f64,
+    /// Progresses where a drive starts or stops moving.
+    breaks: Vec<f64>,
+}
+
+impl<'a> DrivePath<'a> {
+    fn new(forcing: &'a Forcing) -> Self {
+        let duration = forcing.duration();
+        let breaks = if duration > 0.0 {
+            forcing.breakpoints().iter().map(|t| t / duration).collect()
+        } else {
+            Vec::new()
+        };
+        DrivePath {
+            forcing,
+            duration,
+            breaks,
+        }
+    }
+
+    fn drive(&self, u: f64, out: &mut [f64]) {
+        self.forcing.drive_along(u, f64::INFINITY, out);
+    }
+
+    fn time(&self, u: f64) -> f64 {
+        self.forcing.time_along(u, f64::INFINITY)
+    }
+
+    /// The next progress to test from `u`: no drive turns more than `turn` on the way, and
+    /// no break is passed.
+    fn next(&self, u: f64, turn: f64) -> f64 {
+        let next_break = self
+            .breaks
+            .iter()
+            .copied()
+            .find(|&b| b > u + 1e-15)
+            .unwrap_or(1.0)
+            .min(1.0);
+        let rate = if self.duration > 0.0 {
+            let t = u * self.duration;
+            (0..self.forcing.hinges.len())
+                .map(|i| (self.forcing.drive_rate(i, t) * self.duration).abs())
+                .fold(0.0, f64::max)
+        } else {
+            self.forcing.hinges.iter().map(|h| h.target.abs()).fold(0.0, f64::max)
+        };
+        if rate == 0.0 {
+            next_break
+        } else {
+            (u + turn / rate).min(next_break)
+        }
+    }
+}

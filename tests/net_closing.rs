@@ -1,0 +1,267 @@
+//! A net's device folded past its first contact with its seams latching
+//! (`docs/model.md#closing-a-net`): the bundled cube's closing carried on to the lid and its
+//! jam, against the network dynamics' first contacts, the ramps' closed form and the solid.
+
+mod common;
+use common::fitted_distance;
+use nalgebra::Point3;
+use nanofold::commands::nets::*;
+use nanofold::commands::simulate;
+use nanofold::dynamics::simulate::SimulationSettings;
+use nanofold::geometry::polyhedron::Polyhedron;
+use nanofold::pattern::net::NetPattern;
+use std::f64::consts::PI;
+
+/// The cube's best net by compactness (the Latin cross) as the bundled cube device: 100 µm
+/// squares, hinges to 95°, released along `front`.
+fn latin_cross(front: Option<f64>) -> (Polyhedron, NetPattern, NetsOptions) {
+    let (name, solid) = open_solid("cube").unwrap();
+    let options = NetsOptions {
+        top: 1,
+        unit_um: 50.0,
+        overdrive_deg: 5.0,
+        front_deg: front,
+        ..NetsOptions::default()
+    };
+    let report = nets(&name, &solid, &options).unwrap();
+    let made = best_net_patterns(&solid, &report, 1).unwrap().remove(0).1;
+    (solid, made, options)
+}
+
+/// The largest distance from the folded net's corners to its solid's vertices after one
+/// rigid motion, over the solid's size.
+fn distance_from_solid(solid: &Polyhedron, made: &NetPattern, places: &[[f64; 3]]) -> f64 {
+    let folded: Vec<Point3<f64>> = places.iter().map(|p| Point3::new(p[0], p[1], p[2])).collect();
+    let target: Vec<Point3<f64>> = made.solid_vertex.iter().map(|&v| solid.vertices[v]).collect();
+    let centre = solid
+        .vertices
+        .iter()
+        .fold(nalgebra::Vector3::zeros(), |s, p| s + p.coords)
+        / solid.vertices.len() as f64;
+    let size = solid
+        .vertices
+        .iter()
+        .map(|p| (p.coords - centre).norm())
+        .fold(0.0, f64::max);
+    fitted_distance(&folded, &target) / size
+}
+
+/// Every crease's release by a front along `front_deg` (the front has passed its last point;
+/// the first crease freed at t = 0), s, from the net's own coordinates at 1.5 µm/min.
+fn release_times(made: &NetPattern, unit_um: f64, front_deg: f64) -> Vec<f64> {
+    let pattern = &made.pattern;
+    let direction = [front_deg.to_radians().cos(), front_deg.to_radians().sin()];
+    let passed: Vec<f64> = pattern
+        .creases
+        .iter()
+        .map(|&e| {
+            pattern.edges[e]
+                .iter()
+                .map(|&v| (pattern.vertices[v][0] * direction[0] + pattern.vertices[v][1] * direction[1]) * unit_um)
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .collect();
+    let first_freed = passed.iter().copied().fold(f64::INFINITY, f64::min);
+    passed.iter().map(|p| (p - first_freed) / ETCH_UM_PER_S).collect()
+}
+
+/// The bundled cube's etch rate (1.5 µm/min) and its hinges' ρ_c (20 µm): a ramp turns at
+/// a/ρ_c rad/s.
+const ETCH_UM_PER_S: f64 = 1.5 / 60.0;
+const TURN_RATE: f64 = ETCH_UM_PER_S / 20.0;
+
+#[test]
+fn the_cube_closing_along_its_front_carries_on_to_the_lid_and_lands_on_the_cube() {
+    let (solid, made, options) = latin_cross(Some(180.0));
+    let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
+    assert_eq!(run.outcome, Outcome::Closes, "{run:?}");
+    assert_eq!(run.latches.len(), 7, "a cube's net has 7 seams");
+    // The first meeting is the network dynamics' first contact.
+    let scene = net_device(&made, "cube", &options).unwrap();
+    let simulated = simulate(&scene, &SimulationSettings::default()).unwrap();
+    let contact = simulated.simulation.response.collision.unwrap().time;
+    let first = run.first_contact_time_s.unwrap();
+    assert!((first - contact).abs() <= 1e-9 * contact, "{first} against {contact}");
+    // It closes when the last hinge reaches 90°: released when the front has passed its
+    // crease, then turning at a/ρ_c. Both from the net's own coordinates, not from the
+    // scene's drives.
+    let closes = release_times(&made, 50.0, 180.0)
+        .iter()
+        .map(|t| t + (PI / 2.0) / TURN_RATE)
+        .fold(0.0, f64::max);
+    assert!(
+        (run.time_s - closes).abs() <= 1e-9 * closes,
+        "closed at {} s, the last hinge squares at {closes} s",
+        run.time_s
+    );
+    // The walls met at the first contact: four seams latch there, the lid's three at the end.
+    assert_eq!(run.latches.iter().filter(|l| l.time_s == first).count(), 4);
+    assert_eq!(run.latches.iter().filter(|l| l.time_s == run.time_s).count(), 3);
+    // The last state is the cube, every seam shut.
+    let places = NetClosing::new(&made, scene.network().unwrap())
+        .unwrap()
+        .vertex_places(scene.network().unwrap(), &run.frames.last().unwrap().fold_angles);
+    let off = distance_from_solid(&solid, &made, &places);
+    assert!(off <= 1e-9, "{off}");
+    for angle in &run.frames.last().unwrap().fold_angles {
+        assert!((angle - PI / 2.0).abs() <= 1e-9, "{angle}");
+    }
+}
+
+#[test]
+fn the_cube_released_the_other_way_jams_on_its_lid_at_85_degrees() {
+    let (_, made, options) = latin_cross(Some(0.0));
+    let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
+    assert_eq!(run.outcome, Outcome::Jams, "{run:?}");
+    // The south wall, freed last, meets the lid's far edge at 85° (the squares' plane
+    // geometry: the lid leans 5° back from a north wall at 95°). The meeting is seen once
+    // the faces are within 1e-9 of the net's size: 4e-9 rad early at the lid's lever.
+    let freed_last = release_times(&made, 50.0, 0.0).into_iter().fold(0.0, f64::max);
+    let exact = freed_last + 85f64.to_radians() / TURN_RATE;
+    let jam = run.jam.as_ref().unwrap();
+    assert!(
+        (jam.time_s - exact).abs() <= 1e-9 * exact,
+        "{} against {exact}",
+        jam.time_s
+    );
+    let angles = &run.frames.last().unwrap().fold_angles;
+    assert!(
+        angles.iter().any(|a| (a - 85f64.to_radians()).abs() <= 1e-8),
+        "{angles:?}"
+    );
+    // The network dynamics' first contact is the same pair; its panel test decides a
+    // crossing only past a depth of the placements' spread, so it comes 7e-8 rad (6e-5 s)
+    // later, 1e-8 of the time.
+    let scene = net_device(&made, "cube", &options).unwrap();
+    let simulated = simulate(&scene, &SimulationSettings::default()).unwrap();
+    let collision = simulated.simulation.response.collision.unwrap();
+    assert!(
+        (jam.time_s - collision.time).abs() <= 1e-8 * collision.time,
+        "{jam:?} against {collision:?}"
+    );
+    let mut names = jam.faces.map(|f| format!("face {f}")).to_vec();
+    let mut theirs = collision.pair.to_vec();
+    names.sort();
+    theirs.sort();
+    assert_eq!(names, theirs);
+    // The seam there (the lid's far edge and the south wall's top) is 2 sin 5° of its length
+    // out of line, past the 10 % capture.
+    let misaligned = jam.seam_misalignment.unwrap();
+    assert!(
+        (misaligned - 2.0 * 5f64.to_radians().sin()).abs() <= 1e-8,
+        "{misaligned}"
+    );
+    assert!(run.latches.is_empty());
+}
+
+#[test]
+fn a_narrower_capture_turns_the_walls_meeting_out_of_line_into_a_jam() {
+    // Along +y the south wall stands at 95° when the others reach 90°: their seams meet
+    // 2 sin 2.5° of their length out of line (0.0872), inside 10 % and outside 5 %.
+    let (_, made, options) = latin_cross(Some(180.0));
+    let narrow = ClosingSettings { capture_percent: 5.0 };
+    let run = net_closing(&made, "cube", &options, &narrow).unwrap();
+    assert_eq!(run.outcome, Outcome::Jams);
+    let misaligned = run.jam.unwrap().seam_misalignment.unwrap();
+    assert!(
+        (misaligned - 2.0 * 2.5f64.to_radians().sin()).abs() <= 1e-9,
+        "{misaligned}"
+    );
+    assert!(ClosingSettings { capture_percent: 0.0 }.validate().is_err());
+    let error = net_closing(&made, "cube", &options, &ClosingSettings { capture_percent: 80.0 }).unwrap_err();
+    assert!(error.to_string().contains("capture_percent"), "{error}");
+}
+
+#[test]
+fn every_octahedron_net_released_at_once_closes_onto_the_octahedron() {
+    let (name, solid) = open_solid("octahedron").unwrap();
+    let options = NetsOptions {
+        top: 11,
+        ..NetsOptions::default()
+    };
+    let report = nets(&name, &solid, &options).unwrap();
+    let best = best_net_patterns(&solid, &report, 11).unwrap();
+    assert_eq!(best.len(), 11);
+    for (rank, made) in &best {
+        let run = net_closing(made, "octahedron", &options, &ClosingSettings::default()).unwrap();
+        assert_eq!(run.outcome, Outcome::Closes, "net {rank}: {run:?}");
+        assert_eq!(run.latches.len(), 5, "an octahedron's net has 12 − 8 + 1 seams");
+        let scene = net_device(made, "octahedron", &options).unwrap();
+        let model = scene.network().unwrap();
+        let places = NetClosing::new(made, model)
+            .unwrap()
+            .vertex_places(model, &run.frames.last().unwrap().fold_angles);
+        let off = distance_from_solid(&solid, made, &places);
+        assert!(off <= 1e-9, "net {rank}: {off}");
+    }
+}
+
+#[test]
+fn a_balance_with_one_seam_latched_is_a_minimum_on_its_closure() {
+    // One seam of an octahedron's net closes one loop of faces; the balance must satisfy
+    // the closure and leave no energy gradient along it (the Lagrange condition), checked
+    // here with a Jacobian by central differences of the corners' places and an SVD.
+    use nalgebra::{DMatrix, DVector};
+    let (name, solid) = open_solid("octahedron").unwrap();
+    let options = NetsOptions::default();
+    let report = nets(&name, &solid, &options).unwrap();
+    let made = best_net_patterns(&solid, &report, 1).unwrap().remove(0).1;
+    let scene = net_device(&made, "octahedron", &options).unwrap();
+    let model = scene.network().unwrap();
+    let closing = NetClosing::new(&made, model).unwrap();
+    let n = model.columns();
+    let targets: Vec<f64> = model.forcing.hinges.iter().map(|h| h.target).collect();
+    // Drives and stiffnesses off their nominal values, as a fabricated device's are.
+    let drive: Vec<f64> = (0..n)
+        .map(|c| targets[c] * (1.0 + 0.07 * ((c * 7 % 5) as f64 - 2.0)))
+        .collect();
+    let stiffness: Vec<f64> = (0..n).map(|c| 1e-9 * (1.0 + 0.3 * (c % 3) as f64)).collect();
+    for seam in 0..closing.seam_count() {
+        let theta = closing.balance(model, &drive, &stiffness, &[seam], &targets).unwrap();
+        let [e, f] = made.seams[seam];
+        let ends = |theta: &[f64]| -> DVector<f64> {
+            let places = closing.vertex_places(model, theta);
+            let (a, b) = (made.pattern.edges[e], made.pattern.edges[f]);
+            let pairs = if made.solid_vertex[a[0]] == made.solid_vertex[b[0]] {
+                [[a[0], b[0]], [a[1], b[1]]]
+            } else {
+                [[a[0], b[1]], [a[1], b[0]]]
+            };
+            DVector::from_iterator(
+                6,
+                pairs
+                    .iter()
+                    .flat_map(|&[v, w]| (0..3).map(move |i| (v, w, i)))
+                    .map(|(v, w, i)| places[v][i] - places[w][i]),
+            )
+        };
+        assert!(ends(&theta).amax() <= 1e-12, "seam {seam}: {}", ends(&theta).amax());
+        let h = 1e-6;
+        let mut jacobian = DMatrix::zeros(6, n);
+        for c in 0..n {
+            let (mut up, mut down) = (theta.clone(), theta.clone());
+            up[c] += h;
+            down[c] -= h;
+            jacobian.set_column(c, &((ends(&up) - ends(&down)) / (2.0 * h)));
+        }
+        let gradient = DVector::from_iterator(n, (0..n).map(|c| stiffness[c] * (theta[c] - drive[c])));
+        let svd = jacobian.clone().svd(true, true);
+        let largest = svd.singular_values.max();
+        let v_t = svd.v_t.unwrap();
+        let mut along = gradient.clone();
+        for (i, &s) in svd.singular_values.iter().enumerate() {
+            if s > 1e-6 * largest {
+                let row = v_t.row(i).transpose();
+                along -= &row * row.dot(&gradient);
+            }
+        }
+        assert!(
+            along.norm() <= 1e-6 * gradient.norm(),
+            "seam {seam}: gradient {} along the closure of {}",
+            along.norm(),
+            gradient.norm()
+        );
+    }
+    let bad = closing.balance(model, &drive, &stiffness, &[99], &targets).unwrap_err();
+    assert!(bad.to_string().contains("latched"), "{bad}");
+}
