@@ -255,6 +255,25 @@ pub struct NetsArgs {
     /// at the centre of the net's tree).
     #[arg(long)]
     pub anchored_face: Option<usize>,
+    /// How many of the best nets that can be made are simulated closing (0: none).
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().simulate)]
+    pub simulate: usize,
+    /// Etch-front directions each simulated net is released along, k·360°/N (0: all hinges
+    /// at once); --front-deg tries that direction alone.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().fronts)]
+    pub fronts: usize,
+    /// Devices sampled per net and release for the yield (0: the nominal device only).
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().yield_samples)]
+    pub yield_samples: usize,
+    /// Standard deviation of each hinge's stiffness across devices, %.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().stiffness_spread_percent, allow_negative_numbers = true)]
+    pub stiffness_spread_percent: f64,
+    /// Standard deviation of each hinge's residual stress across devices, %.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().stress_spread_percent, allow_negative_numbers = true)]
+    pub stress_spread_percent: f64,
+    /// A seam latches when its edges meet within this share of its length, %.
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().capture_percent, allow_negative_numbers = true)]
+    pub capture_percent: f64,
     /// Output folder (default: output/<shape>-nets/).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -268,6 +287,7 @@ pub enum RankByArg {
     RadiusOfGyration,
     SeamLength,
     Footprint,
+    Yield,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -1097,10 +1117,17 @@ const NETS_FLAGS: &[(&str, &str)] = &[
     ("front_deg", "--front-deg"),
     ("etch_rate_um_per_min", "--etch-rate-um-per-min"),
     ("anchored_face", "--anchored-face"),
+    ("simulate", "--simulate"),
+    ("fronts", "--fronts"),
+    ("yield_samples", "--yield-samples"),
+    ("stiffness_spread_percent", "--stiffness-spread-percent"),
+    ("stress_spread_percent", "--stress-spread-percent"),
+    ("capture_percent", "--capture-percent"),
+    ("rank_by", "--rank-by"),
 ];
 
 fn run_nets(args: &NetsArgs) -> Result<()> {
-    use nanofold::commands::nets::{nets, nets_files, open_solid, NetsOptions, RankBy, Search};
+    use nanofold::commands::nets::{nets, nets_files, open_solid, study_nets, NetsOptions, Outcome, RankBy, Search};
     let options = NetsOptions {
         max_trees: args.max_trees,
         samples: args.samples,
@@ -1109,6 +1136,7 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
             RankByArg::RadiusOfGyration => RankBy::RadiusOfGyration,
             RankByArg::SeamLength => RankBy::SeamLength,
             RankByArg::Footprint => RankBy::Footprint,
+            RankByArg::Yield => RankBy::Yield,
         },
         top: args.top,
         unit_um: args.unit_um,
@@ -1116,11 +1144,32 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         front_deg: args.front_deg,
         etch_rate_um_per_min: args.etch_rate_um_per_min,
         anchored_face: args.anchored_face,
+        simulate: args.simulate,
+        fronts: args.fronts,
+        yield_samples: args.yield_samples,
+        stiffness_spread_percent: args.stiffness_spread_percent,
+        stress_spread_percent: args.stress_spread_percent,
+        capture_percent: args.capture_percent,
     };
     let flags = |e| with_flags(e, NETS_FLAGS);
     options.validate().map_err(flags)?;
     let (name, solid) = open_solid(&args.shape).map_err(|e| anyhow::anyhow!("reading {}: {e}", args.shape))?;
-    let report = nets(&name, &solid, &options).map_err(flags)?;
+    let mut report = nets(&name, &solid, &options).map_err(flags)?;
+    let bar = if args.json || options.simulate == 0 {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(1)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} simulating releases [{bar:40}] {pos}/{len} ({eta} left)")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let studied = study_nets(&solid, &mut report, &options, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    studied.map_err(flags)?;
     let files = nets_files(&solid, &report, &options).map_err(flags)?;
     let dir = args
         .out
@@ -1151,9 +1200,47 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         report.overlapping,
         report.seconds
     );
-    for row in report.nets.iter().take(options.top) {
+    if let Some(study) = &report.study {
+        let releases = match study.releases.as_slice() {
+            [None] => "released at once".to_string(),
+            [Some(phi)] => format!("released by a front along {phi}°"),
+            many => format!("released by fronts along {} directions", many.len()),
+        };
         println!(
-            "  #{}: Rg {:.4} µm, {} leaves, seams {:.4} µm, footprint {:.4} × {:.4} µm{}",
+            "  simulated: the best {} nets, {releases}, {} devices each ({}% stiffness and {}% stress spread), seams latching within {}%: {} devices in {:.2} s",
+            study.nets,
+            1 + study.variation.samples,
+            study.variation.stiffness_spread_percent,
+            study.variation.stress_spread_percent,
+            study.closing.capture_percent,
+            study.devices,
+            study.seconds
+        );
+    }
+    for row in report.nets.iter().take(options.top.max(options.simulate)) {
+        let simulated = row.closing.as_ref().map_or(String::new(), |c| {
+            let best = &c.releases[c.best];
+            let release = best
+                .front_deg
+                .map_or("at once".to_string(), |phi| format!("front {phi}°"));
+            let outcome = match (best.outcome, best.jam_faces) {
+                (Outcome::Jams, Some([a, b])) => format!("jams (faces {a}, {b}) at {:.6e} s", best.time_s),
+                (outcome, _) => format!("{} at {:.6e} s", outcome.label(), best.time_s),
+            };
+            let yield_text = best.yield_estimate.map_or(String::new(), |y| {
+                format!(
+                    ", yield {}/{} ({:.3}, 95% {:.3}–{:.3})",
+                    y.closed, y.samples, y.fraction, y.interval_95[0], y.interval_95[1]
+                )
+            });
+            format!(
+                "; best release {release}: {outcome}{yield_text}; closes in {} of {} releases",
+                c.closes_in,
+                c.releases.len()
+            )
+        });
+        println!(
+            "  #{}: Rg {:.4} µm, {} leaves, seams {:.4} µm, footprint {:.4} × {:.4} µm{}{simulated}",
             row.rank,
             row.radius_of_gyration_um,
             row.leaves,

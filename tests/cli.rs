@@ -1477,11 +1477,35 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
     let dir = temp_dir("nets-cube");
     let (out, report) = json_run(
         nanofold()
-            .args(["nets", "cube", "--top", "3", "--json", "--out"])
+            .args([
+                "nets",
+                "cube",
+                "--top",
+                "3",
+                "--simulate",
+                "3",
+                "--fronts",
+                "0",
+                "--yield-samples",
+                "4",
+                "--json",
+                "--out",
+            ])
             .arg(&dir),
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(report["distinct_nets"], 11);
+    // The three simulated, released at once with no overdrive: every hinge reaches 90° as
+    // the step's path ends, and every seam shuts there.
+    for net in &report["nets"].as_array().unwrap()[..3] {
+        let release = &net["closing"]["releases"][0];
+        assert_eq!(release["front_deg"], serde_json::Value::Null);
+        assert_eq!(release["outcome"], "closes", "{net}");
+        assert_eq!(release["latched"], 7);
+        assert_eq!(release["yield"]["samples"], 4);
+    }
+    assert_eq!(report["nets"][3]["closing"], serde_json::Value::Null);
+    assert_eq!(report["study"]["devices"], 15);
     assert_eq!(report["symmetry_order"], 48);
     assert_eq!(report["search"], "enumerated");
     let rg: Vec<f64> = report["nets"]
@@ -1526,9 +1550,10 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
     }
     let csv = std::fs::read_to_string(dir.join("nets.csv")).unwrap();
     assert_eq!(csv.lines().count(), 12);
+    assert!(csv.lines().nth(1).unwrap().contains(",step,closes,"), "{csv}");
     // Run again with fewer nets into the same folder: the old third net does not stay.
     let again = nanofold()
-        .args(["nets", "cube", "--top", "2", "--out"])
+        .args(["nets", "cube", "--top", "2", "--simulate", "0", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -1548,6 +1573,22 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
             "--etch-rate-um-per-min",
         ),
         (vec!["nets", "cube", "--anchored-face", "9"], "--anchored-face"),
+        (vec!["nets", "cube", "--capture-percent", "0"], "--capture-percent"),
+        (
+            vec!["nets", "cube", "--stress-spread-percent", "40"],
+            "--stress-spread-percent",
+        ),
+        (
+            vec!["nets", "cube", "--stiffness-spread-percent", "-1"],
+            "--stiffness-spread-percent",
+        ),
+        (vec!["nets", "cube", "--yield-samples", "20000"], "--yield-samples"),
+        (vec!["nets", "cube", "--fronts", "1000"], "--fronts"),
+        (vec!["nets", "cube", "--simulate", "500"], "--simulate"),
+        (
+            vec!["nets", "cube", "--rank-by", "yield", "--simulate", "0"],
+            "--rank-by",
+        ),
     ] {
         let out = nanofold().args(&args).arg("--out").arg(&bad_dir).output().unwrap();
         assert!(!out.status.success());
@@ -1609,6 +1650,20 @@ fn the_bundled_cubes_closing_and_jam_come_back_through_the_nets_path() {
             theirs["meeting_at_contact"].as_array().map(Vec::len),
             "{bundled}"
         );
+        // The design study carries the run on: the closing cube latches its walls at that
+        // contact and its lid 4000 s later; the jamming one stops there.
+        let table: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("nets.json")).unwrap()).unwrap();
+        let release = &table["nets"][0]["closing"]["releases"][0];
+        let ended = release["time_s"].as_f64().unwrap();
+        if bundled == "cube_closes" {
+            assert_eq!(release["outcome"], "closes");
+            assert_eq!(release["latched"], 7);
+            assert!(ended > time(&theirs) + 3999.0, "{release}");
+        } else {
+            assert_eq!(release["outcome"], "jams");
+            assert!((ended - time(&theirs)).abs() <= 1e-8 * ended, "{release}");
+        }
         std::fs::remove_dir_all(&dir).ok();
     }
 }

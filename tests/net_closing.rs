@@ -7,6 +7,7 @@ use common::fitted_distance;
 use nalgebra::Point3;
 use nanofold::commands::nets::*;
 use nanofold::commands::simulate;
+use nanofold::design::nets::RankBy;
 use nanofold::dynamics::simulate::SimulationSettings;
 use nanofold::geometry::polyhedron::Polyhedron;
 use nanofold::pattern::net::NetPattern;
@@ -264,4 +265,81 @@ fn a_balance_with_one_seam_latched_is_a_minimum_on_its_closure() {
     }
     let bad = closing.balance(model, &drive, &stiffness, &[99], &targets).unwrap_err();
     assert!(bad.to_string().contains("latched"), "{bad}");
+}
+
+#[test]
+fn a_study_on_the_cores_equals_each_net_studied_alone_and_ranks_by_yield() {
+    let (name, solid) = open_solid("cube").unwrap();
+    let options = NetsOptions {
+        top: 4,
+        simulate: 4,
+        fronts: 4,
+        yield_samples: 12,
+        unit_um: 50.0,
+        overdrive_deg: 5.0,
+        rank_by: RankBy::Yield,
+        ..NetsOptions::default()
+    };
+    let mut report = nets(&name, &solid, &options).unwrap();
+    let before = report.clone();
+    let heard = std::sync::Mutex::new(Vec::new());
+    study_nets(&solid, &mut report, &options, &|done, total| {
+        heard.lock().unwrap().push((done, total))
+    })
+    .unwrap();
+    let mut heard = heard.into_inner().unwrap();
+    heard.sort();
+    assert_eq!(heard, (1..=16).map(|d| (d, 16)).collect::<Vec<_>>());
+    let study = report.study.as_ref().unwrap();
+    assert_eq!((study.nets, study.devices), (4, 16 * 13));
+    // Each net run alone, one release after another, is the same.
+    let simulated: Vec<&NetRow> = report.nets.iter().filter(|r| r.closing.is_some()).collect();
+    assert_eq!(simulated.len(), 4);
+    for row in &simulated {
+        let first_rank = before.nets.iter().find(|r| r.folds == row.folds).unwrap().rank;
+        let alone = study_net(&solid, &before, first_rank, &options).unwrap();
+        assert_eq!(row.closing.as_ref(), Some(&alone), "net first ranked {first_rank}");
+        assert_eq!(alone.releases.len(), 4);
+    }
+    // Ranked by yield: the simulated nets first, best yield first.
+    let yields: Vec<f64> = report
+        .nets
+        .iter()
+        .take(4)
+        .map(|r| r.closing.as_ref().unwrap().best_yield())
+        .collect();
+    assert!(yields.windows(2).all(|w| w[0] >= w[1]), "{yields:?}");
+    assert!(report.nets.iter().enumerate().all(|(k, r)| r.rank == k + 1));
+}
+
+#[test]
+fn without_variation_every_sampled_device_is_the_nominal_one() {
+    let (name, solid) = open_solid("cube").unwrap();
+    let options = NetsOptions {
+        top: 2,
+        simulate: 2,
+        fronts: 8,
+        yield_samples: 3,
+        stiffness_spread_percent: 0.0,
+        stress_spread_percent: 0.0,
+        unit_um: 50.0,
+        overdrive_deg: 5.0,
+        ..NetsOptions::default()
+    };
+    let mut report = nets(&name, &solid, &options).unwrap();
+    study_nets(&solid, &mut report, &options, &|_, _| {}).unwrap();
+    let mut outcomes = std::collections::HashSet::new();
+    for row in report.nets.iter().filter_map(|r| r.closing.as_ref()) {
+        for release in &row.releases {
+            let closed = release.yield_estimate.unwrap().closed;
+            let nominal = usize::from(release.outcome == Outcome::Closes);
+            assert_eq!(closed, 3 * nominal, "{release:?}");
+            outcomes.insert(release.outcome);
+        }
+    }
+    // The releases tried do not all end alike: the direction of the front decides.
+    assert!(
+        outcomes.contains(&Outcome::Closes) && outcomes.contains(&Outcome::Jams),
+        "{outcomes:?}"
+    );
 }

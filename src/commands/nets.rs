@@ -3,10 +3,13 @@
 //! `nanofold nets` writes (nets.json, nets.csv, the best nets as FOLD crease patterns,
 //! gallery.svg).
 
-pub use crate::design::closing::{ClosingReport, ClosingSettings, NetClosing, Outcome};
+pub use crate::design::closing::{
+    ClosingReport, ClosingSettings, NetClosing, NetClosingSummary, Outcome, ReleaseResult,
+};
+pub use crate::design::fabrication::{clopper_pearson, Variation, YieldEstimate};
 pub use crate::design::nets::{
-    best_net_patterns, nets, NetRow, NetsOptions, NetsReport, RankBy, Search, MAX_ENUMERATED_TREES, MAX_SAMPLED_TREES,
-    MAX_WRITTEN_NETS,
+    apply_study, best_net_patterns, nets, NetRow, NetsOptions, NetsReport, RankBy, Search, Study, MAX_ENUMERATED_TREES,
+    MAX_SAMPLED_TREES, MAX_WRITTEN_NETS,
 };
 use crate::error::{NanofoldError, Result};
 use crate::geometry::polyhedron::Polyhedron;
@@ -218,14 +221,190 @@ pub fn net_closing(
     closing.run(model, &model.forcing, &model.stiffness(), settings)
 }
 
-/// The ranked table as CSV.
+/// One simulated net's every release: its nominal device run and `options.yield_samples`
+/// varied devices per release, one after another.
+pub fn study_net(
+    solid: &Polyhedron,
+    report: &NetsReport,
+    rank: usize,
+    options: &NetsOptions,
+) -> Result<NetClosingSummary> {
+    options.validate()?;
+    let row =
+        report.nets.iter().find(|r| r.rank == rank).ok_or_else(|| {
+            NanofoldError::invalid("rank", rank, format!("the table ranks 1 to {}", report.nets.len()))
+        })?;
+    let made = net_of(solid, report, row)?;
+    let releases = options
+        .releases()
+        .into_iter()
+        .map(|front| study_release(&made, &report.solid, rank, front, options))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(NetClosingSummary::new(
+        options.anchored_face.unwrap_or(made.centre_face),
+        releases,
+    ))
+}
+
+/// A ranked net's crease pattern (refused when it cannot be made).
+fn net_of(solid: &Polyhedron, report: &NetsReport, row: &NetRow) -> Result<NetPattern> {
+    if row.overlapping || row.touching == Some(true) {
+        return Err(NanofoldError::invalid(
+            "rank",
+            row.rank,
+            "the net overlaps or touches itself: it cannot be made",
+        ));
+    }
+    let layout = crate::geometry::nets::NetLayout::new(solid);
+    let tree = row.folds.iter().fold(0u64, |t, &k| t | 1 << k);
+    crate::pattern::net::net_pattern(solid, &layout.lay_flat(tree), &report.solid)
+}
+
+/// One release of a net: the nominal device, then the sampled ones.
+fn study_release(
+    made: &NetPattern,
+    name: &str,
+    rank: usize,
+    front_deg: Option<f64>,
+    options: &NetsOptions,
+) -> Result<ReleaseResult> {
+    let released = NetsOptions {
+        front_deg,
+        ..options.clone()
+    };
+    let scene = net_device(made, &format!("{name}_net_{rank:03}"), &released)?;
+    let model = scene.network().expect("a net's scene is a network");
+    let closing = NetClosing::new(made, model)?;
+    let settings = options.closing();
+    let nominal = closing.run(model, &model.forcing, &model.stiffness(), &settings)?;
+    let variation = options.variation();
+    let yield_estimate = if variation.samples > 0 {
+        let stiffness = model.stiffness();
+        let mut closed = 0;
+        for sample in 0..variation.samples {
+            let (forcing, varied) = variation.device(&model.forcing, &stiffness, sample);
+            if closing.run(model, &forcing, &varied, &settings)?.outcome == Outcome::Closes {
+                closed += 1;
+            }
+        }
+        Some(YieldEstimate::new(closed, variation.samples))
+    } else {
+        None
+    };
+    Ok(ReleaseResult {
+        front_deg,
+        outcome: nominal.outcome,
+        time_s: nominal.time_s,
+        latched: nominal.latches.len(),
+        jam_faces: nominal.jam.map(|j| j.faces),
+        yield_estimate,
+    })
+}
+
+/// Simulates the best `options.simulate` nets that can be made, every release of each
+/// (`options.releases()`), on the machine's cores; `progress(done, total)` hears of each
+/// release finished. The table gets each net's closing (and is ranked again by yield when
+/// asked).
+pub fn study_nets(
+    solid: &Polyhedron,
+    report: &mut NetsReport,
+    options: &NetsOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<()> {
+    options.validate()?;
+    if options.simulate == 0 {
+        return Ok(());
+    }
+    let started = std::time::Instant::now();
+    let ranks: Vec<usize> = report
+        .nets
+        .iter()
+        .filter(|r| !r.overlapping && r.touching == Some(false))
+        .take(options.simulate)
+        .map(|r| r.rank)
+        .collect();
+    let nets: Vec<NetPattern> = ranks
+        .iter()
+        .map(|&rank| net_of(solid, report, &report.nets[rank - 1]))
+        .collect::<Result<_>>()?;
+    let releases = options.releases();
+    let jobs: Vec<(usize, usize)> = (0..nets.len())
+        .flat_map(|n| (0..releases.len()).map(move |r| (n, r)))
+        .collect();
+    let results: Vec<std::sync::Mutex<Option<Result<ReleaseResult>>>> =
+        jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len().max(1));
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(&(n, r)) = jobs.get(k) else { break };
+                let result = study_release(&nets[n], &report.solid, ranks[n], releases[r], options);
+                *results[k].lock().expect("no job panics holding it") = Some(result);
+                progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, jobs.len());
+            });
+        }
+    });
+    let mut by_net: Vec<Vec<ReleaseResult>> = vec![Vec::new(); nets.len()];
+    for ((n, _), slot) in jobs.iter().zip(results) {
+        let result = slot
+            .into_inner()
+            .expect("no job panics holding it")
+            .expect("every job ran");
+        by_net[*n].push(result?);
+    }
+    let summaries = by_net
+        .into_iter()
+        .enumerate()
+        .map(|(n, releases)| {
+            let anchored = options.anchored_face.unwrap_or(nets[n].centre_face);
+            (ranks[n], NetClosingSummary::new(anchored, releases))
+        })
+        .collect();
+    let variation = options.variation();
+    let study = Study {
+        nets: nets.len(),
+        releases: releases.clone(),
+        variation,
+        closing: options.closing(),
+        devices: jobs.len() * (1 + variation.samples),
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    apply_study(report, summaries, study);
+    Ok(())
+}
+
+/// The ranked table as CSV: the scores, and for the nets simulated their best release
+/// (`step` or the front's direction), its nominal outcome, the yield with its 95 % interval
+/// and the number of releases that close.
 pub fn nets_csv(report: &NetsReport) -> String {
     let mut csv = String::from(
-        "rank,radius_of_gyration_um,leaves,seam_length_um,footprint_long_um,footprint_short_um,overlapping,touching,folds\n",
+        "rank,radius_of_gyration_um,leaves,seam_length_um,footprint_long_um,footprint_short_um,overlapping,touching,folds,best_release,outcome,yield,yield_low,yield_high,closes_in\n",
     );
     for row in &report.nets {
+        let simulated = row.closing.as_ref().map_or_else(
+            || ",,,,,".to_string(),
+            |c| {
+                let best = &c.releases[c.best];
+                let release = best.front_deg.map_or("step".to_string(), |phi| format!("front {phi}"));
+                let (fraction, [low, high]) = best
+                    .yield_estimate
+                    .map_or((String::new(), [String::new(), String::new()]), |y| {
+                        (y.fraction.to_string(), y.interval_95.map(|x| format!("{x:.6}")))
+                    });
+                format!(
+                    "{release},{},{fraction},{low},{high},{}",
+                    best.outcome.label(),
+                    c.closes_in
+                )
+            },
+        );
         csv += &format!(
-            "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{},{},{}\n",
+            "{},{:.9e},{},{:.9e},{:.9e},{:.9e},{},{},{},{simulated}\n",
             row.rank,
             row.radius_of_gyration_um,
             row.leaves,
@@ -255,7 +434,17 @@ pub fn nets_files(solid: &Polyhedron, report: &NetsReport, options: &NetsOptions
         let description = format!("net ranked {rank} of {} by {}", report.solid, report.rank_by.label());
         let fold = crate::write::net_output::net_fold(made, &description);
         let fold_name = format!("net_{rank:03}.fold");
-        let scene = net_scene(made, &format!("{}_net_{rank:03}", report.solid), &fold_name, options)?;
+        // A simulated net's scene is released its best way, unless one was asked for.
+        let best_release = report.nets[rank - 1]
+            .closing
+            .as_ref()
+            .filter(|_| options.front_deg.is_none())
+            .map(|c| c.releases[c.best].front_deg);
+        let released = NetsOptions {
+            front_deg: best_release.unwrap_or(options.front_deg),
+            ..options.clone()
+        };
+        let scene = net_scene(made, &format!("{}_net_{rank:03}", report.solid), &fold_name, &released)?;
         files.push((
             fold_name,
             serde_json::to_string_pretty(&fold).expect("FOLD is plain data"),

@@ -59,7 +59,7 @@ impl ClosingSettings {
 }
 
 /// How a closing run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
     /// Every seam latched.
@@ -141,6 +141,74 @@ pub struct ClosingReport {
     pub open_seams: Vec<(usize, f64)>,
     /// The start, every event (before and after its latches) and the end.
     pub frames: Vec<ClosingFrame>,
+}
+
+/// One release of a simulated net: its nominal device's closing and its yield.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReleaseResult {
+    /// The etch front's direction, degrees (None: every hinge at once).
+    pub front_deg: Option<f64>,
+    /// How the nominal device's run ended.
+    pub outcome: Outcome,
+    /// When (see [`ClosingReport::time_s`]), s.
+    pub time_s: f64,
+    /// Seams latched by then.
+    pub latched: usize,
+    /// The faces that jammed (FOLD face indices).
+    pub jam_faces: Option<[usize; 2]>,
+    /// The share of sampled devices that close (None: none sampled).
+    #[serde(rename = "yield")]
+    pub yield_estimate: Option<crate::design::fabrication::YieldEstimate>,
+}
+
+/// A simulated net: every release tried and the best.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NetClosingSummary {
+    /// The anchored face (FOLD face index).
+    pub anchored_face: usize,
+    /// Every release tried.
+    pub releases: Vec<ReleaseResult>,
+    /// The best release (index into `releases`): the highest yield, then a nominal device
+    /// that closes, then the earliest closing.
+    pub best: usize,
+    /// Releases whose nominal device closes.
+    pub closes_in: usize,
+}
+
+impl NetClosingSummary {
+    /// The summary of `releases` (at least one), the best chosen.
+    pub fn new(anchored_face: usize, releases: Vec<ReleaseResult>) -> NetClosingSummary {
+        let key = |r: &ReleaseResult| {
+            (
+                r.yield_estimate.map_or(0.0, |y| y.fraction),
+                r.outcome == Outcome::Closes,
+                -r.time_s,
+            )
+        };
+        let best = (0..releases.len())
+            .max_by(|&a, &b| {
+                let (ka, kb) = (key(&releases[a]), key(&releases[b]));
+                ka.0.total_cmp(&kb.0)
+                    .then(ka.1.cmp(&kb.1))
+                    .then(ka.2.total_cmp(&kb.2))
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let closes_in = releases.iter().filter(|r| r.outcome == Outcome::Closes).count();
+        NetClosingSummary {
+            anchored_face,
+            releases,
+            best,
+            closes_in,
+        }
+    }
+
+    /// The best release's yield (its nominal outcome, 1 or 0, when none was sampled).
+    pub fn best_yield(&self) -> f64 {
+        let best = &self.releases[self.best];
+        best.yield_estimate
+            .map_or(if best.outcome == Outcome::Closes { 1.0 } else { 0.0 }, |y| y.fraction)
+    }
 }
 
 #[derive(Debug, Clone)]

@@ -2,6 +2,8 @@
 //! unfolding (or those met in a uniform sample), laid flat, tested for overlap, scored and
 //! ranked, the best that can be made checked for touching themselves.
 
+use crate::design::closing::{ClosingSettings, NetClosingSummary};
+use crate::design::fabrication::Variation;
 use crate::error::{NanofoldError, Result};
 use crate::geometry::nets::NetLayout;
 use crate::geometry::polyhedron::Polyhedron;
@@ -13,8 +15,10 @@ use serde::{Deserialize, Serialize};
 pub const MAX_ENUMERATED_TREES: usize = 10_000_000;
 /// The most trees sampled.
 pub const MAX_SAMPLED_TREES: usize = 1_000_000;
-/// The most nets written as files.
+/// The most nets written as files (and simulated).
 pub const MAX_WRITTEN_NETS: usize = 100;
+/// The most etch-front directions tried per net.
+pub const MAX_FRONTS: usize = 360;
 
 /// The score nets are ranked by (smallest first); every ranking puts the nets that can be
 /// made (no overlap, not touching themselves) first.
@@ -28,6 +32,10 @@ pub enum RankBy {
     SeamLength,
     /// The area of the smallest rectangle holding the net.
     Footprint,
+    /// The simulated yield of the net's best release, highest first (then the releases
+    /// whose nominal device closes, most first); the nets not simulated follow by radius of
+    /// gyration, which also chooses the nets simulated.
+    Yield,
 }
 
 impl RankBy {
@@ -37,6 +45,7 @@ impl RankBy {
             RankBy::RadiusOfGyration => "radius of gyration",
             RankBy::SeamLength => "seam length",
             RankBy::Footprint => "footprint",
+            RankBy::Yield => "simulated yield",
         }
     }
 }
@@ -69,6 +78,19 @@ pub struct NetsOptions {
     /// The face each written scene anchors (a FOLD face index of the net; None: the face at
     /// the centre of the net's tree).
     pub anchored_face: Option<usize>,
+    /// How many of the best nets that can be made are simulated closing (0: none).
+    pub simulate: usize,
+    /// The etch-front directions each simulated net is released along, k·360°/fronts
+    /// (0: every hinge at once, a step); `front_deg` given tries that one alone.
+    pub fronts: usize,
+    /// Devices sampled per net and release for the yield (0: the nominal device only).
+    pub yield_samples: usize,
+    /// Standard deviation of each hinge's stiffness across devices, % of its value.
+    pub stiffness_spread_percent: f64,
+    /// Standard deviation of each hinge's residual stress across devices, %.
+    pub stress_spread_percent: f64,
+    /// A seam latches when its edges meet within this share of its length, %.
+    pub capture_percent: f64,
 }
 
 impl Default for NetsOptions {
@@ -84,6 +106,12 @@ impl Default for NetsOptions {
             front_deg: None,
             etch_rate_um_per_min: 1.5,
             anchored_face: None,
+            simulate: 10,
+            fronts: 16,
+            yield_samples: 50,
+            stiffness_spread_percent: 5.0,
+            stress_spread_percent: 5.0,
+            capture_percent: 10.0,
         }
     }
 }
@@ -136,7 +164,56 @@ impl NetsOptions {
                 "a speed > 0",
             ));
         }
-        Ok(())
+        if self.simulate > MAX_WRITTEN_NETS {
+            return Err(NanofoldError::invalid(
+                "simulate",
+                self.simulate,
+                format!("at most {MAX_WRITTEN_NETS} nets"),
+            ));
+        }
+        if self.fronts > MAX_FRONTS {
+            return Err(NanofoldError::invalid(
+                "fronts",
+                self.fronts,
+                format!("at most {MAX_FRONTS} directions"),
+            ));
+        }
+        if self.rank_by == RankBy::Yield && self.simulate == 0 {
+            return Err(NanofoldError::invalid(
+                "rank_by",
+                "yield",
+                "ranking by yield needs nets simulated (simulate ≥ 1)",
+            ));
+        }
+        self.variation().validate()?;
+        self.closing().validate()
+    }
+
+    /// The fabrication variation these options ask for.
+    pub fn variation(&self) -> Variation {
+        Variation {
+            samples: self.yield_samples,
+            stiffness_spread_percent: self.stiffness_spread_percent,
+            stress_spread_percent: self.stress_spread_percent,
+            seed: self.seed,
+        }
+    }
+
+    /// How seams latch.
+    pub fn closing(&self) -> ClosingSettings {
+        ClosingSettings {
+            capture_percent: self.capture_percent,
+        }
+    }
+
+    /// The releases each simulated net is tried with: `front_deg` alone when given, else
+    /// `fronts` directions from 0°, else a step (None).
+    pub fn releases(&self) -> Vec<Option<f64>> {
+        match (self.front_deg, self.fronts) {
+            (Some(phi), _) => vec![Some(phi)],
+            (None, 0) => vec![None],
+            (None, n) => (0..n).map(|k| Some(360.0 * k as f64 / n as f64)).collect(),
+        }
     }
 }
 
@@ -169,6 +246,8 @@ pub struct NetRow {
     pub overlapping: bool,
     /// The net touches itself at a point or along a seam (checked for the nets written).
     pub touching: Option<bool>,
+    /// Its device's simulated closing (for the nets simulated).
+    pub closing: Option<NetClosingSummary>,
 }
 
 /// The solid and its nets.
@@ -202,8 +281,55 @@ pub struct NetsReport {
     pub unit_um: f64,
     /// The nets, best first.
     pub nets: Vec<NetRow>,
+    /// What the simulated nets were run with (None: no net simulated).
+    pub study: Option<Study>,
     /// Seconds taken.
     pub seconds: f64,
+}
+
+/// What a study simulated.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Study {
+    /// Nets simulated.
+    pub nets: usize,
+    /// Their releases (None: a step).
+    pub releases: Vec<Option<f64>>,
+    /// The devices' variation.
+    pub variation: Variation,
+    /// How seams latch.
+    pub closing: ClosingSettings,
+    /// Devices run (nominal and sampled).
+    pub devices: usize,
+    /// Seconds the study took.
+    pub seconds: f64,
+}
+
+/// Puts the simulated closings into the table (`summaries` by rank) and, when ranking by
+/// yield, ranks again: the simulated nets by their best release's yield (then releases that
+/// close, then the earlier rank), the others after them in their order.
+pub fn apply_study(report: &mut NetsReport, summaries: Vec<(usize, NetClosingSummary)>, study: Study) {
+    for (rank, summary) in summaries {
+        if let Some(row) = report.nets.iter_mut().find(|r| r.rank == rank) {
+            row.closing = Some(summary);
+        }
+    }
+    if report.rank_by == RankBy::Yield {
+        let score = |row: &NetRow| {
+            row.closing
+                .as_ref()
+                .map(|c| (c.best_yield(), c.closes_in))
+                .unwrap_or((-1.0, 0))
+        };
+        report.nets.sort_by(|a, b| {
+            let (ya, ca) = score(a);
+            let (yb, cb) = score(b);
+            yb.total_cmp(&ya).then(cb.cmp(&ca)).then(a.rank.cmp(&b.rank))
+        });
+        for (k, row) in report.nets.iter_mut().enumerate() {
+            row.rank = k + 1;
+        }
+    }
+    report.study = Some(study);
 }
 
 /// Finds, lays flat, tests and ranks the distinct nets of `solid`.
@@ -238,14 +364,15 @@ pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<Net
                 footprint_um: [long * unit, short * unit],
                 overlapping: !net.overlapping_pairs().is_empty(),
                 touching: None,
+                closing: None,
             };
             (tree, row)
         })
         .collect();
     let key = |row: &NetRow| match options.rank_by {
-        RankBy::RadiusOfGyration => row.radius_of_gyration_um,
         RankBy::SeamLength => row.seam_length_um,
         RankBy::Footprint => row.footprint_um[0] * row.footprint_um[1],
+        RankBy::RadiusOfGyration | RankBy::Yield => row.radius_of_gyration_um,
     };
     rows.sort_by(|(ta, a), (tb, b)| {
         a.overlapping
@@ -257,7 +384,7 @@ pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<Net
     // overlapping ones.
     let mut checked = 0;
     for (tree, row) in rows.iter_mut() {
-        if checked >= options.top || row.overlapping {
+        if checked >= options.top.max(options.simulate) || row.overlapping {
             break;
         }
         let touching = net_pattern(solid, &layout.lay_flat(*tree), name).is_err();
@@ -291,6 +418,7 @@ pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<Net
         rank_by: options.rank_by,
         unit_um: unit,
         nets,
+        study: None,
         seconds: started.elapsed().as_secs_f64(),
     })
 }
