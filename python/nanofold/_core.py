@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from pathlib import Path
@@ -11,7 +12,7 @@ import numpy as np
 
 from . import _native
 from ._results import FitResult, FoldResult, NetsResult, PatternResult, Result, SimulationResult
-from .errors import from_native
+from .errors import NanofoldError, from_native
 
 T = TypeVar("T")
 PathLike = Union[str, "os.PathLike[str]"]
@@ -509,26 +510,81 @@ def nets(
     front_deg: Optional[float] = None,
     etch_rate_um_per_min: Optional[float] = None,
     anchored_face: Optional[int] = None,
+    simulate: Optional[int] = None,
+    fronts: Optional[int] = None,
+    yield_samples: Optional[int] = None,
+    stiffness_spread_percent: Optional[float] = None,
+    stress_spread_percent: Optional[float] = None,
+    capture_percent: Optional[float] = None,
+    client: Any = "threads",
+    progress: bool = True,
 ) -> NetsResult:
-    """The distinct nets of a solid (``nanofold nets``): ``shape`` is a .off, .obj or .fold
-    file, or a generated solid (``"cube"``, ``"box:1x2x3"``, ``"prism:6"``,
-    ``"polycube:0,0,0;1,0,0"``, ...). Every net is laid flat, tested for overlap and scored
-    (radius of gyration, leaves, seam length, footprint); ``rank_by`` is
-    ``"radius_of_gyration"`` (default), ``"seam_length"`` or ``"footprint"``; the ``top``
-    best that can be made come back as FOLD crease patterns with ready device scenes, their
-    hinges driven ``overdrive_deg`` past closing, released at once or by an etch front along
-    ``front_deg`` (``etch_rate_um_per_min``), ``anchored_face`` (default: the centre face) held.
+    """The distinct nets of a solid and their simulated self-folding (``nanofold nets``):
+    ``shape`` is a .off, .obj or .fold file, or a generated solid (``"cube"``,
+    ``"box:1x2x3"``, ``"prism:6"``, ``"polycube:0,0,0;1,0,0"``, ...). Every net is laid flat,
+    tested for overlap and scored (radius of gyration, leaves, seam length, footprint);
+    ``rank_by`` is ``"radius_of_gyration"`` (default), ``"seam_length"``, ``"footprint"`` or
+    ``"yield"``. The best ``simulate`` nets that can be made are folded with their seams
+    latching (within ``capture_percent`` of a seam's length), released by an etch front
+    along ``fronts`` directions (or ``front_deg`` alone; ``fronts=0``: all at once), each
+    release's nominal device and ``yield_samples`` devices varied by
+    ``stiffness_spread_percent`` and ``stress_spread_percent``. The ``top`` best come back as
+    FOLD crease patterns with ready device scenes (hinges driven ``overdrive_deg`` past
+    closing, released their best way, ``anchored_face`` held; default the centre face).
+
+    ``client`` runs the study: ``"threads"`` (default: this machine's cores, as the command
+    line), or as :func:`nanofold.sweep` takes it: a ``dask.distributed.Client``, a scheduler
+    address or file, ``None`` (a ``LocalCluster``) or ``"serial"``; one task per net and
+    release.
 
     >>> import nanofold
-    >>> r = nanofold.nets("cube", top=3)
+    >>> r = nanofold.nets("cube", top=3, simulate=0)
     >>> r.distinct_nets, r.symmetry_order, len(r.folds)
     (11, 48, 3)
     """
     keywords = dict(max_trees=max_trees, samples=samples, seed=seed, rank_by=rank_by, top=top, unit_um=unit_um,
                     overdrive_deg=overdrive_deg, front_deg=front_deg, etch_rate_um_per_min=etch_rate_um_per_min,
-                    anchored_face=anchored_face)
-    summary, rest = _call(_native.nets, os.fspath(shape), _settings(keywords))
+                    anchored_face=anchored_face, simulate=simulate, fronts=fronts, yield_samples=yield_samples,
+                    stiffness_spread_percent=stiffness_spread_percent, stress_spread_percent=stress_spread_percent,
+                    capture_percent=capture_percent)
+    settings = _settings(keywords)
+    shape_text = os.fspath(shape)
+    if isinstance(client, str) and client == "threads":
+        summary, rest = _call(_native.nets, shape_text, settings)
+        return NetsResult("nets", summary, rest)
+    import time
+
+    from ._sweep import sweep
+
+    clock = time.perf_counter()
+    table = json.loads(_call(_native.nets_table, shape_text, settings))
+    rows = table["report"]["nets"]
+    chosen = [r for r in rows if not r["overlapping"] and r["touching"] is False][: table["simulate"]]
+    releases = table["releases"]
+    grid = [
+        {"rank": row["rank"], "folds": " ".join(str(k) for k in row["folds"]), "release": k}
+        for row in chosen
+        for k in range(len(releases))
+    ]
+    by_rank: Dict[int, List[Any]] = {row["rank"]: [None] * len(releases) for row in chosen}
+    if grid:
+        task = functools.partial(_net_release, shape_text, settings)
+        done = sweep(task, grid, client=client, progress=progress)
+        failed = done[done["error"].notna()]
+        if len(failed):
+            first = failed.iloc[0]
+            raise NanofoldError(f"a study job failed (net {first['rank']}, release {first['release']}): {first['error']}")
+        for _, job in done.iterrows():
+            by_rank[int(job["rank"])][int(job["release"])] = json.loads(job["result"])
+    study = {"by_rank": [[rank, results] for rank, results in by_rank.items()], "seconds": time.perf_counter() - clock}
+    summary, rest = _call(_native.nets_with_study, shape_text, settings, json.dumps(study))
     return NetsResult("nets", summary, rest)
+
+
+def _net_release(shape: str, settings: str, rank: int, folds: str, release: int) -> Dict[str, Any]:
+    """One job of a nets study (on a worker): the release's result as JSON."""
+    del rank  # a label of the job's row
+    return {"result": _call(_native.nets_release, shape, settings, [int(k) for k in folds.split()], release)}
 
 
 def modes(scene: SceneLike) -> Result:

@@ -383,8 +383,9 @@ fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(St
     })
 }
 
-/// `nets`: a solid (a file path or a generated solid's name) and its ranked nets; the
-/// report, and the ranked table (CSV), the best nets as FOLD and the gallery.
+/// `nets`: a solid (a file path or a generated solid's name) and its ranked nets, the best
+/// simulated closing on this machine's cores (the command line's study); the report, and
+/// the ranked table (CSV), the best nets as FOLD with their scenes and the gallery.
 #[pyfunction]
 fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, String)> {
     let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
@@ -392,32 +393,90 @@ fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, Stri
     run_detached(py, move || {
         let clock = Instant::now();
         let (name, solid) = commands::nets::open_solid(&shape)?;
-        let report = commands::nets::nets(&name, &solid, &options)?;
-        let summary = serde_json::to_value(&report).expect("a report is plain data");
-        let files = commands::nets::nets_files(&solid, &report, &options)?;
-        let (mut folds, mut scenes) = (Vec::new(), Vec::new());
-        let mut rest = serde_json::Map::new();
-        for (file, text) in files {
-            if file.ends_with(".scene.json") {
-                scenes.push(
-                    serde_json::from_str::<Value>(&text)
-                        .map_err(|e| NanofoldError::invalid("scene", file.clone(), e.to_string()))?,
-                );
-            } else if file.ends_with(".fold") {
-                folds.push(
-                    serde_json::from_str::<Value>(&text)
-                        .map_err(|e| NanofoldError::invalid("fold", file.clone(), e.to_string()))?,
-                );
-            } else if file == "nets.csv" {
-                rest.insert("table_csv".into(), Value::String(text));
-            } else if file == "gallery.svg" {
-                rest.insert("gallery_svg".into(), Value::String(text));
-            }
-        }
-        rest.insert("folds".into(), Value::Array(folds));
-        rest.insert("scenes".into(), Value::Array(scenes));
-        Ok(payload(summary, Value::Object(rest), clock))
+        let mut report = commands::nets::nets(&name, &solid, &options)?;
+        commands::nets::study_nets(&solid, &mut report, &options, &|_, _| {})?;
+        nets_payload(&solid, &report, &options, clock)
     })
+}
+
+/// `nets_table`: the ranked nets alone (no study), as JSON, for a study spread over a cluster.
+#[pyfunction]
+fn nets_table(py: Python<'_>, shape: String, settings: &str) -> PyResult<String> {
+    let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
+    options.validate().map_err(to_py)?;
+    run_detached(py, move || {
+        let (name, solid) = commands::nets::open_solid(&shape)?;
+        let report = commands::nets::nets(&name, &solid, &options)?;
+        Ok(serde_json::json!({
+            "report": report,
+            "releases": options.releases(),
+            "simulate": options.simulate,
+        })
+        .to_string())
+    })
+}
+
+/// `nets_release`: one job of a study: release `release` of the net folded along `folds`,
+/// its nominal and sampled devices; the result as JSON.
+#[pyfunction]
+fn nets_release(py: Python<'_>, shape: String, settings: &str, folds: Vec<usize>, release: usize) -> PyResult<String> {
+    let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
+    run_detached(py, move || {
+        let (name, solid) = commands::nets::open_solid(&shape)?;
+        let result = commands::nets::study_release_of(&solid, &name, &folds, release, &options)?;
+        Ok(serde_json::to_string(&result).expect("a result is plain data"))
+    })
+}
+
+/// `nets_with_study`: the ranked nets with a study's releases (JSON: `by_rank`, a list of
+/// [rank, [release results]], and `seconds`) put in; the same payload as `nets`.
+#[pyfunction]
+fn nets_with_study(py: Python<'_>, shape: String, settings: &str, study: &str) -> PyResult<(String, String)> {
+    let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
+    options.validate().map_err(to_py)?;
+    let study = parse_json(study, "study")?;
+    run_detached(py, move || {
+        let clock = Instant::now();
+        let by_rank = commands::nets::releases_from_json(&study["by_rank"])?;
+        let seconds = study["seconds"].as_f64().unwrap_or(0.0);
+        let (name, solid) = commands::nets::open_solid(&shape)?;
+        let mut report = commands::nets::nets(&name, &solid, &options)?;
+        commands::nets::apply_releases(&solid, &mut report, by_rank, &options, seconds)?;
+        nets_payload(&solid, &report, &options, clock)
+    })
+}
+
+/// The report and the files of a ranked (and maybe studied) table, as `nets` returns them.
+fn nets_payload(
+    solid: &nanofold::geometry::polyhedron::Polyhedron,
+    report: &commands::nets::NetsReport,
+    options: &commands::nets::NetsOptions,
+    clock: Instant,
+) -> nanofold::prelude::Result<(String, String)> {
+    let summary = serde_json::to_value(report).expect("a report is plain data");
+    let files = commands::nets::nets_files(solid, report, options)?;
+    let (mut folds, mut scenes) = (Vec::new(), Vec::new());
+    let mut rest = serde_json::Map::new();
+    for (file, text) in files {
+        if file.ends_with(".scene.json") {
+            scenes.push(
+                serde_json::from_str::<Value>(&text)
+                    .map_err(|e| NanofoldError::invalid("scene", file.clone(), e.to_string()))?,
+            );
+        } else if file.ends_with(".fold") {
+            folds.push(
+                serde_json::from_str::<Value>(&text)
+                    .map_err(|e| NanofoldError::invalid("fold", file.clone(), e.to_string()))?,
+            );
+        } else if file == "nets.csv" {
+            rest.insert("table_csv".into(), Value::String(text));
+        } else if file == "gallery.svg" {
+            rest.insert("gallery_svg".into(), Value::String(text));
+        }
+    }
+    rest.insert("folds".into(), Value::Array(folds));
+    rest.insert("scenes".into(), Value::Array(scenes));
+    Ok(payload(summary, Value::Object(rest), clock))
 }
 
 /// `fit`: a scene file's JSON (with the name, source and base folder its pattern path is
@@ -513,6 +572,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(modes, m)?,
         wrap_pyfunction!(fit, m)?,
         wrap_pyfunction!(nets, m)?,
+        wrap_pyfunction!(nets_table, m)?,
+        wrap_pyfunction!(nets_release, m)?,
+        wrap_pyfunction!(nets_with_study, m)?,
         wrap_pyfunction!(noop, m)?,
         wrap_pyfunction!(wait, m)?,
         wrap_pyfunction!(version, m)?,

@@ -262,7 +262,7 @@ def test_fit_takes_a_dataframe_with_gaps_and_gives_the_estimate_its_interval_and
 
 
 def test_nets_rank_a_solids_nets_and_give_the_best_as_fold():
-    r = nanofold.nets("box:1x2x3", top=5, unit_um=50)
+    r = nanofold.nets("box:1x2x3", top=5, unit_um=50, simulate=0)
     # A box of three different sides has 54 distinct nets (and a symmetry group of order 8).
     assert (r.distinct_nets, r.symmetry_order, r.search) == (54, 8, "enumerated")
     table = r.table
@@ -274,7 +274,7 @@ def test_nets_rank_a_solids_nets_and_give_the_best_as_fold():
 
 
 def test_a_best_nets_scene_simulates_and_its_walls_meet_along_seams(tmp_path):
-    r = nanofold.nets("cube", top=1)
+    r = nanofold.nets("cube", top=1, simulate=1, fronts=0, yield_samples=0)
     (scene,) = r.write_scenes(tmp_path)
     run = nanofold.simulate(scene)
     seams = {tuple(s) for s in r.folds[0]["nanofold:seams"]}
@@ -283,8 +283,26 @@ def test_a_best_nets_scene_simulates_and_its_walls_meet_along_seams(tmp_path):
     assert met and all(m in seams for m in met), (met, seams)
 
 
+def test_a_nets_study_closes_the_cube_along_the_bundled_front_and_gives_yields():
+    # The Latin cross released along the bundled cube's closing front (180° as nets lays it).
+    r = nanofold.nets("cube", top=1, simulate=1, front_deg=180, unit_um=50, overdrive_deg=5, yield_samples=20)
+    best = r.to_dict()["nets"][0]["closing"]["releases"][0]
+    assert best["outcome"] == "closes" and best["latched"] == 7
+    low, high = best["yield"]["interval_95"]
+    assert low <= best["yield"]["fraction"] <= high
+    table = r.table
+    assert table.loc[0, "best_release"] == "front 180.0" or table.loc[0, "best_release"] == "front 180"
+    assert table.loc[0, "outcome"] == "closes"
+
+
 def test_nets_refuse_bad_shapes_and_settings_by_name():
     with pytest.raises(nanofold.InvalidFieldError, match="top"):
         nanofold.nets("cube", top=1000)
+    with pytest.raises(nanofold.InvalidFieldError, match="capture_percent"):
+        nanofold.nets("cube", capture_percent=0)
+    with pytest.raises(nanofold.InvalidFieldError, match="stress_spread_percent"):
+        nanofold.nets("cube", stress_spread_percent=45)
+    with pytest.raises(nanofold.InvalidFieldError, match="rank_by"):
+        nanofold.nets("cube", rank_by="yield", simulate=0)
     with pytest.raises(nanofold.InvalidFieldError, match="shape"):
         nanofold.nets("sphere")

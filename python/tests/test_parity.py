@@ -88,6 +88,7 @@ def _first_crease(path):
 
 @pytest.mark.parametrize("shape", ["cube", "box:1x2x3", "pyramid:5:1.5"])
 def test_nets_equal_the_command_line(shape, tmp_path):
-    result = nanofold.nets(shape, top=4, rank_by="seam_length")
-    expected = cli_json("nets", shape, "--top", "4", "--rank-by", "seam-length", "--out", str(tmp_path / "n"))
+    result = nanofold.nets(shape, top=4, rank_by="seam_length", simulate=2, fronts=3, yield_samples=4)
+    expected = cli_json("nets", shape, "--top", "4", "--rank-by", "seam-length", "--simulate", "2", "--fronts", "3",
+                        "--yield-samples", "4", "--out", str(tmp_path / "n"))
     assert comparable(result.to_dict()) == comparable(expected)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import comparable as report_without_times
 
 import nanofold
 import sweep_tasks
@@ -205,3 +206,13 @@ def test_the_command_line_form_runs_on_a_scheduler_started_apart(tmp_path):
             process.terminate()
         for process in workers + [scheduler]:
             process.wait(timeout=30)
+
+
+def test_a_nets_study_on_the_cluster_equals_the_one_on_this_machines_cores(client):
+    keywords = dict(top=3, simulate=3, fronts=3, yield_samples=4, unit_um=50, overdrive_deg=5)
+    on_cores = nanofold.nets("octahedron", **keywords)
+    on_cluster = nanofold.nets("octahedron", client=client, progress=False, **keywords)
+    assert report_without_times(on_cluster.to_dict()) == report_without_times(on_cores.to_dict())
+    assert on_cluster.to_dict()["study"]["devices"] == 3 * 3 * 5
+    assert on_cluster.table.equals(on_cores.table)
+

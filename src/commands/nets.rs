@@ -255,9 +255,108 @@ fn net_of(solid: &Polyhedron, report: &NetsReport, row: &NetRow) -> Result<NetPa
             "the net overlaps or touches itself: it cannot be made",
         ));
     }
+    net_of_folds(solid, &report.solid, &row.folds)
+}
+
+/// The net whose folds are the solid's edges `folds` (a spanning tree of its faces).
+fn net_of_folds(solid: &Polyhedron, name: &str, folds: &[usize]) -> Result<NetPattern> {
+    let edges = solid.dual_edges().len();
+    if let Some(&bad) = folds.iter().find(|&&k| k >= edges) {
+        return Err(NanofoldError::invalid(
+            "folds",
+            bad,
+            format!("the solid has edges 0 to {}", edges - 1),
+        ));
+    }
+    if folds.len() + 1 != solid.faces.len() {
+        return Err(NanofoldError::invalid(
+            "folds",
+            format!("{folds:?}"),
+            format!(
+                "a net of {} faces has {} folds",
+                solid.faces.len(),
+                solid.faces.len() - 1
+            ),
+        ));
+    }
+    let tree = folds.iter().fold(0u64, |t, &k| t | 1 << k);
     let layout = crate::geometry::nets::NetLayout::new(solid);
-    let tree = row.folds.iter().fold(0u64, |t, &k| t | 1 << k);
-    crate::pattern::net::net_pattern(solid, &layout.lay_flat(tree), &report.solid)
+    let net = layout.lay_flat(tree);
+    if !net.overlapping_pairs().is_empty() {
+        return Err(NanofoldError::invalid(
+            "folds",
+            format!("{folds:?}"),
+            "the net overlaps itself: it cannot be made",
+        ));
+    }
+    crate::pattern::net::net_pattern(solid, &net, name)
+}
+
+/// Release `release` (an index into `options.releases()`) of the net folded along the
+/// solid's edges `folds`: one job of [`study_nets`], for a cluster to run.
+pub fn study_release_of(
+    solid: &Polyhedron,
+    name: &str,
+    folds: &[usize],
+    release: usize,
+    options: &NetsOptions,
+) -> Result<ReleaseResult> {
+    options.validate()?;
+    let releases = options.releases();
+    let front = *releases.get(release).ok_or_else(|| {
+        NanofoldError::invalid(
+            "release",
+            release,
+            format!("the options give releases 0 to {}", releases.len() - 1),
+        )
+    })?;
+    let made = net_of_folds(solid, name, folds)?;
+    let rank = 0;
+    study_release(&made, name, rank, front, options)
+}
+
+/// A study's releases by rank from JSON (`[[rank, [release, …]], …]`), as a cluster's jobs
+/// return them.
+pub fn releases_from_json(value: &serde_json::Value) -> Result<Vec<(usize, Vec<ReleaseResult>)>> {
+    crate::read::input::from_value(value)
+}
+
+/// Puts every simulated net's releases (by rank, in `options.releases()` order) into the
+/// table as [`study_nets`] does; `seconds` is what the study took.
+pub fn apply_releases(
+    solid: &Polyhedron,
+    report: &mut NetsReport,
+    by_rank: Vec<(usize, Vec<ReleaseResult>)>,
+    options: &NetsOptions,
+    seconds: f64,
+) -> Result<()> {
+    let releases = options.releases();
+    let mut summaries = Vec::with_capacity(by_rank.len());
+    for (rank, results) in by_rank {
+        let row = report.nets.iter().find(|r| r.rank == rank).ok_or_else(|| {
+            NanofoldError::invalid("rank", rank, format!("the table ranks 1 to {}", report.nets.len()))
+        })?;
+        if results.len() != releases.len() || results.iter().zip(&releases).any(|(r, f)| r.front_deg != *f) {
+            return Err(NanofoldError::invalid(
+                "releases",
+                format!("{} for rank {rank}", results.len()),
+                format!("one per release of the options ({}), in their order", releases.len()),
+            ));
+        }
+        let anchored = options.anchored_face.unwrap_or(net_of(solid, report, row)?.centre_face);
+        summaries.push((rank, NetClosingSummary::new(anchored, results)));
+    }
+    let variation = options.variation();
+    let study = Study {
+        nets: summaries.len(),
+        devices: summaries.len() * releases.len() * (1 + variation.samples),
+        releases,
+        variation,
+        closing: options.closing(),
+        seconds,
+    };
+    apply_study(report, summaries, study);
+    Ok(())
 }
 
 /// One release of a net: the nominal device, then the sampled ones.
@@ -357,25 +456,8 @@ pub fn study_nets(
             .expect("every job ran");
         by_net[*n].push(result?);
     }
-    let summaries = by_net
-        .into_iter()
-        .enumerate()
-        .map(|(n, releases)| {
-            let anchored = options.anchored_face.unwrap_or(nets[n].centre_face);
-            (ranks[n], NetClosingSummary::new(anchored, releases))
-        })
-        .collect();
-    let variation = options.variation();
-    let study = Study {
-        nets: nets.len(),
-        releases: releases.clone(),
-        variation,
-        closing: options.closing(),
-        devices: jobs.len() * (1 + variation.samples),
-        seconds: started.elapsed().as_secs_f64(),
-    };
-    apply_study(report, summaries, study);
-    Ok(())
+    let by_rank = ranks.iter().copied().zip(by_net).collect();
+    apply_releases(solid, report, by_rank, options, started.elapsed().as_secs_f64())
 }
 
 /// The ranked table as CSV: the scores, and for the nets simulated their best release

@@ -10,7 +10,7 @@ use crate::error::{NanofoldError, Result};
 use crate::geometry::surface_intersection::convex_faces_meet;
 use crate::pattern::net::NetPattern;
 use nalgebra::{DMatrix, DVector, Point3, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The most any drive angle moves between two tests of the faces, rad (0.5°): a meeting
 /// that begins and ends inside a smaller turn is not seen.
@@ -59,7 +59,7 @@ impl ClosingSettings {
 }
 
 /// How a closing run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
     /// Every seam latched.
@@ -144,7 +144,8 @@ pub struct ClosingReport {
 }
 
 /// One release of a simulated net: its nominal device's closing and its yield.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ReleaseResult {
     /// The etch front's direction, degrees (None: every hinge at once).
     pub front_deg: Option<f64>,

@@ -112,7 +112,8 @@ impl Normal {
 }
 
 /// The share of sampled devices that close.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct YieldEstimate {
     /// Devices that closed.
     pub closed: usize,
