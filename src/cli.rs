@@ -242,10 +242,11 @@ pub struct NetsArgs {
     pub unit_um: f64,
     /// The written scenes' hinges drive this many degrees past the turn that closes the
     /// solid, so the faces press shut (0 to 45).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().overdrive_deg, allow_negative_numbers = true)]
     pub overdrive_deg: f64,
-    /// Release the written scenes' hinges by an etch front crossing the wafer along this
-    /// direction (degrees; 0 along +x, 90 along +y) instead of all at once.
+    /// Release the simulated and written nets by an etch front crossing the wafer along this
+    /// direction alone (degrees; 0 along +x, 90 along +y); default: the --fronts directions,
+    /// the written scenes released along each net's best.
     #[arg(long, allow_negative_numbers = true)]
     pub front_deg: Option<f64>,
     /// The etch front's speed, µm per minute.

@@ -1495,8 +1495,8 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(report["distinct_nets"], 11);
-    // The three simulated, released at once with no overdrive: every hinge reaches 90° as
-    // the step's path ends, and every seam shuts there.
+    // The three simulated, released at once: every hinge passes 90° together on the step's
+    // path (driven to 95°), and every seam shuts there.
     for net in &report["nets"].as_array().unwrap()[..3] {
         let release = &net["closing"]["releases"][0];
         assert_eq!(release["front_deg"], serde_json::Value::Null);

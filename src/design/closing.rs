@@ -23,6 +23,11 @@ const ALIGNED_TOGETHER: f64 = 1e-6;
 const TOLERANCE: f64 = 1e-9;
 /// Bisection of an event's progress stops at this width.
 const LOCATE: f64 = 1e-15;
+/// A seam's ray within this of the other face's plane (the sine of their angle) has reached
+/// it: the faces met there.
+const PRESS_REACH: f64 = 1e-6;
+/// A run's frames are kept at least this far apart in progress (and at every event).
+const FRAME_SPACING: f64 = 0.005;
 /// The latched seams' equilibrium: Gauss–Newton steps and the step that ends them, rad.
 const SETTLE_ITERATIONS: usize = 80;
 const SETTLE_STEP: f64 = 1e-13;
@@ -135,6 +140,9 @@ pub struct ClosingReport {
     pub first_contact_time_s: Option<f64>,
     /// Every latch in order.
     pub latches: Vec<Latch>,
+    /// Seams whose faces met out of line at a corner they share and pressed on (one face's
+    /// edge resting on the other face), in order; most latch later as they slide into line.
+    pub presses: Vec<Latch>,
     /// The jam.
     pub jam: Option<Jam>,
     /// Seams still open at the end, with their misalignment.
@@ -210,6 +218,78 @@ impl NetClosingSummary {
         best.yield_estimate
             .map_or(if best.outcome == Outcome::Closes { 1.0 } else { 0.0 }, |y| y.fraction)
     }
+}
+
+/// Where a seam stands in a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SeamState {
+    Open,
+    /// Its faces press on each other out of line (see [`Press`]).
+    Pressed,
+    Latched,
+}
+
+/// A seam pressed shut out of line: one face's copy of the seam, a ray from the corner the
+/// two copies share, rests on the other face's plane (`sign` · n · ray ≥ 0 keeps it out).
+#[derive(Debug, Clone, Copy)]
+struct Press {
+    seam: usize,
+    ray_face: usize,
+    /// The ray's pattern vertices on `ray_face`: the shared corner, then the far end.
+    ray: [usize; 2],
+    plane_face: usize,
+    sign: f64,
+}
+
+/// What holds the faces during a run.
+#[derive(Debug, Clone)]
+struct Holds {
+    state: Vec<SeamState>,
+    latched: Vec<usize>,
+    pressed: Vec<Press>,
+}
+
+impl Holds {
+    fn new(seams: usize) -> Holds {
+        Holds {
+            state: vec![SeamState::Open; seams],
+            latched: Vec::new(),
+            pressed: Vec::new(),
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.latched.is_empty() && self.pressed.is_empty()
+    }
+
+    fn latch(&mut self, k: usize) {
+        self.pressed.retain(|p| p.seam != k);
+        self.state[k] = SeamState::Latched;
+        self.latched.push(k);
+    }
+
+    fn press(&mut self, press: Press) {
+        self.state[press.seam] = SeamState::Pressed;
+        self.pressed.push(press);
+    }
+
+    fn part(&mut self, k: usize) {
+        self.pressed.retain(|p| p.seam != k);
+        self.state[k] = SeamState::Open;
+    }
+
+    /// Whether the faces are a pressed seam's.
+    fn pressing(&self, [f, g]: [usize; 2]) -> bool {
+        self.pressed
+            .iter()
+            .any(|p| (p.ray_face == f && p.plane_face == g) || (p.ray_face == g && p.plane_face == f))
+    }
+}
+
+/// Stiffnesses over the largest.
+fn scaled(stiffness: &[f64]) -> DVector<f64> {
+    let largest = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
+    DVector::from_iterator(stiffness.len(), stiffness.iter().map(|k| k / largest))
 }
 
 #[derive(Debug, Clone)]
@@ -392,19 +472,30 @@ impl NetClosing {
         meeting
     }
 
-    /// Whether anything happens at these poses: faces meeting, or an open seam aligned.
-    fn event(&self, data: &NetworkData, latched: &[bool]) -> bool {
-        (0..self.seams.len()).any(|k| !latched[k] && self.misalignment(data, k) <= ALIGNED)
-            || !self.meeting_pairs(data).is_empty()
+    /// Whether anything happens at these poses: faces meeting (other than a pressed seam's),
+    /// an open seam aligned, or a pressed one come within the capture.
+    fn event(&self, data: &NetworkData, holds: &Holds, capture: f64) -> bool {
+        (0..self.seams.len()).any(|k| {
+            let m = || self.misalignment(data, k);
+            match holds.state[k] {
+                SeamState::Open => m() <= ALIGNED,
+                SeamState::Pressed => m() <= capture,
+                SeamState::Latched => false,
+            }
+        }) || self
+            .meeting_pairs(data)
+            .iter()
+            .any(|&(pair, _)| !holds.pressing(self.pairs[pair].faces))
     }
 
-    /// The latched seams' residual (each end's two copies' difference, over the net's size)
-    /// and its Jacobian in the fold angles, at the poses and twists `data` holds.
-    fn seam_rows(&self, data: &NetworkData, latched: &[usize], columns: usize) -> (DVector<f64>, DMatrix<f64>) {
-        let rows = 6 * latched.len();
+    /// The rows that hold the faces, their residual and Jacobian in the fold angles at the
+    /// poses and twists `data` holds: each latched seam's ends on their copies (over the
+    /// net's size, six rows), each pressed seam's ray on the other face's plane (one row).
+    fn hold_rows(&self, data: &NetworkData, holds: &Holds, columns: usize) -> (DVector<f64>, DMatrix<f64>) {
+        let rows = 6 * holds.latched.len() + holds.pressed.len();
         let mut residual = DVector::zeros(rows);
         let mut jacobian = DMatrix::zeros(rows, columns);
-        for (i, &k) in latched.iter().enumerate() {
+        for (i, &k) in holds.latched.iter().enumerate() {
             let seam = &self.seams[k];
             for (e, &[v, w]) in seam.ends.iter().enumerate() {
                 let row = 6 * i + 3 * e;
@@ -421,50 +512,74 @@ impl NetClosing {
                 }
             }
         }
+        for (i, press) in holds.pressed.iter().enumerate() {
+            let row = 6 * holds.latched.len() + i;
+            let (normal, ray) = self.press_vectors(data, press);
+            residual[row] = press.sign * normal.dot(&ray);
+            for &c in &self.paths[self.face_panel[press.plane_face]] {
+                jacobian[(row, c)] += press.sign * data.twist[c].angular.cross(&normal).dot(&ray);
+            }
+            for &c in &self.paths[self.face_panel[press.ray_face]] {
+                jacobian[(row, c)] += press.sign * normal.dot(&data.twist[c].angular.cross(&ray));
+            }
+        }
         (residual, jacobian)
     }
 
-    /// The quasi-static balance with the latched seams held: the fold angles minimising
-    /// Σ ½ K (θ − r)² on the seams' closures, from `theta` (Gauss–Newton on the closures,
-    /// the energy minimised in their null space). Returns whether it converged.
+    /// A pressed seam's plane normal and unit ray, in the world.
+    fn press_vectors(&self, data: &NetworkData, press: &Press) -> (Vector3<f64>, Vector3<f64>) {
+        let normal = data.rotation[self.face_panel[press.plane_face]] * Vector3::z();
+        let [from, to] = press.ray;
+        let ray = (self.place(data, press.ray_face, to) - self.place(data, press.ray_face, from)).normalize();
+        (normal, ray)
+    }
+
+    /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space). Rounding leaves its
+    /// zero eigenvalues near 1e-16 of the largest (not its square), so the cut is well above
+    /// that: singular values below 1e-6 of J's largest.
+    fn row_and_null_space(jacobian: &DMatrix<f64>) -> (Vec<(f64, DVector<f64>)>, Vec<DVector<f64>>) {
+        let eigen = (jacobian.transpose() * jacobian).symmetric_eigen();
+        let cutoff = 1e-12 * eigen.eigenvalues.amax().max(f64::MIN_POSITIVE);
+        let (mut row, mut null) = (Vec::new(), Vec::new());
+        for (i, &lambda) in eigen.eigenvalues.iter().enumerate() {
+            let direction = eigen.eigenvectors.column(i).into_owned();
+            if lambda > cutoff {
+                row.push((lambda, direction));
+            } else {
+                null.push(direction);
+            }
+        }
+        (row, null)
+    }
+
+    /// The quasi-static balance with `holds` held: the fold angles minimising
+    /// Σ ½ K (θ − r)² on their rows, from `theta` (Gauss–Newton on the rows, the energy
+    /// minimised in their null space). Returns whether it converged.
     fn settle(
         &self,
         model: &NetworkModel,
         drive: &[f64],
         stiffness: &[f64],
-        latched: &[usize],
+        holds: &Holds,
         theta: &mut [f64],
         data: &mut NetworkData,
     ) -> bool {
         let n = theta.len();
-        if latched.is_empty() {
+        if holds.is_empty() {
             theta.copy_from_slice(drive);
             update_poses(model, theta, data);
             return true;
         }
-        let k_scale = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
-        let stiff = DVector::from_iterator(n, stiffness.iter().map(|k| k / k_scale));
+        let stiff = scaled(stiffness);
         for _ in 0..SETTLE_ITERATIONS {
             update_poses(model, theta, data);
-            let (residual, jacobian) = self.seam_rows(data, latched, n);
-            // JᵀJ's eigenvectors: those of eigenvalue above the cut-off span J's row space,
-            // the rest its null space (redundant rows are normal: a closed corner's seams).
-            let eigen = (jacobian.transpose() * &jacobian).symmetric_eigen();
-            let largest = eigen.eigenvalues.amax();
-            // Rounding leaves JᵀJ's zero eigenvalues near 1e-16 of the largest (not its
-            // square), so the cut is well above that: singular values below 1e-6 of J's largest.
-            let cutoff = 1e-12 * largest.max(f64::MIN_POSITIVE);
+            let (residual, jacobian) = self.hold_rows(data, holds, n);
+            let (row, null) = Self::row_and_null_space(&jacobian);
             let pulled = jacobian.transpose() * &residual;
-            // The least-norm step onto the closures: −(JᵀJ)⁺ Jᵀ c.
+            // The least-norm step onto the rows: −(JᵀJ)⁺ Jᵀ c.
             let mut step = DVector::zeros(n);
-            let mut null = Vec::new();
-            for (i, &lambda) in eigen.eigenvalues.iter().enumerate() {
-                let direction = eigen.eigenvectors.column(i);
-                if lambda > cutoff {
-                    step -= direction * (direction.dot(&pulled) / lambda);
-                } else {
-                    null.push(direction.into_owned());
-                }
+            for (lambda, direction) in &row {
+                step -= direction * (direction.dot(&pulled) / lambda);
             }
             if !null.is_empty() {
                 let z = DMatrix::from_columns(&null);
@@ -488,8 +603,76 @@ impl NetClosing {
             }
         }
         update_poses(model, theta, data);
-        let (residual, _) = self.seam_rows(data, latched, n);
+        let (residual, _) = self.hold_rows(data, holds, n);
         residual.amax() <= 1e-10
+    }
+
+    /// The pressed seams whose faces the balance would rather part: moving along the
+    /// contact's gradient (within the other rows) lowers the hinges' energy.
+    fn parting(
+        &self,
+        data: &NetworkData,
+        holds: &Holds,
+        drive: &[f64],
+        stiffness: &[f64],
+        theta: &[f64],
+    ) -> Vec<usize> {
+        let n = theta.len();
+        let (_, jacobian) = self.hold_rows(data, holds, n);
+        let stiff = scaled(stiffness);
+        let gradient = DVector::from_iterator(n, (0..n).map(|c| stiff[c] * (theta[c] - drive[c])));
+        let first = 6 * holds.latched.len();
+        (0..holds.pressed.len())
+            .filter(|&i| {
+                let others: Vec<usize> = (0..jacobian.nrows()).filter(|&r| r != first + i).collect();
+                let contact = jacobian.row(first + i).transpose();
+                let apart = if others.is_empty() {
+                    contact.clone()
+                } else {
+                    let (_, null) = Self::row_and_null_space(&jacobian.select_rows(&others));
+                    null.iter().fold(DVector::zeros(n), |d, z| d + z * z.dot(&contact))
+                };
+                gradient.dot(&apart) < -1e-12 * gradient.norm() * apart.norm()
+            })
+            .map(|i| holds.pressed[i].seam)
+            .collect()
+    }
+
+    /// Whether a meeting across seam `k` (faces `faces`) is a seam pressed shut out of line:
+    /// its two copies share a corner, and one copy's ray from it passed through the other
+    /// face's plane between `before` and now.
+    fn press_of(&self, k: usize, before: &NetworkData, now: &NetworkData) -> Option<Press> {
+        let seam = &self.seams[k];
+        let tolerance = TOLERANCE * self.size;
+        let corner = (0..2).find(|&e| {
+            let [v, w] = seam.ends[e];
+            (self.place(now, seam.faces[0], v) - self.place(now, seam.faces[1], w)).norm() <= tolerance
+        })?;
+        let [v, w] = seam.ends[corner];
+        let [v_far, w_far] = seam.ends[1 - corner];
+        // The ray that has reached the other plane (|n · ray| smallest), kept on the side it
+        // came from.
+        [(0, [v, v_far]), (1, [w, w_far])]
+            .into_iter()
+            .map(|(side, ray)| {
+                let candidate = Press {
+                    seam: k,
+                    ray_face: seam.faces[side],
+                    ray,
+                    plane_face: seam.faces[1 - side],
+                    sign: 1.0,
+                };
+                let side_of = |data: &NetworkData| {
+                    let (normal, ray) = self.press_vectors(data, &candidate);
+                    normal.dot(&ray)
+                };
+                let (was, is) = (side_of(before), side_of(now));
+                let sign = if was != 0.0 { was.signum() } else { (was - is).signum() };
+                (is.abs(), Press { sign, ..candidate })
+            })
+            .filter(|(reach, _)| *reach <= PRESS_REACH)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, press)| press)
     }
 
     /// Runs a net's device with `forcing` and `stiffness` (one per crease column; a sample
@@ -511,17 +694,19 @@ impl NetClosing {
             ));
         }
         let path = DrivePath::new(forcing);
+        let capture = settings.capture_percent / 100.0;
         let mut data = NetworkData::new(model);
+        let mut before = NetworkData::new(model);
         let mut drive = vec![0.0; n];
         let mut theta = vec![0.0; n];
-        let mut latched = vec![false; self.seams.len()];
-        let mut latched_list: Vec<usize> = Vec::new();
+        let mut holds = Holds::new(self.seams.len());
         let mut report = ClosingReport {
             outcome: Outcome::Stalls,
             time_s: 0.0,
             progress: 0.0,
             first_contact_time_s: None,
             latches: Vec::new(),
+            presses: Vec::new(),
             jam: None,
             open_seams: Vec::new(),
             frames: Vec::new(),
@@ -531,25 +716,44 @@ impl NetClosing {
             progress: u,
             fold_angles: theta.to_vec(),
         };
+        let no_balance = |holds: &Holds, u: f64| {
+            NanofoldError::invalid(
+                "seams",
+                format!(
+                    "latched {:?}, pressed {:?}",
+                    holds.latched,
+                    holds.pressed.iter().map(|p| p.seam).collect::<Vec<_>>()
+                ),
+                format!("the seams held hold no balance at progress {u:.6}"),
+            )
+        };
         path.drive(0.0, &mut drive);
-        self.settle(model, &drive, stiffness, &latched_list, &mut theta, &mut data);
+        self.settle(model, &drive, stiffness, &holds, &mut theta, &mut data);
         report.frames.push(frame(0.0, &theta));
+        let mut last_frame = 0.0;
         let mut u = 0.0;
         while u < 1.0 {
             let next = path.next(u, MAX_STEP);
             let mut trial = theta.clone();
             path.drive(next, &mut drive);
-            let settled = self.settle(model, &drive, stiffness, &latched_list, &mut trial, &mut data);
-            if !settled {
-                return Err(NanofoldError::invalid(
-                    "seams",
-                    format!("{latched_list:?}"),
-                    format!("the latched seams hold no balance at progress {next:.6}"),
-                ));
+            if !self.settle(model, &drive, stiffness, &holds, &mut trial, &mut data) {
+                return Err(no_balance(&holds, next));
             }
-            if !self.event(&data, &latched) {
+            if !self.event(&data, &holds, capture) {
+                // A pressed seam whose faces would rather part lets go.
+                let parting = self.parting(&data, &holds, &drive, stiffness, &trial);
+                if !parting.is_empty() {
+                    parting.iter().for_each(|&k| holds.part(k));
+                    if !self.settle(model, &drive, stiffness, &holds, &mut trial, &mut data) {
+                        return Err(no_balance(&holds, next));
+                    }
+                }
                 theta = trial;
                 u = next;
+                if u - last_frame >= FRAME_SPACING {
+                    report.frames.push(frame(u, &theta));
+                    last_frame = u;
+                }
                 continue;
             }
             // Bisect for the first progress where something happens.
@@ -558,8 +762,8 @@ impl NetClosing {
                 let mid = 0.5 * (lo + hi);
                 let mut state = theta.clone();
                 path.drive(mid, &mut drive);
-                self.settle(model, &drive, stiffness, &latched_list, &mut state, &mut data);
-                if self.event(&data, &latched) {
+                self.settle(model, &drive, stiffness, &holds, &mut state, &mut data);
+                if self.event(&data, &holds, capture) {
                     hi = mid;
                     at_hi = state;
                 } else {
@@ -567,29 +771,53 @@ impl NetClosing {
                     theta = state;
                 }
             }
+            update_poses(model, &theta, &mut before);
             u = hi;
             theta = at_hi;
             report.first_contact_time_s.get_or_insert(path.time(u));
             report.frames.push(frame(u, &theta));
-            // Latch what meets in line; anything else is a jam. A latch moves the faces
-            // (they snap into line), so look again until nothing new meets.
+            // Latch what meets in line, press what meets out of line at a shared corner;
+            // anything else is a jam. A latch moves the faces (they snap into line), so look
+            // again until nothing new meets.
             loop {
                 path.drive(u, &mut drive);
                 update_poses(model, &theta, &mut data);
                 let mut new: Vec<(usize, f64)> = (0..self.seams.len())
-                    .filter(|&k| !latched[k])
-                    .map(|k| (k, self.misalignment(&data, k)))
-                    .filter(|&(_, m)| m <= ALIGNED_TOGETHER)
+                    .filter_map(|k| {
+                        let m = self.misalignment(&data, k);
+                        let latches = match holds.state[k] {
+                            SeamState::Open => m <= ALIGNED_TOGETHER,
+                            SeamState::Pressed => m <= capture,
+                            SeamState::Latched => false,
+                        };
+                        latches.then_some((k, m))
+                    })
                     .collect();
+                let mut pressed_now = false;
                 for (pair, point) in self.meeting_pairs(&data) {
                     let faces = self.pairs[pair].faces;
-                    let seam = self.pairs[pair].seam.filter(|&k| !latched[k]);
+                    if holds.pressing(faces) {
+                        continue;
+                    }
+                    let seam = self.pairs[pair].seam.filter(|&k| holds.state[k] == SeamState::Open);
                     let misalignment = seam.map(|k| self.misalignment(&data, k));
-                    match (seam, misalignment) {
-                        (Some(k), Some(m)) if m <= settings.capture_percent / 100.0 => {
+                    let press = seam.and_then(|k| self.press_of(k, &before, &data));
+                    match (seam, misalignment, press) {
+                        (Some(k), Some(m), _) if m <= capture => {
                             if !new.iter().any(|&(j, _)| j == k) {
                                 new.push((k, m));
                             }
+                        }
+                        (Some(k), Some(m), Some(press)) if !new.iter().any(|&(j, _)| j == press.seam) => {
+                            holds.press(press);
+                            report.presses.push(Latch {
+                                seam: k,
+                                faces: self.seams[k].faces.map(|f| self.file_face[f]),
+                                time_s: path.time(u),
+                                progress: u,
+                                misalignment: m,
+                            });
+                            pressed_now = true;
                         }
                         _ => {
                             report.outcome = Outcome::Jams;
@@ -602,18 +830,17 @@ impl NetClosing {
                                 point_um: [point.x, point.y, point.z].map(|x| x * 1e6),
                                 seam_misalignment: misalignment,
                             });
-                            report.open_seams = self.open(&data, &latched);
+                            report.open_seams = self.open(&data, &holds);
                             return Ok(report);
                         }
                     }
                 }
-                if new.is_empty() {
+                if new.is_empty() && !pressed_now {
                     break;
                 }
                 new.sort_by_key(|&(k, _)| k);
                 for (k, m) in new {
-                    latched[k] = true;
-                    latched_list.push(k);
+                    holds.latch(k);
                     report.latches.push(Latch {
                         seam: k,
                         faces: self.seams[k].faces.map(|f| self.file_face[f]),
@@ -622,34 +849,32 @@ impl NetClosing {
                         misalignment: m,
                     });
                 }
-                if !self.settle(model, &drive, stiffness, &latched_list, &mut theta, &mut data) {
-                    return Err(NanofoldError::invalid(
-                        "seams",
-                        format!("{latched_list:?}"),
-                        format!("the latched seams hold no balance at progress {u:.6}"),
-                    ));
+                update_poses(model, &theta, &mut before);
+                if !self.settle(model, &drive, stiffness, &holds, &mut theta, &mut data) {
+                    return Err(no_balance(&holds, u));
                 }
                 report.frames.push(frame(u, &theta));
-                if latched.iter().all(|&l| l) {
+                if holds.latched.len() == self.seams.len() {
                     report.outcome = Outcome::Closes;
                     report.time_s = path.time(u);
                     report.progress = u;
                     return Ok(report);
                 }
             }
+            last_frame = u;
         }
         update_poses(model, &theta, &mut data);
         report.outcome = Outcome::Stalls;
         report.time_s = path.time(1.0);
         report.progress = 1.0;
-        report.open_seams = self.open(&data, &latched);
+        report.open_seams = self.open(&data, &holds);
         report.frames.push(frame(1.0, &theta));
         Ok(report)
     }
 
-    fn open(&self, data: &NetworkData, latched: &[bool]) -> Vec<(usize, f64)> {
+    fn open(&self, data: &NetworkData, holds: &Holds) -> Vec<(usize, f64)> {
         (0..self.seams.len())
-            .filter(|&k| !latched[k])
+            .filter(|&k| holds.state[k] != SeamState::Latched)
             .map(|k| (k, self.misalignment(data, k)))
             .collect()
     }
@@ -686,7 +911,9 @@ impl NetClosing {
         }
         let mut theta = start.to_vec();
         let mut data = NetworkData::new(model);
-        if !self.settle(model, drive, stiffness, latched, &mut theta, &mut data) {
+        let mut holds = Holds::new(self.seams.len());
+        latched.iter().for_each(|&k| holds.latch(k));
+        if !self.settle(model, drive, stiffness, &holds, &mut theta, &mut data) {
             return Err(NanofoldError::invalid(
                 "latched",
                 format!("{latched:?}"),

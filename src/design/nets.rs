@@ -102,15 +102,15 @@ impl Default for NetsOptions {
             rank_by: RankBy::RadiusOfGyration,
             top: 10,
             unit_um: 1.0,
-            overdrive_deg: 0.0,
+            overdrive_deg: 5.0,
             front_deg: None,
             etch_rate_um_per_min: 1.5,
             anchored_face: None,
             simulate: 10,
             fronts: 16,
             yield_samples: 50,
-            stiffness_spread_percent: 5.0,
-            stress_spread_percent: 5.0,
+            stiffness_spread_percent: 2.0,
+            stress_spread_percent: 2.0,
             capture_percent: 10.0,
         }
     }
