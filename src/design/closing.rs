@@ -286,6 +286,9 @@ impl Holds {
     }
 }
 
+/// A matrix's row space as JᵀJ's eigenpairs.
+type RowSpace = Vec<(f64, DVector<f64>)>;
+
 /// Stiffnesses over the largest.
 fn scaled(stiffness: &[f64]) -> DVector<f64> {
     let largest = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
@@ -537,7 +540,7 @@ impl NetClosing {
     /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space). Rounding leaves its
     /// zero eigenvalues near 1e-16 of the largest (not its square), so the cut is well above
     /// that: singular values below 1e-6 of J's largest.
-    fn row_and_null_space(jacobian: &DMatrix<f64>) -> (Vec<(f64, DVector<f64>)>, Vec<DVector<f64>>) {
+    fn row_and_null_space(jacobian: &DMatrix<f64>) -> (RowSpace, Vec<DVector<f64>>) {
         let eigen = (jacobian.transpose() * jacobian).symmetric_eigen();
         let cutoff = 1e-12 * eigen.eigenvalues.amax().max(f64::MIN_POSITIVE);
         let (mut row, mut null) = (Vec::new(), Vec::new());
