@@ -2,7 +2,7 @@
 # The 3D pages in a real browser (issue 29): headless Chromium loads `fold.html` (written by
 # `fold`), `unfold.html`, `response.html` (`simulate` of a device, a strip and a closed chain, with
 # the first contact marked), `modes.html` (a network's, a strip's, a closed chain's) and
-# `view.html` (written by `view`) of an animation and of a crease pattern with its angles. Each page must run without a console error and paint its
+# `closing.html` and `jam.html` (written by `nets`), `view.html` (written by `view`) of an animation and of a crease pattern with its angles. Each page must run without a console error and paint its
 # canvas, and moving the frame must change the picture. Installs Debian's chromium when it
 # is missing; where it cannot, says so and skips (fails under NANOFOLD_REQUIRE_CLIENTS=1).
 set -euo pipefail
@@ -82,6 +82,12 @@ check_page "$work/strip_modes/modes.html"
 check_page "$work/closed_modes/modes.html"
 "$bin" simulate patterns/corner_cube_step2.scene.json --out "$work/closed" >/dev/null
 check_page "$work/closed/response.html"
+# A net's design study: the best net closing and a net jamming, the jam's faces marked.
+"$bin" nets cube --unit-um 50 --top 2 --simulate 2 --fronts 4 --yield-samples 0 --out "$work/nets" >/dev/null
+check_page "$work/nets/closing.html"
+check_page "$work/nets/jam.html"
+jam=$(load "$work/nets/jam.html#frame=100000")
+[ "$(attr highlighted "$jam")" = 2 ] || { echo "jam.html: the jamming faces are not marked ($jam)"; exit 1; }
 # Unfoldings: a single vertex and a sheet of many vertices.
 "$bin" unfold patterns/corner_cube.fold --out "$work/vertex" >/dev/null
 check_page "$work/vertex/unfold.html"

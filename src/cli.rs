@@ -1208,9 +1208,9 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
             many => format!("released by fronts along {} directions", many.len()),
         };
         println!(
-            "  simulated: the best {} nets, {releases}, {} devices each ({}% stiffness and {}% stress spread), seams latching within {}%: {} devices in {:.2} s",
+            "  simulated: the best {} nets, {releases}, the nominal device and {} varied ones each ({}% stiffness and {}% stress spread), seams latching within {}%: {} devices in {:.2} s",
             study.nets,
-            1 + study.variation.samples,
+            study.variation.samples,
             study.variation.stiffness_spread_percent,
             study.variation.stress_spread_percent,
             study.closing.capture_percent,

@@ -1545,9 +1545,17 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
             "edges {a} and {b} meet but are no seam: {seams:?}"
         );
     }
-    for name in ["nets.json", "nets.csv", "gallery.svg", "net_001.scene.json"] {
+    for name in [
+        "nets.json",
+        "nets.csv",
+        "gallery.svg",
+        "net_001.scene.json",
+        "closing.html",
+    ] {
         assert!(dir.join(name).exists(), "{name}");
     }
+    // Every release simulated closes: there is no jam to show.
+    assert!(!dir.join("jam.html").exists());
     let csv = std::fs::read_to_string(dir.join("nets.csv")).unwrap();
     assert_eq!(csv.lines().count(), 12);
     assert!(csv.lines().nth(1).unwrap().contains(",step,closes,"), "{csv}");
@@ -1559,6 +1567,10 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         .unwrap();
     assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
     assert!(dir.join("net_002.scene.json").exists() && !dir.join("net_003.fold").exists());
+    assert!(
+        !dir.join("closing.html").exists(),
+        "nothing simulated, so no closing page stays"
+    );
     // A bad shape or setting is refused by name, with nothing written.
     let bad_dir = temp_dir("nets-bad");
     for (args, part) in [
@@ -1661,6 +1673,7 @@ fn the_bundled_cubes_closing_and_jam_come_back_through_the_nets_path() {
             assert_eq!(release["latched"], 7);
             assert!(ended > time(&theirs) + 3999.0, "{release}");
         } else {
+            assert!(dir.join("jam.html").exists());
             assert_eq!(release["outcome"], "jams");
             assert!((ended - time(&theirs)).abs() <= 1e-8 * ended, "{release}");
         }

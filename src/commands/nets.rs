@@ -501,8 +501,68 @@ pub fn nets_csv(report: &NetsReport) -> String {
     csv
 }
 
+/// The most frames of a closing page.
+const PAGE_FRAMES: usize = 121;
+
+/// The 3D page of a net's nominal device closing along `front_deg` (None: a step): every
+/// frame of the run (thinned evenly to [`PAGE_FRAMES`], events kept), the anchored face
+/// fixed, a jam's faces marked.
+pub fn closing_page(made: &NetPattern, name: &str, front_deg: Option<f64>, options: &NetsOptions) -> Result<String> {
+    let released = NetsOptions {
+        front_deg,
+        ..options.clone()
+    };
+    let scene = net_device(made, name, &released)?;
+    let model = scene.network().expect("a net's scene is a network");
+    let run = NetClosing::new(made, model)?.run(model, &model.forcing, &model.stiffness(), &options.closing())?;
+    let events: Vec<f64> = run
+        .latches
+        .iter()
+        .chain(&run.presses)
+        .map(|l| l.progress)
+        .chain(run.jam.as_ref().map(|j| j.progress))
+        .collect();
+    let stride = run.frames.len().div_ceil(PAGE_FRAMES).max(1);
+    let kept: Vec<&crate::design::closing::ClosingFrame> = run
+        .frames
+        .iter()
+        .enumerate()
+        .filter(|(k, f)| k % stride == 0 || k + 1 == run.frames.len() || events.contains(&f.progress))
+        .map(|(_, f)| f)
+        .collect();
+    let labels: Vec<String> = kept
+        .iter()
+        .map(|f| {
+            let latched = run.latches.iter().filter(|l| l.progress <= f.progress).count();
+            let when = match front_deg {
+                Some(_) => format!("t = {:.6e} s", f.time_s),
+                None => format!("{:.2} % of the step's path", 100.0 * f.progress),
+            };
+            format!("{when}: {latched} of {} seams latched", made.seams.len())
+        })
+        .collect();
+    let frames: Vec<(String, &[f64])> = labels
+        .iter()
+        .cloned()
+        .zip(kept.iter().map(|f| f.fold_angles.as_slice()))
+        .collect();
+    let motion = crate::write::folding_output::network_states_fold(
+        model,
+        &frames,
+        &format!("{name}: its device {} ({})", run.outcome.label(), scene.name),
+    );
+    let collision = run.jam.as_ref().map(|j| crate::dynamics::Collision {
+        time: j.time_s,
+        pair: j.faces.map(|f| format!("face {f}")),
+        point: nalgebra::Vector3::from(j.point_um.map(|x| x * 1e-6)),
+    });
+    crate::plot::scene_page::network_response_page(&scene.name, model, &motion, collision.as_ref())
+}
+
 /// The files `nanofold nets` writes: nets.json, nets.csv, `net_<rank>.fold` for the best
-/// `options.top` that can be made with their scenes, and gallery.svg of them drawn to one scale.
+/// `options.top` that can be made with their scenes, gallery.svg of them drawn to one
+/// scale, and when nets were simulated closing.html (the best net closing its best way) and
+/// jam.html (the best net that jams in some release, jamming).
 pub fn nets_files(solid: &Polyhedron, report: &NetsReport, options: &NetsOptions) -> Result<Vec<(String, String)>> {
     let best = best_net_patterns(solid, report, options.top)?;
     let mut files = vec![
@@ -542,5 +602,23 @@ pub fn nets_files(solid: &Polyhedron, report: &NetsReport, options: &NetsOptions
         "gallery.svg".to_string(),
         crate::plot::nets::gallery_svg(&report.solid, &patterns, &rows, report.rank_by, report.unit_um)?,
     ));
+    let simulated = || report.nets.iter().filter_map(|r| r.closing.as_ref().map(|c| (r, c)));
+    if let Some((row, closing)) = simulated().next() {
+        let made = net_of(solid, report, row)?;
+        let best = closing.releases[closing.best].front_deg;
+        let name = format!("{}_net_{:03}", report.solid, row.rank);
+        files.push(("closing.html".to_string(), closing_page(&made, &name, best, options)?));
+    }
+    let jamming = simulated().find_map(|(row, c)| {
+        c.releases
+            .iter()
+            .find(|r| r.outcome == Outcome::Jams)
+            .map(|r| (row, r.front_deg))
+    });
+    if let Some((row, front)) = jamming {
+        let made = net_of(solid, report, row)?;
+        let name = format!("{}_net_{:03}", report.solid, row.rank);
+        files.push(("jam.html".to_string(), closing_page(&made, &name, front, options)?));
+    }
     Ok(files)
 }

@@ -38,6 +38,8 @@ pub const OUTPUT_FILES: &[&str] = &[
     "nets.json",
     "nets.csv",
     "gallery.svg",
+    "closing.html",
+    "jam.html",
     OWNER_FILE,
 ];
 
