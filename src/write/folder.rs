@@ -38,14 +38,17 @@ pub const OUTPUT_FILES: &[&str] = &[
     "nets.json",
     "nets.csv",
     "gallery.svg",
-    "closing.html",
-    "jam.html",
     OWNER_FILE,
 ];
 
-/// A net `nets` writes: `net_<rank>.fold` or `net_<rank>.scene.json`, the rank in digits.
-/// Numbered, they are not in [`OUTPUT_FILES`]: a run never keeps another run's nets.
+/// A file of one `nets` run: `net_<rank>.fold` or `net_<rank>.scene.json` (the rank in
+/// digits), closing.html, jam.html.
+/// They are not in [`OUTPUT_FILES`]: a run never keeps another run's nets.
 fn is_net_file(name: &str) -> bool {
+    // The study's pages show one run's nets: another run's would mislead.
+    if matches!(name, "closing.html" | "jam.html") {
+        return true;
+    }
     name.strip_prefix("net_")
         .and_then(|rest| rest.strip_suffix(".fold").or_else(|| rest.strip_suffix(".scene.json")))
         .is_some_and(|rank| !rank.is_empty() && rank.bytes().all(|b| b.is_ascii_digit()))
