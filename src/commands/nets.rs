@@ -518,8 +518,8 @@ pub fn closing_page(made: &NetPattern, name: &str, front_deg: Option<f64>, optio
     let events: Vec<f64> = run
         .latches
         .iter()
-        .chain(&run.presses)
         .map(|l| l.progress)
+        .chain(run.presses.iter().map(|p| p.progress))
         .chain(run.jam.as_ref().map(|j| j.progress))
         .collect();
     let stride = run.frames.len().div_ceil(PAGE_FRAMES).max(1);

@@ -101,6 +101,21 @@ pub struct Latch {
     pub misalignment: f64,
 }
 
+/// Faces that met at a corner they share and press on each other.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Contact {
+    /// The two faces (FOLD face indices).
+    pub faces: [usize; 2],
+    /// Their open seam, if they share one.
+    pub seam: Option<usize>,
+    /// When, s.
+    pub time_s: f64,
+    /// How far along the drives' path.
+    pub progress: f64,
+    /// The seam's misalignment then.
+    pub misalignment: Option<f64>,
+}
+
 /// Faces meeting where no seam latches them.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Jam {
@@ -140,9 +155,10 @@ pub struct ClosingReport {
     pub first_contact_time_s: Option<f64>,
     /// Every latch in order.
     pub latches: Vec<Latch>,
-    /// Seams whose faces met out of line at a corner they share and pressed on (one face's
-    /// edge resting on the other face), in order; most latch later as they slide into line.
-    pub presses: Vec<Latch>,
+    /// Faces that met at a corner they share and pressed on (one face's edge resting on the
+    /// other face), in order: across a seam out of line (it latches if they slide within
+    /// the capture), or around a solid vertex.
+    pub presses: Vec<Contact>,
     /// The jam.
     pub jam: Option<Jam>,
     /// Seams still open at the end, with their misalignment.
@@ -229,13 +245,15 @@ enum SeamState {
     Latched,
 }
 
-/// A seam pressed shut out of line: one face's copy of the seam, a ray from the corner the
-/// two copies share, rests on the other face's plane (`sign` · n · ray ≥ 0 keeps it out).
+/// Two faces pressing at a corner they share: one face's edge from it (a ray) rests on the
+/// other face's plane (`sign` · n · ray ≥ 0 keeps it out). Across a seam met out of line,
+/// or faces around a solid vertex that meet there.
 #[derive(Debug, Clone, Copy)]
 struct Press {
-    seam: usize,
+    /// The seam between the faces, when they have one still open.
+    seam: Option<usize>,
     ray_face: usize,
-    /// The ray's pattern vertices on `ray_face`: the shared corner, then the far end.
+    /// The ray's pattern vertices on `ray_face`: the shared corner, then the edge's far end.
     ray: [usize; 2],
     plane_face: usize,
     sign: f64,
@@ -263,19 +281,30 @@ impl Holds {
     }
 
     fn latch(&mut self, k: usize) {
-        self.pressed.retain(|p| p.seam != k);
+        self.pressed.retain(|p| p.seam != Some(k));
         self.state[k] = SeamState::Latched;
         self.latched.push(k);
     }
 
     fn press(&mut self, press: Press) {
-        self.state[press.seam] = SeamState::Pressed;
+        if let Some(k) = press.seam {
+            self.state[k] = SeamState::Pressed;
+        }
         self.pressed.push(press);
     }
 
-    fn part(&mut self, k: usize) {
-        self.pressed.retain(|p| p.seam != k);
-        self.state[k] = SeamState::Open;
+    /// Lets go of the presses at `indices` (into `pressed`).
+    fn part(&mut self, indices: &[usize]) {
+        for &i in indices {
+            if let Some(k) = self.pressed[i].seam {
+                self.state[k] = SeamState::Open;
+            }
+        }
+        let mut k = 0;
+        self.pressed.retain(|_| {
+            k += 1;
+            !indices.contains(&(k - 1))
+        });
     }
 
     /// Whether the faces are a pressed seam's.
@@ -610,7 +639,7 @@ impl NetClosing {
         residual.amax() <= 1e-10
     }
 
-    /// The pressed seams whose faces the balance would rather part: moving along the
+    /// The presses (indices into `holds.pressed`) whose faces the balance would rather part: moving along the
     /// contact's gradient (within the other rows) lowers the hinges' energy.
     fn parting(
         &self,
@@ -637,32 +666,40 @@ impl NetClosing {
                 };
                 gradient.dot(&apart) < -1e-12 * gradient.norm() * apart.norm()
             })
-            .map(|i| holds.pressed[i].seam)
             .collect()
     }
 
-    /// Whether a meeting across seam `k` (faces `faces`) is a seam pressed shut out of line:
-    /// its two copies share a corner, and one copy's ray from it passed through the other
-    /// face's plane between `before` and now.
-    fn press_of(&self, k: usize, before: &NetworkData, now: &NetworkData) -> Option<Press> {
-        let seam = &self.seams[k];
+    /// Whether faces `pair` meeting are pressing at a corner they share: an edge of one from
+    /// that corner has reached the other's plane (the ray nearest it, within
+    /// [`PRESS_REACH`]), kept on the side it came from (its side at `before`).
+    fn press_of(
+        &self,
+        pair: &FacePair,
+        open_seam: Option<usize>,
+        before: &NetworkData,
+        now: &NetworkData,
+    ) -> Option<Press> {
         let tolerance = TOLERANCE * self.size;
-        let corner = (0..2).find(|&e| {
-            let [v, w] = seam.ends[e];
-            (self.place(now, seam.faces[0], v) - self.place(now, seam.faces[1], w)).norm() <= tolerance
-        })?;
-        let [v, w] = seam.ends[corner];
-        let [v_far, w_far] = seam.ends[1 - corner];
-        // The ray that has reached the other plane (|n · ray| smallest), kept on the side it
-        // came from.
-        [(0, [v, v_far]), (1, [w, w_far])]
-            .into_iter()
-            .map(|(side, ray)| {
+        let [f, g] = pair.faces;
+        let edges_from = |face: usize, v: usize| {
+            let loop_ = &self.faces[face];
+            let k = loop_.iter().position(|&x| x == v).expect("a corner of the face");
+            [loop_[(k + 1) % loop_.len()], loop_[(k + loop_.len() - 1) % loop_.len()]]
+        };
+        pair.common
+            .iter()
+            .filter(|&&[v, w]| (self.place(now, f, v) - self.place(now, g, w)).norm() <= tolerance)
+            .flat_map(|&[v, w]| {
+                let from_f = edges_from(f, v).map(|far| (f, [v, far], g));
+                let from_g = edges_from(g, w).map(|far| (g, [w, far], f));
+                from_f.into_iter().chain(from_g)
+            })
+            .map(|(ray_face, ray, plane_face)| {
                 let candidate = Press {
-                    seam: k,
-                    ray_face: seam.faces[side],
+                    seam: open_seam,
+                    ray_face,
                     ray,
-                    plane_face: seam.faces[1 - side],
+                    plane_face,
                     sign: 1.0,
                 };
                 let side_of = |data: &NetworkData| {
@@ -725,7 +762,7 @@ impl NetClosing {
                 format!(
                     "latched {:?}, pressed {:?}",
                     holds.latched,
-                    holds.pressed.iter().map(|p| p.seam).collect::<Vec<_>>()
+                    holds.pressed.iter().map(|p| p.ray_face).collect::<Vec<_>>()
                 ),
                 format!("the seams held hold no balance at progress {u:.6}"),
             )
@@ -746,7 +783,7 @@ impl NetClosing {
                 // A pressed seam whose faces would rather part lets go.
                 let parting = self.parting(&data, &holds, &drive, stiffness, &trial);
                 if !parting.is_empty() {
-                    parting.iter().for_each(|&k| holds.part(k));
+                    holds.part(&parting);
                     if !self.settle(model, &drive, stiffness, &holds, &mut trial, &mut data) {
                         return Err(no_balance(&holds, next));
                     }
@@ -804,21 +841,21 @@ impl NetClosing {
                     }
                     let seam = self.pairs[pair].seam.filter(|&k| holds.state[k] == SeamState::Open);
                     let misalignment = seam.map(|k| self.misalignment(&data, k));
-                    let press = seam.and_then(|k| self.press_of(k, &before, &data));
+                    let press = self.press_of(&self.pairs[pair], seam, &before, &data);
                     match (seam, misalignment, press) {
                         (Some(k), Some(m), _) if m <= capture => {
                             if !new.iter().any(|&(j, _)| j == k) {
                                 new.push((k, m));
                             }
                         }
-                        (Some(k), Some(m), Some(press)) if !new.iter().any(|&(j, _)| j == press.seam) => {
+                        (_, _, Some(press)) if press.seam.is_none_or(|k| !new.iter().any(|&(j, _)| j == k)) => {
                             holds.press(press);
-                            report.presses.push(Latch {
-                                seam: k,
-                                faces: self.seams[k].faces.map(|f| self.file_face[f]),
+                            report.presses.push(Contact {
+                                faces: faces.map(|f| self.file_face[f]),
+                                seam,
                                 time_s: path.time(u),
                                 progress: u,
-                                misalignment: m,
+                                misalignment,
                             });
                             pressed_now = true;
                         }
