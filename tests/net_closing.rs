@@ -380,3 +380,27 @@ fn walls_meeting_beyond_the_capture_at_a_shared_corner_press_and_the_cube_stalls
     assert_eq!(run.open_seams.len(), 3);
     assert!(run.open_seams.iter().all(|(_, m)| (m - out_of_line).abs() <= 1e-8));
 }
+
+#[test]
+fn the_anchored_face_moves_the_whole_closing_rigidly_and_changes_no_outcome() {
+    // Quasi-static, with no substrate or gravity in the closing, the face held only fixes
+    // the frame: every release ends alike, at the same time, whichever face is anchored.
+    let (_, made, options) = latin_cross(None);
+    for front in [Some(0.0), Some(180.0), Some(45.0)] {
+        let runs: Vec<ClosingReport> = (0..6)
+            .map(|face| {
+                let held = NetsOptions {
+                    anchored_face: Some(face),
+                    front_deg: front,
+                    ..options.clone()
+                };
+                net_closing(&made, "cube", &held, &ClosingSettings::default()).unwrap()
+            })
+            .collect();
+        for run in &runs[1..] {
+            assert_eq!(run.outcome, runs[0].outcome, "front {front:?}");
+            assert!((run.time_s - runs[0].time_s).abs() <= 1e-9 * runs[0].time_s.max(1.0), "front {front:?}");
+            assert_eq!(run.latches.len(), runs[0].latches.len());
+        }
+    }
+}
