@@ -399,7 +399,10 @@ fn the_anchored_face_moves_the_whole_closing_rigidly_and_changes_no_outcome() {
             .collect();
         for run in &runs[1..] {
             assert_eq!(run.outcome, runs[0].outcome, "front {front:?}");
-            assert!((run.time_s - runs[0].time_s).abs() <= 1e-9 * runs[0].time_s.max(1.0), "front {front:?}");
+            assert!(
+                (run.time_s - runs[0].time_s).abs() <= 1e-9 * runs[0].time_s.max(1.0),
+                "front {front:?}"
+            );
             assert_eq!(run.latches.len(), runs[0].latches.len());
         }
     }

@@ -733,183 +733,65 @@ impl NetClosing {
                 format!("one per crease ({n})"),
             ));
         }
-        let path = DrivePath::new(forcing);
-        let capture = settings.capture_percent / 100.0;
-        let mut data = NetworkData::new(model);
-        let mut before = NetworkData::new(model);
-        let mut drive = vec![0.0; n];
-        let mut theta = vec![0.0; n];
-        let mut holds = Holds::new(self.seams.len());
-        let mut report = ClosingReport {
-            outcome: Outcome::Stalls,
-            time_s: 0.0,
-            progress: 0.0,
-            first_contact_time_s: None,
-            latches: Vec::new(),
-            presses: Vec::new(),
-            jam: None,
-            open_seams: Vec::new(),
-            frames: Vec::new(),
+        let mut run = Run {
+            net: self,
+            model,
+            path: DrivePath::new(forcing),
+            stiffness,
+            capture: settings.capture_percent / 100.0,
+            data: NetworkData::new(model),
+            before: NetworkData::new(model),
+            drive: vec![0.0; n],
+            theta: vec![0.0; n],
+            holds: Holds::new(self.seams.len()),
+            report: ClosingReport {
+                outcome: Outcome::Stalls,
+                time_s: 0.0,
+                progress: 0.0,
+                first_contact_time_s: None,
+                latches: Vec::new(),
+                presses: Vec::new(),
+                jam: None,
+                open_seams: Vec::new(),
+                frames: Vec::new(),
+            },
         };
-        let frame = |u: f64, theta: &[f64]| ClosingFrame {
-            time_s: path.time(u),
-            progress: u,
-            fold_angles: theta.to_vec(),
-        };
-        let no_balance = |holds: &Holds, u: f64| {
-            NanofoldError::invalid(
-                "seams",
-                format!(
-                    "latched {:?}, pressed {:?}",
-                    holds.latched,
-                    holds.pressed.iter().map(|p| p.ray_face).collect::<Vec<_>>()
-                ),
-                format!("the seams held hold no balance at progress {u:.6}"),
-            )
-        };
-        path.drive(0.0, &mut drive);
-        self.settle(model, &drive, stiffness, &holds, &mut theta, &mut data);
-        report.frames.push(frame(0.0, &theta));
+        run.settle_at(0.0)?;
+        run.keep_frame(0.0);
         let mut last_frame = 0.0;
         let mut u = 0.0;
         while u < 1.0 {
-            let next = path.next(u, MAX_STEP);
-            let mut trial = theta.clone();
-            path.drive(next, &mut drive);
-            if !self.settle(model, &drive, stiffness, &holds, &mut trial, &mut data) {
-                return Err(no_balance(&holds, next));
+            let next = run.path.next(u, MAX_STEP);
+            let mut trial = run.theta.clone();
+            run.path.drive(next, &mut run.drive);
+            if !self.settle(model, &run.drive, stiffness, &run.holds, &mut trial, &mut run.data) {
+                return Err(run.no_balance(next));
             }
-            if !self.event(&data, &holds, capture) {
-                // A pressed seam whose faces would rather part lets go.
-                let parting = self.parting(&data, &holds, &drive, stiffness, &trial);
-                if !parting.is_empty() {
-                    holds.part(&parting);
-                    if !self.settle(model, &drive, stiffness, &holds, &mut trial, &mut data) {
-                        return Err(no_balance(&holds, next));
-                    }
-                }
-                theta = trial;
+            if !self.event(&run.data, &run.holds, run.capture) {
+                run.let_go_of_parting(&mut trial, next)?;
+                run.theta = trial;
                 u = next;
                 if u - last_frame >= FRAME_SPACING {
-                    report.frames.push(frame(u, &theta));
+                    run.keep_frame(u);
                     last_frame = u;
                 }
                 continue;
             }
-            // Bisect for the first progress where something happens.
-            let (mut lo, mut hi, mut at_hi) = (u, next, trial);
-            while hi - lo > LOCATE * (1.0 + hi.abs()) {
-                let mid = 0.5 * (lo + hi);
-                let mut state = theta.clone();
-                path.drive(mid, &mut drive);
-                self.settle(model, &drive, stiffness, &holds, &mut state, &mut data);
-                if self.event(&data, &holds, capture) {
-                    hi = mid;
-                    at_hi = state;
-                } else {
-                    lo = mid;
-                    theta = state;
-                }
-            }
-            update_poses(model, &theta, &mut before);
-            u = hi;
-            theta = at_hi;
-            report.first_contact_time_s.get_or_insert(path.time(u));
-            report.frames.push(frame(u, &theta));
-            // Latch what meets in line, press what meets out of line at a shared corner;
-            // anything else is a jam. A latch moves the faces (they snap into line), so look
-            // again until nothing new meets.
-            loop {
-                path.drive(u, &mut drive);
-                update_poses(model, &theta, &mut data);
-                let mut new: Vec<(usize, f64)> = (0..self.seams.len())
-                    .filter_map(|k| {
-                        let m = self.misalignment(&data, k);
-                        let latches = match holds.state[k] {
-                            SeamState::Open => m <= ALIGNED_TOGETHER,
-                            SeamState::Pressed => m <= capture,
-                            SeamState::Latched => false,
-                        };
-                        latches.then_some((k, m))
-                    })
-                    .collect();
-                let mut pressed_now = false;
-                for (pair, point) in self.meeting_pairs(&data) {
-                    let faces = self.pairs[pair].faces;
-                    if holds.pressing(faces) {
-                        continue;
-                    }
-                    let seam = self.pairs[pair].seam.filter(|&k| holds.state[k] == SeamState::Open);
-                    let misalignment = seam.map(|k| self.misalignment(&data, k));
-                    let press = self.press_of(&self.pairs[pair], seam, &before, &data);
-                    match (seam, misalignment, press) {
-                        (Some(k), Some(m), _) if m <= capture => {
-                            if !new.iter().any(|&(j, _)| j == k) {
-                                new.push((k, m));
-                            }
-                        }
-                        (_, _, Some(press)) if press.seam.is_none_or(|k| !new.iter().any(|&(j, _)| j == k)) => {
-                            holds.press(press);
-                            report.presses.push(Contact {
-                                faces: faces.map(|f| self.file_face[f]),
-                                seam,
-                                time_s: path.time(u),
-                                progress: u,
-                                misalignment,
-                            });
-                            pressed_now = true;
-                        }
-                        _ => {
-                            report.outcome = Outcome::Jams;
-                            report.time_s = path.time(u);
-                            report.progress = u;
-                            report.jam = Some(Jam {
-                                faces: faces.map(|f| self.file_face[f]),
-                                time_s: path.time(u),
-                                progress: u,
-                                point_um: [point.x, point.y, point.z].map(|x| x * 1e6),
-                                seam_misalignment: misalignment,
-                            });
-                            report.open_seams = self.open(&data, &holds);
-                            return Ok(report);
-                        }
-                    }
-                }
-                if new.is_empty() && !pressed_now {
-                    break;
-                }
-                new.sort_by_key(|&(k, _)| k);
-                for (k, m) in new {
-                    holds.latch(k);
-                    report.latches.push(Latch {
-                        seam: k,
-                        faces: self.seams[k].faces.map(|f| self.file_face[f]),
-                        time_s: path.time(u),
-                        progress: u,
-                        misalignment: m,
-                    });
-                }
-                update_poses(model, &theta, &mut before);
-                if !self.settle(model, &drive, stiffness, &holds, &mut theta, &mut data) {
-                    return Err(no_balance(&holds, u));
-                }
-                report.frames.push(frame(u, &theta));
-                if holds.latched.len() == self.seams.len() {
-                    report.outcome = Outcome::Closes;
-                    report.time_s = path.time(u);
-                    report.progress = u;
-                    return Ok(report);
-                }
+            u = run.locate(u, next, trial);
+            run.report.first_contact_time_s.get_or_insert(run.path.time(u));
+            run.keep_frame(u);
+            if run.resolve(u)? {
+                return Ok(run.report);
             }
             last_frame = u;
         }
-        update_poses(model, &theta, &mut data);
-        report.outcome = Outcome::Stalls;
-        report.time_s = path.time(1.0);
-        report.progress = 1.0;
-        report.open_seams = self.open(&data, &holds);
-        report.frames.push(frame(1.0, &theta));
-        Ok(report)
+        update_poses(model, &run.theta, &mut run.data);
+        run.report.outcome = Outcome::Stalls;
+        run.report.time_s = run.path.time(1.0);
+        run.report.progress = 1.0;
+        run.report.open_seams = self.open(&run.data, &run.holds);
+        run.keep_frame(1.0);
+        Ok(run.report)
     }
 
     fn open(&self, data: &NetworkData, holds: &Holds) -> Vec<(usize, f64)> {
@@ -976,6 +858,200 @@ impl NetClosing {
             }
         }
         places
+    }
+}
+
+/// One closing run's state: the angles, what holds the faces, the report so far.
+struct Run<'a> {
+    net: &'a NetClosing,
+    model: &'a NetworkModel,
+    path: DrivePath<'a>,
+    stiffness: &'a [f64],
+    capture: f64,
+    data: NetworkData,
+    /// The poses just before the event being resolved (which side a pressing edge came from).
+    before: NetworkData,
+    drive: Vec<f64>,
+    theta: Vec<f64>,
+    holds: Holds,
+    report: ClosingReport,
+}
+
+impl Run<'_> {
+    fn keep_frame(&mut self, u: f64) {
+        self.report.frames.push(ClosingFrame {
+            time_s: self.path.time(u),
+            progress: u,
+            fold_angles: self.theta.clone(),
+        });
+    }
+
+    fn no_balance(&self, u: f64) -> NanofoldError {
+        NanofoldError::invalid(
+            "seams",
+            format!("latched {:?}, {} pressed", self.holds.latched, self.holds.pressed.len()),
+            format!("the seams held hold no balance at progress {u:.6}"),
+        )
+    }
+
+    /// The balance at progress `u` from the current angles.
+    fn settle_at(&mut self, u: f64) -> Result<()> {
+        self.path.drive(u, &mut self.drive);
+        let net = self.net;
+        if net.settle(
+            self.model,
+            &self.drive,
+            self.stiffness,
+            &self.holds,
+            &mut self.theta,
+            &mut self.data,
+        ) {
+            Ok(())
+        } else {
+            Err(self.no_balance(u))
+        }
+    }
+
+    /// Presses whose faces would rather part let go, and the balance `trial` at `u` (the
+    /// drives already set) is found again without them.
+    fn let_go_of_parting(&mut self, trial: &mut [f64], u: f64) -> Result<()> {
+        let net = self.net;
+        let parting = net.parting(&self.data, &self.holds, &self.drive, self.stiffness, trial);
+        if parting.is_empty() {
+            return Ok(());
+        }
+        self.holds.part(&parting);
+        if net.settle(
+            self.model,
+            &self.drive,
+            self.stiffness,
+            &self.holds,
+            trial,
+            &mut self.data,
+        ) {
+            Ok(())
+        } else {
+            Err(self.no_balance(u))
+        }
+    }
+
+    /// The first progress in (u, next] where something happens, `at_next` its balance at
+    /// `next`: bisected to [`LOCATE`]; the angles are left at it, `before` just short of it.
+    fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>) -> f64 {
+        let net = self.net;
+        let (mut lo, mut hi, mut at_hi) = (u, next, at_next);
+        while hi - lo > LOCATE * (1.0 + hi.abs()) {
+            let mid = 0.5 * (lo + hi);
+            let mut state = self.theta.clone();
+            self.path.drive(mid, &mut self.drive);
+            net.settle(
+                self.model,
+                &self.drive,
+                self.stiffness,
+                &self.holds,
+                &mut state,
+                &mut self.data,
+            );
+            if net.event(&self.data, &self.holds, self.capture) {
+                hi = mid;
+                at_hi = state;
+            } else {
+                lo = mid;
+                self.theta = state;
+            }
+        }
+        update_poses(self.model, &self.theta, &mut self.before);
+        self.theta = at_hi;
+        hi
+    }
+
+    /// Latches what meets in line, presses what meets at a shared corner, stops at anything
+    /// else (a jam). A latch moves the faces (they snap into line), so it looks again until
+    /// nothing new meets. Returns whether the run is over (closed or jammed).
+    fn resolve(&mut self, u: f64) -> Result<bool> {
+        let net = self.net;
+        loop {
+            self.path.drive(u, &mut self.drive);
+            update_poses(self.model, &self.theta, &mut self.data);
+            let mut new: Vec<(usize, f64)> = (0..net.seams.len())
+                .filter_map(|k| {
+                    let m = net.misalignment(&self.data, k);
+                    let latches = match self.holds.state[k] {
+                        SeamState::Open => m <= ALIGNED_TOGETHER,
+                        SeamState::Pressed => m <= self.capture,
+                        SeamState::Latched => false,
+                    };
+                    latches.then_some((k, m))
+                })
+                .collect();
+            let mut pressed_now = false;
+            for (pair, point) in net.meeting_pairs(&self.data) {
+                let faces = net.pairs[pair].faces;
+                if self.holds.pressing(faces) {
+                    continue;
+                }
+                let seam = net.pairs[pair].seam.filter(|&k| self.holds.state[k] == SeamState::Open);
+                let misalignment = seam.map(|k| net.misalignment(&self.data, k));
+                let press = net.press_of(&net.pairs[pair], seam, &self.before, &self.data);
+                match (seam, misalignment, press) {
+                    (Some(k), Some(m), _) if m <= self.capture => {
+                        if !new.iter().any(|&(j, _)| j == k) {
+                            new.push((k, m));
+                        }
+                    }
+                    (_, _, Some(press)) if press.seam.is_none_or(|k| !new.iter().any(|&(j, _)| j == k)) => {
+                        self.holds.press(press);
+                        self.report.presses.push(Contact {
+                            faces: faces.map(|f| net.file_face[f]),
+                            seam,
+                            time_s: self.path.time(u),
+                            progress: u,
+                            misalignment,
+                        });
+                        pressed_now = true;
+                    }
+                    _ => {
+                        self.end(Outcome::Jams, u);
+                        self.report.jam = Some(Jam {
+                            faces: faces.map(|f| net.file_face[f]),
+                            time_s: self.path.time(u),
+                            progress: u,
+                            point_um: [point.x, point.y, point.z].map(|x| x * 1e6),
+                            seam_misalignment: misalignment,
+                        });
+                        self.report.open_seams = net.open(&self.data, &self.holds);
+                        return Ok(true);
+                    }
+                }
+            }
+            if new.is_empty() && !pressed_now {
+                return Ok(false);
+            }
+            new.sort_by_key(|&(k, _)| k);
+            for (k, m) in new {
+                self.holds.latch(k);
+                self.report.latches.push(Latch {
+                    seam: k,
+                    faces: net.seams[k].faces.map(|f| net.file_face[f]),
+                    time_s: self.path.time(u),
+                    progress: u,
+                    misalignment: m,
+                });
+            }
+            update_poses(self.model, &self.theta, &mut self.before);
+            self.settle_at(u)?;
+            self.keep_frame(u);
+            if self.holds.latched.len() == net.seams.len() {
+                self.end(Outcome::Closes, u);
+                return Ok(true);
+            }
+        }
+    }
+
+    fn end(&mut self, outcome: Outcome, u: f64) {
+        self.report.outcome = outcome;
+        self.report.time_s = self.path.time(u);
+        self.report.progress = u;
     }
 }
 
