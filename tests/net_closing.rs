@@ -407,3 +407,43 @@ fn the_anchored_face_moves_the_whole_closing_rigidly_and_changes_no_outcome() {
         }
     }
 }
+
+#[test]
+fn seams_closing_a_vertex_at_a_singular_state_are_held_and_the_run_decided() {
+    // The dodecahedron's seventh most compact net, released along 22.5°, its device sample 1
+    // (2 % spreads): two seams latch where their closures lose rank, and the balance used to
+    // cycle there until it gave up. It must be decided, its latched seams held.
+    let (name, solid) = open_solid("dodecahedron").unwrap();
+    let options = NetsOptions {
+        top: 7,
+        unit_um: 50.0,
+        simulate: 0,
+        front_deg: Some(22.5),
+        ..NetsOptions::default()
+    };
+    let report = nets(&name, &solid, &options).unwrap();
+    let made = best_net_patterns(&solid, &report, 7).unwrap().remove(6).1;
+    let scene = net_device(&made, "dodecahedron", &options).unwrap();
+    let model = scene.network().unwrap();
+    let closing = NetClosing::new(&made, model).unwrap();
+    let (forcing, stiffness) = options.variation().device(&model.forcing, &model.stiffness(), 1);
+    let run = closing.run(model, &forcing, &stiffness, &options.closing()).unwrap();
+    assert_ne!(run.outcome, Outcome::Undecided, "{:?}", run.undecided);
+    assert!(run.latches.len() >= 2, "{:?}", run.latches);
+    let places = closing.vertex_places(model, &run.frames.last().unwrap().fold_angles);
+    for latch in &run.latches {
+        let [e, f] = made.seams[latch.seam];
+        let (a, b) = (made.pattern.edges[e], made.pattern.edges[f]);
+        for v in a {
+            let copy = b
+                .into_iter()
+                .find(|&w| made.solid_vertex[w] == made.solid_vertex[v])
+                .unwrap();
+            let gap = (0..3)
+                .map(|i| (places[v][i] - places[copy][i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(gap <= 1e-9, "seam {}: ends {gap} apart", latch.seam);
+        }
+    }
+}

@@ -448,7 +448,7 @@ fn nets_with_study(py: Python<'_>, shape: String, settings: &str, study: &str) -
 
 /// The report and the files of a ranked (and maybe studied) table, as `nets` returns them.
 fn nets_payload(
-    solid: &nanofold::geometry::polyhedron::Polyhedron,
+    solid: &commands::nets::Polyhedron,
     report: &commands::nets::NetsReport,
     options: &commands::nets::NetsOptions,
     clock: Instant,

@@ -12,7 +12,7 @@ pub use crate::design::nets::{
     MAX_SAMPLED_TREES, MAX_WRITTEN_NETS,
 };
 use crate::error::{NanofoldError, Result};
-use crate::geometry::polyhedron::Polyhedron;
+pub use crate::geometry::polyhedron::Polyhedron;
 use crate::geometry::solids;
 use crate::pattern::net::NetPattern;
 use std::path::Path;

@@ -29,8 +29,20 @@ const PRESS_REACH: f64 = 1e-6;
 /// A run's frames are kept at least this far apart in progress (and at every event).
 const FRAME_SPACING: f64 = 0.005;
 /// The latched seams' equilibrium: Gauss–Newton steps and the step that ends them, rad.
-const SETTLE_ITERATIONS: usize = 80;
+const SETTLE_ITERATIONS: usize = 200;
 const SETTLE_STEP: f64 = 1e-13;
+/// JᵀJ's eigenvalues below this share of its largest are zero (singular values below 1e-6
+/// of J's largest).
+const RANK_CUT: f64 = 1e-12;
+/// At a singular state the balance's steps stop shrinking: held rows and steps below this
+/// (rad) are accepted.
+const SINGULAR_STEP: f64 = 1e-4;
+/// The held rows' rank is read once their residual is below this.
+const RANK_READ: f64 = 1e-6;
+/// A latched seam's rows: a hinge's five.
+const SEAM_ROWS: usize = 5;
+/// The rows count as held below this (over the net's size, or the sine of a press's angle).
+const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
 const SETTLE_DAMPING: f64 = 0.3;
 
@@ -73,6 +85,9 @@ pub enum Outcome {
     Jams,
     /// The drives reached their targets with seams still open.
     Stalls,
+    /// No balance was found with the latched seams held (a singular state of their
+    /// closures): the run stops there and says why; it does not count as closing.
+    Undecided,
 }
 
 impl Outcome {
@@ -82,6 +97,7 @@ impl Outcome {
             Outcome::Closes => "closes",
             Outcome::Jams => "jams",
             Outcome::Stalls => "stalls",
+            Outcome::Undecided => "undecided",
         }
     }
 }
@@ -163,6 +179,8 @@ pub struct ClosingReport {
     pub jam: Option<Jam>,
     /// Seams still open at the end, with their misalignment.
     pub open_seams: Vec<(usize, f64)>,
+    /// Why the run could not go on (outcome `undecided`).
+    pub undecided: Option<String>,
     /// The start, every event (before and after its latches) and the end.
     pub frames: Vec<ClosingFrame>,
 }
@@ -521,31 +539,45 @@ impl NetClosing {
     }
 
     /// The rows that hold the faces, their residual and Jacobian in the fold angles at the
-    /// poses and twists `data` holds: each latched seam's ends on their copies (over the
-    /// net's size, six rows), each pressed seam's ray on the other face's plane (one row).
+    /// poses and twists `data` holds: each latched seam's first end on its copy (three rows)
+    /// and its second end's offset across the seam's line (two rows: along face a's normal
+    /// and across the edge in its plane), over the net's size, so a seam on its copy (a
+    /// hinge) has five independent rows wherever it is; each pressed seam's ray on the other
+    /// face's plane (one row).
     fn hold_rows(&self, data: &NetworkData, holds: &Holds, columns: usize) -> (DVector<f64>, DMatrix<f64>) {
-        let rows = 6 * holds.latched.len() + holds.pressed.len();
+        let rows = SEAM_ROWS * holds.latched.len() + holds.pressed.len();
         let mut residual = DVector::zeros(rows);
         let mut jacobian = DMatrix::zeros(rows, columns);
         for (i, &k) in holds.latched.iter().enumerate() {
             let seam = &self.seams[k];
+            let [a, b] = seam.faces;
+            let along = (self.place(data, a, seam.ends[1][0]) - self.place(data, a, seam.ends[0][0])).normalize();
+            let normal = data.rotation[self.face_panel[a]] * Vector3::z();
+            let across = along.cross(&normal);
+            let identity = nalgebra::Matrix3::identity();
             for (e, &[v, w]) in seam.ends.iter().enumerate() {
-                let row = 6 * i + 3 * e;
-                let (x, y) = (self.place(data, seam.faces[0], v), self.place(data, seam.faces[1], w));
-                residual.rows_mut(row, 3).copy_from(&((x - y) / self.size));
-                for (point, face, sign) in [(x, seam.faces[0], 1.0), (y, seam.faces[1], -1.0)] {
+                let (row, directions): (usize, Vec<Vector3<f64>>) = if e == 0 {
+                    (SEAM_ROWS * i, (0..3).map(|j| identity.column(j).into_owned()).collect())
+                } else {
+                    (SEAM_ROWS * i + 3, vec![normal, across])
+                };
+                let (x, y) = (self.place(data, a, v), self.place(data, b, w));
+                for (j, d) in directions.iter().enumerate() {
+                    residual[row + j] = d.dot(&(x - y)) / self.size;
+                }
+                for (point, face, sign) in [(x, a, 1.0), (y, b, -1.0)] {
                     for &c in &self.paths[self.face_panel[face]] {
                         let twist = &data.twist[c];
                         let velocity = twist.angular.cross(&point) + twist.linear;
-                        for j in 0..3 {
-                            jacobian[(row + j, c)] += sign * velocity[j] / self.size;
+                        for (j, d) in directions.iter().enumerate() {
+                            jacobian[(row + j, c)] += sign * d.dot(&velocity) / self.size;
                         }
                     }
                 }
             }
         }
         for (i, press) in holds.pressed.iter().enumerate() {
-            let row = 6 * holds.latched.len() + i;
+            let row = SEAM_ROWS * holds.latched.len() + i;
             let (normal, ray) = self.press_vectors(data, press);
             residual[row] = press.sign * normal.dot(&ray);
             for &c in &self.paths[self.face_panel[press.plane_face]] {
@@ -566,19 +598,28 @@ impl NetClosing {
         (normal, ray)
     }
 
-    /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space). Rounding leaves its
-    /// zero eigenvalues near 1e-16 of the largest (not its square), so the cut is well above
-    /// that: singular values below 1e-6 of J's largest.
-    fn row_and_null_space(jacobian: &DMatrix<f64>) -> (RowSpace, Vec<DVector<f64>>) {
+    /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space): the null space the
+    /// `null_count` smallest when given, else those below the cut. Rounding leaves JᵀJ's zero
+    /// eigenvalues near 1e-16 of the largest (not its square), so the cut is well above that:
+    /// singular values below 1e-6 of J's largest.
+    fn row_and_null_space(
+        jacobian: &DMatrix<f64>,
+        null_count: impl Into<Option<usize>>,
+    ) -> (RowSpace, Vec<DVector<f64>>) {
         let eigen = (jacobian.transpose() * jacobian).symmetric_eigen();
-        let cutoff = 1e-12 * eigen.eigenvalues.amax().max(f64::MIN_POSITIVE);
+        let cutoff = RANK_CUT * eigen.eigenvalues.amax().max(f64::MIN_POSITIVE);
+        let mut order: Vec<usize> = (0..eigen.eigenvalues.len()).collect();
+        order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
+        let nulls = null_count
+            .into()
+            .unwrap_or_else(|| order.iter().filter(|&&i| eigen.eigenvalues[i] <= cutoff).count());
         let (mut row, mut null) = (Vec::new(), Vec::new());
-        for (i, &lambda) in eigen.eigenvalues.iter().enumerate() {
+        for (rank, &i) in order.iter().enumerate() {
             let direction = eigen.eigenvectors.column(i).into_owned();
-            if lambda > cutoff {
-                row.push((lambda, direction));
-            } else {
+            if rank < nulls {
                 null.push(direction);
+            } else {
+                row.push((eigen.eigenvalues[i].max(f64::MIN_POSITIVE), direction));
             }
         }
         (row, null)
@@ -603,14 +644,25 @@ impl NetClosing {
             return true;
         }
         let stiff = scaled(stiffness);
+        let mut last_turn = f64::INFINITY;
+        // The rows' rank is read once they are nearly held and kept from then on: converging
+        // on a point where they lose rank (seams closing a vertex at a singular state), the
+        // direction they lose would pass into the null space, and an energy step along it
+        // breaks them at second order, over and over.
+        let mut null_count = None;
         for _ in 0..SETTLE_ITERATIONS {
             update_poses(model, theta, data);
             let (residual, jacobian) = self.hold_rows(data, holds, n);
-            let (row, null) = Self::row_and_null_space(&jacobian);
+            let (row, null) = Self::row_and_null_space(&jacobian, null_count);
+            if null_count.is_none() && residual.amax() <= RANK_READ {
+                null_count = Some(null.len());
+            }
             let pulled = jacobian.transpose() * &residual;
-            // The least-norm step onto the rows: −(JᵀJ)⁺ Jᵀ c.
+            // The least-norm step onto the rows: −(JᵀJ)⁺ Jᵀ c, over the directions the rows
+            // still see (one they have lost at a singular state takes no step at all).
+            let largest = row.iter().map(|(lambda, _)| *lambda).fold(0.0, f64::max);
             let mut step = DVector::zeros(n);
-            for (lambda, direction) in &row {
+            for (lambda, direction) in row.iter().filter(|(lambda, _)| *lambda > RANK_CUT * largest) {
                 step -= direction * (direction.dot(&pulled) / lambda);
             }
             if !null.is_empty() {
@@ -622,21 +674,21 @@ impl NetClosing {
                     step -= z * y;
                 }
             }
-            let largest_turn = step.amax();
-            if largest_turn > SETTLE_DAMPING {
-                step *= SETTLE_DAMPING / largest_turn;
+            last_turn = step.amax();
+            if last_turn > SETTLE_DAMPING {
+                step *= SETTLE_DAMPING / last_turn;
             }
             for c in 0..n {
                 theta[c] += step[c];
             }
-            if largest_turn <= SETTLE_STEP {
+            if last_turn <= SETTLE_STEP {
                 update_poses(model, theta, data);
                 return true;
             }
         }
         update_poses(model, theta, data);
-        let (residual, _) = self.hold_rows(data, holds, n);
-        residual.amax() <= 1e-10
+        // Slow (linear) convergence at a rank-deficient point: held, and the steps small.
+        last_turn <= SINGULAR_STEP && self.hold_rows(data, holds, n).0.amax() <= SETTLE_HELD
     }
 
     /// The presses (indices into `holds.pressed`) whose faces the balance would rather part: moving along the
@@ -653,7 +705,7 @@ impl NetClosing {
         let (_, jacobian) = self.hold_rows(data, holds, n);
         let stiff = scaled(stiffness);
         let gradient = DVector::from_iterator(n, (0..n).map(|c| stiff[c] * (theta[c] - drive[c])));
-        let first = 6 * holds.latched.len();
+        let first = SEAM_ROWS * holds.latched.len();
         (0..holds.pressed.len())
             .filter(|&i| {
                 let others: Vec<usize> = (0..jacobian.nrows()).filter(|&r| r != first + i).collect();
@@ -661,7 +713,7 @@ impl NetClosing {
                 let apart = if others.is_empty() {
                     contact.clone()
                 } else {
-                    let (_, null) = Self::row_and_null_space(&jacobian.select_rows(&others));
+                    let (_, null) = Self::row_and_null_space(&jacobian.select_rows(&others), None);
                     null.iter().fold(DVector::zeros(n), |d, z| d + z * z.dot(&contact))
                 };
                 gradient.dot(&apart) < -1e-12 * gradient.norm() * apart.norm()
@@ -753,44 +805,19 @@ impl NetClosing {
                 presses: Vec::new(),
                 jam: None,
                 open_seams: Vec::new(),
+                undecided: None,
                 frames: Vec::new(),
             },
         };
-        run.settle_at(0.0)?;
-        run.keep_frame(0.0);
-        let mut last_frame = 0.0;
-        let mut u = 0.0;
-        while u < 1.0 {
-            let next = run.path.next(u, MAX_STEP);
-            let mut trial = run.theta.clone();
-            run.path.drive(next, &mut run.drive);
-            if !self.settle(model, &run.drive, stiffness, &run.holds, &mut trial, &mut run.data) {
-                return Err(run.no_balance(next));
-            }
-            if !self.event(&run.data, &run.holds, run.capture) {
-                run.let_go_of_parting(&mut trial, next)?;
-                run.theta = trial;
-                u = next;
-                if u - last_frame >= FRAME_SPACING {
-                    run.keep_frame(u);
-                    last_frame = u;
-                }
-                continue;
-            }
-            u = run.locate(u, next, trial);
-            run.report.first_contact_time_s.get_or_insert(run.path.time(u));
-            run.keep_frame(u);
-            if run.resolve(u)? {
-                return Ok(run.report);
-            }
-            last_frame = u;
+        if let Err(why) = run.drive_through() {
+            // No balance holds the latched seams here: the run cannot say what the device
+            // does next, and says so (counted as not closing).
+            let u = run.report.frames.last().map_or(0.0, |f| f.progress);
+            run.end(Outcome::Undecided, u);
+            run.report.undecided = Some(why.to_string());
+            update_poses(model, &run.theta, &mut run.data);
+            run.report.open_seams = self.open(&run.data, &run.holds);
         }
-        update_poses(model, &run.theta, &mut run.data);
-        run.report.outcome = Outcome::Stalls;
-        run.report.time_s = run.path.time(1.0);
-        run.report.progress = 1.0;
-        run.report.open_seams = self.open(&run.data, &run.holds);
-        run.keep_frame(1.0);
         Ok(run.report)
     }
 
@@ -878,6 +905,53 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
+    /// From flat to the end of the drives, the report filled; an error when no balance holds
+    /// the latched seams somewhere on the way.
+    fn drive_through(&mut self) -> Result<()> {
+        let net = self.net;
+        self.settle_at(0.0)?;
+        self.keep_frame(0.0);
+        let mut last_frame = 0.0;
+        let mut u = 0.0;
+        while u < 1.0 {
+            let next = self.path.next(u, MAX_STEP);
+            let mut trial = self.theta.clone();
+            self.path.drive(next, &mut self.drive);
+            if !net.settle(
+                self.model,
+                &self.drive,
+                self.stiffness,
+                &self.holds,
+                &mut trial,
+                &mut self.data,
+            ) {
+                return Err(self.no_balance(next));
+            }
+            if !net.event(&self.data, &self.holds, self.capture) {
+                self.let_go_of_parting(&mut trial, next)?;
+                self.theta = trial;
+                u = next;
+                if u - last_frame >= FRAME_SPACING {
+                    self.keep_frame(u);
+                    last_frame = u;
+                }
+                continue;
+            }
+            u = self.locate(u, next, trial);
+            self.report.first_contact_time_s.get_or_insert(self.path.time(u));
+            self.keep_frame(u);
+            if self.resolve(u)? {
+                return Ok(());
+            }
+            last_frame = u;
+        }
+        update_poses(self.model, &self.theta, &mut self.data);
+        self.end(Outcome::Stalls, 1.0);
+        self.report.open_seams = net.open(&self.data, &self.holds);
+        self.keep_frame(1.0);
+        Ok(())
+    }
+
     fn keep_frame(&mut self, u: f64) {
         self.report.frames.push(ClosingFrame {
             time_s: self.path.time(u),
