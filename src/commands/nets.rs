@@ -505,7 +505,7 @@ pub fn nets_csv(report: &NetsReport) -> String {
 const PAGE_FRAMES: usize = 121;
 
 /// The 3D page of a net's nominal device closing along `front_deg` (None: a step): every
-/// frame of the run (thinned evenly to [`PAGE_FRAMES`], events kept), the anchored face
+/// frame of the run (thinned evenly to `PAGE_FRAMES`, events kept), the anchored face
 /// fixed, a jam's faces marked.
 pub fn closing_page(made: &NetPattern, name: &str, front_deg: Option<f64>, options: &NetsOptions) -> Result<String> {
     let released = NetsOptions {
