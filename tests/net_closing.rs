@@ -447,3 +447,30 @@ fn seams_closing_a_vertex_at_a_singular_state_are_held_and_the_run_decided() {
         }
     }
 }
+
+#[test]
+fn a_study_jobs_bad_net_release_or_results_are_refused_by_name() {
+    let (name, solid) = open_solid("cube").unwrap();
+    let options = NetsOptions {
+        top: 2,
+        simulate: 1,
+        fronts: 2,
+        yield_samples: 0,
+        ..NetsOptions::default()
+    };
+    let mut report = nets(&name, &solid, &options).unwrap();
+    let folds = report.nets[0].folds.clone();
+    let message = |e: nanofold::NanofoldError| e.to_string();
+    assert!(message(study_release_of(&solid, &name, &folds, 2, &options).unwrap_err()).contains("release"));
+    assert!(message(study_release_of(&solid, &name, &folds[..3], 0, &options).unwrap_err()).contains("folds"));
+    assert!(message(study_release_of(&solid, &name, &[0, 1, 2, 3, 99], 0, &options).unwrap_err()).contains("folds"));
+    // One release where the options give two: refused, the table untouched.
+    let one = study_release_of(&solid, &name, &folds, 0, &options).unwrap();
+    let error = apply_releases(&solid, &mut report, vec![(1, vec![one.clone()])], &options, 0.0).unwrap_err();
+    assert!(message(error).contains("releases"));
+    assert!(report.nets[0].closing.is_none() && report.study.is_none());
+    let error = apply_releases(&solid, &mut report, vec![(99, vec![one.clone(), one])], &options, 0.0).unwrap_err();
+    assert!(message(error).contains("rank"));
+    let bad = serde_json::json!([[1, [{"front_deg": 0.0, "outcome": "flies"}]]]);
+    assert!(message(releases_from_json(&bad).unwrap_err()).contains("outcome"));
+}
