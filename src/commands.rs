@@ -170,11 +170,60 @@ impl Pattern {
                 if !refused_as_vertex(&refusal, sheet.is_ok()) {
                     return Err(refusal);
                 }
-                Ok(Pattern::Sheet {
+                let pattern = Pattern::Sheet {
                     model: Box::new(FoldingModel::new(sheet?)?),
                     origin: origin_of(),
-                })
+                };
+                Ok(pattern.settled(&value, name, origin))
             }
+        }
+    }
+
+    /// A sheet whose state is off rigid within [`NOISY_STATE_BOUND`] moved onto the nearest
+    /// rigid state ([`Pattern::projected`]); anything else, or a sheet the projection cannot
+    /// move, as it is (its check then says how far from rigid it is).
+    fn settled(self, value: &serde_json::Value, name: &str, source: &str) -> Pattern {
+        let off = match &self {
+            Pattern::Sheet { model, .. } => off_rigid(model),
+            Pattern::Vertex { .. } => return self,
+        };
+        if !(off > RIGID_WITHIN && off <= NOISY_STATE_BOUND) {
+            return self;
+        }
+        let Pattern::Sheet { model, origin } = self else {
+            unreachable!("matched above")
+        };
+        if model.pattern.folded_form.is_some() {
+            if let Some(moved) = rigid_form_of(&model, value, name, source) {
+                let (model, mut projection) = moved;
+                projection.note = format!(
+                    "off rigid by {off:.2e} (within {NOISY_STATE_BOUND:.0e}: an exporter's noise), {}",
+                    projection.note
+                );
+                return Pattern::Sheet {
+                    model: Box::new(model),
+                    origin: Origin {
+                        projection: Some(projection),
+                        ..origin
+                    },
+                };
+            }
+        }
+        let kept = (model.clone(), origin.clone());
+        match (Pattern::Sheet { model, origin }).projected() {
+            Ok(Pattern::Sheet { model, mut origin }) => {
+                if let Some(projection) = origin.projection.as_mut() {
+                    projection.note = format!(
+                        "off rigid by {off:.2e} (within {NOISY_STATE_BOUND:.0e}: an exporter's noise), {}",
+                        projection.note
+                    );
+                }
+                Pattern::Sheet { model, origin }
+            }
+            _ => Pattern::Sheet {
+                model: kept.0,
+                origin: kept.1,
+            },
         }
     }
 
@@ -254,6 +303,77 @@ impl Pattern {
     }
 }
 
+pub use crate::folding::NOISY_STATE_BOUND;
+
+/// Off rigid by at most this, a state is rigid already (`check`'s closure tolerance).
+const RIGID_WITHIN: f64 = 1e-6;
+
+/// A folded form's file moved onto the nearest rigid folded form
+/// ([`crate::geometry::rigid_form::rigidify`]) and read again: the model and the move. None
+/// where the file's key frame lacks what that needs or the move fails.
+fn rigid_form_of(
+    model: &FoldingModel,
+    value: &serde_json::Value,
+    name: &str,
+    source: &str,
+) -> Option<(FoldingModel, Projection)> {
+    let fit = model.pattern.folded_form?;
+    let coords: Vec<[f64; 3]> = serde_json::from_value(value.get("vertices_coords")?.clone()).ok()?;
+    let faces: Vec<Vec<usize>> = serde_json::from_value(value.get("faces_vertices")?.clone()).ok()?;
+    let edges: Vec<[usize; 2]> = serde_json::from_value(value.get("edges_vertices")?.clone()).ok()?;
+    let letters: Vec<String> = serde_json::from_value(value.get("edges_assignment")?.clone()).ok()?;
+    let flat_edges: Vec<[usize; 2]> = edges
+        .iter()
+        .zip(&letters)
+        .filter(|(_, a)| a.eq_ignore_ascii_case("F"))
+        .map(|(e, _)| *e)
+        .collect();
+    let form = crate::geometry::rigid_form::rigidify(&coords, &faces, &flat_edges, 1e-13).ok()?;
+    let mut moved_file = value.clone();
+    moved_file["vertices_coords"] = serde_json::to_value(&form.coords).ok()?;
+    let moved = FoldingModel::new(crate::read::crease_pattern_of_value(&moved_file, name, source).ok()?).ok()?;
+    let (before, after) = (model.given_fold_angles(), moved.given_fold_angles());
+    if before.len() != after.len() || off_rigid(&moved) > RIGID_WITHIN {
+        return None;
+    }
+    let changes: Vec<f64> = before.iter().zip(&after).map(|(a, b)| (a - b).abs()).collect();
+    let max_change = changes.iter().copied().fold(0.0, f64::max);
+    let rms_change = (changes.iter().map(|c| c * c).sum::<f64>() / changes.len().max(1) as f64).sqrt();
+    let residual_before = crate::folding::vertex_residuals(model, &before)
+        .into_iter()
+        .fold(0.0, f64::max);
+    let note = format!(
+        "moved onto the nearest rigid folded form (planar faces, flat facets, developable vertices, flat-foldable ones kept so): vertices moved by up to {:.3e} ({:.1e} of the sheet's size), fold angles by up to {max_change:.3e} rad (RMS {rms_change:.3e}); before, worst vertex closure {residual_before:.3e} rad, facets bent by up to {:.3e} rad, faces developing with a mismatch of {:.3e}",
+        form.max_move,
+        form.max_move / model.size,
+        fit.max_facet_angle,
+        fit.development_error
+    );
+    let figures = ProjectionFigures {
+        max_change_rad: max_change,
+        rms_change_rad: rms_change,
+        residual_before_rad: residual_before,
+        newton_iterations: form.iterations,
+        moved: "vertex_positions",
+        max_vertex_move: Some(form.max_move),
+        folded_form: Some(FoldedFormBend::from(&fit)),
+    };
+    Some((moved, Projection { note, figures }))
+}
+
+/// How far a sheet's state is from rigid, in the measures of [`NOISY_STATE_BOUND`].
+fn off_rigid(model: &FoldingModel) -> f64 {
+    let closure = crate::folding::vertex_residuals(model, &model.given_fold_angles())
+        .into_iter()
+        .fold(0.0, f64::max);
+    let form = model.pattern.folded_form.map_or(0.0, |fit| {
+        fit.max_facet_angle
+            .max(fit.development_error / model.size)
+            .max(fit.face_nonplanarity / model.size)
+    });
+    closure.max(form)
+}
+
 /// How far a crease pattern's state was moved to make it rigid ([`Pattern::projected`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Projection {
@@ -325,6 +445,8 @@ impl Pattern {
             rms_change_rad: projection.rms_change,
             residual_before_rad: projection.residual_before,
             newton_iterations: projection.iterations,
+            moved: "fold_angles",
+            max_vertex_move: None,
             folded_form: fit.as_ref().map(FoldedFormBend::from),
         };
         Ok(Pattern::Sheet {

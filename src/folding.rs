@@ -23,7 +23,7 @@ pub use frames::{fold_path_and_frames, path_frames, path_frames_on, PathFrame, F
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{
     fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep, Projection, StopReason,
-    MIN_GOAL_PERCENT, MIN_STEP,
+    MIN_GOAL_PERCENT, MIN_STEP, NOISY_STATE_BOUND,
 };
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{

@@ -1,12 +1,14 @@
 //! The geometry layer: points on the unit sphere around a vertex (geodesics, fold angles
 //! measured from nodes) and the kinematics of one vertex (fold angles ↔ ray directions,
 //! loop closure), which boxes overlap (the broad phase of planarity and contact tests), and
-//! the closed solids a net is designed for (their dual graphs, spanning trees, symmetries).
+//! the closed solids a net is designed for (their dual graphs, spanning trees, symmetries),
+//! and the nearest rigid folded form to a noisy one.
 
 pub(crate) mod broad_phase;
 pub mod kinematics;
 pub mod nets;
 pub mod polyhedron;
+pub mod rigid_form;
 pub mod solids;
 pub mod sphere;
 pub mod surface_intersection;

@@ -1636,3 +1636,100 @@ fn frames_placed_during_the_path_are_the_frames_placed_after_it() {
         .to_string();
     assert!(refused.contains("frames") && refused.contains('1'), "{refused}");
 }
+
+/// The export above with Gaussian noise of `sigma` on every coordinate (seeded), turned
+/// about a tilted axis and moved when `turned`.
+fn noisy_export(text: &str, sigma: f64, turned: bool, seed: u64) -> String {
+    let mut file: serde_json::Value = serde_json::from_str(text).unwrap();
+    let mut state = seed;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    let mut gauss = move || (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos();
+    let turn = nalgebra::Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(nalgebra::Vector3::new(0.3, -0.5, 0.8)),
+        0.9,
+    );
+    let coords: Vec<[f64; 3]> = serde_json::from_value(file["vertices_coords"].clone()).unwrap();
+    let moved: Vec<[f64; 3]> = coords
+        .iter()
+        .map(|p| {
+            let mut q = nalgebra::Vector3::new(p[0], p[1], p[2]);
+            if turned {
+                q = turn * q + nalgebra::Vector3::new(12.0, -7.0, 3.0);
+            }
+            [q.x + sigma * gauss(), q.y + sigma * gauss(), q.z + sigma * gauss()]
+        })
+        .collect();
+    file["vertices_coords"] = serde_json::json!(moved);
+    file.to_string()
+}
+
+/// A compliant simulator's export off rigid within its noise (1e-4) is moved, when read, onto
+/// the nearest rigid folded form: every vertex closes and every facet is flat again, the
+/// Miura-ori keeps its one degree of freedom (its vertices kept flat-foldable) and unfolds
+/// flat, and the move is reported; turned and moved in space, the same. Beyond the bound
+/// the form stays as read and `check` says `not_rigid`, naming the bound.
+#[test]
+fn a_noisy_folded_form_is_moved_onto_the_nearest_rigid_form_when_read() {
+    use nanofold::commands::{check, unfold, CheckVerdict, Pattern, Settings};
+    use nanofold::folding::PatternVerdict;
+    let model = miura(3, 4, 65.0, 110.0);
+    let rho = model.given_fold_angles();
+    let clean = simulator_export(&model, &rho, 0.0, false);
+    for (sigma, turned, seed) in [(3e-6, false, 7), (3e-6, true, 11), (1e-5, false, 13)] {
+        let text = noisy_export(&clean, sigma, turned, seed);
+        let pattern = Pattern::parse(&text, "noisy", "test", &LoadOptions::default()).unwrap();
+        let projection = pattern.projection().unwrap_or_else(|| panic!("σ {sigma:e}: not moved"));
+        let figures = &projection.figures;
+        assert_eq!(figures.moved, "vertex_positions");
+        // Noise σ per coordinate: a vertex moves by a few σ, the angles by a few σ / edge.
+        assert!(figures.max_vertex_move.unwrap() < 20.0 * sigma, "{}", projection.note);
+        assert!(figures.residual_before_rad > 1e-6, "{}", projection.note);
+        let sheet = pattern.sheet().unwrap();
+        let worst = nanofold::folding::vertex_residuals(sheet, &sheet.given_fold_angles())
+            .into_iter()
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "closure {worst:e} after the move");
+        let near = sheet
+            .given_fold_angles()
+            .iter()
+            .zip(&rho)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(near < 1e-3, "σ {sigma:e}: {near:e} rad from the clean state");
+        let report = check(&pattern, &Settings::default()).unwrap();
+        assert_eq!(
+            report.verdict,
+            CheckVerdict::Pattern(PatternVerdict::Rigid),
+            "{}",
+            report.evidence
+        );
+        assert!(
+            report.evidence.contains("1 DOF at the given state") || report.evidence.contains("(1 DOF"),
+            "{}",
+            report.evidence
+        );
+        let unfolded = unfold(&pattern, &Settings::default()).unwrap();
+        assert_eq!(
+            unfolded.verdict,
+            nanofold::commands::UnfoldVerdict::Flat,
+            "{}",
+            unfolded.evidence
+        );
+    }
+    let far = noisy_export(&clean, 1e-3, true, 5);
+    let pattern = Pattern::parse(&far, "far", "test", &LoadOptions::default()).unwrap();
+    assert!(pattern.projection().is_none());
+    let report = check(&pattern, &Settings::default()).unwrap();
+    assert_eq!(
+        report.verdict,
+        CheckVerdict::Pattern(PatternVerdict::NotRigid),
+        "{}",
+        report.evidence
+    );
+    assert!(report.evidence.contains("beyond the 1e-4"), "{}", report.evidence);
+}

@@ -171,6 +171,12 @@ impl NormalSolver {
         }
     }
 
+    /// Sets μ relative to the largest diagonal entry of JᵀJ for the factorisations to come
+    /// (a damped least-squares step's, [`crate::folding::project_to_rigid`]).
+    pub fn set_regularisation(&mut self, regularisation: f64) {
+        self.regularisation = regularisation;
+    }
+
     /// Numeric factorisations made so far.
     pub fn factorisations(&self) -> usize {
         self.factorisations

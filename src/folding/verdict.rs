@@ -6,6 +6,7 @@
 use super::closure::{closure_jacobian, vertex_residuals};
 use super::contact::{panel_contacts, ContactSettings};
 use super::model::{FoldingModel, Star};
+use super::path::NOISY_STATE_BOUND;
 use super::path::{fold_path, Drive, FoldPath, FoldSettings, StopReason};
 use super::poses::{panel_poses, tree_mismatch};
 use super::rank::{jacobian_rank, RankReport};
@@ -330,7 +331,7 @@ fn state_verdict(
     if let Some(bent) = bent {
         (
             PatternVerdict::NotRigid,
-            format!("the folded form is not rigid: {bent}; worst vertex closure {max_residual:.3e} rad"),
+            format!("the folded form is not rigid: {bent}; worst vertex closure {max_residual:.3e} rad (beyond the {NOISY_STATE_BOUND:.0e} an exporter's noise explains, so not moved onto a rigid form; `project` moves it anyway)"),
         )
     } else if max_residual > settings.closure_tol {
         let list: Vec<String> = worst

@@ -633,31 +633,10 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
                 graph.coords = coords;
                 reading = Some(planarity);
             }
-            None => return read_folded_form(graph, kinds, name).map(Into::into),
+            None => return read_folded_form(graph, kinds, name),
         }
     }
-    let mut fold_angles = Vec::with_capacity(graph.edges.len());
-    for (e, &kind) in kinds.iter().enumerate() {
-        let angle_field = format!("{}[{e}]", graph.angle_key);
-        let degrees = match graph.angles_json.map(|a| &a[e]) {
-            None | Some(Value::Null) if !matches!(kind, EdgeKind::Crease(_)) || graph.angles_json.is_none() => 0.0,
-            None | Some(Value::Null) => {
-                return Err(NanofoldError::invalid(
-                    angle_field,
-                    "null",
-                    "a crease needs its fold angle (degrees), or the file none at all (the flat state)",
-                ))
-            }
-            Some(v) => number(v, &angle_field)?,
-        };
-        // A facet or boundary edge is flat whatever the file says of it (Origami Simulator
-        // writes its facets' target angles); a crease keeps its angle.
-        fold_angles.push(if matches!(kind, EdgeKind::Crease(_)) {
-            degrees.to_radians()
-        } else {
-            0.0
-        });
-    }
+    let mut fold_angles = crease_angles(&graph, &kinds)?;
     if let Some(planarity) = reading {
         // The sheet is the state (flat); its angles can only be targets.
         let targets = std::mem::replace(&mut fold_angles, vec![0.0; graph.edges.len()]);
@@ -699,9 +678,44 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
     .into())
 }
 
+/// The file's angle of each edge, rad: a crease's as given (required when the file gives
+/// angles at all), 0 for boundary and facet edges whatever the file says of them (Origami
+/// Simulator writes its facets' target angles).
+fn crease_angles(graph: &FoldGraph<'_>, kinds: &[EdgeKind]) -> Result<Vec<f64>> {
+    let mut fold_angles = Vec::with_capacity(graph.edges.len());
+    for (e, &kind) in kinds.iter().enumerate() {
+        let angle_field = format!("{}[{e}]", graph.angle_key);
+        let degrees = match graph.angles_json.map(|a| &a[e]) {
+            None | Some(Value::Null) if !matches!(kind, EdgeKind::Crease(_)) || graph.angles_json.is_none() => 0.0,
+            None | Some(Value::Null) => {
+                return Err(NanofoldError::invalid(
+                    angle_field,
+                    "null",
+                    "a crease needs its fold angle (degrees), or the file none at all (the flat state)",
+                ))
+            }
+            Some(v) => number(v, &angle_field)?,
+        };
+        // A facet or boundary edge is flat whatever the file says of it (Origami Simulator
+        // writes its facets' target angles); a crease keeps its angle.
+        fold_angles.push(if matches!(kind, EdgeKind::Crease(_)) {
+            degrees.to_radians()
+        } else {
+            0.0
+        });
+    }
+    Ok(fold_angles)
+}
+
 /// A crease of a 3D folded form within this of ±π is folded flat (its faces' normals
 /// opposite, the dihedral's sign noise), rad: it is read at ±π with its assignment's sign.
 pub const FOLDED_FLAT: f64 = 1e-4;
+
+/// A 3D folded form whose every dihedral angle (creases and facets) lies within this of 0,
+/// rad, is a flat sheet with an exporter's noise: Origami Simulator's compliant solver
+/// leaves its float32 exports off rigid by a few 1e-5 rad, and so bent. The same bound as
+/// [`FOLDED_FLAT`] at the other end of the range.
+pub const FLAT_DIHEDRAL_NOISE: f64 = 1e-4;
 
 /// A 3D sheet whose vertices all lie within this fraction of its size of one plane is flat
 /// (float noise of an exporter), not a folded state.
@@ -786,15 +800,43 @@ fn flat_within_noise(coords: &[[f64; 3]], faces: Option<&[Vec<usize>]>) -> Optio
 
 /// A 3D folded form: the crease pattern developed from its faces, the state from its
 /// dihedral angles (`edges_foldAngle` is ignored: Origami Simulator writes the targets there).
-fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> Result<CreasePatternBuilder> {
+fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> Result<ReadBuilder> {
     let source_magnitude = largest_coordinate(&graph.coords3);
-    let Some(faces) = graph.faces_vertices else {
+    let Some(faces) = graph.faces_vertices.clone() else {
         return Err(NanofoldError::missing_with(
             "faces_vertices",
             "a 3D folded form is developed into its crease pattern face by face",
         ));
     };
     let development = crate::read::folded_form::develop(&graph.coords3, &graph.edges, &faces)?;
+    // Bent nowhere beyond a compliant exporter's noise, the sheet is flat: the nearest
+    // rigid state is the flat one, and the file's angles can only be targets.
+    let bend = development.fold_angles.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+    if bend <= FLAT_DIHEDRAL_NOISE {
+        let targets = crease_angles(&graph, &kinds)?;
+        let any_target = targets.iter().any(|a| *a != 0.0);
+        let edge_count = graph.edges.len();
+        return Ok(CreasePatternBuilder {
+            name: name.to_string(),
+            vertices: development.vertices,
+            edges: graph.edges,
+            kinds,
+            fold_angles: vec![0.0; edge_count],
+            faces: None,
+            angle_field: graph.angle_key.to_string(),
+            folded_form: None,
+            locked: graph.locked,
+            unit: graph.unit,
+            source_magnitude,
+        }
+        .with_reading(
+            format!(
+                "a 3D sheet whose every dihedral angle lies within {FLAT_DIHEDRAL_NOISE:.0e} rad of flat (largest {bend:.2e} rad, creases and facets): read as the flat crease pattern developed from its faces, with its assignment, moved to flat by at most {bend:.2e} rad{}",
+                if any_target { format!("; its {} read as targets", graph.angle_key) } else { String::new() }
+            ),
+            any_target.then_some(targets),
+        ));
+    }
     // Faces listed clockwise give a mirrored development with every angle's sign flipped:
     // the assignments say which way round the file is.
     let (mut agree, mut disagree) = (0usize, 0usize);
@@ -870,5 +912,6 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
             assignment_conflicts,
             folded_flat: snapped,
         }),
-    })
+    }
+    .into())
 }

@@ -58,6 +58,13 @@ pub struct ProjectionFigures {
     pub residual_before_rad: f64,
     /// Newton iterations taken.
     pub newton_iterations: usize,
+    /// What was moved: `fold_angles` (least-norm Newton, damped least squares where Newton
+    /// stalls near a branch point) or `vertex_positions` (a folded form's vertices, onto
+    /// planar faces, flat facets and developable vertices).
+    pub moved: &'static str,
+    /// Largest distance a folded form's vertex moved, in the file's length unit (None: the
+    /// fold angles were moved).
+    pub max_vertex_move: Option<f64>,
     /// How far a folded form's facets were from rigid (None: the file gave fold angles).
     pub folded_form: Option<FoldedFormBend>,
 }
