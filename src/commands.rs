@@ -895,7 +895,7 @@ pub fn fold_run(pattern: &Pattern, options: &options::FoldOptions) -> Result<Fol
     use crate::write::folding_output::{crease_pattern_fold, fold_path_fold};
     let model = sheet_of(pattern, "fold")?;
     let settings = options.settings(model)?;
-    let start = model.given_fold_angles();
+    let start = options.start(model);
     let clock = Instant::now();
     let (path, frames) = crate::folding::fold_path_and_frames(model, &start, &settings, options.frames)?;
     let report = fold_report(pattern, model, start, path, clock);

@@ -22,8 +22,8 @@ pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
 pub use frames::{fold_path_and_frames, path_frames, path_frames_on, PathFrame, FRAME_CLOSURE, MAX_FRAME_THREADS};
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{
-    fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep, Projection, StopReason,
-    MIN_GOAL_PERCENT, MIN_STEP, NOISY_STATE_BOUND,
+    damped_projection, fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep,
+    Projection, StopReason, MIN_GOAL_PERCENT, MIN_STEP, NOISY_STATE_BOUND,
 };
 pub use poses::{panel_poses, tree_mismatch, vertex_positions, Pose};
 pub use rank::{

@@ -1733,3 +1733,120 @@ fn a_noisy_folded_form_is_moved_onto_the_nearest_rigid_form_when_read() {
     );
     assert!(report.evidence.contains("beyond the 1e-4"), "{}", report.evidence);
 }
+
+/// The worst relative edge-length error of a state's 3D placement (panels posed along the
+/// spanning tree, every vertex placed once): a check of rigidity apart from the closures.
+fn worst_edge_error(model: &FoldingModel, fold_angles: &[f64]) -> f64 {
+    let mut poses = Vec::new();
+    panel_poses(model, fold_angles, &mut poses);
+    let placed = vertex_positions(model, &poses);
+    let pattern = &model.pattern;
+    pattern.edges.iter().fold(0.0_f64, |worst, &[a, b]| {
+        let (p, q) = (pattern.vertices[a], pattern.vertices[b]);
+        let flat = (p[0] - q[0]).hypot(p[1] - q[1]);
+        let folded = (0..3)
+            .map(|k| (placed[a][k] - placed[b][k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst.max((folded - flat).abs() / flat)
+    })
+}
+
+/// `fold --drive-to-targets` on a Miura-ori whose targets are a rigid state (its own folded
+/// state, 110° zigzags) folds from flat onto it to 1e-9 rad; every frame holds its edges
+/// and closures to 1e-9 and keeps the assigned signs; `to: 50` stops with the furthest
+/// crease halfway. Targets no rigid state meets (every crease at half its angle but one)
+/// stop at the rigid state nearest them on the path, naming the furthest crease and the
+/// vertex the targets leave open.
+#[test]
+fn a_targets_drive_folds_a_miura_ori_onto_its_rigid_state_or_stops_nearest() {
+    use nanofold::commands::{fold_run, FoldOptions, Pattern};
+    use nanofold::folding::{fold_path, Drive, FoldSettings, StopReason};
+    let folded = miura(3, 4, 65.0, 110.0);
+    let targets = folded.given_fold_angles();
+    let pattern = Pattern::from_crease_pattern(folded.pattern.clone()).unwrap();
+    let options = FoldOptions {
+        drive_to_targets: Some(true),
+        frames: 21,
+        ..FoldOptions::default()
+    };
+    let run = fold_run(&pattern, &options).unwrap();
+    assert_eq!(run.report.start_fold_angles_rad, vec![0.0; targets.len()]);
+    let end = &run.report.final_fold_angles_rad;
+    let off = end.iter().zip(&targets).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(off < 1e-9, "{off:e} rad from the targets: {}", run.report.evidence);
+    for frame in &run.frames {
+        let closure = nanofold::folding::vertex_residuals(&folded, &frame.fold_angles)
+            .into_iter()
+            .fold(0.0, f64::max);
+        assert!(closure < 1e-9 && worst_edge_error(&folded, &frame.fold_angles) < 1e-9);
+        assert!(frame.fold_angles.iter().zip(&targets).all(|(a, t)| a * t >= 0.0));
+    }
+    let halfway = fold_run(
+        &pattern,
+        &FoldOptions {
+            to: 50.0,
+            ..options.clone()
+        },
+    )
+    .unwrap();
+    let span = targets.iter().fold(0.0_f64, |m, t| m.max(t.abs()));
+    let left = halfway
+        .report
+        .final_fold_angles_rad
+        .iter()
+        .zip(&targets)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!((left / span - 0.5).abs() < 1e-9, "{left} of {span} left");
+
+    let mut off_targets: Vec<f64> = targets.iter().map(|t| 0.5 * t).collect();
+    off_targets[0] = targets[0];
+    let settings = FoldSettings {
+        drive: Drive::Targets {
+            targets: off_targets.clone(),
+            to: 100.0,
+        },
+        ..FoldSettings::default()
+    };
+    let flat = vec![0.0; targets.len()];
+    let path = fold_path(&folded, &flat, &settings).unwrap();
+    let StopReason::Nearest { crease, vertex } = path.stop.clone() else {
+        panic!("{:?}: {}", path.stop, path.evidence);
+    };
+    let open = nanofold::folding::vertex_residuals(&folded, &off_targets);
+    let worst = (0..open.len()).max_by(|&a, &b| open[a].total_cmp(&open[b])).unwrap();
+    assert_eq!(vertex, Some(folded.stars[worst].vertex));
+    let last = &path.steps.last().unwrap().fold_angles;
+    let furthest = (0..last.len())
+        .max_by(|&a, &b| {
+            (off_targets[a] - last[a])
+                .abs()
+                .total_cmp(&(off_targets[b] - last[b]).abs())
+        })
+        .unwrap();
+    assert_eq!(crease, furthest);
+    assert!(
+        path.evidence
+            .contains(&format!("leave vertex {} open", folded.stars[worst].vertex)),
+        "{}",
+        path.evidence
+    );
+    // Stationary: the distance to the targets grows both ways along the one motion.
+    let distance = |rho: &[f64]| off_targets.iter().zip(rho).map(|(t, r)| (t - r).powi(2)).sum::<f64>();
+    let steps = &path.steps;
+    assert!(distance(last) <= distance(&steps[steps.len() - 2].fold_angles));
+    // Bad targets are refused by name: one per crease, signs as assigned.
+    let mut wrong_sign = targets.clone();
+    wrong_sign[3] = -wrong_sign[3];
+    for (bad, field) in [(vec![0.1; 3], "drive.targets"), (wrong_sign, "drive.targets[3]")] {
+        let settings = FoldSettings {
+            drive: Drive::Targets {
+                targets: bad,
+                to: 100.0,
+            },
+            ..FoldSettings::default()
+        };
+        let error = fold_path(&folded, &flat, &settings).unwrap_err().to_string();
+        assert!(error.contains(field), "{error}");
+    }
+}

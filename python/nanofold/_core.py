@@ -370,10 +370,15 @@ def fold(
     frames: Optional[int] = None,
     max_step: Optional[float] = None,
     max_steps: Optional[int] = None,
+    drive_to_targets: Optional[bool] = None,
 ) -> FoldResult:
     """Folds a pattern rigidly: from flat along its assignment until the most folded crease
     reaches ``to`` % of 180° (a percentage, default 100, as ``fold --to``), or ``drive`` =
-    {FOLD edge index: angle in degrees} (as ``fold --drive EDGE=DEG``). ``frames`` snapshots
+    {FOLD edge index: angle in degrees} (as ``fold --drive EDGE=DEG``). A file whose
+    ``edges_foldAngle`` are targets folds every crease towards them (``to`` % of the way);
+    ``drive_to_targets`` (as ``fold --drive-to-targets``) asks for that, or with ``False``
+    the assignment instead; on a file whose angles are a folded state, ``True`` folds from
+    flat to it. ``frames`` snapshots
     go into the FOLD animation (``fold_file()``); ``max_step`` is the largest change of any
     fold angle in one step, degrees (as ``fold --max-step``).
 
@@ -383,7 +388,8 @@ def fold(
     ('reached', 1, 5)
     """
     pat = _pattern(pattern)
-    keywords = dict(to=to, drive=drive, frames=frames, max_step=max_step, max_steps=max_steps)
+    keywords = dict(to=to, drive=drive, frames=frames, max_step=max_step, max_steps=max_steps,
+                    drive_to_targets=drive_to_targets)
     summary, rest = _call(_native.fold, pat._handle, _settings(keywords))
     return FoldResult("fold", summary, rest)
 

@@ -306,3 +306,14 @@ def test_nets_refuse_bad_shapes_and_settings_by_name():
         nanofold.nets("cube", rank_by="yield", simulate=0)
     with pytest.raises(nanofold.InvalidFieldError, match="shape"):
         nanofold.nets("sphere")
+
+
+def test_drive_to_targets_folds_from_flat_onto_a_given_state_and_refuses_a_sheet_without_one():
+    folded = nanofold.generate.miura(3, 4, angle_deg=65, fold_deg=110)
+    targets = np.asarray(folded.fold_angles)
+    r = nanofold.fold(folded, drive_to_targets=True)
+    assert r.verdict == "reached"
+    assert np.abs(np.asarray(r.final_fold_angles_rad) - targets).max() < 1e-9
+    flat = nanofold.generate.miura(3, 4, angle_deg=65)
+    with pytest.raises(nanofold.NanofoldError, match="drive_to_targets"):
+        nanofold.fold(flat, drive_to_targets=True)

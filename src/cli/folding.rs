@@ -15,13 +15,19 @@ pub struct FoldArgs {
     /// A FOLD crease pattern (any number of vertices): from flat, or from its state.
     pub pattern: PathBuf,
     /// Drive these creases (FOLD edge index) to these angles, e.g. `--drive 12=-90`;
-    /// without it, every mountain and valley folds towards ±180° as assigned.
+    /// without it, every crease folds towards its target where the file gives targets, else
+    /// every mountain and valley towards ±180° as assigned.
     #[arg(long, value_name = "EDGE=DEG", allow_negative_numbers = true)]
     pub drive: Vec<String>,
-    /// Stop when the most folded crease reaches this percentage of 180° (assignment drive;
-    /// 0.1 to 100).
+    /// Stop when the most folded crease reaches this percentage of 180° (assignment drive),
+    /// or this percentage of the way to the targets (0.1 to 100).
     #[arg(long, default_value_t = 100.0)]
     pub to: f64,
+    /// Drive every crease towards its target angle (a file's `edges_foldAngle` read as
+    /// targets): `--drive-to-targets` requires them, `--drive-to-targets false` folds by the
+    /// assignment instead; without it, a file's targets are used when it gives them.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    pub drive_to_targets: Option<bool>,
     /// Number of snapshots written as FOLD frames (start and end included; 2 to 10 000).
     #[arg(long, default_value_t = 11)]
     pub frames: usize,
@@ -234,6 +240,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
             .collect::<Result<_>>()?,
         max_step: args.max_step,
         frames: args.frames,
+        drive_to_targets: args.drive_to_targets,
         ..nanofold::commands::FoldOptions::default()
     };
     let pattern = nanofold::commands::Pattern::open(&args.pattern, &nanofold::prelude::LoadOptions::default())
@@ -243,6 +250,7 @@ pub fn run_fold(args: &FoldArgs) -> Result<()> {
             e,
             &[
                 ("drive.to", "--to"),
+                ("drive_to_targets", "--drive-to-targets"),
                 ("drive", "--drive"),
                 ("max_step", "--max-step"),
                 ("frames", "--frames"),

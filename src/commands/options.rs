@@ -155,6 +155,10 @@ pub struct FoldOptions {
     pub max_steps: usize,
     /// Frames of the FOLD animation (2 to 10 000).
     pub frames: usize,
+    /// Drive every crease towards the pattern's target angles (a file's `edges_foldAngle`
+    /// read as targets): None folds towards them when the file gives them and no `drive` is
+    /// named, `Some(true)` requires them, `Some(false)` folds by the assignment instead.
+    pub drive_to_targets: Option<bool>,
 }
 
 /// Most frames of a fold's animation.
@@ -172,16 +176,58 @@ impl Default for FoldOptions {
             max_step: d.max_step.to_degrees(),
             max_steps: d.max_steps,
             frames: 11,
+            drive_to_targets: None,
         }
     }
 }
 
 impl FoldOptions {
+    /// Whether the run folds from flat to the pattern's given state (`drive_to_targets`
+    /// asked of a file whose angles are a folded state, not targets).
+    fn folds_to_given_state(&self, model: &crate::folding::FoldingModel) -> bool {
+        self.drive_to_targets == Some(true)
+            && self.drive.is_empty()
+            && model.pattern.target_angles.is_none()
+            && model.given_fold_angles().iter().any(|&a| a != 0.0)
+    }
+
+    /// Where the run starts: the pattern's state, or flat where it folds to that state.
+    pub fn start(&self, model: &crate::folding::FoldingModel) -> Vec<f64> {
+        let given = model.given_fold_angles();
+        if self.folds_to_given_state(model) {
+            vec![0.0; given.len()]
+        } else {
+            given
+        }
+    }
+
     /// The folding settings for `pattern`, validated (a driven edge must be one of its
     /// creases).
     pub fn settings(&self, model: &crate::folding::FoldingModel) -> Result<FoldSettings> {
+        let targets = match &model.pattern.target_angles {
+            Some(by_edge) => Some(model.pattern.creases.iter().map(|&e| by_edge[e]).collect::<Vec<f64>>()),
+            // Asked for targets, a file whose angles are a state gives that state.
+            None if self.folds_to_given_state(model) => Some(model.given_fold_angles()),
+            None => None,
+        };
         let drive = if self.drive.is_empty() {
-            Drive::Assignment { to: self.to }
+            match (self.drive_to_targets, targets) {
+                (Some(true), None) => {
+                    return Err(NanofoldError::invalid(
+                        "drive_to_targets",
+                        "true",
+                        "the pattern gives no target angles and no folded state (a file's edges_foldAngle are its targets, or the state to fold to from flat)",
+                    ))
+                }
+                (None | Some(true), Some(targets)) => Drive::Targets { targets, to: self.to },
+                _ => Drive::Assignment { to: self.to },
+            }
+        } else if self.drive_to_targets == Some(true) {
+            return Err(NanofoldError::invalid(
+                "drive_to_targets",
+                "true",
+                "drive either named creases (drive) or every crease to its target, not both",
+            ));
         } else {
             Drive::Creases(
                 self.drive

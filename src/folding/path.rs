@@ -23,6 +23,17 @@ pub enum Drive {
     },
     /// The listed creases (fold-angle columns) towards their target angles (rad).
     Creases(Vec<(usize, f64)>),
+    /// Every crease towards its target (one per crease column, rad; a file's
+    /// `edges_foldAngle` read as targets), the state kept rigid: the velocity θ* − ρ
+    /// projected onto the closures' null space. It stops at the targets, at `to` % of the
+    /// way there (measured by the crease furthest from its target), or at the rigid state
+    /// nearest them that the path reaches.
+    Targets {
+        /// The target angles, rad, one per crease column.
+        targets: Vec<f64>,
+        /// Percentage of the way to stop at, in [0.1, 100] (as `fold --to`).
+        to: f64,
+    },
 }
 
 /// Settings of a folding path, validated by [`FoldSettings::validate`].
@@ -73,6 +84,34 @@ impl FoldSettings {
                         format!("{to:e}"),
                         format!("must lie in [{MIN_GOAL_PERCENT}, 100] (percent of a full fold)"),
                     ));
+                }
+            }
+            Drive::Targets { targets, to } => {
+                if !(*to >= MIN_GOAL_PERCENT && *to <= 100.0) {
+                    return Err(NanofoldError::invalid(
+                        "drive.to",
+                        format!("{to:e}"),
+                        format!("must lie in [{MIN_GOAL_PERCENT}, 100] (percent of the way to the targets)"),
+                    ));
+                }
+                model.expect_fold_angles("drive.targets", targets)?;
+                let signs = assigned_signs(model);
+                for (column, &target) in targets.iter().enumerate() {
+                    let edge = model.pattern.creases[column];
+                    if !(target.is_finite() && target.abs() <= PI) {
+                        return Err(NanofoldError::invalid(
+                            format!("drive.targets[{column}] (edge {edge})"),
+                            target.to_degrees(),
+                            "a target lies in [−180°, 180°]",
+                        ));
+                    }
+                    if signs[column] * target < 0.0 && !model.locked_columns[column] {
+                        return Err(NanofoldError::invalid(
+                            format!("drive.targets[{column}] (edge {edge})"),
+                            format!("{:.3}°", target.to_degrees()),
+                            "the target's sign contradicts the crease's assignment (mountain ≤ 0 ≤ valley)",
+                        ));
+                    }
                 }
             }
             Drive::Creases(list) => {
@@ -174,6 +213,14 @@ pub enum StopReason {
         /// assignment.
         creases: Vec<usize>,
     },
+    /// A targets drive ended short of its targets at the rigid state nearest them that its
+    /// path reaches: the projected velocity towards them vanished.
+    Nearest {
+        /// The crease (column) furthest from its target there.
+        crease: usize,
+        /// The interior vertex the targets leave most open (None: they close every vertex).
+        vertex: Option<usize>,
+    },
     /// The step budget ran out.
     StepLimit,
     /// More pairs of panels overlap than the contact test's budget (layers stacked deep):
@@ -210,6 +257,10 @@ pub struct FoldPath {
     pub evidence: String,
     /// How the path left the flat state (None: it did not start flat).
     pub branch: Option<String>,
+    /// Whether it left flat by damped least squares (the rigid state nearest the kicked
+    /// one), Newton finding no rigid state from the kick: flat's branches are then not
+    /// followed to first order, and a path that goes no further is no witness.
+    pub left_flat_damped: bool,
     /// Largest closure residual over every step, rad.
     pub max_closure_residual: f64,
     /// Smallest panel clearance over every step (None: no pair came within the search range).
@@ -322,7 +373,15 @@ pub(crate) fn progress_crease(drive: &Drive, rho: &[f64], signs: &[f64]) -> Opti
             .iter()
             .max_by(|x, y| (x.1 - rho[x.0]).abs().total_cmp(&(y.1 - rho[y.0]).abs()))
             .map(|&(c, _)| c),
+        Drive::Targets { targets, .. } => {
+            (0..rho.len()).max_by(|&a, &b| (targets[a] - rho[a]).abs().total_cmp(&(targets[b] - rho[b]).abs()))
+        }
     }
+}
+
+/// The largest distance of any crease from its target, rad.
+fn target_distance(targets: &[f64], rho: &[f64]) -> f64 {
+    targets.iter().zip(rho).fold(0.0_f64, |m, (t, r)| m.max((t - r).abs()))
 }
 
 /// The progress a state has when crease `crease`, at `value`, is the one that sets it (see
@@ -337,6 +396,13 @@ pub(crate) fn progress_by_crease(drive: &Drive, start: &[f64], crease: usize, va
                 return 1.0;
             }
             1.0 - (target - value).abs() / span
+        }
+        Drive::Targets { targets, to } => {
+            let span = target_distance(targets, start);
+            if span == 0.0 {
+                return 1.0;
+            }
+            (1.0 - (targets[crease] - value).abs() / span) / (to / 100.0)
         }
     }
 }
@@ -359,6 +425,13 @@ pub(crate) fn progress(drive: &Drive, start: &[f64], rho: &[f64], signs: &[f64])
             }
             1.0 - list.iter().fold(0.0_f64, |m, &(c, t)| m.max((t - rho[c]).abs())) / span
         }
+        Drive::Targets { targets, to } => {
+            let span = target_distance(targets, start);
+            if span == 0.0 {
+                return 1.0;
+            }
+            (1.0 - target_distance(targets, rho) / span) / (to / 100.0)
+        }
     }
 }
 
@@ -372,6 +445,7 @@ fn desired_velocity(drive: &Drive, rho: &[f64], signs: &[f64]) -> Vec<f64> {
             }
             d
         }
+        Drive::Targets { targets, .. } => targets.iter().zip(rho).map(|(t, r)| t - r).collect(),
     }
 }
 
@@ -452,6 +526,8 @@ struct Walk<'a> {
     steps: Vec<PathStep>,
     newton_iterations: usize,
     branch: Option<String>,
+    /// Whether the path left flat by damped least squares, Newton finding nothing.
+    left_flat_damped: bool,
     /// The next step's length (the largest fold-angle change), rad.
     h: f64,
     /// The corrector's last factorisation (near `rho`: at the start of its last fresh step).
@@ -506,6 +582,7 @@ impl<'a> Walk<'a> {
             steps: Vec::new(),
             newton_iterations: 0,
             branch: None,
+            left_flat_damped: false,
             h: settings.max_step.min(INITIAL_STEP),
             carried: None,
             first_contacts: None,
@@ -571,14 +648,51 @@ impl<'a> Walk<'a> {
 
     /// Leaving the flat state: a kick along the projected direction, Newton onto the nearest
     /// branch, and every crease's sign checked against its assignment.
+    /// The stop of a targets drive whose projected velocity vanishes short of them: the
+    /// crease furthest from its target, and the vertex the targets themselves leave most
+    /// open.
+    fn nearest_to_targets(&self, projected: f64) -> Stop {
+        let Drive::Targets { targets, .. } = &self.settings.drive else {
+            unreachable!("a targets drive")
+        };
+        let model = self.model;
+        let crease = progress_crease(&self.settings.drive, &self.rho, &self.signs).unwrap_or(0);
+        let open = crate::folding::vertex_residuals(model, targets);
+        let (star, residual) = open
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map_or((None, 0.0), |(k, &r)| (Some(model.stars[k].vertex), r));
+        let targets_note = match star {
+            Some(vertex) if residual > self.settings.closure_tol => {
+                format!("the targets are no rigid state: they leave vertex {vertex} open by {residual:.3e} rad")
+            }
+            _ => "the targets close every vertex, but this path does not reach them".to_string(),
+        };
+        Stop::new(
+            StopReason::Nearest {
+                crease,
+                vertex: star.filter(|_| residual > self.settings.closure_tol),
+            },
+            format!(
+                "at progress {:.6} no step along the drive's velocity, projected onto the rigid motions, brings the state nearer the targets (steps down to {projected:.1e} rad tried): the rigid state nearest them on this path; crease {crease} (edge {}) is furthest, at {:.3}° for {:.3}°; {targets_note}",
+                self.progress_of(&self.rho),
+                model.pattern.creases[crease],
+                self.rho[crease].to_degrees(),
+                targets[crease].to_degrees()
+            ),
+        )
+    }
+
     fn leave_flat(&mut self) -> Result<Option<Stop>> {
         let (model, settings) = (self.model, self.settings);
         // The branch is the assignment's, whatever drives the motion afterwards (a driven
         // crease alone would pick any branch, e.g. a straight line folded on its own).
-        let mut d = if self.signs.iter().any(|&s| s != 0.0) {
-            self.signs.clone()
-        } else {
-            desired_velocity(&settings.drive, &self.rho, &self.signs)
+        let mut d = match &settings.drive {
+            // Targets carry the assignment's signs, and say how much each crease folds.
+            Drive::Targets { targets, .. } => targets.clone(),
+            _ if self.signs.iter().any(|&s| s != 0.0) => self.signs.clone(),
+            drive => desired_velocity(drive, &self.rho, &self.signs),
         };
         model.hold_locked(&mut d);
         let factor = self.solver.factor(&closure_jacobian(model, &self.rho))?;
@@ -597,18 +711,34 @@ impl<'a> Walk<'a> {
             let mut trial: Vec<f64> = self.rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
             if let Some(correction) = correct(model, &mut trial, settings.closure_tol, &mut self.solver, None, false)? {
                 self.newton_iterations += correction.iterations;
-                landed = Some((kick, trial, correction));
+                landed = Some((kick, trial, correction, false));
+                break;
+            }
+            // Flat is a branch point: where the first-order direction leads to no branch,
+            // damped least squares still find the rigid state nearest the kicked one.
+            let mut damped: Vec<f64> = self.rho.iter().zip(&v).map(|(r, x)| r + kick * x / size).collect();
+            if let Some(iterations) = damped_projection(model, &mut damped, settings.closure_tol, &mut self.solver)? {
+                self.newton_iterations += iterations;
+                let correction = Correction {
+                    iterations,
+                    first: 0.0,
+                    residual: crate::folding::vertex_residuals(model, &damped)
+                        .into_iter()
+                        .fold(0.0, f64::max),
+                    factor: None,
+                };
+                landed = Some((kick, damped, correction, true));
                 break;
             }
             if raised == settings.kick {
                 break;
             }
         }
-        let Some((kick, trial, correction)) = landed else {
+        let Some((kick, trial, correction, damped)) = landed else {
             return Ok(Some(Stop::new(
                 StopReason::BranchPoint { creases: vec![] },
                 format!(
-                    "Newton found no rigid state {:.0e} rad from flat along the projected direction",
+                    "neither Newton nor damped least squares found a rigid state {:.0e} rad from flat along the projected direction (no rigid state there)",
                     settings.kick
                 ),
             )));
@@ -622,7 +752,8 @@ impl<'a> Walk<'a> {
             return Ok(Some(Stop::new(StopReason::BranchPoint { creases: wrong }, evidence)));
         }
         self.branch = Some(format!(
-            "left flat by a kick of {kick:.0e} rad along the projected direction, Newton onto the closure, every crease's sign checked against its assignment{}",
+            "left flat by a kick of {kick:.0e} rad along the projected direction, {} onto the closure, every crease's sign checked against its assignment{}",
+            if damped { "damped least squares (Newton found no rigid state there)" } else { "Newton" },
             if kick > settings.kick {
                 format!(" (the kick raised from {:.0e}: the sheet's vertices are flat-foldable only to its noise, and noise of size ε splits the branches within about √ε of flat)", settings.kick)
             } else {
@@ -643,6 +774,7 @@ impl<'a> Walk<'a> {
             }
         };
         self.rho = trial;
+        self.left_flat_damped = damped;
         self.record(self.rho.clone(), correction.residual, min_clearance);
         Ok(None)
     }
@@ -655,6 +787,9 @@ impl<'a> Walk<'a> {
         }
         let tangent = match self.tangent()? {
             Ok(tangent) => tangent,
+            Err(size) if matches!(self.settings.drive, Drive::Targets { .. }) => {
+                return Ok(Some(self.nearest_to_targets(size)));
+            }
             Err(size) => {
                 return Ok(Some(Stop::new(
                     StopReason::Locked,
@@ -671,6 +806,20 @@ impl<'a> Walk<'a> {
                 }
             }
         }
+        if let Drive::Targets { targets, .. } = &self.settings.drive {
+            // No further than the point of the tangent line nearest the targets.
+            let along: f64 = targets
+                .iter()
+                .zip(&self.rho)
+                .zip(&tangent)
+                .map(|((t, r), x)| (t - r) * x)
+                .sum();
+            let nearest = along / tangent.iter().map(|x| x * x).sum::<f64>();
+            if nearest <= NEAREST_STEP {
+                return Ok(Some(self.nearest_to_targets(nearest)));
+            }
+            self.h = self.h.min(nearest);
+        }
         let bend = if self.curved && self.one_dof == Some(true) {
             self.bend(&tangent)
         } else {
@@ -681,6 +830,7 @@ impl<'a> Walk<'a> {
                 self.next_tangent = tangent;
                 (next, min_clearance, correction)
             }
+            Trial::Event(stop) if matches!(stop.reason, StopReason::Nearest { .. }) => return Ok(Some(stop)),
             Trial::Event(stop) => {
                 return Ok(Some(Stop::new(
                     stop.reason,
@@ -888,9 +1038,22 @@ impl<'a> Walk<'a> {
                 },
             };
             self.newton_iterations += correction.iterations;
-            if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_)) {
+            if trial.iter().any(|r| r.abs() > PI) && matches!(settings.drive, Drive::Creases(_) | Drive::Targets { .. })
+            {
                 self.h /= 2.0;
                 continue;
+            }
+            if let Drive::Targets { targets, .. } = &settings.drive {
+                // Nearer the targets or not at all: past the nearest state on a curved
+                // path, the tangent's own estimate overshoots.
+                let squared = |rho: &[f64]| targets.iter().zip(rho).map(|(t, r)| (t - r) * (t - r)).sum::<f64>();
+                if squared(&trial) >= squared(&self.rho) {
+                    self.h /= 2.0;
+                    if self.h < NEAREST_STEP {
+                        return Ok(Trial::Event(self.nearest_to_targets(self.h)));
+                    }
+                    continue;
+                }
             }
             let reached = if landed_early {
                 predicted
@@ -995,6 +1158,7 @@ impl<'a> Walk<'a> {
             stop: stop.reason,
             evidence: stop.evidence,
             branch: self.branch,
+            left_flat_damped: self.left_flat_damped,
             max_closure_residual,
             min_panel_clearance,
             newton_iterations: self.newton_iterations,
@@ -1058,7 +1222,7 @@ fn land_on_goal(
             None => return Ok(None),
         },
         Drive::Creases(list) if list.len() == 1 => list[0],
-        Drive::Creases(_) => return Ok(None),
+        Drive::Creases(_) | Drive::Targets { .. } => return Ok(None),
     };
     let mut state = trial.to_vec();
     state[crease] = value;
@@ -1270,6 +1434,10 @@ pub fn project_to_rigid(model: &FoldingModel, fold_angles: &[f64], tol: f64) -> 
     })
 }
 
+/// A targets drive whose best step towards them is below this, rad, has stopped at the
+/// rigid state nearest them.
+const NEAREST_STEP: f64 = 1e-9;
+
 /// Most iterations of [`damped_projection`].
 const DAMPED_ITERATIONS: usize = 500;
 
@@ -1277,7 +1445,7 @@ const DAMPED_ITERATIONS: usize = 500;
 /// where a step fails to cut ‖r‖ and lowered where it does. Where the Jacobian loses rank
 /// (a branch point) it converges linearly where Newton does not converge. Returns the
 /// iterations, or None when μ runs away or the iterations run out.
-pub(crate) fn damped_projection(
+pub fn damped_projection(
     model: &FoldingModel,
     fold_angles: &mut [f64],
     tol: f64,

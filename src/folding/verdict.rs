@@ -282,7 +282,24 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
         "flat-foldability at the vertices: {}",
         report.flat_foldability.summary(model.stars.len())
     ));
-    let path = fold_path(model, &rho, &path_settings)?;
+    let mut path = fold_path(model, &rho, &path_settings)?;
+    // A file's targets drive a second path where the assignment's finds no witness.
+    if let (false, Some(by_edge)) = (witnesses(&path), model.pattern.target_angles.as_ref()) {
+        let targets = model.pattern.creases.iter().map(|&e| by_edge[e]).collect();
+        let by_targets = FoldSettings {
+            drive: Drive::Targets { targets, to: 100.0 },
+            ..settings.path.clone()
+        };
+        if by_targets.validate(model).is_ok() {
+            let towards = fold_path(model, &rho, &by_targets)?;
+            report.tried.push(format!(
+                "folding path from flat by the assignment: {} ({})",
+                path.stop.as_str(),
+                path.evidence
+            ));
+            path = towards;
+        }
+    }
     let reached = path.steps.last().map_or(0.0, |s| s.progress);
     let fully_assigned = model.pattern.creases.iter().all(|&e| {
         matches!(
@@ -290,11 +307,15 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
             EdgeKind::Crease(Assignment::Mountain) | EdgeKind::Crease(Assignment::Valley)
         )
     });
-    if path.steps.len() > 2 && reached > 0.0 {
+    if witnesses(&path) {
         report.verdict = PatternVerdict::RigidlyFoldable;
         report.evidence = format!(
-            "a rigid folding path from flat with the assigned signs reaches {:.1}% of full folding ({} steps, closure ≤ {:.1e} rad, stop: {} — {})",
+            "a rigid folding path from flat with the assigned signs reaches {:.1}% of {} ({} steps, closure ≤ {:.1e} rad, stop: {} — {})",
             100.0 * reached,
+            match path.drive {
+                Drive::Targets { .. } => "the way to the file's targets",
+                _ => "full folding",
+            },
             path.steps.len(),
             path.max_closure_residual,
             path.stop.as_str(),
@@ -302,9 +323,21 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
         );
     } else {
         report.tried.push(format!(
-            "folding path from flat: {} ({})",
+            "folding path from flat{}: {} ({}{})",
+            match path.drive {
+                Drive::Targets { .. } => " towards the file's targets",
+                _ => "",
+            },
             path.stop.as_str(),
-            path.evidence
+            path.evidence,
+            if path.left_flat_damped {
+                format!(
+                    "; it left flat by damped least squares and reached {:.2e} of the way, short of the {DAMPED_WITNESS_PROGRESS} a witness needs",
+                    reached
+                )
+            } else {
+                String::new()
+            }
         ));
         let verdict_by_path = matches!(path.stop, StopReason::Locked) && fully_assigned && model.stars.is_empty();
         report.verdict = if verdict_by_path {
@@ -316,6 +349,18 @@ fn judge(model: &FoldingModel, settings: &CheckSettings) -> Result<CheckReport> 
     }
     report.witness = Some(path);
     Ok(report)
+}
+
+/// The progress a path that left flat by damped least squares must make to witness a
+/// rigid folding: its start is the rigid state nearest a kick, not a branch followed.
+const DAMPED_WITNESS_PROGRESS: f64 = 0.01;
+
+/// Whether a path from flat witnesses a rigid folding with the assigned signs: states past
+/// the one it left flat to, some progress, and where it left flat by damped least squares,
+/// [`DAMPED_WITNESS_PROGRESS`] of it.
+fn witnesses(path: &crate::folding::FoldPath) -> bool {
+    let reached = path.steps.last().map_or(0.0, |s| s.progress);
+    path.steps.len() > 2 && reached > 0.0 && (!path.left_flat_damped || reached >= DAMPED_WITNESS_PROGRESS)
 }
 
 /// The verdict of a folded state (or a folded form whose facets bend, `bent`): not rigid,
