@@ -172,11 +172,20 @@ pub fn unfold_observed(
             .value(&start, &model.arcs, &mut EnergyWorkspace::default())
             .is_finite()
     {
-        let scaled: Vec<f64> = model
+        let mut scaled: Vec<f64> = model
             .folded_ray_angles
             .iter()
             .map(|r| r * (1.0 - FLAT_FOLDED_BACKOFF))
             .collect();
+        // Closed in the fold angles first (minimum-norm Newton, then to rounding): the
+        // nodes placed from closed angles keep every arc, where restoring the scaled nodes
+        // from near the singular flat-folded state converges only linearly.
+        let every: Vec<usize> = (0..scaled.len()).collect();
+        let mut closed = scaled.clone();
+        if kinematics::solve_closure(&model.sector_angles, &mut closed, &every, 1e-14, 200).is_ok() {
+            kinematics::refine_closure(&model.sector_angles, &mut closed, &every, 50);
+            scaled = closed;
+        }
         start = kinematics::forward(&model.sector_angles, &scaled);
         adjustments.push(format!(
             "start has touching charges (flat-folded, infinite energy): fold angles scaled by {} and constraints restored",
