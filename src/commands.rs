@@ -970,7 +970,14 @@ pub fn unfold_files(
         (Detail::VertexUnfold(run), Some(vertex), _) => {
             let model = crate::unfold::UnfoldModel::new(vertex);
             let trajectory = crate::write::output::trajectory_json(vertex, &settings.unfold, run, 1000);
-            let animation = crate::write::output::fold_animation(vertex, &model, run);
+            let mut animation = crate::write::output::fold_animation(vertex, &model, run);
+            // A file without faces: its sheet's own (the same vertices where none was
+            // left out), so the page has faces to draw.
+            if animation.get("faces_vertices").is_none() {
+                if let Some(sheet) = pattern.sheet().filter(|s| s.pattern.ignored_vertices.is_empty()) {
+                    animation["faces_vertices"] = serde_json::json!(sheet.pattern.faces);
+                }
+            }
             Ok(vec![
                 ("trajectory.json", trajectory.to_string()),
                 ("unfold.fold", pretty(&animation)?),

@@ -16,7 +16,7 @@ use std::f64::consts::{PI, TAU};
 pub const MIN_SECTOR_RAD: f64 = 1e-6;
 
 /// Most rays (creases, split rays and boundary rays) one vertex may have; an unfold
-/// iteration costs O(n²) in the energy; 512 rays unfold in about 30 s on a 2-core machine,
+/// iteration costs O(n²) in the energy (512 rays unfold in seconds: docs/guide/limits.md),
 /// and a 1000-ray vertex stalled short of flat.
 pub const MAX_RAYS: usize = 512;
 

@@ -87,6 +87,30 @@ fn an_accordion_of_thin_panels_folds() {
     assert!(path.steps.last().unwrap().progress > 0.9, "{}", path.evidence);
 }
 
+/// An accordion of 2 000 panels 1 × 100 folded to ±170° (no interior vertex: every state
+/// rigid) unfolds flat along the ray to flat, halving its angles each step: at most 20
+/// steps, where creeping down the layers' barrier took 81 for 1 000 panels and 421 for
+/// 49 999 (README's Limits table).
+#[test]
+fn a_folded_accordion_unfolds_along_the_ray_to_flat() {
+    let mut file = common::strip_fold(2000, 1.0, 100.0);
+    let angles: Vec<serde_json::Value> = file["edges_assignment"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| match a.as_str().unwrap() {
+            "V" => serde_json::json!(170.0),
+            "M" => serde_json::json!(-170.0),
+            _ => serde_json::Value::Null,
+        })
+        .collect();
+    file["edges_foldAngle"] = serde_json::json!(angles);
+    let pattern = Pattern::parse(&file.to_string(), "accordion", "accordion", &LoadOptions::default()).unwrap();
+    let report = unfold(&pattern, &Settings::default()).unwrap();
+    assert_eq!(report.verdict, UnfoldVerdict::Flat, "{}", report.evidence);
+    assert!(report.steps <= 20, "{} steps: {}", report.steps, report.evidence);
+}
+
 /// Folded until its layers stack, a strip's panels overlap in nearly every pair: the path
 /// stops where its contact test would pass 64 pairs per panel, and says so; the stacked
 /// state's own check is `unknown` for the same reason.
@@ -125,6 +149,12 @@ fn layers_stacked_deep_stop_at_the_contact_budget() {
 /// A fan of `n` thin panels about one vertex, folded by 60° along the straight line of
 /// creases 0 and n/2 (the others unassigned creases at 0), as a crease pattern.
 fn fan(n: usize) -> Pattern {
+    let sheet = nanofold::read::parse_crease_pattern(&fan_fold(n).to_string(), "fan", "fan").unwrap();
+    Pattern::from_crease_pattern(sheet).unwrap()
+}
+
+/// The FOLD object of [`fan`] (no `faces_vertices`, as a hand-written file may have none).
+fn fan_fold(n: usize) -> serde_json::Value {
     let tau = std::f64::consts::TAU;
     let mut vertices = vec![[0.0, 0.0]];
     vertices.extend((0..n).map(|k| [(tau * k as f64 / n as f64).cos(), (tau * k as f64 / n as f64).sin()]));
@@ -141,13 +171,25 @@ fn fan(n: usize) -> Pattern {
         assignment.push("B");
         angles.push(0.0);
     }
-    let text = serde_json::json!({
+    serde_json::json!({
         "vertices_coords": vertices, "edges_vertices": edges,
         "edges_assignment": assignment, "edges_foldAngle": angles,
     })
-    .to_string();
-    let sheet = nanofold::read::parse_crease_pattern(&text, "fan", "fan").unwrap();
-    Pattern::from_crease_pattern(sheet).unwrap()
+}
+
+/// A FOLD vertex without `faces_vertices` (a fan of 64 panels folded along a line) goes to
+/// the single-vertex engine, unfolds flat, and its page is drawn from the sheet's own faces
+/// (it was refused for want of faces after the unfolding had run).
+#[test]
+fn a_vertex_file_without_faces_unfolds_and_writes_its_page() {
+    let pattern = Pattern::parse(&fan_fold(64).to_string(), "fan", "fan", &LoadOptions::default()).unwrap();
+    assert_eq!(pattern.engine(), Engine::Vertex);
+    let settings = Settings::default();
+    let report = unfold(&pattern, &settings).unwrap();
+    assert_eq!(report.verdict, UnfoldVerdict::Flat, "{}", report.evidence);
+    let files = nanofold::commands::unfold_files(&pattern, &report, &settings).unwrap();
+    let page = files.iter().find(|(name, _)| *name == "unfold.html").unwrap();
+    assert!(page.1.contains("<canvas"), "no page drawn");
 }
 
 /// Every two of a fan's panels meet at its centre: those pairs are the vertex's to order on

@@ -306,7 +306,10 @@ impl<'a> NetworkDescent<'a> {
         let mut refused_for_crossing = None;
         let mut halvings = 0;
         // Near flat the ray to flat is tried first: the cheapest step that keeps the branch.
-        let radial_first = largest <= NEAR_FLAT;
+        // Without interior vertices every state is rigid, the ray among them: first at any
+        // fold (an accordion halves its angles each step instead of creeping down its
+        // barrier's gradient).
+        let radial_first = largest <= NEAR_FLAT || model.stars.is_empty();
         let mut accepted = None;
         if radial_first {
             accepted = self.try_radial(&mut refused_for_crossing)?;
