@@ -49,6 +49,7 @@ pub mod outputs;
 mod scene;
 #[cfg(feature = "plot")]
 mod view;
+mod witness;
 
 pub use crate::constraints::network::NetworkCurves;
 pub use crate::constraints::ConstraintReport;
@@ -475,7 +476,7 @@ impl From<VertexPattern> for Pattern {
 /// The sheet of a single vertex: the vertex at the origin, a unit ray per crease (virtual
 /// rays as flat facet lines, an open chain's end rays as boundary), the rays' tips joined
 /// by the paper's outline.
-fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
+pub(crate) fn sheet_of_vertex(vertex: &VertexPattern) -> Result<FoldingModel> {
     if !vertex.flat_foldable {
         return Err(NanofoldError::invalid(
             "sector_angles",
@@ -1082,7 +1083,14 @@ fn vertex_report(
     settings: &Settings,
     progress: Option<UnfoldProgress>,
 ) -> Result<Report<UnfoldVerdict>> {
-    let report = crate::unfold::unfold_observed(vertex, &settings.unfold, progress)?;
+    let mut report = crate::unfold::unfold_observed(vertex, &settings.unfold, progress)?;
+    if matches!(report.verdict, UnfoldVerdict::LocalMinimum | UnfoldVerdict::Stuck) {
+        if let Ok(sheet) = sheet_of_vertex(vertex) {
+            if let Some(witnessed) = witness::unfold_by_folding_path(vertex, &sheet, &report, &settings.unfold)? {
+                report = witnessed;
+            }
+        }
+    }
     let summary = VertexUnfoldSummary::new(vertex, pattern.file(), &report);
     Ok(Report {
         pattern: pattern.name().to_string(),

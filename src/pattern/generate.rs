@@ -1,5 +1,5 @@
 //! Crease patterns built from parameters (`docs/model.md#pattern-generators`): Miura-ori
-//! with its folded state in closed form.
+//! with its folded state in closed form, and flat-foldable single vertices folded flat.
 
 use super::crease_pattern::{CreasePatternBuilder, EdgeKind, MAX_EDGES};
 
@@ -506,4 +506,59 @@ impl BirdBaseSpec {
             [s, s],
         ))
     }
+}
+
+/// A flat-foldable vertex of even `degree` (at least 4) folded flat: seeded sectors whose
+/// alternate sums are π, and an assignment made by crimping the smallest sector again and
+/// again (Hull: its two creases fold opposite ways and the three sectors about it become
+/// one; the last two creases fold alike), so a flat folding exists. Returns the sector
+/// angles (sector k after crease k) and the fold angles, every one ±π.
+pub fn flat_folded_vertex(degree: usize, seed: u64) -> crate::Result<(Vec<f64>, Vec<f64>)> {
+    if degree < 4 || !degree.is_multiple_of(2) || degree > crate::pattern::MAX_RAYS {
+        return Err(crate::NanofoldError::invalid(
+            "degree",
+            degree,
+            format!(
+                "a flat-foldable vertex has an even degree in [4, {}]",
+                crate::pattern::MAX_RAYS
+            ),
+        ));
+    }
+    let mut state = seed | 1;
+    let mut draw = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut halves: [Vec<f64>; 2] = [
+        (0..degree / 2).map(|_| 0.3 + draw()).collect(),
+        (0..degree / 2).map(|_| 0.3 + draw()).collect(),
+    ];
+    for half in &mut halves {
+        let total: f64 = half.iter().sum();
+        half.iter_mut().for_each(|x| *x *= std::f64::consts::PI / total);
+    }
+    let sectors: Vec<f64> = (0..degree).map(|k| halves[k % 2][k / 2]).collect();
+    let (mut creases, mut after): (Vec<usize>, Vec<f64>) = ((0..degree).collect(), sectors.clone());
+    let mut sign = vec![0.0; degree];
+    let mut turn = if draw() < 0.5 { 1.0 } else { -1.0 };
+    while creases.len() > 2 {
+        let m = creases.len();
+        let k = (0..m)
+            .min_by(|&a, &b| after[a].total_cmp(&after[b]))
+            .expect("creases left");
+        let (previous, next) = ((k + m - 1) % m, (k + 1) % m);
+        sign[creases[k]] = turn;
+        sign[creases[next]] = -turn;
+        turn = -turn;
+        after[previous] += after[next] - after[k];
+        let keep = |i: &usize| *i != k && *i != next;
+        creases = (0..m).filter(keep).map(|i| creases[i]).collect();
+        after = (0..m).filter(keep).map(|i| after[i]).collect();
+    }
+    let last = if draw() < 0.5 { 1.0 } else { -1.0 };
+    sign[creases[0]] = last;
+    sign[creases[1]] = last;
+    Ok((sectors, sign.iter().map(|s| s * std::f64::consts::PI).collect()))
 }

@@ -22,6 +22,9 @@ pub enum StepKind {
     NewtonFinish,
     /// A state on an open chain's straight path to flat.
     OpenChainPath,
+    /// A state of the rigid folding path from flat onto the folded state, reversed (where
+    /// the descent stopped short of flat).
+    FoldingPath,
 }
 
 /// The state after a step.
