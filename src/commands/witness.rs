@@ -85,7 +85,11 @@ pub(crate) fn unfold_by_folding_path(
             } else {
                 StepKind::FoldingPath
             },
-            energy: energy.value(&nodes, &model.arcs, &mut workspace),
+            // The folded state itself has touching charges (infinite energy): its energy is
+            // the backed-off start's, as the descent reports it.
+            energy: Some(energy.value(&nodes, &model.arcs, &mut workspace))
+                .filter(|u| u.is_finite())
+                .unwrap_or(energy_run.energy_initial),
             fold_angles: model.crease_angles(&nodes),
             max_arc_residual: arc_residual,
             direction_norm,
