@@ -1850,3 +1850,41 @@ fn a_targets_drive_folds_a_miura_ori_onto_its_rigid_state_or_stops_nearest() {
         assert!(error.contains(field), "{error}");
     }
 }
+
+/// `drive_to_targets` with named creases, or asked of a flat sheet that gives no targets, is
+/// refused by name, before any folding.
+#[test]
+fn drive_to_targets_is_refused_by_name_where_it_cannot_apply() {
+    use nanofold::commands::{fold_run, FoldOptions, Pattern};
+    let folded = miura(3, 4, 65.0, 110.0);
+    let pattern = Pattern::from_crease_pattern(folded.pattern.clone()).unwrap();
+    let edge = folded.pattern.creases[0];
+    let both = FoldOptions {
+        drive: [(edge, 10.0_f64.copysign(folded.given_fold_angles()[0]))]
+            .into_iter()
+            .collect(),
+        drive_to_targets: Some(true),
+        ..FoldOptions::default()
+    };
+    let Err(error) = fold_run(&pattern, &both) else {
+        panic!("named creases and targets together were accepted")
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("drive_to_targets") && error.contains("not both"),
+        "{error}"
+    );
+    let flat = Pattern::from_crease_pattern(miura(3, 4, 65.0, 0.0).pattern.clone()).unwrap();
+    let none = FoldOptions {
+        drive_to_targets: Some(true),
+        ..FoldOptions::default()
+    };
+    let Err(error) = fold_run(&flat, &none) else {
+        panic!("targets asked of a flat sheet without any were accepted")
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("drive_to_targets") && error.contains("no target angles"),
+        "{error}"
+    );
+}

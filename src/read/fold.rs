@@ -636,30 +636,22 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
             None => return read_folded_form(graph, kinds, name),
         }
     }
-    let mut fold_angles = crease_angles(&graph, &kinds)?;
+    let fold_angles = crease_angles(&graph, &kinds)?;
     if let Some(planarity) = reading {
         // The sheet is the state (flat); its angles can only be targets.
-        let targets = std::mem::replace(&mut fold_angles, vec![0.0; graph.edges.len()]);
-        let any_target = targets.iter().any(|a| *a != 0.0);
-        return Ok(CreasePatternBuilder {
-            name: name.to_string(),
-            vertices: graph.coords,
-            edges: graph.edges,
+        return Ok(flat_sheet(
+            graph,
+            None,
             kinds,
             fold_angles,
-            faces: None,
-            angle_field: graph.angle_key.to_string(),
-            folded_form: None,
-            locked: graph.locked,
-            unit: graph.unit,
+            name,
             source_magnitude,
-        }
-        .with_reading(
-            format!(
+            |targets| {
+                format!(
                 "a 3D sheet flat within its noise (every vertex within {planarity:.1e} of the sheet's size of one plane; tolerance {FLAT_NOISE:.0e}): read as the flat crease pattern with its assignment{}",
-                if any_target { format!(", its {} read as targets", graph.angle_key) } else { String::new() }
-            ),
-            any_target.then_some(targets),
+                targets.map_or(String::new(), |t| format!(", {t}"))
+            )
+            },
         ));
     }
     Ok(CreasePatternBuilder {
@@ -676,6 +668,38 @@ pub(crate) fn read_crease_pattern(value: &Value, name: &str) -> Result<ReadBuild
         source_magnitude,
     }
     .into())
+}
+
+/// A 3D sheet read as its flat crease pattern (at `vertices`, or the graph's own flat
+/// coordinates): every fold angle 0, the file's angles kept as targets where any is not 0,
+/// and `reading` saying so (given "its … read as targets" when there are targets).
+fn flat_sheet(
+    graph: FoldGraph<'_>,
+    vertices: Option<Vec<[f64; 2]>>,
+    kinds: Vec<EdgeKind>,
+    targets: Vec<f64>,
+    name: &str,
+    source_magnitude: f64,
+    reading: impl FnOnce(Option<&str>) -> String,
+) -> ReadBuilder {
+    let any_target = targets.iter().any(|a| *a != 0.0);
+    let targets_note = format!("its {} read as targets", graph.angle_key);
+    let note = reading(any_target.then_some(targets_note.as_str()));
+    let edge_count = graph.edges.len();
+    CreasePatternBuilder {
+        name: name.to_string(),
+        vertices: vertices.unwrap_or(graph.coords),
+        edges: graph.edges,
+        kinds,
+        fold_angles: vec![0.0; edge_count],
+        faces: None,
+        angle_field: graph.angle_key.to_string(),
+        folded_form: None,
+        locked: graph.locked,
+        unit: graph.unit,
+        source_magnitude,
+    }
+    .with_reading(note, any_target.then_some(targets))
 }
 
 /// The file's angle of each edge, rad: a crease's as given (required when the file gives
@@ -814,27 +838,19 @@ fn read_folded_form(graph: FoldGraph<'_>, kinds: Vec<EdgeKind>, name: &str) -> R
     let bend = development.fold_angles.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
     if bend <= FLAT_DIHEDRAL_NOISE {
         let targets = crease_angles(&graph, &kinds)?;
-        let any_target = targets.iter().any(|a| *a != 0.0);
-        let edge_count = graph.edges.len();
-        return Ok(CreasePatternBuilder {
-            name: name.to_string(),
-            vertices: development.vertices,
-            edges: graph.edges,
+        return Ok(flat_sheet(
+            graph,
+            Some(development.vertices),
             kinds,
-            fold_angles: vec![0.0; edge_count],
-            faces: None,
-            angle_field: graph.angle_key.to_string(),
-            folded_form: None,
-            locked: graph.locked,
-            unit: graph.unit,
+            targets,
+            name,
             source_magnitude,
-        }
-        .with_reading(
-            format!(
+            |targets| {
+                format!(
                 "a 3D sheet whose every dihedral angle lies within {FLAT_DIHEDRAL_NOISE:.0e} rad of flat (largest {bend:.2e} rad, creases and facets): read as the flat crease pattern developed from its faces, with its assignment, moved to flat by at most {bend:.2e} rad{}",
-                if any_target { format!("; its {} read as targets", graph.angle_key) } else { String::new() }
-            ),
-            any_target.then_some(targets),
+                targets.map_or(String::new(), |t| format!("; {t}"))
+            )
+            },
         ));
     }
     // Faces listed clockwise give a mirrored development with every angle's sign flipped:
