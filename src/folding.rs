@@ -19,7 +19,9 @@ pub use second_order::{cone_range, quadratic_form, second_order, SecondOrder};
 
 pub use closure::{closure_jacobian, closure_residual, vertex_residuals, worst_of, ClosureJacobian};
 pub use contact::{panel_contacts, ContactReport, ContactSettings, PanelContact};
-pub use frames::{fold_path_and_frames, path_frames, path_frames_on, PathFrame, FRAME_CLOSURE, MAX_FRAME_THREADS};
+pub use frames::{
+    fold_path_and_frames, path_frames, path_frames_on, PathFrame, FRAME_CLOSURE, MAX_FRAME_POINTS, MAX_FRAME_THREADS,
+};
 pub use model::{FoldingModel, Star, TreeStep};
 pub use path::{
     damped_projection, fold_path, project_to_rigid, restore_closure, Drive, FoldPath, FoldSettings, PathStep,

@@ -684,6 +684,39 @@ fn constraints_of_a_folded_crease_pattern_fit_every_crease_against_the_driver() 
         .unwrap();
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("folded state"));
     assert!(!dir.join("flat").exists());
+    // Each sweep point closes every vertex anew: a large sheet is swept at fewer samples,
+    // the most it allows named (samples × creases ≤ 5 × 10⁶), before any work.
+    let large = dir.join("miura_120.fold");
+    let made = nanofold()
+        .args([
+            "generate",
+            "miura",
+            "--rows",
+            "120",
+            "--cols",
+            "120",
+            "--fold-deg",
+            "90",
+            "--out",
+        ])
+        .arg(&large)
+        .output()
+        .unwrap();
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    let out = nanofold()
+        .args(["constraints", "--drive", "120", "--out"])
+        .arg(dir.join("large"))
+        .arg(&large)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && err.contains("--samples 201")
+            && err.contains("28560 creases is swept at 175 samples at most"),
+        "{err}"
+    );
+    assert!(!dir.join("large").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -1331,8 +1364,14 @@ fn many_vertex_settings_and_inputs_at_their_edges() {
     // Generators: the edge count is the pattern's own; a length far below the tolerances is
     // refused by its range.
     let miura = dir.join("miura.fold").display().to_string();
-    let (ok, stdout, err) = run(&["generate", "miura", "--rows", "258", "--cols", "258", "--out", &miura]);
-    assert!(ok && stdout.contains("132612 creases"), "{stdout}{err}");
+    let (ok, stdout, err) = run(&["generate", "miura", "--rows", "174", "--cols", "174", "--out", &miura]);
+    assert!(ok && stdout.contains("60204 creases"), "{stdout}{err}");
+    // One more row and column passes the interior vertices' limit, refused by name.
+    let (ok, _, err) = run(&["generate", "miura", "--rows", "175", "--cols", "175", "--out", &miura]);
+    assert!(
+        !ok && err.contains("--rows, --cols") && err.contains("30276 interior vertices"),
+        "{err}"
+    );
     let (ok, _, err) = run(&["generate", "bird-base", "--half-side", "1e-300", "--out", &miura]);
     assert!(!ok && err.contains("half_side") && err.contains("[1e-6, 1e6]"), "{err}");
     // A vertex that no edge uses (a stray point, valid FOLD): left out and said so; the

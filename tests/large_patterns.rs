@@ -251,3 +251,66 @@ fn a_long_folded_strip_is_checked_within_a_bounded_address_space() {
     assert_eq!(line["verdict"], "rigid", "{line}");
     assert_eq!(line["unfold"]["verdict"], "flat", "{line}");
 }
+
+/// Passing the contact budget is located by bisection towards the state that passed it, to
+/// 1e-2 rad: every trial near it measures millions of pairs on a long sheet. Crept up on
+/// to 1e-6 rad by halving and regrowing the step, a strip of 100 000 vertices took 30
+/// steps and 61 contact tests (13 s); a strip of 2 000 took 28 steps.
+#[test]
+fn the_contact_budget_is_located_in_few_contact_tests() {
+    let report = check_text(&triangle_strip(999, 0.0).to_string());
+    assert_eq!(report.verdict, PatternVerdict::RigidlyFoldable, "{}", report.evidence);
+    let path = witness(&report);
+    assert!(
+        matches!(path.stop, nanofold::folding::StopReason::ContactBudget { .. }),
+        "{}",
+        path.evidence
+    );
+    assert!(path.steps.last().unwrap().progress > 0.99, "{}", path.evidence);
+    assert!(path.evidence.contains("located to 1e-2 rad"), "{}", path.evidence);
+    assert!(
+        path.contact_tests <= 24 && path.steps.len() <= 22,
+        "{} contact tests, {} steps",
+        path.contact_tests,
+        path.steps.len()
+    );
+}
+
+/// A fold's animation holds every frame in memory and on its 3D page: frames × vertices is
+/// bounded (4 × 10⁶) before anything is folded, and the error names the most this pattern
+/// gets. 2 000 frames of a strip of 100 000 vertices ran out of a 4 GiB address space.
+#[test]
+fn more_frames_than_a_large_pattern_allows_are_refused_by_name() {
+    use nanofold::commands::{fold_run, FoldOptions};
+    let text = triangle_strip(2_499, 0.0).to_string();
+    let pattern = Pattern::parse(&text, "strip", "strip", &LoadOptions::default()).unwrap();
+    let options = |frames| FoldOptions {
+        frames,
+        to: 1.0,
+        ..FoldOptions::default()
+    };
+    let error = fold_run(&pattern, &options(801)).unwrap_err().to_string();
+    assert!(
+        error.contains("frames") && error.contains("801") && error.contains("at most 800 frames"),
+        "{error}"
+    );
+    let run = fold_run(&pattern, &options(800)).unwrap();
+    assert_eq!(run.frames.len(), 800);
+}
+
+/// Every folding step factorises the closure system of the interior vertices, whose fill
+/// grows faster than their number: past 30 000 of them a pattern is refused by name, before
+/// anything is folded (README's Limits table). A strip of 100 000 vertices has none.
+#[test]
+fn more_interior_vertices_than_the_limit_are_refused_by_name() {
+    let text = grid(174, None);
+    let pattern = Pattern::parse(&text, "grid", "grid", &LoadOptions::default()).unwrap();
+    assert_eq!(pattern.sheet().unwrap().stars.len(), 173 * 173);
+    let error = Pattern::parse(&grid(175, None), "grid", "grid", &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("vertices_coords") && error.contains("30276 interior vertices"),
+        "{error}"
+    );
+}

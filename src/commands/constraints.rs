@@ -13,6 +13,10 @@ use crate::folding::FoldingModel;
 use crate::names::Named;
 use serde_json::Value;
 
+/// Most sweep samples × creases of a crease pattern of many vertices (a 174 × 174
+/// Miura-ori's 60 204 creases: 83 samples; timings in `docs/guide/limits.md`).
+pub const MAX_SWEEP_WORK: usize = 5_000_000;
+
 /// How the curves' degree is chosen.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Degree {
@@ -360,6 +364,19 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
         let (a, b) = (0.05 * rho[driver], rho[driver]);
         [a.min(b), a.max(b)]
     });
+    // Each of the sweep's points closes every vertex anew (a factorisation of the closure
+    // system at least): their cost grows with the creases.
+    let creases = model.crease_count();
+    let most = (MAX_SWEEP_WORK / creases.max(1)).max(2);
+    if settings.samples > most {
+        return Err(NanofoldError::invalid(
+            "samples",
+            settings.samples,
+            format!(
+                "a pattern of {creases} creases is swept at {most} samples at most (samples × creases ≤ {MAX_SWEEP_WORK}, so that the sweep answers within 10 s)"
+            ),
+        ));
+    }
     // The sweep's points are fitted and the midpoints between them checked.
     let sweep = network_sweep(&model, &rho, driver, domain, settings.samples.div_ceil(2).max(2))?;
     let curves = match settings.degree {

@@ -264,6 +264,18 @@ impl FoldOptions {
                 format!("must lie in [2, {MAX_FRAMES}]"),
             ));
         }
+        let vertices = model.pattern.vertices.len().max(1);
+        let most = crate::folding::MAX_FRAME_POINTS / vertices;
+        if self.frames > most {
+            return Err(NanofoldError::invalid(
+                "frames",
+                self.frames,
+                format!(
+                    "a pattern of {vertices} vertices gets at most {most} frames (frames × vertices ≤ {}: the 3D page shows them all)",
+                    crate::folding::MAX_FRAME_POINTS
+                ),
+            ));
+        }
         let settings = FoldSettings {
             drive,
             max_step: self.max_step.to_radians(),

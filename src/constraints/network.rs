@@ -120,6 +120,62 @@ fn restore_held(
     .into())
 }
 
+/// A factorisation of the held Jacobian (the driver's column zeroed) that chord steps reuse.
+struct HeldFactor {
+    jacobian: crate::folding::ClosureJacobian,
+    factor: crate::folding::normal::NormalFactor,
+}
+
+/// [`restore_held`] by chord steps: `held`'s factorisation (from a state nearby on the
+/// sweep) serves while each step cuts the residual tenfold; where one does not, a fresh one
+/// is made and kept for the next states. Neighbouring sweep points are a fraction of a
+/// degree apart, so most states need no factorisation of their own.
+fn restore_held_chord(
+    model: &FoldingModel,
+    fold_angles: &mut [f64],
+    driver: usize,
+    solver: &mut NormalSolver,
+    held: &mut Option<HeldFactor>,
+) -> Result<f64> {
+    let mut residual = Vec::with_capacity(3 * model.stars.len());
+    let mut step = vec![0.0; fold_angles.len()];
+    let mut previous = f64::INFINITY;
+    let mut fresh = false;
+    for _ in 0..40 {
+        crate::folding::closure_residual(model, fold_angles, &mut residual);
+        let worst = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        if !worst.is_finite() {
+            break;
+        }
+        // Chord steps converge linearly: a tenth of Newton's tolerance leaves the sweep's
+        // states as closed as Newton's quadratic last step did.
+        if worst <= 0.1 * SWEEP_TOL {
+            return Ok(worst);
+        }
+        if held.is_none() || (worst > 0.1 * previous && !fresh) {
+            let mut jacobian = closure_jacobian(model, fold_angles);
+            for entry in jacobian.entries.iter_mut().filter(|e| e.1 == driver) {
+                entry.2 = 0.0;
+            }
+            let factor = solver.factor(&jacobian)?;
+            *held = Some(HeldFactor { jacobian, factor });
+            fresh = true;
+        } else if worst > 0.5 * previous {
+            // Even a fresh factorisation does not converge here.
+            break;
+        }
+        previous = worst;
+        let chord = held.as_ref().expect("set above");
+        chord.jacobian.apply_transpose(&residual, &mut step);
+        chord.factor.solve(&mut step);
+        for (rho, d) in fold_angles.iter_mut().zip(&step) {
+            *rho -= d;
+        }
+    }
+    // Newton's own steps, from where the chord steps stopped.
+    restore_held(model, fold_angles, driver, solver)
+}
+
 /// d(fold angles)/d(driver) at a state: the null vector of J scaled to move the driver at
 /// unit rate.
 fn tangent(model: &FoldingModel, fold_angles: &[f64], driver: usize, solver: &mut NormalSolver) -> Result<Vec<f64>> {
@@ -225,8 +281,11 @@ pub fn network_sweep(
         .map(|(k, _)| k)
         .expect("at least three points");
     let mut max_residual: f64 = 0.0;
+    let mut held = None;
     for direction in [1_i64, -1] {
         let mut state = rho.clone();
+        // The state before, for the secant predictor (the tangent's first, where none).
+        let mut before: Option<Vec<f64>> = None;
         let mut k = nearest as i64;
         while (0..points as i64).contains(&k) {
             let target = grid[k as usize];
@@ -238,14 +297,28 @@ pub fn network_sweep(
                 } else {
                     state[driver] + gap / substeps as f64
                 };
-                let t = tangent(model, &state, driver, &mut solver)?;
                 let step = aim - state[driver];
-                for (x, dx) in state.iter_mut().zip(&t) {
-                    *x += step * dx;
+                if step == 0.0 {
+                    continue;
+                }
+                let secant = before
+                    .as_ref()
+                    .filter(|b| (state[driver] - b[driver]).abs() > 1e-12)
+                    .map(|b| (b, step / (state[driver] - b[driver])));
+                let direction: Vec<f64> = match secant {
+                    Some((b, scale)) => state.iter().zip(b.iter()).map(|(s, b)| (s - b) * scale).collect(),
+                    None => tangent(model, &state, driver, &mut solver)?
+                        .iter()
+                        .map(|t| t * step)
+                        .collect(),
+                };
+                before = Some(state.clone());
+                for (x, dx) in state.iter_mut().zip(&direction) {
+                    *x += dx;
                 }
                 // The driver is held exactly at its grid value (Newton leaves it alone).
                 state[driver] = aim;
-                max_residual = max_residual.max(restore_held(model, &mut state, driver, &mut solver)?);
+                max_residual = max_residual.max(restore_held_chord(model, &mut state, driver, &mut solver, &mut held)?);
             }
             states[k as usize] = state.clone();
             k += direction;

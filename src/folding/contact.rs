@@ -163,45 +163,116 @@ pub fn panel_contacts(model: &FoldingModel, poses: &[Pose], settings: &ContactSe
             return report;
         }
     };
-    for (a, b) in pairs {
-        report.pairs_measured += 1;
-        let mut distance = f64::INFINITY;
-        let mut crossing = false;
-        // Triangles farther apart than this cannot be a contact nor lower the smallest
-        // clearance found so far (nor matter beyond the search range): a lower bound of
-        // their distance (their boxes' gap, or how far one lies on one side of the other's
-        // plane) stands in for it.
-        let relevant = search.min(report.min_clearance.unwrap_or(f64::INFINITY)).max(clearance);
-        for i in first[a]..first[a + 1] {
-            for j in first[b]..first[b + 1] {
-                let (s_box, t_box) = (&triangle_boxes[i], &triangle_boxes[j]);
-                let gap = (0..3)
-                    .map(|k| (s_box.0[k] - t_box.1[k]).max(t_box.0[k] - s_box.1[k]))
-                    .fold(0.0_f64, f64::max);
-                let bound = gap
-                    .max(plane_gap(&triangles[i], planes[j]))
-                    .max(plane_gap(&triangles[j], planes[i]));
-                if bound > relevant {
-                    distance = distance.min(bound);
-                    continue;
-                }
-                let normal = |k: usize| planes[k].map(|(n, _)| n);
-                let (d, c) = triangle_distance_with(&triangles[i], &triangles[j], normal(i), normal(j), depth);
-                distance = distance.min(d);
-                crossing |= c;
-            }
-        }
-        report.min_clearance = Some(report.min_clearance.map_or(distance, |m: f64| m.min(distance)));
-        if crossing || distance <= clearance {
-            report.contacts.push(PanelContact {
-                panels: [a.min(b), a.max(b)],
-                distance,
-                crossing,
-            });
-        }
+    let placed = Placed {
+        first: &first,
+        triangles: &triangles,
+        boxes: &triangle_boxes,
+        planes: &planes,
+        search,
+        clearance,
+        depth,
+    };
+    report.pairs_measured = pairs.len();
+    // The pairs are independent: large tests (stacked layers) are shared among the cores.
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let chunks = cores.min(pairs.len() / PAIRS_PER_THREAD).max(1);
+    let measured: Vec<Measured> = if chunks == 1 {
+        vec![placed.measure(&pairs)]
+    } else {
+        let size = pairs.len().div_ceil(chunks);
+        std::thread::scope(|scope| {
+            let placed = &placed;
+            let handles: Vec<_> = pairs
+                .chunks(size)
+                .map(|chunk| scope.spawn(move || placed.measure(chunk)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+                .collect()
+        })
+    };
+    for part in measured {
+        report.contacts.extend(part.contacts);
+        report.min_clearance = match (report.min_clearance, part.min_clearance) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
     }
     report.contacts.sort_by_key(|c| c.panels);
     report
+}
+
+/// Pairs below which a contact test's narrow phase stays on one thread.
+const PAIRS_PER_THREAD: usize = 50_000;
+
+/// The panels' triangles as one state places them, with what the narrow phase needs.
+struct Placed<'a> {
+    /// A panel's run of triangles starts at `first[p]`.
+    first: &'a [usize],
+    triangles: &'a [[Point; 3]],
+    boxes: &'a [([f64; 3], [f64; 3])],
+    planes: &'a [Option<(Point, f64)>],
+    search: f64,
+    clearance: f64,
+    depth: f64,
+}
+
+/// The narrow phase's findings over some pairs.
+struct Measured {
+    contacts: Vec<PanelContact>,
+    min_clearance: Option<f64>,
+}
+
+impl Placed<'_> {
+    /// The exact distance (or a lower bound above what matters) of every pair.
+    fn measure(&self, pairs: &[(usize, usize)]) -> Measured {
+        let (first, triangles, planes) = (self.first, self.triangles, self.planes);
+        let mut found = Measured {
+            contacts: Vec::new(),
+            min_clearance: None,
+        };
+        for &(a, b) in pairs {
+            let mut distance = f64::INFINITY;
+            let mut crossing = false;
+            // Triangles farther apart than this cannot be a contact nor lower the smallest
+            // clearance found so far (nor matter beyond the search range): a lower bound of
+            // their distance (their boxes' gap, or how far one lies on one side of the
+            // other's plane) stands in for it.
+            let relevant = self
+                .search
+                .min(found.min_clearance.unwrap_or(f64::INFINITY))
+                .max(self.clearance);
+            for i in first[a]..first[a + 1] {
+                for j in first[b]..first[b + 1] {
+                    let (s_box, t_box) = (&self.boxes[i], &self.boxes[j]);
+                    let gap = (0..3)
+                        .map(|k| (s_box.0[k] - t_box.1[k]).max(t_box.0[k] - s_box.1[k]))
+                        .fold(0.0_f64, f64::max);
+                    let bound = gap
+                        .max(plane_gap(&triangles[i], planes[j]))
+                        .max(plane_gap(&triangles[j], planes[i]));
+                    if bound > relevant {
+                        distance = distance.min(bound);
+                        continue;
+                    }
+                    let normal = |k: usize| planes[k].map(|(n, _)| n);
+                    let (d, c) = triangle_distance_with(&triangles[i], &triangles[j], normal(i), normal(j), self.depth);
+                    distance = distance.min(d);
+                    crossing |= c;
+                }
+            }
+            found.min_clearance = Some(found.min_clearance.map_or(distance, |m| m.min(distance)));
+            if crossing || distance <= self.clearance {
+                found.contacts.push(PanelContact {
+                    panels: [a.min(b), a.max(b)],
+                    distance,
+                    crossing,
+                });
+            }
+        }
+        found
+    }
 }
 
 /// The largest distance between two placements of one vertex by the panels that hold it:

@@ -270,6 +270,9 @@ pub struct FoldPath {
     /// Numeric factorisations of JᵀJ + μI over the whole path: Newton's fresh steps and the
     /// tangents not served by the corrector's last one.
     pub factorisations: usize,
+    /// Contact tests over the whole path (one per trial state the corrector closed, and the
+    /// start's): near stacked layers each measures millions of pairs.
+    pub contact_tests: usize,
     /// What drove it (frames placed on the path measure their progress by it).
     pub drive: Drive,
 }
@@ -333,9 +336,21 @@ const MAX_GROWTH: f64 = 2.0;
 /// Newton iterations past which the next step does not grow.
 const SLOW_CORRECTOR: usize = 6;
 
-/// How closely an event (a crease reaching flat against its assignment, panels crossing,
-/// the contact budget) is located: the last step before it is at most this long, rad.
+/// How closely an event (a crease reaching flat against its assignment, panels crossing)
+/// is located: the last step before it is at most this long, rad.
 pub const LOCATE: f64 = 1e-6;
+
+/// How closely the contact budget's passing is located, rad: it is a limit of the test, not
+/// an event of the folding, and each trial near it measures millions of pairs.
+pub const LOCATE_BUDGET: f64 = 1e-2;
+
+/// The step to which a trial's stop is located.
+fn located_to(reason: &StopReason) -> f64 {
+    match reason {
+        StopReason::ContactBudget { .. } => LOCATE_BUDGET,
+        _ => LOCATE,
+    }
+}
 
 /// The residual cut per step for which a corrector (a path's, a frame's polish) reuses its
 /// factorisation (chord steps); a step that cuts less is followed by a fresh one.
@@ -543,6 +558,15 @@ struct Walk<'a> {
     /// serves. With more, the path follows the projected drive, which the tangent
     /// predictor and least-norm corrector define; they are kept as they are.
     one_dof: Option<bool>,
+    /// The nearest the goal a landing on it failed from (1 − progress): the goal is then
+    /// singular (a flat-folded state), and landing is tried again only from ten times
+    /// nearer, each failure costing a dozen factorisations.
+    landing_failed: Option<f64>,
+    /// A state further along whose contact test passed the budget, and the pairs it
+    /// counted: the next steps bisect towards it until it is within [`LOCATE_BUDGET`].
+    budget_passed: Option<(Vec<f64>, usize)>,
+    /// Contact tests run (counted where the walk is borrowed, beside the tangent).
+    contact_tests: std::cell::Cell<usize>,
 }
 
 /// A tangent scaled to a largest component of 1, or the size of the projected velocity
@@ -561,7 +585,7 @@ enum Trial {
     /// The next state, its smallest clearance, its corrector's record and (where it was
     /// projected beside the contact test) the tangent there.
     Accepted(Vec<f64>, Option<f64>, Correction, Option<(Tangent, Option<bool>)>),
-    /// An event located to within [`LOCATE`].
+    /// An event located to within [`located_to`] its kind.
     Event(Stop),
     /// Newton found no rigid state, even with the shortest step.
     Lost,
@@ -589,6 +613,9 @@ impl<'a> Walk<'a> {
             curved: true,
             next_tangent: None,
             one_dof: None,
+            landing_failed: None,
+            budget_passed: None,
+            contact_tests: std::cell::Cell::new(0),
         };
         let mut residual = Vec::with_capacity(3 * model.stars.len());
         closure_residual(model, &walk.rho, &mut residual);
@@ -617,6 +644,7 @@ impl<'a> Walk<'a> {
     }
 
     fn contacts(&mut self, rho: &[f64]) -> ContactReport {
+        self.contact_tests.set(self.contact_tests.get() + 1);
         panel_poses(self.model, rho, &mut self.poses);
         panel_contacts(self.model, &self.poses, &self.settings.contact)
     }
@@ -820,6 +848,9 @@ impl<'a> Walk<'a> {
             }
             self.h = self.h.min(nearest);
         }
+        if let Some(stop) = self.bisect_budget(here) {
+            return Ok(Some(stop));
+        }
         let bend = if self.curved && self.one_dof == Some(true) {
             self.bend(&tangent)
         } else {
@@ -832,10 +863,11 @@ impl<'a> Walk<'a> {
             }
             Trial::Event(stop) if matches!(stop.reason, StopReason::Nearest { .. }) => return Ok(Some(stop)),
             Trial::Event(stop) => {
+                let within = located_to(&stop.reason);
                 return Ok(Some(Stop::new(
                     stop.reason,
-                    format!("{} (located to {LOCATE:.0e} rad)", stop.evidence),
-                )))
+                    format!("{} (located to {within:.0e} rad)", stop.evidence),
+                )));
             }
             Trial::Lost => {
                 let mut creases: Vec<usize> = (0..tangent.len()).collect();
@@ -888,6 +920,32 @@ impl<'a> Walk<'a> {
         }
         self.record(self.rho.clone(), correction.residual, min_clearance);
         Ok(None)
+    }
+
+    /// Where a state further along passed the contact budget: the stop, if that state is
+    /// within [`LOCATE_BUDGET`] of this one; else the step is capped at half the way there.
+    fn bisect_budget(&mut self, here: f64) -> Option<Stop> {
+        let (passed, pairs) = self.budget_passed.as_ref()?;
+        let bracket = passed
+            .iter()
+            .zip(&self.rho)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        if bracket <= LOCATE_BUDGET {
+            return Some(Stop::new(
+                StopReason::ContactBudget { pairs: *pairs },
+                format!(
+                    "{} (located to {LOCATE_BUDGET:.0e} rad)",
+                    over_budget(pairs + 1, &format!("after progress {here:.6}"))
+                ),
+            ));
+        }
+        self.h = self.h.min(bracket / 2.0);
+        None
+    }
+
+    fn landing_failed(&mut self, here: f64) {
+        let distance = 1.0 - here;
+        self.landing_failed = Some(self.landing_failed.map_or(distance, |d| d.min(distance)));
     }
 
     /// Predictor: the desired velocity projected onto the tangent space, scaled to a largest
@@ -987,12 +1045,12 @@ impl<'a> Walk<'a> {
 
     /// Corrector: Newton onto every closure. A trial that fails, overshoots the goal, or
     /// meets an event (a crease against its assignment, panels crossing, the contact budget)
-    /// is retried shorter; an event is located to within LOCATE rad.
+    /// is retried shorter; an event is located to within [`located_to`] its kind.
     fn trials(&mut self, tangent: &[f64], bend: Option<&(Vec<f64>, Vec<f64>)>, here: f64) -> Result<Trial> {
         let (model, settings) = (self.model, self.settings);
         // Landing on the goal is tried until a landed state meets an event: at a singular
         // goal (a flat-folded state) holding one crease there can push another past it.
-        let mut may_land = true;
+        let mut may_land = self.landing_failed.is_none_or(|failed| 1.0 - here <= failed / 10.0);
         for _ in 0..80 {
             let h = self.h;
             let mut trial: Vec<f64> = self.rho.iter().zip(tangent).map(|(r, x)| r + h * x).collect();
@@ -1017,6 +1075,10 @@ impl<'a> Walk<'a> {
                     settings.closure_tol,
                     &mut self.solver,
                 )?;
+                if goal.is_none() {
+                    self.landing_failed(here);
+                    may_land = false;
+                }
                 early = goal.map(|landing| (state, landing));
             }
             let landed_early = early.is_some();
@@ -1078,6 +1140,9 @@ impl<'a> Walk<'a> {
                     correction.factor = None;
                     ahead = self.progress_of(&trial);
                     landed = true;
+                } else {
+                    self.landing_failed(here);
+                    may_land = false;
                 }
             }
             // Overshoot: aim at the goal by the secant on progress.
@@ -1096,13 +1161,16 @@ impl<'a> Walk<'a> {
                 Ok(min_clearance) => return Ok(Trial::Accepted(trial, min_clearance, correction, tangent)),
                 Err(found) => found,
             };
+            if let StopReason::ContactBudget { pairs } = found.reason {
+                self.budget_passed = Some((trial, pairs));
+            }
             if landed {
                 // The event is the landing's: approach the goal from before it instead.
                 may_land = false;
                 self.h *= secant;
                 continue;
             }
-            if self.h <= LOCATE {
+            if self.h <= located_to(&found.reason) {
                 return Ok(Trial::Event(found));
             }
             self.h /= 2.0;
@@ -1137,6 +1205,7 @@ impl<'a> Walk<'a> {
     /// The contact test of `trial` on a second thread, and the tangent there on this one.
     fn contacts_and_tangent(&self, trial: &[f64], factored: &Factored) -> (ContactReport, (Tangent, Option<bool>)) {
         let (model, contact) = (self.model, &self.settings.contact);
+        self.contact_tests.set(self.contact_tests.get() + 1);
         std::thread::scope(|scope| {
             let test = scope.spawn(move || {
                 let mut poses = Vec::new();
@@ -1163,6 +1232,7 @@ impl<'a> Walk<'a> {
             min_panel_clearance,
             newton_iterations: self.newton_iterations,
             factorisations: self.solver.factorisations(),
+            contact_tests: self.contact_tests.get(),
             drive: self.settings.drive.clone(),
         };
         (path, self.solver)
@@ -1340,7 +1410,11 @@ fn correct(
                 factor: factored,
             }));
         }
-        if iteration > 3 && worst > 0.5 * previous {
+        // A landing (a crease held at its goal) that does not converge fast is at a
+        // singular goal (a flat-folded state): it gives up early, the walk then
+        // approaching the goal by the secant instead.
+        let patience = if held.is_some() { 1 } else { 3 };
+        if iteration > patience && worst > 0.5 * previous {
             return Ok(None);
         }
         let chord = chord_steps && factored.is_some() && worst <= CHORD_CONTRACTION * previous;

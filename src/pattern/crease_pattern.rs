@@ -11,6 +11,13 @@ use std::f64::consts::TAU;
 /// Most edges a crease pattern may have (a 100 × 100 Miura-ori has about 20 000 creases).
 pub const MAX_EDGES: usize = 200_000;
 
+/// Most interior vertices with creases (each a loop that must close) a crease pattern may
+/// have: a 174 × 174 Miura-ori has 29 929. Every folding step factorises a system of their
+/// closures, whose fill grows faster than their number; past this, folding and unfolding
+/// take more than 10 s on 2 cores (`docs/guide/limits.md`). A strip or accordion of
+/// 100 000 vertices has none.
+pub const MAX_INTERIOR_VERTICES: usize = 30_000;
+
 /// What an edge of the paper is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EdgeKind {
@@ -359,6 +366,15 @@ impl CreasePatternBuilder {
                 creases: around.iter().map(|&(e, _)| e).collect(),
                 sector_angles,
             });
+        }
+        if stars.len() > MAX_INTERIOR_VERTICES {
+            return Err(NanofoldError::invalid(
+                "vertices_coords",
+                format!("{} interior vertices where creases meet", stars.len()),
+                format!(
+                    "a crease pattern has at most {MAX_INTERIOR_VERTICES} (a 174 × 174 Miura-ori); more would take longer than 10 s to fold or unfold"
+                ),
+            ));
         }
         let length_precision = 16.0 * f64::EPSILON * largest_coordinate;
         let angle_precision = angle_precision(length_precision, &vertices, &edges);
@@ -785,7 +801,11 @@ fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<Vec<u
             format!("the edges enclose {} faces", faces.len()),
         ));
     }
-    if let Some(i) = (0..given.len()).find(|&i| !file_face.contains(&i)) {
+    let mut listed = vec![false; given.len()];
+    for &i in file_face.iter().filter(|&&i| i != usize::MAX) {
+        listed[i] = true;
+    }
+    if let Some(i) = listed.iter().position(|&seen| !seen) {
         return Err(NanofoldError::invalid(
             format!("faces_vertices[{i}]"),
             format!("{:?}", given[i]),

@@ -1,7 +1,7 @@
 //! Crease patterns built from parameters (`docs/model.md#pattern-generators`): Miura-ori
 //! with its folded state in closed form, and flat-foldable single vertices folded flat.
 
-use super::crease_pattern::{CreasePatternBuilder, EdgeKind, MAX_EDGES};
+use super::crease_pattern::{CreasePatternBuilder, EdgeKind, MAX_EDGES, MAX_INTERIOR_VERTICES};
 
 /// The shortest length a generator takes: the crease-pattern reader's planarity tolerances
 /// are fixed fractions of 1, so patterns far smaller lose their faces to rounding.
@@ -52,6 +52,14 @@ impl MiuraSpec {
                 "rows, cols",
                 format!("{} × {} ({edges} edges)", self.rows, self.cols),
                 format!("at least 1 × 1, and at most {MAX_EDGES} edges ((rows + 1)·cols + rows·(cols + 1))"),
+            ));
+        }
+        let interior = (self.rows - 1).saturating_mul(self.cols - 1);
+        if interior > MAX_INTERIOR_VERTICES {
+            return Err(NanofoldError::invalid(
+                "rows, cols",
+                format!("{} × {} ({interior} interior vertices)", self.rows, self.cols),
+                format!("at most {MAX_INTERIOR_VERTICES} interior vertices ((rows − 1)·(cols − 1); 174 × 174 at most for a square sheet)"),
             ));
         }
         let gamma = self.sector_angle;
@@ -394,6 +402,14 @@ impl WaterbombSpec {
                 "rows, cols",
                 format!("{rows} × {cols}"),
                 format!("at least 1 × 1, and at most {MAX_EDGES} edges"),
+            ));
+        }
+        let interior = (rows - 1) * (2 * cols - 1);
+        if interior > MAX_INTERIOR_VERTICES {
+            return Err(NanofoldError::invalid(
+                "rows, cols",
+                format!("{rows} × {cols} ({interior} interior vertices)"),
+                format!("at most {MAX_INTERIOR_VERTICES} interior vertices ((rows − 1)·(2·cols − 1))"),
             ));
         }
         let height = self.row_height;

@@ -492,6 +492,8 @@ pub struct FoldSummary {
     pub newton_iterations: usize,
     /// Factorisations of the closure Jacobian.
     pub factorisations: usize,
+    /// Contact tests (one per trial state closed).
+    pub contact_tests: usize,
     /// How the file was read.
     pub reading: Vec<String>,
     /// The file's angles read as targets, per crease.
@@ -522,6 +524,7 @@ impl FoldSummary {
             min_panel_clearance: path.min_panel_clearance,
             newton_iterations: path.newton_iterations,
             factorisations: path.factorisations,
+            contact_tests: path.contact_tests,
             reading: model.pattern.reading.clone(),
             target_angles_rad: target_angles(model),
             seconds,
