@@ -296,6 +296,25 @@ fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &Constr
     })
 }
 
+/// A sweep of `samples` points over a crease pattern of many vertices, refused by name
+/// where samples × creases passes [`MAX_SWEEP_WORK`].
+fn within_sweep_work(model: &FoldingModel, samples: usize) -> Result<()> {
+    // Each of the sweep's points closes every vertex anew (a factorisation of the closure
+    // system at least): their cost grows with the creases.
+    let creases = model.crease_count();
+    let most = (MAX_SWEEP_WORK / creases.max(1)).max(2);
+    if samples > most {
+        return Err(NanofoldError::invalid(
+            "samples",
+            samples,
+            format!(
+                "a pattern of {creases} creases is swept at {most} samples at most (samples × creases ≤ {MAX_SWEEP_WORK}, so that the sweep answers within 10 s)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> Result<Constraints> {
     if !settings.checks.is_empty() {
         return Err(NanofoldError::invalid(
@@ -364,19 +383,7 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
         let (a, b) = (0.05 * rho[driver], rho[driver]);
         [a.min(b), a.max(b)]
     });
-    // Each of the sweep's points closes every vertex anew (a factorisation of the closure
-    // system at least): their cost grows with the creases.
-    let creases = model.crease_count();
-    let most = (MAX_SWEEP_WORK / creases.max(1)).max(2);
-    if settings.samples > most {
-        return Err(NanofoldError::invalid(
-            "samples",
-            settings.samples,
-            format!(
-                "a pattern of {creases} creases is swept at {most} samples at most (samples × creases ≤ {MAX_SWEEP_WORK}, so that the sweep answers within 10 s)"
-            ),
-        ));
-    }
+    within_sweep_work(&model, settings.samples)?;
     // The sweep's points are fitted and the midpoints between them checked.
     let sweep = network_sweep(&model, &rho, driver, domain, settings.samples.div_ceil(2).max(2))?;
     let curves = match settings.degree {

@@ -271,19 +271,43 @@ pub fn network_sweep(
     let grid: Vec<f64> = (0..points)
         .map(|k| a + (b - a) * k as f64 / (points - 1) as f64)
         .collect();
-    let mut states = vec![Vec::new(); points];
-    // Continue from the state to each end: predictor along the tangent, Newton with the
-    // driver held, in steps of at most SWEEP_STEP.
     let nearest = grid
         .iter()
         .enumerate()
         .min_by(|x, y| (x.1 - theta0).abs().total_cmp(&(y.1 - theta0).abs()))
         .map(|(k, _)| k)
         .expect("at least three points");
+    let (states, max_residual) = continue_over_grid(model, &rho, driver, &grid, nearest, &mut solver)?;
+    let max_closure_residual = states
+        .iter()
+        .map(|s| vertex_residuals(model, s).into_iter().fold(0.0, f64::max))
+        .fold(max_residual, f64::max);
+    Ok(NetworkSweep {
+        driver,
+        domain,
+        driver_values: grid,
+        states,
+        max_closure_residual,
+    })
+}
+
+/// The sweep's states at every grid value of the driver, continued from `start` (at the grid
+/// point `nearest`) to each end: a secant predictor (the tangent's first), then Newton with
+/// the driver held, in steps of at most `SWEEP_STEP`; and the largest residual left.
+fn continue_over_grid(
+    model: &FoldingModel,
+    start: &[f64],
+    driver: usize,
+    grid: &[f64],
+    nearest: usize,
+    solver: &mut NormalSolver,
+) -> Result<(Vec<Vec<f64>>, f64)> {
+    let points = grid.len();
+    let mut states = vec![Vec::new(); points];
     let mut max_residual: f64 = 0.0;
     let mut held = None;
     for direction in [1_i64, -1] {
-        let mut state = rho.clone();
+        let mut state = start.to_vec();
         // The state before, for the secant predictor (the tangent's first, where none).
         let mut before: Option<Vec<f64>> = None;
         let mut k = nearest as i64;
@@ -307,7 +331,7 @@ pub fn network_sweep(
                     .map(|b| (b, step / (state[driver] - b[driver])));
                 let direction: Vec<f64> = match secant {
                     Some((b, scale)) => state.iter().zip(b.iter()).map(|(s, b)| (s - b) * scale).collect(),
-                    None => tangent(model, &state, driver, &mut solver)?
+                    None => tangent(model, &state, driver, solver)?
                         .iter()
                         .map(|t| t * step)
                         .collect(),
@@ -318,23 +342,13 @@ pub fn network_sweep(
                 }
                 // The driver is held exactly at its grid value (Newton leaves it alone).
                 state[driver] = aim;
-                max_residual = max_residual.max(restore_held_chord(model, &mut state, driver, &mut solver, &mut held)?);
+                max_residual = max_residual.max(restore_held_chord(model, &mut state, driver, solver, &mut held)?);
             }
             states[k as usize] = state.clone();
             k += direction;
         }
     }
-    let max_closure_residual = states
-        .iter()
-        .map(|s| vertex_residuals(model, s).into_iter().fold(0.0, f64::max))
-        .fold(max_residual, f64::max);
-    Ok(NetworkSweep {
-        driver,
-        domain,
-        driver_values: grid,
-        states,
-        max_closure_residual,
-    })
+    Ok((states, max_residual))
 }
 
 /// Fits every crease but the driver with a degree-`degree` polynomial on the even sweep

@@ -834,19 +834,8 @@ impl<'a> Walk<'a> {
                 }
             }
         }
-        if let Drive::Targets { targets, .. } = &self.settings.drive {
-            // No further than the point of the tangent line nearest the targets.
-            let along: f64 = targets
-                .iter()
-                .zip(&self.rho)
-                .zip(&tangent)
-                .map(|((t, r), x)| (t - r) * x)
-                .sum();
-            let nearest = along / tangent.iter().map(|x| x * x).sum::<f64>();
-            if nearest <= NEAREST_STEP {
-                return Ok(Some(self.nearest_to_targets(nearest)));
-            }
-            self.h = self.h.min(nearest);
+        if let Some(stop) = self.cap_at_targets(&tangent) {
+            return Ok(Some(stop));
         }
         if let Some(stop) = self.bisect_budget(here) {
             return Ok(Some(stop));
@@ -920,6 +909,26 @@ impl<'a> Walk<'a> {
         }
         self.record(self.rho.clone(), correction.residual, min_clearance);
         Ok(None)
+    }
+
+    /// A targets drive steps no further than the point of the tangent line nearest the
+    /// targets; where that point is (nearly) here, the stop `nearest`.
+    fn cap_at_targets(&mut self, tangent: &[f64]) -> Option<Stop> {
+        let Drive::Targets { targets, .. } = &self.settings.drive else {
+            return None;
+        };
+        let along: f64 = targets
+            .iter()
+            .zip(&self.rho)
+            .zip(tangent)
+            .map(|((t, r), x)| (t - r) * x)
+            .sum();
+        let nearest = along / tangent.iter().map(|x| x * x).sum::<f64>();
+        if nearest <= NEAREST_STEP {
+            return Some(self.nearest_to_targets(nearest));
+        }
+        self.h = self.h.min(nearest);
+        None
     }
 
     /// Where a state further along passed the contact budget: the stop, if that state is

@@ -340,42 +340,7 @@ impl CreasePatternBuilder {
             outline.iter().for_each(|&v| on[v] = true);
             on
         };
-        let mut stars = Vec::new();
-        for v in (0..nv).filter(|&v| !on_outline[v]) {
-            let around: Vec<(usize, f64)> = graph.around[v]
-                .iter()
-                .filter(|&&(e, _)| matches!(kinds[e], EdgeKind::Crease(_)))
-                .map(|&(e, angle)| (e, angle))
-                .collect();
-            if around.is_empty() {
-                continue;
-            }
-            let k = around.len();
-            let sector_angles = (0..k)
-                .map(|j| {
-                    let gap = (around[(j + 1) % k].1 - around[j].1).rem_euclid(TAU);
-                    if k == 1 {
-                        TAU
-                    } else {
-                        gap
-                    }
-                })
-                .collect();
-            stars.push(VertexStar {
-                vertex: v,
-                creases: around.iter().map(|&(e, _)| e).collect(),
-                sector_angles,
-            });
-        }
-        if stars.len() > MAX_INTERIOR_VERTICES {
-            return Err(NanofoldError::invalid(
-                "vertices_coords",
-                format!("{} interior vertices where creases meet", stars.len()),
-                format!(
-                    "a crease pattern has at most {MAX_INTERIOR_VERTICES} (a 174 × 174 Miura-ori); more would take longer than 10 s to fold or unfold"
-                ),
-            ));
-        }
+        let stars = vertex_stars(&graph, &kinds, &on_outline)?;
         let length_precision = 16.0 * f64::EPSILON * largest_coordinate;
         let angle_precision = angle_precision(length_precision, &vertices, &edges);
         Ok(CreasePattern {
@@ -813,6 +778,48 @@ fn check_given_faces(given: &[Vec<usize>], faces: &[Vec<usize>]) -> Result<Vec<u
         ));
     }
     Ok(file_face)
+}
+
+/// Every interior vertex with at least one crease, and its star (creases counter-clockwise,
+/// the sector angles between them); at most [`MAX_INTERIOR_VERTICES`].
+fn vertex_stars(graph: &PlanarGraph, kinds: &[EdgeKind], on_outline: &[bool]) -> Result<Vec<VertexStar>> {
+    let mut stars = Vec::new();
+    for v in (0..on_outline.len()).filter(|&v| !on_outline[v]) {
+        let around: Vec<(usize, f64)> = graph.around[v]
+            .iter()
+            .filter(|&&(e, _)| matches!(kinds[e], EdgeKind::Crease(_)))
+            .map(|&(e, angle)| (e, angle))
+            .collect();
+        if around.is_empty() {
+            continue;
+        }
+        let k = around.len();
+        let sector_angles = (0..k)
+            .map(|j| {
+                let gap = (around[(j + 1) % k].1 - around[j].1).rem_euclid(TAU);
+                if k == 1 {
+                    TAU
+                } else {
+                    gap
+                }
+            })
+            .collect();
+        stars.push(VertexStar {
+            vertex: v,
+            creases: around.iter().map(|&(e, _)| e).collect(),
+            sector_angles,
+        });
+    }
+    if stars.len() > MAX_INTERIOR_VERTICES {
+        return Err(NanofoldError::invalid(
+            "vertices_coords",
+            format!("{} interior vertices where creases meet", stars.len()),
+            format!(
+                "a crease pattern has at most {MAX_INTERIOR_VERTICES} (a 174 × 174 Miura-ori); more would take longer than 10 s to fold or unfold"
+            ),
+        ));
+    }
+    Ok(stars)
 }
 
 /// Panels: faces joined across facet edges (union–find).
