@@ -271,7 +271,7 @@ impl FoldOptions {
                 "frames",
                 self.frames,
                 format!(
-                    "a pattern of {vertices} vertices gets at most {most} frames (frames × vertices ≤ {}: the 3D page shows them all)",
+                    "a pattern of {vertices} vertices gets at most {most} frames (frames × vertices ≤ {}: every frame is held in memory until written)",
                     crate::folding::MAX_FRAME_POINTS
                 ),
             ));

@@ -25,9 +25,10 @@ const CHORD_ONLY: f64 = 1e-13;
 /// Most frames one call places.
 pub const MAX_FRAMES: usize = 100_000;
 
-/// Most frames × vertices of a fold's animation: its 3D page shows every frame, and
-/// placing them holds all in memory (2 000 frames of 100 000 vertices ran out of 4 GiB).
-pub const MAX_FRAME_POINTS: usize = 4_000_000;
+/// Most frames × vertices of a fold's animation: its frames, their FOLD text and its 3D
+/// page are all held in memory before anything is written, about 90 MB a frame of 100 000
+/// vertices; 12 such frames stay within 2 GiB (`docs/guide/limits.md`).
+pub const MAX_FRAME_POINTS: usize = 1_200_000;
 
 /// One frame on a path.
 #[derive(Debug, Clone, PartialEq)]

@@ -7,9 +7,8 @@
 use crate::error::{NanofoldError, Result};
 use serde_json::json;
 
-/// Most frames × vertices one page holds (about 25 MB of coordinates at the limit): a
-/// fold's animation, all of it.
-pub const MAX_PAGE_POINTS: usize = crate::folding::MAX_FRAME_POINTS;
+/// Most frames × vertices one page holds (about 25 MB of coordinates at the limit).
+pub const MAX_PAGE_POINTS: usize = 4_000_000;
 
 /// One frame of a page.
 #[derive(Debug, Clone, PartialEq)]
