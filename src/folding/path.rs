@@ -858,15 +858,7 @@ impl<'a> Walk<'a> {
                     format!("{} (located to {within:.0e} rad)", stop.evidence),
                 )));
             }
-            Trial::Lost => {
-                let mut creases: Vec<usize> = (0..tangent.len()).collect();
-                creases.sort_by(|&a, &b| tangent[b].abs().total_cmp(&tangent[a].abs()));
-                creases.truncate(6);
-                return Ok(Some(Stop::new(
-                    StopReason::BranchPoint { creases },
-                    "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad",
-                )));
-            }
+            Trial::Lost => return Ok(Some(lost(&tangent))),
         };
         // Step control: the corrector's first move from the tangent's prediction ρ + h t is
         // the angle between the chord and the tangent, ∝ h (curvature); aim it at
@@ -952,9 +944,47 @@ impl<'a> Walk<'a> {
         None
     }
 
-    fn landing_failed(&mut self, here: f64) {
-        let distance = 1.0 - here;
-        self.landing_failed = Some(self.landing_failed.map_or(distance, |d| d.min(distance)));
+    /// Whether a targets drive's trial is no nearer the targets than the state it left: past
+    /// the nearest state on a curved path, the tangent's own estimate overshoots, and a
+    /// step is taken nearer or not at all.
+    fn not_nearer_targets(&self, trial: &[f64]) -> bool {
+        let Drive::Targets { targets, .. } = &self.settings.drive else {
+            return false;
+        };
+        let squared = |rho: &[f64]| targets.iter().zip(rho).map(|(t, r)| (t - r) * (t - r)).sum::<f64>();
+        squared(trial) >= squared(&self.rho)
+    }
+
+    /// The predictor's state h along the tangent (and the curvature terms, if any).
+    fn predict(&self, tangent: &[f64], bend: Option<&(Vec<f64>, Vec<f64>)>) -> Vec<f64> {
+        let h = self.h;
+        let mut trial: Vec<f64> = self.rho.iter().zip(tangent).map(|(r, x)| r + h * x).collect();
+        if let Some((q, r)) = bend {
+            trial
+                .iter_mut()
+                .zip(q.iter().zip(r))
+                .for_each(|(x, (q, r))| *x += h * h * (q + h * r));
+        }
+        trial
+    }
+
+    /// [`land_on_goal`] from `state`, a failure remembered (from `here`'s distance to the
+    /// goal) so that landing is not retried from as far.
+    fn land(&mut self, state: &mut [f64], here: f64) -> Result<Option<Correction>> {
+        let (model, settings) = (self.model, self.settings);
+        let goal = land_on_goal(
+            model,
+            &settings.drive,
+            state,
+            &self.signs,
+            settings.closure_tol,
+            &mut self.solver,
+        )?;
+        if goal.is_none() {
+            let distance = 1.0 - here;
+            self.landing_failed = Some(self.landing_failed.map_or(distance, |d| d.min(distance)));
+        }
+        Ok(goal)
     }
 
     /// Predictor: the desired velocity projected onto the tangent space, scaled to a largest
@@ -1061,14 +1091,7 @@ impl<'a> Walk<'a> {
         // goal (a flat-folded state) holding one crease there can push another past it.
         let mut may_land = self.landing_failed.is_none_or(|failed| 1.0 - here <= failed / 10.0);
         for _ in 0..80 {
-            let h = self.h;
-            let mut trial: Vec<f64> = self.rho.iter().zip(tangent).map(|(r, x)| r + h * x).collect();
-            if let Some((q, r)) = bend {
-                trial
-                    .iter_mut()
-                    .zip(q.iter().zip(r))
-                    .for_each(|(x, (q, r))| *x += h * h * (q + h * r));
-            }
+            let mut trial = self.predict(tangent, bend);
             // A prediction past the goal lands on it from there, the crease that sets progress
             // held at its goal: the state past it, which the path would not keep, is not
             // corrected first.
@@ -1076,18 +1099,8 @@ impl<'a> Walk<'a> {
             let mut early = None;
             if may_land && predicted > 1.0 + 1e-10 {
                 let mut state = trial.clone();
-                let goal = land_on_goal(
-                    model,
-                    &settings.drive,
-                    &mut state,
-                    &self.signs,
-                    settings.closure_tol,
-                    &mut self.solver,
-                )?;
-                if goal.is_none() {
-                    self.landing_failed(here);
-                    may_land = false;
-                }
+                let goal = self.land(&mut state, here)?;
+                may_land = goal.is_some();
                 early = goal.map(|landing| (state, landing));
             }
             let landed_early = early.is_some();
@@ -1114,17 +1127,12 @@ impl<'a> Walk<'a> {
                 self.h /= 2.0;
                 continue;
             }
-            if let Drive::Targets { targets, .. } = &settings.drive {
-                // Nearer the targets or not at all: past the nearest state on a curved
-                // path, the tangent's own estimate overshoots.
-                let squared = |rho: &[f64]| targets.iter().zip(rho).map(|(t, r)| (t - r) * (t - r)).sum::<f64>();
-                if squared(&trial) >= squared(&self.rho) {
-                    self.h /= 2.0;
-                    if self.h < NEAREST_STEP {
-                        return Ok(Trial::Event(self.nearest_to_targets(self.h)));
-                    }
-                    continue;
+            if self.not_nearer_targets(&trial) {
+                self.h /= 2.0;
+                if self.h < NEAREST_STEP {
+                    return Ok(Trial::Event(self.nearest_to_targets(self.h)));
                 }
+                continue;
             }
             let reached = if landed_early {
                 predicted
@@ -1135,22 +1143,13 @@ impl<'a> Walk<'a> {
             let mut landed = landed_early;
             if !landed && ahead > 1.0 + 1e-10 && may_land {
                 // Past the goal: onto it directly, the crease that sets progress held there.
-                let goal = land_on_goal(
-                    model,
-                    &settings.drive,
-                    &mut trial,
-                    &self.signs,
-                    settings.closure_tol,
-                    &mut self.solver,
-                )?;
-                if let Some(landing) = goal {
+                if let Some(landing) = self.land(&mut trial, here)? {
                     self.newton_iterations += landing.iterations;
                     correction.residual = landing.residual;
                     correction.factor = None;
                     ahead = self.progress_of(&trial);
                     landed = true;
                 } else {
-                    self.landing_failed(here);
                     may_land = false;
                 }
             }
@@ -1246,6 +1245,18 @@ impl<'a> Walk<'a> {
         };
         (path, self.solver)
     }
+}
+
+/// The stop where Newton finds no rigid state along the tangent: a branch point, named by
+/// the six creases moving fastest along it.
+fn lost(tangent: &[f64]) -> Stop {
+    let mut creases: Vec<usize> = (0..tangent.len()).collect();
+    creases.sort_by(|&a, &b| tangent[b].abs().total_cmp(&tangent[a].abs()));
+    creases.truncate(6);
+    Stop::new(
+        StopReason::BranchPoint { creases },
+        "Newton found no rigid state along the projected velocity, even with a step of 1e-9 rad",
+    )
 }
 
 /// A crease that passes through flat against its assignment has left the branch.
