@@ -102,9 +102,7 @@ fn restore_held(
         if worst <= SWEEP_TOL {
             return Ok(worst);
         }
-        for entry in jac.entries.iter_mut().filter(|e| e.1 == driver) {
-            entry.2 = 0.0;
-        }
+        jac.hold(driver);
         let factor = solver.factor(&jac)?;
         let mut step = vec![0.0; jac.cols];
         jac.apply_transpose(&jac.residual, &mut step);
@@ -143,7 +141,7 @@ fn restore_held_chord(
     let mut fresh = false;
     for _ in 0..40 {
         crate::folding::closure_residual(model, fold_angles, &mut residual);
-        let worst = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        let worst = crate::folding::worst_of(&residual);
         if !worst.is_finite() {
             break;
         }
@@ -154,9 +152,7 @@ fn restore_held_chord(
         }
         if held.is_none() || (worst > 0.1 * previous && !fresh) {
             let mut jacobian = closure_jacobian(model, fold_angles);
-            for entry in jacobian.entries.iter_mut().filter(|e| e.1 == driver) {
-                entry.2 = 0.0;
-            }
+            jacobian.hold(driver);
             let factor = solver.factor(&jacobian)?;
             *held = Some(HeldFactor { jacobian, factor });
             fresh = true;
