@@ -1,6 +1,7 @@
 //! Command-line interface: argument definitions and the `unfold`, `check`, `constraints`,
 //! `simulate` and `modes` commands.
 
+#[path = "cli/folding.rs"]
 mod folding;
 
 use anyhow::{Context, Result};
@@ -12,6 +13,17 @@ use nanofold::prelude::{
 };
 use serde_json::json;
 use std::path::{Path, PathBuf};
+
+/// A number flag's value: a finite number, or clap's refusal naming the flag (NaN and ±inf
+/// never reach the door, where a JSON bridge would turn them into null, that is, a default).
+pub fn finite(text: &str) -> std::result::Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|_| format!("{text:?} is not a number"))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("{text} is not a finite number"))
+    }
+}
 
 #[derive(Parser)]
 #[command(
@@ -132,7 +144,7 @@ pub enum ExportKind {
         out: Option<PathBuf>,
         /// RK4 time step in seconds (default: 1e-9; at most a twentieth of the scene's
         /// fastest natural period).
-        #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = 1e-9)]
         timestep: f64,
         /// How a closed loop is closed: `connect` equalities (exact; every crease a hinge) or
         /// fitted quartic `polycoef` equalities (the cut crease has no joint).
@@ -160,17 +172,17 @@ pub struct SimulateArgs {
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     pub method: MethodArg,
     /// Relative tolerance (the absolute tolerance is the same in rad).
-    #[arg(long, default_value_t = nanofold::commands::SimulateOptions::default().rtol, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::SimulateOptions::default().rtol)]
     pub rtol: f64,
     /// End time in seconds, overriding the scene's time.t_end_s.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
     pub t_end: Option<f64>,
     /// Integrate through contacts instead of stopping at the first one.
     #[arg(long)]
     pub ignore_collisions: bool,
     /// Stop with an error after this many integrator steps (a method unsuited to the scene
     /// can need billions).
-    #[arg(long, default_value_t = nanofold::commands::SimulateOptions::default().max_steps)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::SimulateOptions::default().max_steps)]
     pub max_steps: usize,
     /// Output folder (default: output/<scene name>/).
     #[arg(long)]
@@ -191,17 +203,17 @@ pub struct FitArgs {
     pub measured: PathBuf,
     /// A parameter to fit, PATH=LOWER:UPPER, its path into the scene file (e.g.
     /// environment.drag_coefficient=0.5:4, hinges[*].target_angle_deg=60:120); repeat it.
-    #[arg(long, required = true)]
+    #[arg(long, required = true, allow_hyphen_values = true)]
     pub free: Vec<String>,
     /// The measurement's noise in each column's unit: SIGMA for every column or
     /// COLUMN=SIGMA (repeat it); without it, each column's is estimated from its residuals.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub noise: Vec<String>,
     /// Relative tolerance of each simulation.
-    #[arg(long, default_value_t = nanofold::commands::FitOptions::default().rtol, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::FitOptions::default().rtol)]
     pub rtol: f64,
     /// Levenberg–Marquardt iterations at most.
-    #[arg(long, default_value_t = nanofold::commands::FitOptions::default().max_iterations)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::FitOptions::default().max_iterations)]
     pub max_iterations: usize,
     /// Integrator (diffsol).
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
@@ -223,57 +235,57 @@ pub struct NetsArgs {
     /// polycube:X,Y,Z;X,Y,Z;...
     pub shape: String,
     /// Enumerate every spanning tree when there are at most this many; else sample.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().max_trees)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().max_trees)]
     pub max_trees: usize,
     /// Trees drawn uniformly (Wilson's algorithm) when they are too many to enumerate.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().samples)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().samples)]
     pub samples: usize,
     /// The sampler's seed.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().seed)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().seed)]
     pub seed: u64,
     /// The score the nets are ranked by, smallest first (nets that can be made come first).
     #[arg(long, value_enum, default_value_t = RankByArg::RadiusOfGyration)]
     pub rank_by: RankByArg,
     /// How many of the best nets are written as FOLD and drawn.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().top)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().top)]
     pub top: usize,
     /// The length of the solid's unit in µm.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().unit_um, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().unit_um)]
     pub unit_um: f64,
     /// The written scenes' hinges drive this many degrees past the turn that closes the
     /// solid, so the faces press shut (0 to 45).
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().overdrive_deg, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().overdrive_deg)]
     pub overdrive_deg: f64,
     /// Release the simulated and written nets by an etch front crossing the wafer along this
     /// direction alone (degrees; 0 along +x, 90 along +y); default: the --fronts directions,
     /// the written scenes released along each net's best.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
     pub front_deg: Option<f64>,
     /// The etch front's speed, µm per minute.
-    #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = 1.5)]
     pub etch_rate_um_per_min: f64,
     /// The face the written scenes anchor (a face index of the net's FOLD; default: the face
     /// at the centre of the net's tree).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub anchored_face: Option<usize>,
     /// How many of the best nets that can be made are simulated closing (0: none).
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().simulate)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().simulate)]
     pub simulate: usize,
     /// Etch-front directions each simulated net is released along, k·360°/N (0: all hinges
     /// at once); --front-deg tries that direction alone.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().fronts)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().fronts)]
     pub fronts: usize,
     /// Devices sampled per net and release for the yield (0: the nominal device only).
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().yield_samples)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::nets::NetsOptions::default().yield_samples)]
     pub yield_samples: usize,
     /// Standard deviation of each hinge's stiffness across devices, %.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().stiffness_spread_percent, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().stiffness_spread_percent)]
     pub stiffness_spread_percent: f64,
     /// Standard deviation of each hinge's residual stress across devices, %.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().stress_spread_percent, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().stress_spread_percent)]
     pub stress_spread_percent: f64,
     /// A seam latches when its edges meet within this share of its length, %.
-    #[arg(long, default_value_t = nanofold::commands::nets::NetsOptions::default().capture_percent, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().capture_percent)]
     pub capture_percent: f64,
     /// Output folder (default: output/<shape>-nets/).
     #[arg(long)]
@@ -315,7 +327,7 @@ pub struct ConstraintsArgs {
     /// vertices with one degree of freedom (e.g. folded.fold from `nanofold fold`).
     pub pattern: PathBuf,
     /// The driving crease (a crease pattern of many vertices: its FOLD edge index).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub drive: usize,
     /// Hold crease J at DEG degrees (repeatable), e.g. --lock 1=0 (a crease pattern of many
     /// vertices: J is a FOLD edge index).
@@ -324,7 +336,7 @@ pub struct ConstraintsArgs {
     /// Keep only these creases free besides the driver (comma-separated indices, e.g.
     /// --free 2,3,4); every other crease is held at its folded angle, as if each had a
     /// --lock. An explicit --lock still sets its own angle.
-    #[arg(long, value_name = "I,J,...", value_delimiter = ',')]
+    #[arg(long, allow_hyphen_values = true, value_name = "I,J,...", value_delimiter = ',')]
     pub free: Vec<usize>,
     /// Measure a given polynomial of crease J against exact loop closure (repeatable), e.g. a
     /// published table's: coefficients in degrees of the driving angle in degrees, constant
@@ -335,7 +347,7 @@ pub struct ConstraintsArgs {
     #[arg(long, default_value = "4", allow_hyphen_values = true)]
     pub degree: String,
     /// With --degree auto: the largest accepted fit error, rad.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
     pub tol: Option<f64>,
     /// Where the samples come from: an exact sweep or an unfolding trajectory.
     #[arg(long, value_enum, default_value_t = SourceArg::Sweep)]
@@ -345,7 +357,7 @@ pub struct ConstraintsArgs {
     #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
     pub range: Option<String>,
     /// Number of sweep samples.
-    #[arg(long, default_value_t = 201)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 201)]
     pub samples: usize,
     /// Export format besides constraints.json.
     #[arg(long, value_enum, default_value_t = ExportFormat::Json)]
@@ -357,7 +369,7 @@ pub struct ConstraintsArgs {
     #[arg(long)]
     pub json: bool,
     /// Largest accepted loop-closure residual of the input's folded state (rad).
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = 1e-6)]
     pub closure_tol: f64,
 }
 
@@ -421,32 +433,32 @@ pub struct SolverArgs {
     #[arg(long, value_enum, default_value_t = EnergyArg::Separable)]
     pub energy: EnergyArg,
     /// Exponent p (default 2 separable, 4 non-separable).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite)]
     pub p: Option<f64>,
     /// Direction solver: the direct null-space projection or the Clarabel QP.
     #[arg(long, value_enum, default_value_t = QpArg::Direct)]
     pub qp: QpArg,
     /// Flat when every |fold angle| ≤ this (rad).
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = 1e-6)]
     pub flat_tol: f64,
     /// A crease pattern of many vertices (or a folded form) whose state does not close, as a
     /// compliant simulator exports it: move it to the nearest rigid state first and say how far.
     #[arg(long)]
     pub project: bool,
     /// Weight κ of the bending metric of the direction (0: the plain QP, M = I).
-    #[arg(long, default_value_t = UnfoldSettings::default().bending_metric, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = UnfoldSettings::default().bending_metric)]
     pub bending_metric: f64,
     /// Iteration limit.
-    #[arg(long, alias = "max-iter", default_value_t = nanofold::commands::UnfoldOptions::default().max_iterations)]
+    #[arg(long, allow_hyphen_values = true, alias = "max-iter", default_value_t = nanofold::commands::UnfoldOptions::default().max_iterations)]
     pub max_iterations: usize,
     /// Restarts from perturbed states before a stuck verdict.
-    #[arg(long, default_value_t = nanofold::commands::UnfoldOptions::default().restarts)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::UnfoldOptions::default().restarts)]
     pub restarts: usize,
     /// Seed of the restarts' perturbations.
-    #[arg(long, default_value_t = nanofold::commands::UnfoldOptions::default().seed)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = nanofold::commands::UnfoldOptions::default().seed)]
     pub seed: u64,
     /// Largest accepted loop-closure residual of the input's folded state (rad).
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = 1e-6)]
     pub closure_tol: f64,
 }
 
@@ -482,7 +494,7 @@ impl SolverArgs {
 pub struct ParallelArgs {
     /// Patterns run at once (0: one per core; at most 256). Lines come out as patterns
     /// finish, each naming its file.
-    #[arg(long, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=256))]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=256))]
     pub jobs: usize,
 }
 
@@ -1107,6 +1119,7 @@ const FIT_FLAGS: &[(&str, &str)] = &[
     ("rtol", "--rtol"),
     ("max_iterations", "--max-iterations"),
     ("free", "--free"),
+    ("noise", "--noise"),
 ];
 
 const NETS_FLAGS: &[(&str, &str)] = &[
@@ -1518,10 +1531,18 @@ fn with_flags(error: nanofold::prelude::NanofoldError, flags: &[(&str, &str)]) -
     use nanofold::prelude::NanofoldError;
     use nanofold::prelude::NumericalError;
     let context = match &error {
+        // A field or a part of it: `free[1].bounds` is set by --free, `noise.default` by --noise.
         NanofoldError::InvalidField { field, value, .. } => flags
             .iter()
-            .find(|(name, _)| name == field)
+            .find(|(name, _)| {
+                field
+                    .strip_prefix(name)
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with(['[', '.']))
+            })
             .map(|(_, flag)| format!("invalid {flag} {value}")),
+        NanofoldError::Unreachable { .. } if flags.iter().any(|(name, _)| *name == "range") => {
+            Some("sweeping --drive over --range with every --lock held".to_string())
+        }
         NanofoldError::Numerical(
             NumericalError::StepBudget { .. } | NumericalError::NewtonFailures { .. } | NumericalError::Strayed { .. },
         ) => Some("simulate (flags that help: --method, --model, --rtol, --max-steps)".to_string()),

@@ -88,6 +88,7 @@ pub enum RayRole {
 }
 
 /// A crease as the user wrote it.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct Crease {
     /// How errors and outputs name it (`edges[3]`, `creases[1]`).

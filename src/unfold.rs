@@ -34,7 +34,7 @@ pub use solver::{ProjectedGradient, SplitMix64, StepOutcome, Termination};
 use crate::error::{NanofoldError, NumericalError, Result};
 use crate::geometry::kinematics;
 use crate::geometry::sphere::Vec3;
-use crate::pattern::VertexPattern;
+use crate::pattern::{Chain, VertexPattern};
 use argmin::core::observers::ObserverMode;
 use argmin::core::Executor;
 use serde::Serialize;
@@ -75,6 +75,7 @@ pub enum Verdict {
 impl crate::names::Named for Verdict {}
 
 /// Everything an unfolding run produced.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct UnfoldReport {
     /// The answer.
@@ -151,6 +152,16 @@ pub fn unfold_observed(
     settings.validate()?;
     let started = Instant::now();
     let model = UnfoldModel::new(pattern);
+    let paper: f64 = model.sector_angles.iter().sum();
+    if model.chain == Chain::Open && paper >= 2.0 * PI - 1e-9 {
+        // Its two boundary rays lie on one another when flat: a node on an arc's end, where
+        // the repulsive energy is infinite (`docs/model.md#energy`).
+        return Err(NanofoldError::invalid(
+            "sector_angles",
+            format!("sum {:.9}°", paper.to_degrees()),
+            "an open chain of a full turn of paper has its two boundary rays on one another when flat, where the repulsive energy is infinite: give it less paper, or close it (the boundary rays one crease)",
+        ));
+    }
     let mut adjustments = pattern.adjustments.clone();
     let mut start = model.folded_nodes();
     let initial_fold_angles: Vec<f64> = pattern.creases.iter().map(|c| c.folded_angle).collect();
@@ -180,9 +191,12 @@ pub fn unfold_observed(
         // Closed in the fold angles first (minimum-norm Newton, then to rounding): the
         // nodes placed from closed angles keep every arc, where restoring the scaled nodes
         // from near the singular flat-folded state converges only linearly.
+        // An open chain has no loop to close: its scaled angles place its nodes as they are.
         let every: Vec<usize> = (0..scaled.len()).collect();
         let mut closed = scaled.clone();
-        if kinematics::solve_closure(&model.sector_angles, &mut closed, &every, 1e-14, 200).is_ok() {
+        if model.chain == Chain::Closed
+            && kinematics::solve_closure(&model.sector_angles, &mut closed, &every, 1e-14, 200).is_ok()
+        {
             kinematics::refine_closure(&model.sector_angles, &mut closed, &every, 50);
             scaled = closed;
         }

@@ -90,11 +90,12 @@ impl FitSettings {
                 .map(|(k, v)| (k.as_str(), v))
                 .chain(default.iter().map(|d| ("default", d)))
             {
-                if !(sigma.is_finite() && sigma > 0.0) {
+                // Its weight 1/σ² and the covariance it scales stay finite numbers.
+                if !(1e-150..=1e150).contains(&sigma) {
                     return Err(NanofoldError::invalid(
                         format!("noise.{name}"),
                         sigma,
-                        "a standard deviation must be finite and > 0",
+                        "a standard deviation must be finite, > 0 and within 1e-150..1e150",
                     ));
                 }
             }
@@ -116,6 +117,7 @@ pub enum FitStatus {
 }
 
 /// One fitted parameter.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct FittedParameter {
     /// Its path in the scene file.
@@ -193,8 +195,10 @@ pub struct FitReport {
     pub t_quantile: f64,
     /// The parameters.
     pub parameters: Vec<FittedParameter>,
-    /// Correlations of the determined parameters (None for an undetermined one).
-    pub correlation: Vec<Vec<Option<f64>>>,
+    /// The determined parameters' paths, in the order of `correlation`'s rows.
+    pub correlated: Vec<String>,
+    /// Correlations among the determined parameters (an undetermined one has none).
+    pub correlation: Vec<Vec<f64>>,
     /// Singular values of the scaled, weighted sensitivity matrix, largest first.
     pub singular_values: Vec<f64>,
     /// Combinations the data cannot separate.
@@ -991,16 +995,17 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
             }
         })
         .collect();
-    let correlation = (0..m)
-        .map(|a| {
-            (0..m)
-                .map(|b| {
-                    (!loose[a] && !loose[b])
-                        .then(|| covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt())
-                })
+    let determined: Vec<usize> = (0..m).filter(|&j| !loose[j]).collect();
+    let correlation = determined
+        .iter()
+        .map(|&a| {
+            determined
+                .iter()
+                .map(|&b| covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt())
                 .collect()
         })
         .collect();
+    let correlated = determined.iter().map(|&j| problem.parameters[j].path.clone()).collect();
     let measurement = problem.measurement;
     let residuals = column_residuals(problem, at, given);
     Ok(FitReport {
@@ -1016,6 +1021,7 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
         reduced_chi_square: reduced,
         t_quantile: t,
         parameters,
+        correlated,
         correlation,
         singular_values,
         undetermined,

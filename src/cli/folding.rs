@@ -17,11 +17,11 @@ pub struct FoldArgs {
     /// Drive these creases (FOLD edge index) to these angles, e.g. `--drive 12=-90`;
     /// without it, every crease folds towards its target where the file gives targets, else
     /// every mountain and valley towards ±180° as assigned.
-    #[arg(long, value_name = "EDGE=DEG", allow_negative_numbers = true)]
+    #[arg(long, value_name = "EDGE=DEG", allow_hyphen_values = true)]
     pub drive: Vec<String>,
     /// Stop when the most folded crease reaches this percentage of 180° (assignment drive),
     /// or this percentage of the way to the targets (0.1 to 100).
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 100.0)]
     pub to: f64,
     /// Drive every crease towards its target angle (a file's `edges_foldAngle` read as
     /// targets): `--drive-to-targets` requires them, `--drive-to-targets false` folds by the
@@ -29,11 +29,11 @@ pub struct FoldArgs {
     #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
     pub drive_to_targets: Option<bool>,
     /// Number of snapshots written as FOLD frames (start and end included; 2 to 10 000).
-    #[arg(long, default_value_t = 11)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 11)]
     pub frames: usize,
     /// Largest change of any fold angle in one step (degrees; 5.7e-5 to 28.6): a cap, the
     /// step control chooses each step below it.
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 15.0)]
     pub max_step: f64,
     /// Output folder (default: output/<pattern name>/).
     #[arg(long)]
@@ -49,23 +49,23 @@ pub enum GenerateKind {
     /// Miura-ori: rows × cols parallelogram panels (`docs/model.md#pattern-generators`).
     Miura {
         /// Panels along y.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
         rows: usize,
         /// Panels along x.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
         cols: usize,
         /// The panels' acute angle (degrees).
-        #[arg(long, alias = "angle", default_value_t = 60.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, alias = "angle", default_value_t = 60.0)]
         angle_deg: f64,
         /// Length of the panels' horizontal sides.
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.0)]
         width: f64,
         /// Length of the panels' slanted sides.
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.0)]
         slant: f64,
         /// Also write the folded state with the zigzag creases at this angle (degrees; 0 or
         /// absent: the crease pattern alone).
-        #[arg(long, alias = "fold", allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, alias = "fold")]
         fold_deg: Option<f64>,
         /// The FOLD file to write.
         #[arg(long)]
@@ -74,13 +74,13 @@ pub enum GenerateKind {
     /// Square twist: a central square and four pleats turned by the twist angle.
     SquareTwist {
         /// Side of the central square.
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.0)]
         side: f64,
         /// Half the side of the square sheet.
-        #[arg(long, default_value_t = 1.5, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.5)]
         half_sheet: f64,
         /// Twist angle (degrees, 1 to 45).
-        #[arg(long, alias = "twist", default_value_t = 30.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, alias = "twist", default_value_t = 30.0)]
         twist_deg: f64,
         /// Flip each corner's crease after its smallest sector (breaks big-little-big: no
         /// longer flat-foldable) instead of the classic assignment.
@@ -94,13 +94,13 @@ pub enum GenerateKind {
     /// than 1, the Huffman-style rectangular waterbomb.
     Waterbomb {
         /// Rows of triangles.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
         rows: usize,
         /// Units across (the sheet is twice as wide).
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = 4)]
         cols: usize,
         /// Height of a row in half-cell widths (1: square cells; 0.1 to 10).
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.0)]
         row_height: f64,
         /// The FOLD file to write.
         #[arg(long)]
@@ -109,7 +109,7 @@ pub enum GenerateKind {
     /// Bird base: the flat-foldable crease pattern (midlines, kites, one diagonal).
     BirdBase {
         /// Half the side of the square sheet.
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true, value_parser = super::finite, default_value_t = 1.0)]
         half_side: f64,
         /// The FOLD file to write.
         #[arg(long)]

@@ -171,8 +171,36 @@ pub fn constraints_files(
     Ok(files)
 }
 
+impl ConstraintSettings {
+    /// Checks the numbers a caller hands over: every held angle a finite fold angle in
+    /// [−180°, 180°], a range of finite ends (a checked curve's coefficients are checked
+    /// with the curve).
+    pub fn validate(&self) -> Result<()> {
+        for (crease, angle) in &self.lock {
+            if !(angle.is_finite() && angle.abs() <= std::f64::consts::PI) {
+                return Err(NanofoldError::invalid(
+                    "lock",
+                    format!("{crease}={}", angle.to_degrees()),
+                    "a held angle is a finite fold angle in [-180°, 180°]",
+                ));
+            }
+        }
+        if let Some([a, b]) = self.range {
+            if !(a.is_finite() && b.is_finite()) {
+                return Err(NanofoldError::invalid(
+                    "range",
+                    format!("{}:{}", a.to_degrees(), b.to_degrees()),
+                    "needs finite A < B (degrees)",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Sweeps the driver across its range by exact loop closure and fits every free crease.
 pub fn constraints(pattern: &Pattern, settings: &ConstraintSettings) -> Result<Constraints> {
+    settings.validate()?;
     match pattern.vertex() {
         Some(vertex) => vertex_constraints(vertex, settings),
         None => {
@@ -221,7 +249,17 @@ fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &Constr
         .iter()
         .map(|(i, coefficients)| Ok((index(*i, "check")?, coefficients)))
         .collect::<Result<Vec<_>>>()?;
-    let setup = Setup::new(pattern, driver, &locks)?;
+    // With `free`, the locks are the creases it leaves out: a refusal of them is of `free`.
+    let setup = Setup::new(pattern, driver, &locks).map_err(|error| match error {
+        NanofoldError::InvalidField { field, value, reason } if field == "lock" && !settings.free.is_empty() => {
+            NanofoldError::InvalidField {
+                field: "free".into(),
+                value: format!("{:?} ({value})", settings.free),
+                reason,
+            }
+        }
+        other => other,
+    })?;
     for &(crease, _) in &checks {
         if !setup.dependents.contains(&crease) {
             return Err(NanofoldError::invalid(

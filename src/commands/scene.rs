@@ -39,6 +39,7 @@ pub const MODE_AMPLITUDE: f64 = 0.1;
 
 /// A scene's modes: the summary and, for a network, each mode as a pair of FOLD frames. It
 /// serialises as its summary (`nanofold modes --json`, less the command line's `out`).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct ModesReport {
     /// As `nanofold modes --json` prints it.
@@ -133,6 +134,7 @@ pub fn modes_files(scene: &Scene, report: &ModesReport) -> Result<Vec<(&'static 
 
 /// A scene's simulated response in the forms the command line writes. It serialises as its
 /// summary (`nanofold simulate --json`).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct SimulationReport {
     /// As `nanofold simulate --json` prints it.

@@ -118,6 +118,7 @@ pub struct Latch {
 }
 
 /// Faces that met at a corner they share and press on each other.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Contact {
     /// The two faces (FOLD face indices).
@@ -133,6 +134,7 @@ pub struct Contact {
 }
 
 /// Faces meeting where no seam latches them.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Jam {
     /// The two faces (FOLD face indices).
@@ -159,6 +161,7 @@ pub struct ClosingFrame {
 }
 
 /// A closing run.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ClosingReport {
     /// How it ended.
@@ -186,6 +189,7 @@ pub struct ClosingReport {
 }
 
 /// One release of a simulated net: its nominal device's closing and its yield.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReleaseResult {

@@ -51,6 +51,7 @@ impl RankBy {
 }
 
 /// `nets`' options, as the command line and Python give them.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct NetsOptions {
@@ -140,9 +141,15 @@ impl NetsOptions {
                 format!("at most {MAX_WRITTEN_NETS}"),
             ));
         }
-        if !(self.unit_um.is_finite() && self.unit_um > 0.0) {
-            return Err(NanofoldError::invalid("unit_um", self.unit_um, "a length > 0"));
-        }
+        // The scenes made of the nets take the lengths and speeds any scene takes.
+        use crate::read::scene_spec::{limits, within};
+        within("unit_um", self.unit_um, limits::LENGTH_UNIT_UM, "µm")?;
+        within(
+            "etch_rate_um_per_min",
+            self.etch_rate_um_per_min,
+            limits::ETCH_RATE_UM_PER_MIN,
+            "µm/min",
+        )?;
         if !(0.0..=45.0).contains(&self.overdrive_deg) {
             return Err(NanofoldError::invalid(
                 "overdrive_deg",
@@ -155,13 +162,6 @@ impl NetsOptions {
                 "front_deg",
                 phi,
                 "a finite direction in degrees",
-            ));
-        }
-        if !(self.etch_rate_um_per_min.is_finite() && self.etch_rate_um_per_min > 0.0) {
-            return Err(NanofoldError::invalid(
-                "etch_rate_um_per_min",
-                self.etch_rate_um_per_min,
-                "a speed > 0",
             ));
         }
         if self.simulate > MAX_WRITTEN_NETS {
@@ -228,6 +228,7 @@ pub enum Search {
 }
 
 /// One distinct net and its scores, lengths in µm.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NetRow {
     /// 1 for the best.
@@ -251,6 +252,7 @@ pub struct NetRow {
 }
 
 /// The solid and its nets.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NetsReport {
     /// The solid's name.
@@ -287,12 +289,34 @@ pub struct NetsReport {
     pub seconds: f64,
 }
 
+/// A release as JSON shows it: its kind, and the front's direction when it has one.
+fn releases_shown<S: serde::Serializer>(
+    releases: &[Option<f64>],
+    serializer: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    #[serde_with::skip_serializing_none]
+    #[derive(Serialize)]
+    struct Shown {
+        kind: &'static str,
+        front_deg: Option<f64>,
+    }
+    let mut seq = serializer.serialize_seq(Some(releases.len()))?;
+    for &front_deg in releases {
+        let kind = if front_deg.is_some() { "etch_front" } else { "step" };
+        seq.serialize_element(&Shown { kind, front_deg })?;
+    }
+    seq.end()
+}
+
 /// What a study simulated.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Study {
     /// Nets simulated.
     pub nets: usize,
-    /// Their releases (None: a step).
+    /// Their releases (None: a step), written as `{"kind": "step"}` or
+    /// `{"kind": "etch_front", "front_deg": φ}`.
+    #[serde(serialize_with = "releases_shown")]
     pub releases: Vec<Option<f64>>,
     /// The devices' variation.
     pub variation: Variation,

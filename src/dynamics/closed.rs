@@ -732,6 +732,7 @@ impl Plant for ClosedPlant<'_> {
 }
 
 /// What a closed-chain run reports beside its response.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct ClosedReport {
     /// FOLD edge index of the cut crease.

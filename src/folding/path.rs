@@ -320,6 +320,14 @@ pub fn restore_closure(
     tol: f64,
     solver: &mut NormalSolver,
 ) -> Result<Option<usize>> {
+    // Newton from a non-finite start never meets its tolerance: refuse it by name.
+    if let Some(k) = fold_angles.iter().position(|r| !r.is_finite()) {
+        return Err(NanofoldError::invalid(
+            format!("fold_angles[{k}]"),
+            fold_angles[k],
+            "a fold angle must be finite",
+        ));
+    }
     Ok(correct(model, fold_angles, tol, solver, None, false)?.map(|c| c.iterations))
 }
 

@@ -16,6 +16,13 @@ const PHI: f64 = 1.618_033_988_749_895;
 /// vertices).
 pub fn convex_hull(vertices: Vec<Point3<f64>>) -> Result<Polyhedron> {
     let n = vertices.len();
+    if let Some(k) = vertices.iter().position(|p| !p.coords.iter().all(|x| x.is_finite())) {
+        return Err(NanofoldError::invalid(
+            format!("vertices[{k}]"),
+            format!("{:?}", vertices[k].coords.as_slice()),
+            "coordinates must be finite",
+        ));
+    }
     let centre = Point3::from(vertices.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n as f64);
     let size = vertices.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
     let tolerance = 1e-9 * size;
@@ -38,6 +45,9 @@ pub fn convex_hull(vertices: Vec<Point3<f64>>) -> Result<Polyhedron> {
                 let mut on: Vec<usize> = (0..n)
                     .filter(|&v| side(&vertices[v], &unit).abs() <= tolerance)
                     .collect();
+                if on.len() < 3 {
+                    continue; // not a plane through three vertices (rounding at a degenerate triple)
+                }
                 on.sort_unstable();
                 if faces.iter().any(|f| {
                     let mut sorted = f.clone();
@@ -141,9 +151,18 @@ pub fn truncated_octahedron() -> Result<Polyhedron> {
 /// A box a × b × c.
 pub fn cuboid(a: f64, b: f64, c: f64) -> Result<Polyhedron> {
     for (name, x) in [("a", a), ("b", b), ("c", c)] {
-        if !(x.is_finite() && x > 0.0) {
-            return Err(NanofoldError::invalid(name, x, "a box's sides are finite and > 0"));
+        if !(x.is_finite() && x > 0.0 && x <= 1e6) {
+            return Err(NanofoldError::invalid(name, x, "a box's sides are > 0 and at most 1e6"));
         }
+    }
+    // The solid's tolerances are 1e-9 of its size: its shortest side must stand well clear.
+    let (shortest, longest) = (a.min(b).min(c), a.max(b).max(c));
+    if longest > 1e6 * shortest {
+        return Err(NanofoldError::invalid(
+            "a, b, c",
+            format!("{a} x {b} x {c}"),
+            "the longest side is at most 1e6 times the shortest",
+        ));
     }
     convex_hull(signed(&[[a / 2.0, b / 2.0, c / 2.0]], false))
 }

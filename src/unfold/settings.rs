@@ -22,6 +22,7 @@ pub const MAX_ITERATIONS_LIMIT: usize = 10_000_000;
 
 /// Solver settings (plain data; [`UnfoldSettings::validate`] checks them and every entry
 /// point calls it).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct UnfoldSettings {
     /// Which repulsive energy.

@@ -48,6 +48,7 @@ pub enum Summary {
 }
 
 /// How far `--project` moved a state to make it rigid.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProjectionFigures {
     /// Largest change of a fold angle, rad.
@@ -157,6 +158,7 @@ impl VertexUnfoldSummary {
 /// `unfold --json` of a crease pattern of many vertices: the single vertex's keys where
 /// they apply, with the end's distance from the flat crease pattern (`flat_layout_error`)
 /// and from the plane.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct NetworkUnfoldSummary {
     /// The pattern's name.
@@ -257,6 +259,7 @@ pub fn crease_labels(model: &FoldingModel) -> Vec<String> {
 }
 
 /// `check --json` of a crease pattern of many vertices.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct CheckSummary {
     /// The pattern's name.
@@ -342,6 +345,7 @@ pub struct WitnessSummary {
 }
 
 /// The flat state's Kawasaki and Maekawa figures.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct FlatFoldabilitySummary {
     /// The vertex furthest from Kawasaki's theorem.
@@ -459,6 +463,7 @@ fn target_angles(model: &FoldingModel) -> Option<Vec<f64>> {
 }
 
 /// `fold --json` (`frames` and `out` are the command line's own keys).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct FoldSummary {
     /// The pattern's name.
@@ -535,6 +540,7 @@ impl FoldSummary {
 /// `simulate --json`, and the head of `response.json`: the model chosen and why, the
 /// first contact, the end; a closed chain's or a network's own figures beside them (angles
 /// are every crease's, in FOLD edge order).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct ResponseSummary {
     /// The scene's name.
@@ -612,6 +618,7 @@ pub struct CollisionSummary {
 }
 
 /// A closed chain's figures of a run.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct ClosedRunSummary {
     /// The cut crease (FOLD edge).
@@ -753,6 +760,7 @@ pub struct ClosedModesSummary {
 
 /// A network's modes: the equilibrium, the released locks, the frequencies (with and
 /// without the constraints' load term) and the shapes over every crease.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct NetworkModesSummary {
     /// The scene's name.

@@ -25,6 +25,7 @@ use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
 /// What a network run reports beside its response.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct NetworkRunReport {
     /// Panels.
