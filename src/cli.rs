@@ -104,7 +104,7 @@ pub enum Command {
     /// separate, residuals; writes fit.json, fit.csv, fitted.scene.json, fit.svg and the fitted
     /// motion's page response.html.
     Fit(FitArgs),
-    /// The distinct nets of a solid (a .off, .obj or .fold file, or a generated one such as
+    /// The distinct nets of a solid (an .obj, .stl, .ply, .off or .fold file, or a generated one such as
     /// cube, box:1x2x3, prism:6, polycube:0,0,0;1,0,0), each laid flat, tested for overlap,
     /// scored and ranked (`docs/model.md#nets-of-polyhedra`); writes nets.json, nets.csv,
     /// the best nets as FOLD crease patterns (net_<rank>.fold) and gallery.svg.
@@ -229,7 +229,7 @@ pub struct FitArgs {
 /// Arguments of `nanofold nets`.
 #[derive(Args)]
 pub struct NetsArgs {
-    /// The solid: a .off, .obj or .fold file, or tetrahedron, cube, octahedron,
+    /// The solid: an .obj, .stl, .ply, .off or .fold file, or tetrahedron, cube, octahedron,
     /// dodecahedron, icosahedron, truncated_tetrahedron, cuboctahedron,
     /// truncated_octahedron, box:AxBxC, prism:N[:H], antiprism:N[:H], pyramid:N[:H],
     /// polycube:X,Y,Z;X,Y,Z;...
@@ -287,12 +287,26 @@ pub struct NetsArgs {
     /// A seam latches when its edges meet within this share of its length, %.
     #[arg(long, allow_hyphen_values = true, value_parser = finite, default_value_t = nanofold::commands::nets::NetsOptions::default().capture_percent)]
     pub capture_percent: f64,
+    /// A solid file's faces in one plane: merged into one (always), kept as written (never),
+    /// or merged when the file is all triangles, as STL is (auto).
+    #[arg(long, value_enum, default_value_t = MergeArg::Auto)]
+    pub merge_coplanar: MergeArg,
     /// Output folder (default: output/<shape>-nets/).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Print the report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MergeArg {
+    /// Merge when every face is a triangle (STL, triangulated exports).
+    Auto,
+    /// Merge every pair of faces that share an edge in one plane.
+    Always,
+    /// Keep the faces as the file writes them.
+    Never,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -1141,7 +1155,9 @@ const NETS_FLAGS: &[(&str, &str)] = &[
 ];
 
 fn run_nets(args: &NetsArgs) -> Result<()> {
-    use nanofold::commands::nets::{nets, nets_files, open_solid, study_nets, NetsOptions, Outcome, RankBy, Search};
+    use nanofold::commands::nets::{
+        nets, nets_files, open_solid_with, study_nets, MergeCoplanar, NetsOptions, Outcome, RankBy, Search,
+    };
     let options = NetsOptions {
         max_trees: args.max_trees,
         samples: args.samples,
@@ -1164,11 +1180,19 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         stiffness_spread_percent: args.stiffness_spread_percent,
         stress_spread_percent: args.stress_spread_percent,
         capture_percent: args.capture_percent,
+        merge_coplanar: match args.merge_coplanar {
+            MergeArg::Auto => MergeCoplanar::Auto,
+            MergeArg::Always => MergeCoplanar::Always,
+            MergeArg::Never => MergeCoplanar::Never,
+        },
     };
     let flags = |e| with_flags(e, NETS_FLAGS);
     options.validate().map_err(flags)?;
-    let (name, solid) = open_solid(&args.shape).map_err(|e| anyhow::anyhow!("reading {}: {e}", args.shape))?;
-    let mut report = nets(&name, &solid, &options).map_err(flags)?;
+    let opened = open_solid_with(&args.shape, &options.solid_options())
+        .map_err(|e| anyhow::anyhow!("reading {}: {e}", args.shape))?;
+    let mut report = nets(&opened.name, &opened.solid, &options).map_err(flags)?;
+    report.reading = opened.reading;
+    let (name, solid) = (opened.name, opened.solid);
     let bar = if args.json || options.simulate == 0 {
         indicatif::ProgressBar::hidden()
     } else {
@@ -1203,17 +1227,49 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
         ),
     };
     println!(
-        "{}: {} faces, {} edges, {} vertices, symmetry group of order {} ({} rotations); {how}: {} distinct nets, {} overlapping ({:.2} s)",
+        "{}: {} faces, {} edges, {} vertices, symmetry group {} of order {} ({} rotations); {how}: {} distinct nets, {} overlapping ({:.2} s)",
         report.solid,
         report.faces,
         report.edges,
         report.vertices,
+        report.symmetry.point_group,
         report.symmetry_order,
         report.rotations,
         report.distinct_nets,
         report.overlapping,
         report.seconds
     );
+    if let Some(reading) = &report.reading {
+        let merged = if reading.faces_merged < reading.faces_read {
+            format!(
+                "; its {} faces in {} planes{}",
+                reading.faces_read,
+                reading.faces_merged,
+                if reading.concave_faces_cut > 0 {
+                    format!(
+                        ", {} concave ones cut at their reflex corners",
+                        reading.concave_faces_cut
+                    )
+                } else {
+                    String::new()
+                }
+            )
+        } else {
+            String::new()
+        };
+        println!(
+            "  read as {}: {} vertices, {} of them copies{merged}; coordinates: {}; planar to {:.1e}, symmetric to {:.1e}",
+            reading.format,
+            reading.vertices_read,
+            reading.vertices_welded,
+            reading.tolerances.precision.describe(),
+            reading.tolerances.planarity,
+            reading.tolerances.symmetry
+        );
+    }
+    for warning in &report.warnings {
+        println!("  warning: {warning}");
+    }
     if let Some(study) = &report.study {
         let releases = match study.releases.as_slice() {
             [None] => "released at once".to_string(),

@@ -6,8 +6,11 @@
 
 pub(crate) mod broad_phase;
 pub mod kinematics;
+pub mod mesh;
 pub mod nets;
+pub mod point_group;
 pub mod polyhedron;
+pub mod precision;
 pub mod rigid_form;
 pub mod solids;
 pub mod sphere;

@@ -565,7 +565,7 @@ def nets(
     clock = time.perf_counter()
     table = json.loads(_call(_native.nets_table, shape_text, settings))
     rows = table["report"]["nets"]
-    chosen = [r for r in rows if not r["overlapping"] and r["touching"] is False][: table["simulate"]]
+    chosen = [r for r in rows if not r["overlapping"] and r.get("touching") is False][: table["simulate"]]
     releases = table["releases"]
     grid = [
         {"rank": row["rank"], "folds": " ".join(str(k) for k in row["folds"]), "release": k}

@@ -392,8 +392,8 @@ fn nets(py: Python<'_>, shape: String, settings: &str) -> PyResult<(String, Stri
     options.validate().map_err(to_py)?;
     run_detached(py, move || {
         let clock = Instant::now();
-        let (name, solid) = commands::nets::open_solid(&shape)?;
-        let mut report = commands::nets::nets(&name, &solid, &options)?;
+        let (opened, mut report) = commands::nets::nets_of_shape(&shape, &options)?;
+        let solid = opened.solid;
         commands::nets::study_nets(&solid, &mut report, &options, &|_, _| {})?;
         nets_payload(&solid, &report, &options, clock)
     })
@@ -405,8 +405,7 @@ fn nets_table(py: Python<'_>, shape: String, settings: &str) -> PyResult<String>
     let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
     options.validate().map_err(to_py)?;
     run_detached(py, move || {
-        let (name, solid) = commands::nets::open_solid(&shape)?;
-        let report = commands::nets::nets(&name, &solid, &options)?;
+        let (_, report) = commands::nets::nets_of_shape(&shape, &options)?;
         Ok(serde_json::json!({
             "report": report,
             "releases": options.releases(),
@@ -422,8 +421,8 @@ fn nets_table(py: Python<'_>, shape: String, settings: &str) -> PyResult<String>
 fn nets_release(py: Python<'_>, shape: String, settings: &str, folds: Vec<usize>, release: usize) -> PyResult<String> {
     let options = options::<commands::nets::NetsOptions>(settings, "settings")?;
     run_detached(py, move || {
-        let (name, solid) = commands::nets::open_solid(&shape)?;
-        let result = commands::nets::study_release_of(&solid, &name, &folds, release, &options)?;
+        let opened = commands::nets::open_solid_with(&shape, &options.solid_options())?;
+        let result = commands::nets::study_release_of(&opened.solid, &opened.name, &folds, release, &options)?;
         Ok(serde_json::to_string(&result).expect("a result is plain data"))
     })
 }
@@ -439,8 +438,8 @@ fn nets_with_study(py: Python<'_>, shape: String, settings: &str, study: &str) -
         let clock = Instant::now();
         let by_rank = commands::nets::releases_from_json(&study["by_rank"])?;
         let seconds = study["seconds"].as_f64().unwrap_or(0.0);
-        let (name, solid) = commands::nets::open_solid(&shape)?;
-        let mut report = commands::nets::nets(&name, &solid, &options)?;
+        let (opened, mut report) = commands::nets::nets_of_shape(&shape, &options)?;
+        let solid = opened.solid;
         commands::nets::apply_releases(&solid, &mut report, by_rank, &options, seconds)?;
         nets_payload(&solid, &report, &options, clock)
     })

@@ -12,27 +12,46 @@ pub use crate::design::nets::{
     MAX_SAMPLED_TREES, MAX_WRITTEN_NETS,
 };
 use crate::error::{NanofoldError, Result};
-pub use crate::geometry::polyhedron::Polyhedron;
+pub use crate::geometry::mesh::{MergeCoplanar, MeshReading};
+pub use crate::geometry::polyhedron::{Polyhedron, SymmetrySummary};
+pub use crate::geometry::precision::{Precision, Tolerances};
 use crate::geometry::solids;
 use crate::pattern::net::NetPattern;
+pub use crate::read::solid::SolidOptions;
 use std::path::Path;
 
-/// A solid from a file (`.off`, `.obj`, `.fold`) or a generator's name: `tetrahedron`,
-/// `cube`, `octahedron`, `dodecahedron`, `icosahedron`, `truncated_tetrahedron`,
-/// `cuboctahedron`, `truncated_octahedron`, `box:AxBxC`, `prism:N[:H]`, `antiprism:N[:H]`,
-/// `pyramid:N[:H]`, `polycube:X,Y,Z;X,Y,Z;…`. Returns its name and the solid.
+/// A solid from a file (`.off`, `.obj`, `.stl`, `.ply`, `.fold`) or a generator's name
+/// ([`open_solid_with`]), read with the default options. Returns its name and the solid.
 pub fn open_solid(shape: &str) -> Result<(String, Polyhedron)> {
+    let opened = open_solid_with(shape, &SolidOptions::default())?;
+    Ok((opened.name, opened.solid))
+}
+
+/// A solid opened for its nets, with what reading its file did.
+#[derive(Debug, Clone)]
+pub struct OpenedSolid {
+    /// Its name (a file's stem, or the generator's text made a plain name).
+    pub name: String,
+    /// The solid.
+    pub solid: Polyhedron,
+    /// A file's reading: its format, welding, merging, precision and tolerances.
+    pub reading: Option<MeshReading>,
+}
+
+/// A solid from a file (`.off`, `.obj`, `.stl`, `.ply`, `.fold`, read with `options`) or a
+/// generator's name: `tetrahedron`, `cube`, `octahedron`, `dodecahedron`, `icosahedron`,
+/// `truncated_tetrahedron`, `cuboctahedron`, `truncated_octahedron`, `box:AxBxC`,
+/// `prism:N[:H]`, `antiprism:N[:H]`, `pyramid:N[:H]`, `polycube:X,Y,Z;X,Y,Z;…`.
+pub fn open_solid_with(shape: &str, options: &SolidOptions) -> Result<OpenedSolid> {
     let path = Path::new(shape);
-    let is_file = matches!(
-        path.extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref(),
-        Some("off" | "obj" | "fold")
-    );
-    if is_file {
+    if crate::read::solid::is_solid_file(path) {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("solid").to_string();
-        return Ok((name, crate::read::solid::load_solid(path)?));
+        let (solid, reading) = crate::read::solid::read_solid(path, options)?;
+        return Ok(OpenedSolid {
+            name,
+            solid,
+            reading: Some(reading),
+        });
     }
     let (kind, rest) = shape.split_once(':').unwrap_or((shape, ""));
     let bad = |why: &str| NanofoldError::invalid("shape", shape, why.to_string());
@@ -94,10 +113,23 @@ pub fn open_solid(shape: &str) -> Result<(String, Polyhedron)> {
             solids::polycube(&cubes)?
         }
         _ => return Err(bad(
-            "a .off, .obj or .fold file, or one of tetrahedron, cube, octahedron, dodecahedron, icosahedron, truncated_tetrahedron, cuboctahedron, truncated_octahedron, box:AxBxC, prism:N[:H], antiprism:N[:H], pyramid:N[:H], polycube:X,Y,Z;…",
+            "a .off, .obj, .stl, .ply or .fold file, or one of tetrahedron, cube, octahedron, dodecahedron, icosahedron, truncated_tetrahedron, cuboctahedron, truncated_octahedron, box:AxBxC, prism:N[:H], antiprism:N[:H], pyramid:N[:H], polycube:X,Y,Z;…",
         )),
     };
-    Ok((shape.replace([':', ';', ',', '/'], "_"), solid))
+    Ok(OpenedSolid {
+        name: shape.replace([':', ';', ',', '/'], "_"),
+        solid,
+        reading: None,
+    })
+}
+
+/// The ranked nets of a shape: a file read as `options` say, or a generated solid; the
+/// file's reading goes into the report.
+pub fn nets_of_shape(shape: &str, options: &NetsOptions) -> Result<(OpenedSolid, NetsReport)> {
+    let opened = open_solid_with(shape, &options.solid_options())?;
+    let mut report = nets(&opened.name, &opened.solid, options)?;
+    report.reading = opened.reading.clone();
+    Ok((opened, report))
 }
 
 /// A ready device scene for a net whose crease pattern is the file `pattern_file` beside

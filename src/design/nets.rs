@@ -5,9 +5,12 @@
 use crate::design::closing::{ClosingSettings, NetClosingSummary};
 use crate::design::fabrication::Variation;
 use crate::error::{NanofoldError, Result};
+use crate::geometry::mesh::{MergeCoplanar, MeshReading};
 use crate::geometry::nets::NetLayout;
-use crate::geometry::polyhedron::Polyhedron;
-use crate::geometry::unfoldings::{distinct_among, distinct_nets, edge_map, sample_trees, spanning_trees, Tree};
+use crate::geometry::polyhedron::{Polyhedron, SymmetrySummary};
+use crate::geometry::unfoldings::{
+    check_orbits, distinct_among, distinct_nets, edge_map, sample_trees, spanning_trees, Tree,
+};
 use crate::pattern::net::{net_pattern, NetPattern};
 use serde::{Deserialize, Serialize};
 
@@ -92,6 +95,8 @@ pub struct NetsOptions {
     pub stress_spread_percent: f64,
     /// A seam latches when its edges meet within this share of its length, %.
     pub capture_percent: f64,
+    /// How a solid file's faces in one plane are read ([`MergeCoplanar`]).
+    pub merge_coplanar: MergeCoplanar,
 }
 
 impl Default for NetsOptions {
@@ -113,6 +118,7 @@ impl Default for NetsOptions {
             stiffness_spread_percent: 2.0,
             stress_spread_percent: 2.0,
             capture_percent: 10.0,
+            merge_coplanar: MergeCoplanar::Auto,
         }
     }
 }
@@ -187,6 +193,13 @@ impl NetsOptions {
         }
         self.variation().validate()?;
         self.closing().validate()
+    }
+
+    /// How these options read a solid file.
+    pub fn solid_options(&self) -> crate::read::solid::SolidOptions {
+        crate::read::solid::SolidOptions {
+            merge_coplanar: self.merge_coplanar,
+        }
     }
 
     /// The fabrication variation these options ask for.
@@ -267,6 +280,14 @@ pub struct NetsReport {
     pub symmetry_order: usize,
     /// Rotations among them.
     pub rotations: usize,
+    /// The symmetry group: its point group, the tolerance its maps were found within, and
+    /// how many near-symmetries were left out so that the rest form a group.
+    pub symmetry: SymmetrySummary,
+    /// A file's reading: its format, welded vertices, merged faces, precision and the
+    /// tolerances from it (absent for a generated solid).
+    pub reading: Option<MeshReading>,
+    /// What the answer should be read with (a near-symmetric solid's group).
+    pub warnings: Vec<String>,
     /// Spanning trees by the matrix-tree theorem.
     pub spanning_trees: f64,
     /// Enumerated or sampled.
@@ -360,7 +381,8 @@ pub fn apply_study(report: &mut NetsReport, summaries: Vec<(usize, NetClosingSum
 pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<NetsReport> {
     options.validate()?;
     let started = std::time::Instant::now();
-    let symmetries = solid.symmetries();
+    let group = solid.symmetry_group();
+    let symmetries = &group.elements;
     let maps: Vec<Vec<usize>> = symmetries.iter().map(|s| edge_map(solid, s)).collect();
     let count = solid.spanning_tree_count();
     let (search, trees) = if count <= options.max_trees as f64 {
@@ -369,7 +391,11 @@ pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<Net
         (Search::Sampled, sample_trees(solid, options.samples, options.seed)?)
     };
     let distinct = match search {
-        Search::Enumerated => distinct_nets(&trees, &maps),
+        Search::Enumerated => {
+            let distinct = distinct_nets(&trees, &maps);
+            check_orbits(trees.len(), &distinct, &maps)?;
+            distinct
+        }
         Search::Sampled => distinct_among(&trees, &maps),
     };
     let layout = NetLayout::new(solid);
@@ -434,6 +460,9 @@ pub fn nets(name: &str, solid: &Polyhedron, options: &NetsOptions) -> Result<Net
         vertices: solid.vertices.len(),
         symmetry_order: symmetries.len(),
         rotations: symmetries.iter().filter(|s| s.is_rotation()).count(),
+        symmetry: SymmetrySummary::from(&group),
+        reading: None,
+        warnings: group.warning().into_iter().collect(),
         spanning_trees: count,
         search,
         trees_considered: trees.len(),

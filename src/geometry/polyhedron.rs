@@ -3,9 +3,12 @@
 //! generated solids, the face-adjacency (dual) graph, its number of spanning trees (the edge
 //! unfoldings) and the solid's symmetry group found from its geometry.
 
+use super::point_group::{classify, PointGroup};
+use super::precision::{Precision, Tolerances};
 use super::surface_intersection::{first_self_intersection, newell_normal};
 use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, Matrix3, Point3, Vector3};
+use serde::Serialize;
 use std::collections::HashMap;
 
 /// Most vertices of a solid (the convex hull of a generated solid is found by brute force,
@@ -21,6 +24,8 @@ pub struct Polyhedron {
     pub vertices: Vec<Point3<f64>>,
     /// Each face's vertices, counter-clockwise seen from outside.
     pub faces: Vec<Vec<usize>>,
+    /// The tolerances its tests use, from its coordinates' precision.
+    pub tolerances: Tolerances,
 }
 
 /// An edge of the face-adjacency graph: two faces and the surface edge they share.
@@ -41,6 +46,66 @@ pub struct Symmetry {
     pub vertex_map: Vec<usize>,
     /// Where each face goes.
     pub face_map: Vec<usize>,
+    /// The largest distance between a vertex's image and the vertex it lands on.
+    pub residual: f64,
+}
+
+/// A solid's symmetry group, checked to be one: closed under composition and a point group.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SymmetryGroup {
+    /// Its elements, the identity first.
+    pub elements: Vec<Symmetry>,
+    /// Which point group it is.
+    pub point_group: PointGroup,
+    /// How far an image may land from its vertex (the solid's symmetry tolerance).
+    pub tolerance: f64,
+    /// The largest residual among the elements kept.
+    pub largest_residual: f64,
+    /// Maps found within the tolerance but left out because with them the set was no group
+    /// (the solid is near-symmetric at the tolerance's scale).
+    pub left_out: usize,
+}
+
+impl SymmetryGroup {
+    /// What the group is, in words, with a warning when near-symmetries were left out.
+    pub fn warning(&self) -> Option<String> {
+        (self.left_out > 0).then(|| {
+            format!(
+                "{} more maps send every vertex within {:.1e} of a vertex but do not close into a group with the others (the solid is nearly, not exactly, more symmetric at that scale): the group of the best-fitting maps, {} of order {}, is used (its maps within {:.1e})",
+                self.left_out, self.tolerance, self.point_group.name, self.point_group.order, self.largest_residual
+            )
+        })
+    }
+}
+
+/// The symmetry group as a report shows it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SymmetrySummary {
+    /// Schoenflies symbol.
+    pub point_group: String,
+    /// Order.
+    pub order: usize,
+    /// Rotations among them.
+    pub rotations: usize,
+    /// The tolerance a vertex's image was matched within.
+    pub tolerance: f64,
+    /// The largest residual among the kept maps.
+    pub largest_residual: f64,
+    /// Maps within the tolerance left out so that the rest form a group.
+    pub left_out: usize,
+}
+
+impl From<&SymmetryGroup> for SymmetrySummary {
+    fn from(group: &SymmetryGroup) -> Self {
+        SymmetrySummary {
+            point_group: group.point_group.name.clone(),
+            order: group.point_group.order,
+            rotations: group.point_group.rotations,
+            tolerance: group.tolerance,
+            largest_residual: group.largest_residual,
+            left_out: group.left_out,
+        }
+    }
 }
 
 impl Symmetry {
@@ -51,11 +116,23 @@ impl Symmetry {
 }
 
 impl Polyhedron {
-    /// A validated closed surface: every face of at least three distinct vertices, every
-    /// edge in exactly two faces that run it in opposite directions (closed, manifold,
-    /// consistently wound), faces planar to 1e-9 of the solid's size, wound outwards
-    /// (positive volume), and all of one piece. Errors name the face or edge and the value.
+    /// A validated closed surface of exactly known coordinates: every face of at least three
+    /// distinct vertices, every edge in exactly two faces that run it in opposite directions
+    /// (closed, manifold, consistently wound), faces planar to 1e-9 of the solid's size,
+    /// wound outwards (positive volume), and all of one piece. Errors name the face or edge
+    /// and the value.
     pub fn new(vertices: Vec<Point3<f64>>, faces: Vec<Vec<usize>>) -> Result<Polyhedron> {
+        Polyhedron::with_precision(vertices, faces, Precision::EXACT)
+    }
+
+    /// As [`Polyhedron::new`], its coordinates rounded by `precision` (a file's digits or
+    /// float width): planarity, convexity and self-intersection allow what that rounding can
+    /// do ([`Tolerances`]), and the solid carries them for its symmetry search.
+    pub fn with_precision(
+        vertices: Vec<Point3<f64>>,
+        faces: Vec<Vec<usize>>,
+        precision: Precision,
+    ) -> Result<Polyhedron> {
         if vertices.len() < 4 || vertices.len() > MAX_VERTICES {
             return Err(NanofoldError::invalid(
                 "vertices",
@@ -77,7 +154,12 @@ impl Polyhedron {
                 "a closed solid has at least 4 faces",
             ));
         }
-        let solid = Polyhedron { vertices, faces };
+        let size = size_of(&vertices);
+        let solid = Polyhedron {
+            vertices,
+            faces,
+            tolerances: Tolerances::new(precision, size),
+        };
         solid.check_faces()?;
         solid.check_edges()?;
         solid.check_pinched()?;
@@ -97,7 +179,7 @@ impl Polyhedron {
                 "a solid is one closed surface",
             ));
         }
-        if let Some((f, g)) = first_self_intersection(&solid.vertices, &solid.faces, 1e-9 * solid.size()) {
+        if let Some((f, g)) = first_self_intersection(&solid.vertices, &solid.faces, solid.tolerances.planarity) {
             return Err(NanofoldError::invalid(
                 format!("faces[{f}]"),
                 format!("meets faces[{g}]"),
@@ -206,13 +288,23 @@ impl Polyhedron {
     }
 
     /// The size the tolerances are relative to: the largest distance from the centroid.
-    fn size(&self) -> f64 {
-        let c = self.centroid();
-        self.vertices.iter().map(|p| (p - c).norm()).fold(0.0, f64::max)
+    pub fn size(&self) -> f64 {
+        self.tolerances.size
     }
 
     fn check_planar(&self) -> Result<()> {
         let size = self.size();
+        let tolerance = self.tolerances.planarity;
+        let within = || {
+            if self.tolerances.rounded() {
+                format!(
+                    "{tolerance:.1e}, what coordinates rounded to {} can be off",
+                    self.tolerances.precision.describe()
+                )
+            } else {
+                format!("{tolerance:.1e}, 1e-9 of the solid's size")
+            }
+        };
         for f in 0..self.faces.len() {
             let (normal, centre) = (self.face_normal(f), self.face_centroid(f));
             if normal.norm() <= 1e-12 * size * size {
@@ -227,25 +319,30 @@ impl Polyhedron {
                 .iter()
                 .map(|&v| (self.vertices[v] - centre).dot(&unit).abs())
                 .fold(0.0, f64::max);
-            if off > 1e-9 * size {
+            if off > tolerance {
                 return Err(NanofoldError::invalid(
                     format!("faces[{f}]"),
-                    format!("a vertex {off:e} off its plane"),
-                    format!("faces must be planar (to 1e-9 of the solid's size, {size:e})"),
+                    format!("a vertex {off:.3e} off its plane"),
+                    format!("faces must be planar (to {})", within()),
                 ));
             }
             let face = &self.faces[f];
             for k in 0..face.len() {
                 let [a, b, c] = [0, 1, 2].map(|i| self.vertices[face[(k + i) % face.len()]]);
-                let turn = (b - a).cross(&(c - b)).dot(&unit);
-                if turn < -1e-9 * size * size {
+                // c's distance from the line through a and b, on the inner side when positive.
+                let turn = (b - a).cross(&(c - b)).dot(&unit) / (b - a).norm();
+                if turn < -tolerance {
                     return Err(NanofoldError::invalid(
                         format!("faces[{f}]"),
                         format!(
-                            "corner at vertex {} turns {turn:e} the wrong way",
-                            face[(k + 1) % face.len()]
+                            "corner at vertex {} turns {:.3e} the wrong way",
+                            face[(k + 1) % face.len()],
+                            -turn
                         ),
-                        "faces must be convex (split a concave face into convex ones)",
+                        format!(
+                            "faces must be convex, to {} (split a concave face into convex ones)",
+                            within()
+                        ),
                     ));
                 }
             }
@@ -348,14 +445,74 @@ impl Polyhedron {
         }
     }
 
-    /// Every isometry about the centroid that maps the solid onto itself (rotations and
-    /// reflections): face 0's first edge and normal are sent to each face's edges, both ways
-    /// round (the other way is a reflection), and a candidate is kept when it is orthogonal
-    /// and maps every vertex onto a vertex and every face onto a face.
+    /// The elements of the solid's symmetry group ([`Polyhedron::symmetry_group`]).
     pub fn symmetries(&self) -> Vec<Symmetry> {
+        self.symmetry_group().elements
+    }
+
+    /// Every isometry about the centroid that maps the solid onto itself (rotations and
+    /// reflections), checked to be a group.
+    ///
+    /// A candidate sends face 0's first edge and normal to each face's edges, both ways
+    /// round (the other way is a reflection); each vertex's image is matched to the nearest
+    /// vertex within half the closest two vertices' distance, the map refitted to those
+    /// pairs (Kabsch), and kept when every vertex lands within the symmetry tolerance and
+    /// every face on a face. The maps kept must close under composition: while they do not,
+    /// the map of largest residual is left out (a near-symmetry of rounded data), and the
+    /// set that closes is named as a point group ([`classify`]) or cut further.
+    pub fn symmetry_group(&self) -> SymmetryGroup {
+        let tolerance = self.tolerances.symmetry;
+        let identity: Vec<usize> = (0..self.vertices.len()).collect();
+        let mut found = self.isometries(tolerance);
+        found.retain(|s| s.vertex_map != identity);
+        found.sort_by(|a, b| a.residual.total_cmp(&b.residual));
+        found.insert(
+            0,
+            Symmetry {
+                matrix: Matrix3::identity(),
+                vertex_map: identity,
+                face_map: (0..self.faces.len()).collect(),
+                residual: 0.0,
+            },
+        );
+        let mut left_out = 0;
+        // A fitted map's turn is off by about its residual over the size.
+        let angle_tolerance = 1e-6_f64.max(2.0 * tolerance / self.size());
+        while found.len() > 1 {
+            if closed(&found) {
+                let matrices: Vec<Matrix3<f64>> = found.iter().map(|s| s.matrix).collect();
+                if let Some(point_group) = classify(&matrices, angle_tolerance) {
+                    let largest_residual = found.iter().map(|s| s.residual).fold(0.0, f64::max);
+                    return SymmetryGroup {
+                        elements: found,
+                        point_group,
+                        tolerance,
+                        largest_residual,
+                        left_out,
+                    };
+                }
+            }
+            // The identity (first) stays: at worst the trivial group is left.
+            found.pop();
+            left_out += 1;
+        }
+        SymmetryGroup {
+            elements: found,
+            point_group: PointGroup {
+                name: "C1".into(),
+                order: 1,
+                rotations: 1,
+            },
+            tolerance,
+            largest_residual: 0.0,
+            left_out,
+        }
+    }
+
+    /// Every map about the centroid found by the candidates, its residual within `tolerance`.
+    fn isometries(&self, tolerance: f64) -> Vec<Symmetry> {
         let c = self.centroid();
         let size = self.size();
-        let tolerance = 1e-7 * size;
         let frame = |f: usize, a: usize, b: usize| {
             let n = self.face_normal(f).normalize() * size;
             Matrix3::from_columns(&[self.vertices[a] - c, self.vertices[b] - c, n])
@@ -374,7 +531,8 @@ impl Polyhedron {
                 (key, f)
             })
             .collect();
-        let mut found = Vec::new();
+        let lookup = NearestVertex::new(&self.vertices);
+        let mut found: Vec<Symmetry> = Vec::new();
         for (g, face) in self.faces.iter().enumerate() {
             if face.len() != base_face.len() {
                 continue;
@@ -388,14 +546,12 @@ impl Polyhedron {
                     } else {
                         (face[k], face[(k + 1) % face.len()])
                     };
-                    let matrix = frame(g, a, b) * base_inverse;
-                    if (matrix.transpose() * matrix - Matrix3::identity()).norm() > 1e-7 {
+                    let guess = frame(g, a, b) * base_inverse;
+                    let Some(symmetry) = self.as_symmetry(guess, !reflected, c, &lookup, tolerance, &face_keys) else {
                         continue;
-                    }
-                    if let Some(symmetry) = self.as_symmetry(matrix, c, tolerance, &face_keys) {
-                        if !found.iter().any(|s: &Symmetry| s.vertex_map == symmetry.vertex_map) {
-                            found.push(symmetry);
-                        }
+                    };
+                    if !found.iter().any(|s| s.vertex_map == symmetry.vertex_map) {
+                        found.push(symmetry);
                     }
                 }
             }
@@ -403,17 +559,42 @@ impl Polyhedron {
         found
     }
 
+    /// The map near `guess` that sends the solid onto itself: vertices matched to their
+    /// images' nearest, the orthogonal map of determinant ±1 (`proper`) fitted to the
+    /// pairs, kept when every vertex lands within `tolerance` and faces on faces.
     fn as_symmetry(
         &self,
-        matrix: Matrix3<f64>,
+        guess: Matrix3<f64>,
+        proper: bool,
         c: Point3<f64>,
+        lookup: &NearestVertex,
         tolerance: f64,
         face_keys: &HashMap<Vec<usize>, usize>,
     ) -> Option<Symmetry> {
         let mut vertex_map = Vec::with_capacity(self.vertices.len());
+        let mut taken = vec![false; self.vertices.len()];
         for p in &self.vertices {
-            let image = c + matrix * (p - c);
-            vertex_map.push(self.vertices.iter().position(|q| (q - image).norm() <= tolerance)?);
+            let w = lookup.nearest(&(c + guess * (p - c)))?;
+            if std::mem::replace(&mut taken[w], true) {
+                return None;
+            }
+            vertex_map.push(w);
+        }
+        let matrix = kabsch(
+            self.vertices
+                .iter()
+                .zip(&vertex_map)
+                .map(|(p, &w)| (p - c, self.vertices[w] - c)),
+            proper,
+        )?;
+        let residual = self
+            .vertices
+            .iter()
+            .zip(&vertex_map)
+            .map(|(p, &w)| (c + matrix * (p - c) - self.vertices[w]).norm())
+            .fold(0.0, f64::max);
+        if residual > tolerance {
+            return None;
         }
         let mut face_map = Vec::with_capacity(self.faces.len());
         for face in &self.faces {
@@ -425,6 +606,103 @@ impl Polyhedron {
             matrix,
             vertex_map,
             face_map,
+            residual,
         })
+    }
+}
+
+/// The largest distance of a vertex from the vertices' centroid.
+fn size_of(vertices: &[Point3<f64>]) -> f64 {
+    let c = Point3::from(vertices.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / vertices.len() as f64);
+    vertices.iter().map(|p| (p - c).norm()).fold(0.0, f64::max)
+}
+
+/// Whether the maps (by their vertex permutations) hold the identity and every composition
+/// of two of them.
+fn closed(maps: &[Symmetry]) -> bool {
+    let index: HashMap<&[usize], usize> = maps
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (s.vertex_map.as_slice(), k))
+        .collect();
+    let n = maps.first().map_or(0, |s| s.vertex_map.len());
+    let identity: Vec<usize> = (0..n).collect();
+    if !index.contains_key(identity.as_slice()) {
+        return false;
+    }
+    let mut composed = vec![0; n];
+    maps.iter().all(|a| {
+        maps.iter().all(|b| {
+            for (v, slot) in composed.iter_mut().enumerate() {
+                *slot = a.vertex_map[b.vertex_map[v]];
+            }
+            index.contains_key(composed.as_slice())
+        })
+    })
+}
+
+/// The orthogonal map R of determinant +1 (`proper`) or −1 minimising Σ |R a − b|² over the
+/// pairs (Kabsch): R = V diag(1, 1, ±1) Uᵀ from the SVD of Σ a bᵀ = U Σ Vᵀ.
+fn kabsch(pairs: impl Iterator<Item = (Vector3<f64>, Vector3<f64>)>, proper: bool) -> Option<Matrix3<f64>> {
+    let covariance = pairs.fold(Matrix3::zeros(), |h, (a, b)| h + a * b.transpose());
+    let svd = covariance.svd(true, true);
+    let (u, v_t) = (svd.u?, svd.v_t?);
+    let mut d = Matrix3::identity();
+    let sign = (v_t.transpose() * u.transpose()).determinant().signum();
+    d[(2, 2)] = if proper { sign } else { -sign };
+    Some(v_t.transpose() * d * u.transpose())
+}
+
+/// The nearest vertex to a point, among those closer than half the smallest distance
+/// between two vertices (so at most one is), by a grid of that cell size.
+struct NearestVertex<'a> {
+    vertices: &'a [Point3<f64>],
+    radius: f64,
+    cells: HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl<'a> NearestVertex<'a> {
+    fn new(vertices: &'a [Point3<f64>]) -> Self {
+        let mut closest = f64::INFINITY;
+        for (i, p) in vertices.iter().enumerate() {
+            for q in &vertices[i + 1..] {
+                closest = closest.min((p - q).norm());
+            }
+        }
+        let radius = 0.5 * closest;
+        let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+        for (k, p) in vertices.iter().enumerate() {
+            cells.entry(Self::cell(p, radius)).or_default().push(k);
+        }
+        NearestVertex {
+            vertices,
+            radius,
+            cells,
+        }
+    }
+
+    fn cell(p: &Point3<f64>, radius: f64) -> [i64; 3] {
+        [0, 1, 2].map(|i| (p[i] / radius).floor() as i64)
+    }
+
+    fn nearest(&self, p: &Point3<f64>) -> Option<usize> {
+        if self.radius.is_nan() || self.radius <= 0.0 {
+            return None;
+        }
+        let [x, y, z] = Self::cell(p, self.radius);
+        let mut best: Option<(f64, usize)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &k in self.cells.get(&[x + dx, y + dy, z + dz]).into_iter().flatten() {
+                        let d = (self.vertices[k] - p).norm();
+                        if d < self.radius && best.is_none_or(|(b, _)| d < b) {
+                            best = Some((d, k));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, k)| k)
     }
 }

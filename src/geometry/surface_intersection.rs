@@ -99,7 +99,15 @@ fn faces_meet(
     tolerance: f64,
 ) -> Option<Point3<f64>> {
     let direction = plane_a.0.cross(&plane_b.0);
-    if direction.norm() < 1e-9 {
+    // Planes at an angle that moves no corner by more than the tolerance are one plane (the
+    // faces of a rounded file that lie in one plane are at such angles).
+    let centre = a.iter().chain(b).fold(Vector3::zeros(), |s, p| s + p.coords) / (a.len() + b.len()) as f64;
+    let extent = a
+        .iter()
+        .chain(b)
+        .map(|p| (p.coords - centre).norm())
+        .fold(0.0, f64::max);
+    if direction.norm() < 1e-9 || direction.norm() * extent <= tolerance {
         // Parallel planes: apart, or one plane, where the faces meet if their outlines
         // overlap with area (faces glued back to back, or folded flat onto each other).
         if (plane_a.1 - plane_a.0.dot(&plane_b.0) * plane_b.1).abs() > tolerance {

@@ -152,6 +152,36 @@ pub fn distinct_nets(trees: &[Tree], maps: &[Vec<usize>]) -> Vec<Tree> {
     representatives
 }
 
+/// Checks the nets against the orbit–stabiliser theorem before they are counted: each net's
+/// orbit (its distinct images) has a size that divides the group's order, and the orbits of
+/// all the nets together hold every tree once. A set of maps that is not a group breaks it.
+pub fn check_orbits(trees: usize, nets: &[Tree], maps: &[Vec<usize>]) -> Result<()> {
+    let mut total = 0usize;
+    let mut images = Vec::with_capacity(maps.len());
+    for &tree in nets {
+        images.clear();
+        images.extend(maps.iter().map(|m| image(tree, m)));
+        images.sort_unstable();
+        images.dedup();
+        if !maps.len().is_multiple_of(images.len()) {
+            return Err(NanofoldError::invalid(
+                "symmetries",
+                format!("an orbit of {} trees under {} maps", images.len(), maps.len()),
+                "an orbit's size divides the group's order: the maps are not a group",
+            ));
+        }
+        total += images.len();
+    }
+    if total != trees {
+        return Err(NanofoldError::invalid(
+            "symmetries",
+            format!("orbits of {total} trees in all, of {trees}"),
+            "the nets' orbits hold every tree once: the maps are not a group",
+        ));
+    }
+    Ok(())
+}
+
 /// One tree of each distinct net among some of a solid's trees (a sample): each tree's
 /// class is its smallest image, the classes in the order first met.
 pub fn distinct_among(trees: &[Tree], maps: &[Vec<usize>]) -> Vec<Tree> {

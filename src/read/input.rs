@@ -17,6 +17,18 @@ pub const MAX_SCENE_BYTES: u64 = 1 << 20;
 
 /// The text of a regular file of at most `limit` bytes.
 pub fn read_text(path: &Path, limit: u64) -> Result<String> {
+    let bytes = read_bytes(path, limit)?;
+    String::from_utf8(bytes).map_err(|e| {
+        NanofoldError::invalid(
+            path.display().to_string(),
+            format!("byte {} is not UTF-8", e.utf8_error().valid_up_to()),
+            "a text file (UTF-8) was expected",
+        )
+    })
+}
+
+/// The bytes of a regular file of at most `limit` bytes.
+pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>> {
     let io = |source| NanofoldError::Io {
         path: path.display().to_string(),
         source,
@@ -33,13 +45,13 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String> {
         return Err(too_large(path, metadata.len(), limit));
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let mut text = String::new();
+    let mut bytes = Vec::new();
     // The size can change between the check and the read: read at most one byte more.
-    file.take(limit + 1).read_to_string(&mut text).map_err(io)?;
-    if text.len() as u64 > limit {
-        return Err(too_large(path, text.len() as u64, limit));
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(path, bytes.len() as u64, limit));
     }
-    Ok(text)
+    Ok(bytes)
 }
 
 fn too_large(path: &Path, size: u64, limit: u64) -> NanofoldError {
