@@ -806,6 +806,7 @@ pub fn unfold_observed(
 /// crease pattern of many vertices by its state (rigid, not rigid, self-intersecting) or,
 /// flat, by its assignment (rigidly foldable or not, with a witness path).
 pub fn check(pattern: &Pattern, settings: &Settings) -> Result<Report<CheckVerdict>> {
+    settings.check.validate()?;
     match pattern.vertex() {
         Some(vertex) => Ok(
             vertex_report(pattern, vertex, CommandKind::Check, settings, None)?.map_verdict(CheckVerdict::Unfolding)

@@ -328,9 +328,9 @@ fn cases() -> Vec<Case> {
                         for bad in BAD {
                             let value = slot.replace("{}", bad);
                             let mut args: Vec<String> = base.iter().map(|s| s.to_string()).collect();
-                            // A repeatable option is added beside the run's own.
-                            let repeatable = matches!(arg.get_action(), clap::ArgAction::Append);
-                            if let (Some(long), false) = (&flag, repeatable) {
+                            // The option's value replaces the run's own (a repeatable one's too:
+                            // `fit --free` alone, not beside the run's).
+                            if let Some(long) = &flag {
                                 args = without(&args, long, true);
                             }
                             for (context_flag, context_value) in &context {

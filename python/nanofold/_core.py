@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import os
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, TypeVar, Union
@@ -12,7 +13,7 @@ import numpy as np
 
 from . import _native
 from ._results import FitResult, FoldResult, NetsResult, PatternResult, Result, SimulationResult
-from .errors import NanofoldError, from_native
+from .errors import InvalidFieldError, NanofoldError, from_native
 
 T = TypeVar("T")
 PathLike = Union[str, "os.PathLike[str]"]
@@ -29,7 +30,23 @@ def _call(function: Callable[..., T], *args: Any) -> T:
 
 
 def _settings(values: Mapping[str, Any]) -> str:
-    """Keywords as the JSON the extension reads; None means "the library's default"."""
+    """Keywords as the JSON the extension reads; None means "the library's default". A NaN
+    or an infinity (which JSON cannot carry) is refused here, naming its keyword."""
+    def finite(key: str, v: Any) -> None:
+        if isinstance(v, (float, np.floating)) and not math.isfinite(float(v)):
+            raise InvalidFieldError(
+                f"invalid `{key}`: {v} (a number must be finite)", "invalid_field", key, str(v)
+            )
+        if isinstance(v, Mapping):
+            for x in v.values():
+                finite(key, x)
+        elif isinstance(v, (list, tuple, np.ndarray)):
+            for x in v:
+                finite(key, x)
+
+    for key, v in values.items():
+        finite(key, v)
+
     def plain(v: Any) -> Any:
         if isinstance(v, np.generic):
             return v.item()
@@ -522,11 +539,14 @@ def nets(
     stiffness_spread_percent: Optional[float] = None,
     stress_spread_percent: Optional[float] = None,
     capture_percent: Optional[float] = None,
+    merge_coplanar: Optional[str] = None,
     client: Any = "threads",
     progress: bool = True,
 ) -> NetsResult:
     """The distinct nets of a solid and their simulated self-folding (``nanofold nets``):
-    ``shape`` is a .off, .obj or .fold file, or a generated solid (``"cube"``,
+    ``shape`` is an .obj, .stl, .ply, .off or .fold file (read with the precision of its own
+    digits or float width; ``merge_coplanar``: ``"auto"``, ``"always"`` or ``"never"``, as
+    ``--merge-coplanar``), or a generated solid (``"cube"``,
     ``"box:1x2x3"``, ``"prism:6"``, ``"polycube:0,0,0;1,0,0"``, ...). Every net is laid flat,
     tested for overlap and scored (radius of gyration, leaves, seam length, footprint);
     ``rank_by`` is ``"radius_of_gyration"`` (default), ``"seam_length"``, ``"footprint"`` or
@@ -552,7 +572,7 @@ def nets(
                     overdrive_deg=overdrive_deg, front_deg=front_deg, etch_rate_um_per_min=etch_rate_um_per_min,
                     anchored_face=anchored_face, simulate=simulate, fronts=fronts, yield_samples=yield_samples,
                     stiffness_spread_percent=stiffness_spread_percent, stress_spread_percent=stress_spread_percent,
-                    capture_percent=capture_percent)
+                    capture_percent=capture_percent, merge_coplanar=merge_coplanar)
     settings = _settings(keywords)
     shape_text = os.fspath(shape)
     if isinstance(client, str) and client == "threads":

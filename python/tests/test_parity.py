@@ -86,7 +86,7 @@ def _first_crease(path):
     return int(label.split("[")[1].rstrip("]"))
 
 
-@pytest.mark.parametrize("shape", ["cube", "box:1x2x3", "pyramid:5:1.5"])
+@pytest.mark.parametrize("shape", ["cube", "box:1x2x3", "pyramid:5:1.5", "patterns/solids/cube_binary.stl"])
 def test_nets_equal_the_command_line(shape, tmp_path):
     result = nanofold.nets(shape, top=4, rank_by="seam_length", simulate=2, fronts=3, yield_samples=4)
     expected = cli_json("nets", shape, "--top", "4", "--rank-by", "seam-length", "--simulate", "2", "--fronts", "3",

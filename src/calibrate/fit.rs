@@ -541,6 +541,7 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
     settings.validate()?;
     let parameters = resolve(document, &settings.free)?;
     let scene = document.spec()?.build()?;
+    within_the_scenes_ranges(document, &parameters)?;
     let outputs = map_columns(&scene, measurement)?;
     let m = parameters.len();
     let n = measurement.observations();
@@ -593,6 +594,27 @@ pub fn fit(document: &SceneDocument, measurement: &Measurement, settings: &FitSe
         fitted_scene: absolute_pattern(&fitted),
         ..report
     })
+}
+
+/// Every parameter at each of its bounds (the others at their starts) still makes a valid
+/// scene: a bound the scene refuses (a negative drag coefficient) is refused as the
+/// parameter's, before the fit would step there.
+fn within_the_scenes_ranges(document: &SceneDocument, parameters: &[ResolvedParameter]) -> Result<()> {
+    let starts: Vec<f64> = parameters.iter().map(|p| p.start).collect();
+    for (k, parameter) in parameters.iter().enumerate() {
+        for bound in [parameter.lower, parameter.upper] {
+            let mut values = starts.clone();
+            values[k] = bound;
+            if let Err(error) = with_values(document, parameters, &values).spec().and_then(|spec| spec.build()) {
+                return Err(NanofoldError::invalid(
+                    format!("free[{k}].bounds"),
+                    format!("{}:{}", parameter.lower, parameter.upper),
+                    format!("at {bound} the scene is refused: {error}"),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// What the report's numbers do not say by themselves.

@@ -201,7 +201,7 @@ impl ConstraintSettings {
 /// Sweeps the driver across its range by exact loop closure and fits every free crease.
 pub fn constraints(pattern: &Pattern, settings: &ConstraintSettings) -> Result<Constraints> {
     settings.validate()?;
-    match pattern.vertex() {
+    let swept = match pattern.vertex() {
         Some(vertex) => vertex_constraints(vertex, settings),
         None => {
             let model = pattern
@@ -209,7 +209,16 @@ pub fn constraints(pattern: &Pattern, settings: &ConstraintSettings) -> Result<C
                 .ok_or_else(|| NanofoldError::invalid("pattern", pattern.name(), "has neither a vertex nor a sheet"))?;
             network_constraints(model, settings)
         }
-    }
+    };
+    // A sweep that cannot go on says which settings set it going.
+    swept.map_err(|error| match error {
+        NanofoldError::Unreachable { what, reached, reason } => NanofoldError::Unreachable {
+            what: format!("{what} (sweeping `drive` over `range`, every `lock` held)"),
+            reached,
+            reason,
+        },
+        other => other,
+    })
 }
 
 fn vertex_constraints(pattern: &crate::pattern::VertexPattern, settings: &ConstraintSettings) -> Result<Constraints> {

@@ -58,6 +58,21 @@ impl Default for CheckSettings {
     }
 }
 
+impl CheckSettings {
+    /// Refuses a closure tolerance outside (0, 0.1] rad by name (the contact and path
+    /// settings check themselves where they are used).
+    pub fn validate(&self) -> crate::error::Result<()> {
+        if !(self.closure_tol > 0.0 && self.closure_tol <= 0.1) {
+            return Err(crate::error::NanofoldError::invalid(
+                "closure_tol",
+                self.closure_tol,
+                "a closure tolerance lies in (0, 0.1] rad",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A check's verdict with its evidence.
 #[derive(Debug, Clone)]
 pub struct CheckReport {
