@@ -16,7 +16,7 @@
 //! Run: `cargo run --release --example vertex_limits [N ...]` (default 128 256 400 512).
 
 use nanofold::geometry::kinematics::solve_closure;
-use nanofold::prelude::{check, LoadOptions, Pattern, Settings};
+use nanofold::prelude::{check, LoadOptions, Named, Pattern, Settings};
 use std::time::Instant;
 
 /// splitmix64 in [0, 1).
@@ -65,7 +65,13 @@ fn seeded(n: usize, amplitude: f64, seed: u64) -> Option<String> {
 fn fan(n: usize) -> String {
     let sectors = vec![std::f64::consts::TAU / n as f64; n];
     let creases: Vec<(char, f64)> = (0..n)
-        .map(|k| if k == 0 || k == n / 2 { ('V', 60f64.to_radians()) } else { ('U', 0.0) })
+        .map(|k| {
+            if k == 0 || k == n / 2 {
+                ('V', 60f64.to_radians())
+            } else {
+                ('U', 0.0)
+            }
+        })
         .collect();
     native(&sectors, &creases)
 }
@@ -77,7 +83,7 @@ fn few_folded(n: usize, base_deg: [f64; 4], folds_deg: [f64; 4], assignments: [c
     let mut sectors = Vec::new();
     let mut creases = Vec::new();
     for k in 0..4 {
-        let pieces = ((base_deg[k] / mean).round() as usize).max(1);
+        let pieces = ((base_deg[k] / mean).floor() as usize).max(1);
         let weights: Vec<f64> = (0..pieces).map(|_| 0.7 + 0.5 * draws.next()).collect();
         let total: f64 = weights.iter().sum();
         creases.push((assignments[k], folds_deg[k].to_radians()));
@@ -106,7 +112,11 @@ fn degree4_folded(sectors_deg: [f64; 4], first_deg: f64) -> Option<[f64; 4]> {
 
 fn main() {
     let sizes: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
-    let sizes = if sizes.is_empty() { vec![128, 256, 400, 512] } else { sizes };
+    let sizes = if sizes.is_empty() {
+        vec![128, 256, 400, 512]
+    } else {
+        sizes
+    };
     // The generic vertex of patterns/degree4_native.json, and a second one folded by Newton
     // from near flat (its first crease driven to 120°, the other three following).
     let generic = (
@@ -119,14 +129,21 @@ fn main() {
         let assignments = folds.map(|f: f64| if f >= 0.0 { 'V' } else { 'M' });
         (second_sectors, folds, assignments)
     });
-    println!("{:<18} {:>6} {:>5} {:>18} {:>9} {:>10}", "family", "rays", "seed", "verdict", "steps", "seconds");
+    println!(
+        "{:<18} {:>6} {:>5} {:>18} {:>9} {:>10}",
+        "family", "rays", "seed", "verdict", "steps", "seconds"
+    );
     let mut worst: (f64, String) = (0.0, String::new());
     for &n in &sizes {
         let mut cases: Vec<(String, u64, Option<String>)> = Vec::new();
         for seed in 1..=3 {
             cases.push(("seeded".into(), seed, seeded(n, 0.3, seed)));
             cases.push(("seeded_large".into(), seed, seeded(n, 0.75, seed)));
-            cases.push(("few_folded".into(), seed, Some(few_folded(n, generic.0, generic.1, generic.2, seed))));
+            cases.push((
+                "few_folded".into(),
+                seed,
+                Some(few_folded(n, generic.0, generic.1, generic.2, seed)),
+            ));
             cases.push((
                 "few_folded_second".into(),
                 seed,
@@ -150,7 +167,7 @@ fn main() {
             let outcome = check(&pattern, &Settings::default());
             let seconds = started.elapsed().as_secs_f64();
             let (verdict, steps) = match &outcome {
-                Ok(report) => (report.verdict.to_string(), report.steps),
+                Ok(report) => (report.verdict.as_str().to_string(), report.steps),
                 Err(e) => (format!("error: {e}"), 0),
             };
             println!("{family:<18} {n:>6} {seed:>5} {verdict:>18} {steps:>9} {seconds:>10.2}");

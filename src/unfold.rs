@@ -296,7 +296,18 @@ fn verdict(solver: &ProjectedGradient, settings: &UnfoldSettings) -> (Verdict, S
             dof,
             largest,
         }) => {
-            let why = if stationary { "stationary" } else { "iteration limit" };
+            let budget = solver::step_budget(settings.max_iterations, model.node_count);
+            let why = if stationary {
+                "stationary".to_string()
+            } else if budget < settings.max_iterations {
+                format!(
+                    "work bound ({budget} steps for {} nodes, {} node pairs in all)",
+                    model.node_count,
+                    solver::DESCENT_WORK
+                )
+            } else {
+                "iteration limit".to_string()
+            };
             if settings.restarts == 0 || !stationary {
                 (
                     Verdict::Stuck,

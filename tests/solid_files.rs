@@ -101,6 +101,28 @@ fn ply(vertices: &[Point3<f64>], faces: &[Vec<usize>]) -> String {
     text
 }
 
+/// Binary little-endian PLY with float coordinates and uint8-counted int indices.
+fn binary_ply(vertices: &[Point3<f64>], faces: &[Vec<usize>]) -> Vec<u8> {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        faces.len()
+    )
+    .into_bytes();
+    for p in vertices {
+        for x in p.coords.iter() {
+            bytes.extend((*x as f32).to_le_bytes());
+        }
+    }
+    for f in faces {
+        bytes.push(f.len() as u8);
+        for &v in f {
+            bytes.extend((v as i32).to_le_bytes());
+        }
+    }
+    bytes
+}
+
 fn read_bytes(bytes: &[u8], format: &str) -> nanofold::Result<Polyhedron> {
     Ok(parse_solid(bytes, format, &format!("test.{format}"), &SolidOptions::default())?.0)
 }
@@ -167,6 +189,7 @@ fn solids_written_by_mesh_tools_read_back_with_their_group_and_nets() {
             ));
             files.push(("binary STL".into(), binary_stl(&vertices, &solid.faces), "stl"));
             files.push(("ASCII PLY".into(), ply(&vertices, &solid.faces).into_bytes(), "ply"));
+            files.push(("binary PLY".into(), binary_ply(&vertices, &solid.faces), "ply"));
             for (what, bytes, format) in files {
                 let read = read_bytes(&bytes, format).unwrap_or_else(|e| panic!("{name}, {what}: {e}"));
                 let group_read = read.symmetry_group();

@@ -605,7 +605,10 @@ fn within_the_scenes_ranges(document: &SceneDocument, parameters: &[ResolvedPara
         for bound in [parameter.lower, parameter.upper] {
             let mut values = starts.clone();
             values[k] = bound;
-            if let Err(error) = with_values(document, parameters, &values).spec().and_then(|spec| spec.build()) {
+            if let Err(error) = with_values(document, parameters, &values)
+                .spec()
+                .and_then(|spec| spec.build())
+            {
                 return Err(NanofoldError::invalid(
                     format!("free[{k}].bounds"),
                     format!("{}:{}", parameter.lower, parameter.upper),

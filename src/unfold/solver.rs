@@ -149,6 +149,17 @@ enum Phase {
     Done,
 }
 
+/// The most node pairs the descent evaluates, summed over its steps (each step's energy is
+/// O(n²) in the nodes): a vertex of many rays hands over to the folding-path witness after
+/// about this much work instead of creeping to flat (`docs/model.md#unfolding`).
+pub const DESCENT_WORK: usize = 60_000_000;
+
+/// The steps the descent takes at most: `max_iterations`, and no more than [`DESCENT_WORK`]
+/// allows for `nodes` nodes (at least 100).
+pub fn step_budget(max_iterations: usize, nodes: usize) -> usize {
+    max_iterations.min((DESCENT_WORK / (nodes * nodes).max(1)).max(100))
+}
+
 /// The iterating solver: the model, the energy, the state (nodes) and the driver's phase.
 pub struct ProjectedGradient<'a> {
     model: &'a UnfoldModel,
@@ -197,6 +208,7 @@ impl<'a> ProjectedGradient<'a> {
         settings.validate()?;
         let mut settings = settings.clone();
         settings.restore_tol = model.restore_tolerance(settings.restore_tol);
+        settings.max_iterations = step_budget(settings.max_iterations, model.node_count);
         let settings = &settings;
         let energy = settings.energy.build(settings.p);
         let mut ws = Workspace::new(model);
