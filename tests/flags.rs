@@ -181,7 +181,7 @@ fn contexts(option: &str) -> Vec<Vec<(&'static str, Option<&'static str>)>> {
 fn templates(option: &str) -> Option<Vec<&'static str>> {
     Some(match option {
         "fold --drive" => vec!["4={}"],
-        "constraints --lock" => vec!["1={}"],
+        "constraints --lock" => vec!["5={}"],
         "constraints --check" => vec!["1={},0.5"],
         "constraints --degree" => vec!["{}"],
         "constraints --range" => vec!["{}:20", "0:{}"],

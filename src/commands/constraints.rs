@@ -432,7 +432,27 @@ fn network_constraints(model: &FoldingModel, settings: &ConstraintSettings) -> R
     });
     within_sweep_work(&model, settings.samples)?;
     // The sweep's points are fitted and the midpoints between them checked.
-    let sweep = network_sweep(&model, &rho, driver, domain, settings.samples.div_ceil(2).max(2))?;
+    // Held creases that leave the state no motion (or more than one) are the holder's doing.
+    let held_by = if !settings.lock.is_empty() {
+        Some("lock")
+    } else if !settings.free.is_empty() {
+        Some("free")
+    } else {
+        None
+    };
+    let sweep =
+        network_sweep(&model, &rho, driver, domain, settings.samples.div_ceil(2).max(2)).map_err(|error| {
+            match (error, held_by) {
+                (NanofoldError::InvalidField { field, value, reason }, Some(held)) if field == "fold angles" => {
+                    NanofoldError::InvalidField {
+                        field: held.into(),
+                        value: format!("{value} with the creases held"),
+                        reason,
+                    }
+                }
+                (other, _) => other,
+            }
+        })?;
     let curves = match settings.degree {
         Degree::Fixed(d) => fit_network(&model, &sweep, d)?,
         Degree::Auto { tol, at_most } if at_most < crate::constraints::MAX_DEGREE => {
