@@ -393,3 +393,48 @@ fn bad_stl_and_ply_files_are_refused_where_the_fault_is() {
     let open: Vec<Vec<usize>> = cube.faces[1..].to_vec();
     refused(&binary_stl(&cube.vertices, &open), "stl", &["not closed"]);
 }
+
+mod fuzz {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The bundled mesh files, each with its format.
+    fn files() -> Vec<(Vec<u8>, &'static str)> {
+        let cube = solids::cube().unwrap();
+        let vertices = placed(&cube, 0.1);
+        vec![
+            (obj(&vertices, &cube.faces, 6).into_bytes(), "obj"),
+            (ascii_stl(&vertices, &cube.faces).into_bytes(), "stl"),
+            (binary_stl(&vertices, &cube.faces), "stl"),
+            (ply(&vertices, &cube.faces).into_bytes(), "ply"),
+            (binary_ply(&vertices, &cube.faces), "ply"),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+
+        /// Bytes changed anywhere in a mesh file: a solid or an error, never a panic.
+        #[test]
+        fn mutated_mesh_files_never_panic(
+            file in any::<prop::sample::Index>(),
+            edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6),
+        ) {
+            let all = files();
+            let (mut bytes, format) = all[file.index(all.len())].clone();
+            for (at, byte) in edits {
+                let k = at.index(bytes.len());
+                bytes[k] = byte;
+            }
+            let _ = parse_solid(&bytes, format, "fuzzed", &SolidOptions::default());
+        }
+
+        /// Arbitrary bytes as every format.
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
+            for format in ["obj", "stl", "ply", "off", "fold"] {
+                let _ = parse_solid(&bytes, format, "arbitrary", &SolidOptions::default());
+            }
+        }
+    }
+}
