@@ -71,7 +71,7 @@ impl SymmetryGroup {
     pub fn warning(&self) -> Option<String> {
         (self.left_out > 0).then(|| {
             format!(
-                "{} more maps send every vertex within {:.1e} of a vertex but do not close into a group with the others (the solid is nearly, not exactly, more symmetric at that scale): the group of the best-fitting maps, {} of order {}, is used (its maps within {:.1e})",
+                "{} more maps send every vertex within {:.1e} of a vertex but do not close into a group with the others (the solid is nearly, not exactly, more symmetric at that scale): the largest group among the maps, {} of order {}, is used (its maps within {:.1e})",
                 self.left_out, self.tolerance, self.point_group.name, self.point_group.order, self.largest_residual
             )
         })
@@ -475,36 +475,30 @@ impl Polyhedron {
                 residual: 0.0,
             },
         );
-        let mut left_out = 0;
         // A fitted map's turn is off by about its residual over the size.
         let angle_tolerance = 1e-6_f64.max(2.0 * tolerance / self.size());
-        while found.len() > 1 {
-            if closed(&found) {
-                let matrices: Vec<Matrix3<f64>> = found.iter().map(|s| s.matrix).collect();
-                if let Some(point_group) = classify(&matrices, angle_tolerance) {
-                    let largest_residual = found.iter().map(|s| s.residual).fold(0.0, f64::max);
-                    return SymmetryGroup {
-                        elements: found,
-                        point_group,
-                        tolerance,
-                        largest_residual,
-                        left_out,
-                    };
-                }
-            }
-            // The identity (first) stays: at worst the trivial group is left.
-            found.pop();
-            left_out += 1;
-        }
+        let named = |maps: &[Symmetry]| {
+            let matrices: Vec<Matrix3<f64>> = maps.iter().map(|s| s.matrix).collect();
+            classify(&matrices, angle_tolerance)
+        };
+        let kept = if closed(&found) && named(&found).is_some() {
+            (0..found.len()).collect()
+        } else {
+            largest_group(&found, &named)
+        };
+        let left_out = found.len() - kept.len();
+        let elements: Vec<Symmetry> = kept.into_iter().map(|k| found[k].clone()).collect();
+        let point_group = named(&elements).unwrap_or(PointGroup {
+            name: "C1".into(),
+            order: 1,
+            rotations: 1,
+        });
+        let largest_residual = elements.iter().map(|s| s.residual).fold(0.0, f64::max);
         SymmetryGroup {
-            elements: found,
-            point_group: PointGroup {
-                name: "C1".into(),
-                order: 1,
-                rotations: 1,
-            },
+            elements,
+            point_group,
             tolerance,
-            largest_residual: 0.0,
+            largest_residual,
             left_out,
         }
     }
@@ -615,6 +609,67 @@ impl Polyhedron {
 fn size_of(vertices: &[Point3<f64>]) -> f64 {
     let c = Point3::from(vertices.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / vertices.len() as f64);
     vertices.iter().map(|p| (p - c).norm()).fold(0.0, f64::max)
+}
+
+/// The largest group among maps that are not one (near-symmetries of rounded data), as
+/// indices into `maps` (the identity first): of the group left when the worst-fitting maps
+/// are dropped one by one until the rest close, and every group two of the maps generate
+/// within the set (tried while |maps|³ · vertices stays below 2·10⁸), the largest that is a
+/// point group.
+fn largest_group(maps: &[Symmetry], named: &dyn Fn(&[Symmetry]) -> Option<PointGroup>) -> Vec<usize> {
+    let pick = |indices: &[usize]| indices.iter().map(|&k| maps[k].clone()).collect::<Vec<_>>();
+    // Worst fit first out (the identity, first, stays).
+    let mut best: Vec<usize> = (0..maps.len()).collect();
+    while best.len() > 1 && !(closed(&pick(&best)) && named(&pick(&best)).is_some()) {
+        let worst = (1..best.len())
+            .max_by(|&a, &b| maps[best[a]].residual.total_cmp(&maps[best[b]].residual))
+            .expect("more than the identity");
+        best.remove(worst);
+    }
+    let n = maps.len();
+    let vertices = maps.first().map_or(0, |s| s.vertex_map.len());
+    if (n * n * n).saturating_mul(vertices) > 200_000_000 {
+        return best;
+    }
+    let index: HashMap<&[usize], usize> = maps
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (s.vertex_map.as_slice(), k))
+        .collect();
+    for a in 1..n {
+        for b in a..n {
+            if let Some(group) = generated(maps, &index, &[a, b]) {
+                if group.len() > best.len() && named(&pick(&group)).is_some() {
+                    best = group;
+                }
+            }
+        }
+    }
+    best
+}
+
+/// The group `generators` generate, as indices into `maps`, or None when a product falls
+/// outside the maps.
+fn generated(maps: &[Symmetry], index: &HashMap<&[usize], usize>, generators: &[usize]) -> Option<Vec<usize>> {
+    let identity = *index.get((0..maps[0].vertex_map.len()).collect::<Vec<_>>().as_slice())?;
+    let mut group = vec![identity];
+    let mut k = 0;
+    while k < group.len() {
+        for &g in generators {
+            let product: Vec<usize> = maps[g]
+                .vertex_map
+                .iter()
+                .map(|&v| maps[group[k]].vertex_map[v])
+                .collect();
+            let at = *index.get(product.as_slice())?;
+            if !group.contains(&at) {
+                group.push(at);
+            }
+        }
+        k += 1;
+    }
+    group.sort_unstable();
+    Some(group)
 }
 
 /// Whether the maps (by their vertex permutations) hold the identity and every composition
