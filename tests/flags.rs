@@ -10,6 +10,7 @@
 #[allow(dead_code, unused_imports)]
 #[path = "../src/cli.rs"]
 mod cli;
+mod common;
 
 use clap::CommandFactory;
 use std::any::TypeId;
@@ -227,38 +228,30 @@ struct Case {
     signed: bool,
 }
 
+/// The number types an option may parse to.
+const NUMBERS: [fn() -> TypeId; 7] = [
+    TypeId::of::<f64>,
+    TypeId::of::<f32>,
+    TypeId::of::<usize>,
+    TypeId::of::<u64>,
+    TypeId::of::<u32>,
+    TypeId::of::<i64>,
+    TypeId::of::<i32>,
+];
+
 fn numeric(type_id: TypeId) -> bool {
-    [
-        TypeId::of::<f64>(),
-        TypeId::of::<f32>(),
-        TypeId::of::<usize>(),
-        TypeId::of::<u64>(),
-        TypeId::of::<u32>(),
-        TypeId::of::<i64>(),
-        TypeId::of::<i32>(),
-    ]
-    .contains(&type_id)
+    NUMBERS.iter().any(|t| t() == type_id)
 }
 
+/// The type an option's value parser gives (clap's AnyValueId compares with a TypeId).
 fn value_type(arg: &clap::Arg) -> TypeId {
-    // clap's AnyValueId compares with a TypeId.
     let id = arg.get_value_parser().type_id();
-    for t in [
-        TypeId::of::<f64>(),
-        TypeId::of::<f32>(),
-        TypeId::of::<usize>(),
-        TypeId::of::<u64>(),
-        TypeId::of::<u32>(),
-        TypeId::of::<i64>(),
-        TypeId::of::<i32>(),
-        TypeId::of::<String>(),
-        TypeId::of::<PathBuf>(),
-    ] {
-        if id == t {
-            return t;
-        }
-    }
-    TypeId::of::<()>()
+    NUMBERS
+        .iter()
+        .map(|t| t())
+        .chain([TypeId::of::<String>(), TypeId::of::<PathBuf>()])
+        .find(|&t| id == t)
+        .unwrap_or(TypeId::of::<()>())
 }
 
 /// `args` with `flag` removed, and the value after it when it takes one.
@@ -370,19 +363,6 @@ fn cases() -> Vec<Case> {
     cases
 }
 
-/// Whether a JSON value holds a null anywhere, and where.
-fn null_in(value: &serde_json::Value, at: String) -> Option<String> {
-    match value {
-        serde_json::Value::Null => Some(at),
-        serde_json::Value::Array(items) => items
-            .iter()
-            .enumerate()
-            .find_map(|(k, v)| null_in(v, format!("{at}[{k}]"))),
-        serde_json::Value::Object(map) => map.iter().find_map(|(k, v)| null_in(v, format!("{at}.{k}"))),
-        _ => None,
-    }
-}
-
 /// Runs a case; an empty answer is a pass, else what went wrong.
 fn run(case: &Case, root: &Path, k: usize) -> Option<String> {
     let out = root.join(format!("case-{k}"));
@@ -401,18 +381,15 @@ fn run(case: &Case, root: &Path, k: usize) -> Option<String> {
         .spawn()
         .unwrap();
     // Drain the pipes beside the wait so a large output cannot block the child.
-    let mut stdout = child.stdout.take().unwrap();
-    let mut stderr = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        std::io::Read::read_to_string(&mut stdout, &mut s).ok();
-        s
-    });
-    let error_reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        std::io::Read::read_to_string(&mut stderr, &mut s).ok();
-        s
-    });
+    let drain = |mut pipe: Box<dyn std::io::Read + Send>| {
+        std::thread::spawn(move || {
+            let mut s = String::new();
+            pipe.read_to_string(&mut s).ok();
+            s
+        })
+    };
+    let reader = drain(Box::new(child.stdout.take().unwrap()));
+    let error_reader = drain(Box::new(child.stderr.take().unwrap()));
     let started = Instant::now();
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
@@ -459,7 +436,7 @@ fn run(case: &Case, root: &Path, k: usize) -> Option<String> {
         .next()
         .and_then(|l| serde_json::from_str::<serde_json::Value>(l).ok())
     {
-        if let Some(at) = null_in(&json, String::new()) {
+        if let Some(at) = common::null_in(&json, String::new()) {
             return Some(format!("{shown}: exit-0 JSON has null at {at}"));
         }
     }

@@ -2,6 +2,8 @@
 //! taken and replaced by a default, a hang, a null number in exit-0 JSON, and a slow vertex.
 //! `tests/flags.rs` walks every option so that none can be dropped again unseen.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -140,19 +142,6 @@ fn constraints_with_a_nan_lock_are_refused_instead_of_hanging() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A null anywhere in a JSON value, and where.
-fn null_in(value: &serde_json::Value, at: String) -> Option<String> {
-    match value {
-        serde_json::Value::Null => Some(at),
-        serde_json::Value::Array(items) => items
-            .iter()
-            .enumerate()
-            .find_map(|(k, v)| null_in(v, format!("{at}[{k}]"))),
-        serde_json::Value::Object(map) => map.iter().find_map(|(k, v)| null_in(v, format!("{at}.{k}"))),
-        _ => None,
-    }
-}
-
 #[test]
 fn projected_checks_and_unfoldings_print_numbers_never_null() {
     // A Miura crease pattern, a bent Miura sheet, a self-crossing sheet and a nearly rigid
@@ -178,7 +167,7 @@ fn projected_checks_and_unfoldings_print_numbers_never_null() {
             }
             let line = String::from_utf8_lossy(&out.stdout);
             let value: serde_json::Value = serde_json::from_str(line.lines().next().unwrap()).unwrap();
-            assert_eq!(null_in(&value, String::new()), None, "{command} {file}");
+            assert_eq!(common::null_in(&value, String::new()), None, "{command} {file}");
             let projection = &value["projection"];
             assert!(projection.is_object(), "{command} {file}: {value}");
             for key in ["max_change_rad", "rms_change_rad", "residual_before_rad"] {

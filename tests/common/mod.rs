@@ -129,3 +129,16 @@ pub fn fitted_distance(moved: &[nalgebra::Point3<f64>], fixed: &[nalgebra::Point
         .map(|(m, f)| (rotation * (m.coords - cm) + cf - f.coords).norm())
         .fold(0.0, f64::max)
 }
+
+/// A null anywhere in a JSON value, and where (`at` the path so far).
+pub fn null_in(value: &serde_json::Value, at: String) -> Option<String> {
+    match value {
+        serde_json::Value::Null => Some(at),
+        serde_json::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(k, v)| null_in(v, format!("{at}[{k}]"))),
+        serde_json::Value::Object(map) => map.iter().find_map(|(k, v)| null_in(v, format!("{at}.{k}"))),
+        _ => None,
+    }
+}
