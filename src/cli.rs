@@ -96,8 +96,8 @@ pub enum Command {
     /// constraints.xml for MuJoCo).
     Constraints(ConstraintsArgs),
     /// Response of a scene (a strip of plates, a closed vertex or a device of many panels) to
-    /// its actuation: writes response.json, response.svg and snapshots.svg, and a device's 3D
-    /// page (`docs/model.md#dynamics`).
+    /// its actuation: writes response.json, response.svg, snapshots.svg, motion.fold (the
+    /// run as a FOLD animation) and its 3D page response.html (`docs/model.md#dynamics`).
     Simulate(SimulateArgs),
     /// Fit a scene's parameters to a measured trajectory (`docs/model.md#calibration`):
     /// estimates with standard errors and 95 % intervals, correlations, what the data cannot

@@ -10,7 +10,7 @@ pub(crate) mod response;
 pub(crate) mod scene_page;
 pub(crate) mod work_precision;
 pub use page::{page_html, page_of_fold, PageFrame, PageScene, MAX_PAGE_POINTS};
-pub use scene_page::{closed_modes_page, closed_scene, response_page, MAX_RESPONSE_FRAMES, MODE_PHASES};
+pub use scene_page::{closed_modes_page, closed_scene, response_page, MODE_PHASES};
 pub use work_precision::{
     error_by_parameter_svg, largest_sizes, power_law_fit, scaling_svg, work_precision_svg, ErrorSeries, ScalingSeries,
     WorkPoint, WorkSeries,

@@ -466,7 +466,8 @@ fn marks_on_a_miura_sheet_stay_on_their_panels_as_it_folds() {
     let flat = vec![0.0; folded.len()];
     let unit = model.unit * 1e6;
     let faces = &model.folding.pattern.faces;
-    let vertices = &model.folding.pattern.vertices;
+    // Marks are drawn in the file's coordinates (times the unit), as a user reads them.
+    let vertices = model.folding.pattern.file_vertices();
     let mut moved = 0;
     for (face, corners) in faces.iter().enumerate() {
         let panel = points.panel(face).unwrap();
@@ -497,7 +498,7 @@ fn marks_on_a_miura_sheet_stay_on_their_panels_as_it_folds() {
         moved += usize::from(placed.iter().any(|p| p[2].abs() > 1.0));
     }
     assert!(moved > 0, "the sheet folded out of its plane");
-    for (f, g) in [(0usize, 1usize)] {
+    for (f, g) in [(0usize, 1usize), (0, 5), (5, 6), (10, 15)] {
         let shared: Vec<usize> = faces[f].iter().copied().filter(|v| faces[g].contains(v)).collect();
         for v in shared {
             let at = [vertices[v][0] * unit, vertices[v][1] * unit];

@@ -169,7 +169,7 @@ fn a_strips_response_page_shows_its_hinge_angles_and_its_contact() {
     let faces: Vec<Vec<usize>> = serde_json::from_value(value["faces"].clone()).unwrap();
     let letters: Vec<char> = value["letters"].as_str().unwrap().chars().collect();
     let frames = value["frames"].as_array().unwrap();
-    assert!(frames.len() > 100 && frames.len() <= nanofold::plot::MAX_RESPONSE_FRAMES);
+    assert!(frames.len() > 90 && frames.len() <= nanofold::write::MOTION_FRAMES);
     let step = value["step"].as_f64().unwrap();
     let start = positions(&value, 0);
     let mut worst: f64 = 0.0;
@@ -241,8 +241,9 @@ fn a_closed_chains_modes_page_oscillates_with_its_loop_closed() {
     let flat = closed_scene(
         &scene.name,
         chain,
-        &[("flat".into(), vec![0.0; chain.joint_creases.len()])],
-    );
+        &[("flat".into(), vec![0.0; chain.crease_labels.len()])],
+    )
+    .unwrap();
     let flat_count = distinct(&flat.frames[0].coords, 1e-9 * half);
     for k in 0..frames.len() {
         assert_eq!(

@@ -111,7 +111,7 @@ class Result:
         return np.asarray(self._payload.get("trajectory") or [], dtype=float)
 
     def fold_file(self) -> Optional[Dict[str, Any]]:
-        """The FOLD animation the command writes (``fold.fold``, a network's ``motion.fold``
+        """The FOLD animation the command writes (``fold.fold``, a scene's ``motion.fold``
         or ``modes.fold``), as a dict; None where it writes none."""
         value = self._payload.get("fold_file")
         return copy.deepcopy(value) if value is not None else None

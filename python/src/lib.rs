@@ -366,7 +366,7 @@ fn parse_scene(py: Python<'_>, text: String, source: String, name: String, base:
     })
 }
 
-/// `simulate`: the summary, response.json and a network's motion.fold.
+/// `simulate`: the summary, response.json and motion.fold.
 #[pyfunction]
 fn simulate(py: Python<'_>, scene: &SceneHandle, settings: &str) -> PyResult<(String, String)> {
     let settings = options::<commands::SimulateOptions>(settings, "settings")?

@@ -5,7 +5,7 @@
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::{simulate_scene, Simulation, SimulationSettings};
 use crate::error::Result;
-use crate::write::folding_output::{network_modes_fold, network_motion_fold};
+use crate::write::folding_output::{motion_fold, network_modes_fold};
 use crate::write::output::{
     closed_modes_summary, network_modes_summary, response_json, response_summary, strip_modes_summary,
 };
@@ -143,9 +143,9 @@ pub struct SimulationReport {
     /// response.json: the settings, the model chosen and every sample.
     #[serde(skip)]
     pub response: Value,
-    /// A network's motion.fold.
+    /// motion.fold: the response at even times, every point placed as the fit's marks are.
     #[serde(skip)]
-    pub fold: Option<Value>,
+    pub fold: Value,
     /// The run itself.
     #[serde(skip)]
     pub simulation: Simulation,
@@ -159,25 +159,19 @@ impl SimulationReport {
 }
 
 /// The files `simulate` writes for a run (rendered, not written): response.json,
-/// response.svg, snapshots.svg, the 3D page response.html and a network's motion.fold.
+/// response.svg, snapshots.svg, the 3D page response.html and motion.fold.
 #[cfg(feature = "plot")]
 pub fn simulation_files(scene: &Scene, report: &SimulationReport) -> Result<Vec<(&'static str, String)>> {
     use crate::plot::response::{response_svg, snapshots_svg};
-    use crate::plot::scene_page::{network_response_page, response_page};
+    use crate::plot::scene_page::response_page;
     let response = &report.simulation.response;
     let mut files = vec![
         ("response.json", report.response.to_string()),
         ("response.svg", response_svg(scene, response)?),
         ("snapshots.svg", snapshots_svg(scene, response)?),
     ];
-    match (&scene.system, &report.fold) {
-        (System::Network(model), Some(motion)) => {
-            let page = network_response_page(&scene.name, model, motion, response.collision.as_ref())?;
-            files.push(("response.html", page));
-            files.push(("motion.fold", motion.to_string()));
-        }
-        _ => files.push(("response.html", response_page(scene, response)?)),
-    }
+    files.push(("response.html", response_page(scene, response)?));
+    files.push(("motion.fold", report.fold.to_string()));
     Ok(files)
 }
 
@@ -185,10 +179,7 @@ pub fn simulation_files(scene: &Scene, report: &SimulationReport) -> Result<Vec<
 pub fn simulate(scene: &Scene, settings: &SimulationSettings) -> Result<SimulationReport> {
     settings.validate()?;
     let simulation = simulate_scene(scene, settings)?;
-    let fold = match &scene.system {
-        System::Network(model) => Some(network_motion_fold(model, &simulation.response)),
-        _ => None,
-    };
+    let fold = motion_fold(scene, &simulation.response);
     let summary = response_summary(scene, settings, &simulation);
     Ok(SimulationReport {
         response: response_json(&summary, &simulation.response),

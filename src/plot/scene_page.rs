@@ -2,40 +2,29 @@
 //! as oscillations, for strips, closed chains and networks, in µm, with the substrate or
 //! anchored panel grey and the first contact's bodies marked.
 
-use super::page::{page_html, scene_of_fold, PageFrame, PageScene};
-use crate::dynamics::algorithms::{update_corners, update_poses};
+use super::page::{page_html, scene_of_fold, PageScene};
 use crate::dynamics::closed::ClosedChain;
 use crate::dynamics::contact::Collision;
-use crate::dynamics::model::{Data, Model};
 use crate::dynamics::network::NetworkModel;
 use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::Response;
 use crate::dynamics::strip::StripChain;
 use crate::error::Result;
-use nalgebra::Point3;
-
-/// Most frames a response page keeps (samples are thinned evenly in time, the last kept).
-pub const MAX_RESPONSE_FRAMES: usize = 241;
+use crate::write::folding_output::{closed_states_fold, strip_states_fold};
 
 const MICROMETRES: f64 = 1e6;
 
-/// `response.html` of a scene's simulation: its samples as frames (at most
-/// [`MAX_RESPONSE_FRAMES`]), the first contact's bodies red on the last frame.
+/// `response.html` of a scene's simulation: its `motion.fold` (up to
+/// [`MOTION_FRAMES`](crate::write::MOTION_FRAMES) frames at even times, every point placed as
+/// the fit's marks are), the fixed body grey, the first contact's bodies red on the last
+/// frame.
 pub fn response_page(scene: &Scene, response: &Response) -> Result<String> {
-    let picks = super::response::snapshot_samples(response, MAX_RESPONSE_FRAMES);
-    let label = |k: usize| format!("t = {}", super::response::time_label(response.samples[k].time));
+    let motion = crate::write::folding_output::motion_fold(scene, response);
     let collision = response.collision.as_ref();
     match &scene.system {
-        System::Network(model) => {
-            let motion = crate::write::folding_output::network_motion_fold(model, response);
-            network_response_page(&scene.name, model, &motion, collision)
-        }
-        System::Strip(chain) => {
-            let states: Vec<(String, Vec<f64>)> = picks
-                .iter()
-                .map(|&k| (label(k), response.samples[k].angles.as_slice().to_vec()))
-                .collect();
-            let mut page = strip_scene(&scene.name, chain, &states);
+        System::Network(model) => network_response_page(&scene.name, model, &motion, collision),
+        System::Strip(_) => {
+            let mut page = plates_page(&motion, &scene.name)?;
             mark_contact(&mut page, collision, |name| {
                 if name == "substrate" {
                     Some(0)
@@ -46,14 +35,7 @@ pub fn response_page(scene: &Scene, response: &Response) -> Result<String> {
             page_html(&page)
         }
         System::Closed(chain) => {
-            let states: Vec<(String, Vec<f64>)> = picks
-                .iter()
-                .map(|&k| {
-                    let angles = &response.samples[k].angles;
-                    (label(k), chain.joint_creases.iter().map(|&c| angles[c]).collect())
-                })
-                .collect();
-            let mut page = closed_scene(&scene.name, chain, &states);
+            let mut page = plates_page(&motion, &scene.name)?;
             mark_contact(&mut page, collision, |name| {
                 if name == "anchored sector" {
                     return Some(0);
@@ -68,6 +50,14 @@ pub fn response_page(scene: &Scene, response: &Response) -> Result<String> {
             page_html(&page)
         }
     }
+}
+
+/// The page of a strip's or a closed vertex's plates as FOLD (µm), face 0 (the substrate or
+/// the anchored sector) fixed.
+fn plates_page(fold: &serde_json::Value, name: &str) -> Result<PageScene> {
+    let mut page = scene_of_fold(fold, name)?.scaled(1.0, "µm");
+    page.fixed = vec![0];
+    Ok(page)
 }
 
 /// A network's `response.html` from its `motion.fold` (every sample a frame), the anchored
@@ -106,126 +96,16 @@ fn mark_contact(page: &mut PageScene, collision: Option<&Collision>, face_of: im
 
 /// A strip's page: the substrate (face 0, reaching back from its edge a third of the
 /// strip's length) and the plates (face 1 + i), at each (title, hinge angles).
-pub fn strip_scene(name: &str, chain: &StripChain, states: &[(String, Vec<f64>)]) -> PageScene {
-    let model = &chain.model;
-    let mut data = Data::new(model);
-    update_poses(model, &vec![0.0; model.dof()], &mut data);
-    update_corners(model, &mut data);
-    let (mut x_lo, mut x_hi, mut y_hi) = (f64::INFINITY, f64::NEG_INFINITY, chain.substrate_edge_y);
-    for c in &data.corners {
-        x_lo = x_lo.min(c.x);
-        x_hi = x_hi.max(c.x);
-        y_hi = y_hi.max(c.y);
-    }
-    let edge = chain.substrate_edge_y;
-    let depth = (y_hi - edge).max(x_hi - x_lo) / 3.0;
-    let substrate = [
-        Point3::new(x_lo, edge - depth, 0.0),
-        Point3::new(x_hi, edge - depth, 0.0),
-        Point3::new(x_hi, edge, 0.0),
-        Point3::new(x_lo, edge, 0.0),
-    ];
-    let hinge_letters = letters_by_sign(model.dof(), states);
-    plates_scene(name, model, &substrate, &hinge_letters, states)
+pub fn strip_scene(name: &str, chain: &StripChain, states: &[(String, Vec<f64>)]) -> Result<PageScene> {
+    let states: Vec<(String, &[f64])> = states.iter().map(|(t, a)| (t.clone(), a.as_slice())).collect();
+    plates_page(&strip_states_fold(chain, &states, name), name)
 }
 
 /// A closed chain's page: the anchored sector (face 0) and the joints' plates (face 1 + j),
-/// at each (title, joint angles).
-pub fn closed_scene(name: &str, chain: &ClosedChain, states: &[(String, Vec<f64>)]) -> PageScene {
-    let hinge_letters = letters_by_sign(chain.model.dof(), states);
-    plates_scene(name, &chain.model, &chain.ground, &hinge_letters, states)
-}
-
-/// Mountain or valley by the sign of each hinge's largest excursion over the states.
-fn letters_by_sign(hinges: usize, states: &[(String, Vec<f64>)]) -> Vec<char> {
-    (0..hinges)
-        .map(|j| {
-            let largest = states
-                .iter()
-                .map(|(_, a)| a[j])
-                .fold(0.0_f64, |m, a| if a.abs() > m.abs() { a } else { m });
-            match largest.partial_cmp(&0.0) {
-                Some(std::cmp::Ordering::Greater) => 'V',
-                Some(std::cmp::Ordering::Less) => 'M',
-                _ => 'U',
-            }
-        })
-        .collect()
-}
-
-/// Rigid plates on hinges and one fixed polygon, as a page: each plate's outline is its own
-/// face (its own vertices), the outline edge lying on its joint's axis is that hinge's crease
-/// (assignment `hinge_letters`, fold angle the joint's), the rest boundary.
-fn plates_scene(
-    name: &str,
-    model: &Model,
-    fixed: &[Point3<f64>],
-    hinge_letters: &[char],
-    states: &[(String, Vec<f64>)],
-) -> PageScene {
-    let mut data = Data::new(model);
-    let mut faces = vec![(0..fixed.len()).collect::<Vec<_>>()];
-    let mut edges: Vec<[usize; 2]> = (0..fixed.len()).map(|k| [k, (k + 1) % fixed.len()]).collect();
-    let mut assignments = vec!['B'; fixed.len()];
-    let mut hinge_edges = vec![None; model.dof()];
-    // At θ = 0 the plates lie at their reference poses, where each joint's axis is given.
-    update_poses(model, &vec![0.0; model.dof()], &mut data);
-    update_corners(model, &mut data);
-    let size = data
-        .corners
-        .iter()
-        .map(|c| c.coords.norm())
-        .fold(f64::MIN_POSITIVE, f64::max);
-    let mut next = fixed.len();
-    for (j, plate) in model.plates().iter().enumerate() {
-        let n = plate.outline.len();
-        faces.push((next..next + n).collect());
-        let joint = &model.joints()[j];
-        let on_axis = |p: &Point3<f64>| (p - joint.point).cross(&joint.axis).norm() <= 1e-9 * size;
-        for k in 0..n {
-            let (a, b) = (model.corner_index(j, k), model.corner_index(j, (k + 1) % n));
-            edges.push([next + k, next + (k + 1) % n]);
-            if hinge_edges[j].is_none() && on_axis(&data.corners[a]) && on_axis(&data.corners[b]) {
-                hinge_edges[j] = Some(edges.len() - 1);
-                assignments.push(hinge_letters[j]);
-            } else {
-                assignments.push('B');
-            }
-        }
-        next += n;
-    }
-    let frames = states
-        .iter()
-        .map(|(title, angles)| {
-            update_poses(model, angles, &mut data);
-            update_corners(model, &mut data);
-            let mut fold_angles = vec![0.0; edges.len()];
-            for (j, edge) in hinge_edges.iter().enumerate() {
-                if let Some(e) = edge {
-                    fold_angles[*e] = angles[j].to_degrees();
-                }
-            }
-            PageFrame {
-                title: title.clone(),
-                coords: fixed
-                    .iter()
-                    .chain(&data.corners)
-                    .map(|p| [p.x * MICROMETRES, p.y * MICROMETRES, p.z * MICROMETRES])
-                    .collect(),
-                fold_angles_deg: Some(fold_angles),
-                highlight: Vec::new(),
-            }
-        })
-        .collect();
-    PageScene {
-        title: name.to_string(),
-        unit: "µm".into(),
-        faces,
-        edges,
-        assignments,
-        frames,
-        fixed: vec![0],
-    }
+/// at each (title, every crease's angle).
+pub fn closed_scene(name: &str, chain: &ClosedChain, states: &[(String, Vec<f64>)]) -> Result<PageScene> {
+    let states: Vec<(String, &[f64])> = states.iter().map(|(t, a)| (t.clone(), a.as_slice())).collect();
+    plates_page(&closed_states_fold(chain, &states, name), name)
 }
 
 /// Phases of one cycle a mode's page shows.
@@ -265,7 +145,7 @@ pub fn strip_modes_page(
             states.push((label, angles));
         }
     }
-    page_html(&strip_scene(name, chain, &states))
+    page_html(&strip_scene(name, chain, &states)?)
 }
 
 /// `modes.html` of a closed chain: the equilibrium, then each mode as [`MODE_PHASES`] phases
@@ -276,8 +156,7 @@ pub fn closed_modes_page(
     modes: &crate::dynamics::closed::modes::ClosedModes,
     amplitude: f64,
 ) -> Result<String> {
-    let joints = |angles: &[f64]| -> Vec<f64> { chain.joint_creases.iter().map(|&c| angles[c]).collect() };
-    let mut states = vec![("folded equilibrium".to_string(), joints(&modes.equilibrium))];
+    let mut states = vec![("folded equilibrium".to_string(), modes.equilibrium.clone())];
     let centre: Vec<f64> = modes.coordinates.iter().map(|&c| modes.equilibrium[c]).collect();
     for (k, shape) in modes.modes.mode_shapes.column_iter().enumerate() {
         let largest = shape.amax().max(f64::MIN_POSITIVE);
@@ -288,8 +167,8 @@ pub fn closed_modes_page(
                 .map(|(e, s)| e + factor * amplitude * s / largest)
                 .collect();
             let state = chain.closure_state(&modes.coordinates, &theta_c, &modes.equilibrium)?;
-            states.push((label, joints(&state.angles)));
+            states.push((label, state.angles));
         }
     }
-    page_html(&closed_scene(name, chain, &states))
+    page_html(&closed_scene(name, chain, &states)?)
 }

@@ -2,11 +2,16 @@
 //! the crease pattern (with or without a state), the folding path as FOLD frames over the
 //! crease pattern, and its trajectory.
 
-use crate::dynamics::network::algorithms::update_poses;
+use crate::dynamics::algorithms::{update_corners, update_poses as update_plates};
+use crate::dynamics::closed::ClosedChain;
+use crate::dynamics::model::{Data, Model};
 use crate::dynamics::network::manifold::{projection_solver, restore};
 use crate::dynamics::network::modes::NetworkModes;
-use crate::dynamics::network::{NetworkData, NetworkModel};
+use crate::dynamics::network::NetworkModel;
+use crate::dynamics::points::{FlatOutline, PanelPoints, GROUND};
+use crate::dynamics::scene::{Scene, System};
 use crate::dynamics::simulate::Response;
+use crate::dynamics::strip::StripChain;
 use crate::error::Result;
 use crate::folding::{panel_poses, vertex_positions, FoldPath, FoldingModel, PathFrame};
 use crate::names::Named;
@@ -198,19 +203,20 @@ pub fn network_states_fold(model: &NetworkModel, frames: &[(String, &[f64])], de
     root["edges_assignment"] = json!(pattern.kinds.iter().map(|&kind| letter(kind, 0.0)).collect::<Vec<_>>());
     root["file_classes"] = json!(["animation"]);
     root["frame_title"] = json!(format!("{}: crease pattern", pattern.name));
-    let mut data = NetworkData::new(model);
+    // Every vertex placed by the panel it belongs to, as the fit's marks are.
+    let mut points = PanelPoints::for_network(model);
+    let unit_um = model.unit * 1e6;
     let frames: Vec<Value> = frames
         .iter()
         .map(|(title, fold_angles)| {
-            update_poses(model, fold_angles, &mut data);
+            points.pose(fold_angles);
             let coords: Vec<[f64; 3]> = pattern
                 .vertices
                 .iter()
                 .zip(&model.folding.panel_of_vertex)
-                .map(|(&[x, y], &panel)| {
-                    let p =
-                        data.place(panel, &nalgebra::Vector3::new(x * model.unit, y * model.unit, 0.0)) / model.unit;
-                    pattern.file_point_3d([p.x, p.y, p.z])
+                .map(|(&vertex, &panel)| {
+                    let [x, y] = pattern.file_point(vertex);
+                    points.place(panel, [x * unit_um, y * unit_um]).map(|c| c / unit_um)
                 })
                 .collect();
             let (angles, letters) = edge_arrays(pattern, fold_angles);
@@ -230,12 +236,12 @@ pub fn network_states_fold(model: &NetworkModel, frames: &[(String, &[f64])], de
     root
 }
 
-/// Most frames of a network's motion animation.
+/// Most frames of a motion animation.
 pub const MOTION_FRAMES: usize = 101;
 
-/// `motion.fold`: the response at up to [`MOTION_FRAMES`] evenly spaced times (the sample
-/// nearest each), so FOLD viewers play it at an even pace.
-pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
+/// The samples a motion animation shows: the nearest to each of up to [`MOTION_FRAMES`]
+/// evenly spaced times, so FOLD viewers play it at an even pace.
+fn motion_samples(response: &Response) -> Vec<(String, &[f64])> {
     let samples = &response.samples;
     let end = samples.last().map_or(0.0, |s| s.time);
     let count = MOTION_FRAMES.min(samples.len()).max(1);
@@ -252,15 +258,198 @@ pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
         })
         .collect();
     chosen.dedup();
-    let frames: Vec<(String, &[f64])> = chosen
+    chosen
         .iter()
         .map(|&i| (format!("t = {:.6e} s", samples[i].time), samples[i].angles.as_slice()))
-        .collect();
+        .collect()
+}
+
+/// A network's `motion.fold` ([`motion_fold`]).
+pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
     network_states_fold(
         model,
-        &frames,
+        &motion_samples(response),
         "a network's motion written by nanofold simulate (frames at even times)",
     )
+}
+
+/// `motion.fold` of any scene: the response at up to [`MOTION_FRAMES`] evenly spaced times,
+/// every point placed by [`PanelPoints`] (as the fit's marks are). A pattern's in its file's
+/// coordinates ([`network_states_fold`]); a strip's or a closed vertex's in µm
+/// ([`plates_states_fold`]).
+pub fn motion_fold(scene: &Scene, response: &Response) -> Value {
+    let states = motion_samples(response);
+    let description = "a device's motion written by nanofold simulate (frames at even times)";
+    match &scene.system {
+        System::Network(model) => network_motion_fold(model, response),
+        System::Strip(chain) => strip_states_fold(chain, &states, description),
+        System::Closed(chain) => closed_states_fold(chain, &states, description),
+    }
+}
+
+/// A strip's states ([`plates_states_fold`]): the substrate's edge strip first (a third of
+/// the strip's length deep, as wide as the plates), then plate i as face 1 + i; `states`
+/// hold the hinge angles.
+pub fn strip_states_fold(chain: &StripChain, states: &[(String, &[f64])], description: &str) -> Value {
+    let mut points = PanelPoints::for_strip(chain);
+    let outlines = points.plate_outlines();
+    let (mut x_lo, mut x_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let edge = chain.substrate_edge_y * 1e6;
+    let mut y_hi = edge;
+    for [x, y] in outlines.iter().flat_map(|o| o.corners.iter().copied()) {
+        x_lo = x_lo.min(x);
+        x_hi = x_hi.max(x);
+        y_hi = y_hi.max(y);
+    }
+    let depth = (y_hi - edge).max(x_hi - x_lo) / 3.0;
+    let substrate = vec![[x_lo, edge - depth], [x_hi, edge - depth], [x_hi, edge], [x_lo, edge]];
+    plates_states_fold(
+        &mut points,
+        &chain.model,
+        Some(substrate),
+        outlines,
+        &|angles, j| angles[j],
+        states,
+        description,
+    )
+}
+
+/// A closed vertex's states ([`plates_states_fold`]): the anchored sector first, then joint
+/// j's plate as face 1 + j; `states` hold every crease's angle.
+pub fn closed_states_fold(chain: &ClosedChain, states: &[(String, &[f64])], description: &str) -> Value {
+    let mut points = PanelPoints::for_closed(chain);
+    let outlines = points.plate_outlines();
+    plates_states_fold(
+        &mut points,
+        &chain.model,
+        None,
+        outlines,
+        &|angles, j| angles[chain.joint_creases[j]],
+        states,
+        description,
+    )
+}
+
+/// Plates on hinges as a FOLD animation in µm: `fixed` (if any) and each outline a face of
+/// its own corners, placed by `points` at every state (the first the key frame, the others
+/// its frames); the outline edge of joint j's plate on its axis is that hinge's crease, its
+/// fold angle `joint_angle(state, j)` and its assignment the sign of its largest excursion.
+fn plates_states_fold(
+    points: &mut PanelPoints,
+    model: &Model,
+    fixed: Option<Vec<[f64; 2]>>,
+    outlines: Vec<FlatOutline>,
+    joint_angle: &dyn Fn(&[f64], usize) -> f64,
+    states: &[(String, &[f64])],
+    description: &str,
+) -> Value {
+    // Joint j's hinge edge: the outline edge whose ends lie on its axis when flat.
+    let mut data = Data::new(model);
+    update_plates(model, &vec![0.0; model.dof()], &mut data);
+    update_corners(model, &mut data);
+    let size = data
+        .corners
+        .iter()
+        .map(|c| c.coords.norm())
+        .fold(f64::MIN_POSITIVE, f64::max);
+    let hinge_of = |j: usize| -> Option<usize> {
+        let joint = &model.joints()[j];
+        let on_axis = |k: usize| {
+            let p = data.corners[model.corner_index(j, k)];
+            (p - joint.point).cross(&joint.axis).norm() <= 1e-9 * size
+        };
+        let n = model.plates()[j].outline.len();
+        (0..n).find(|&k| on_axis(k) && on_axis((k + 1) % n))
+    };
+    let largest = |j: usize| {
+        states
+            .iter()
+            .map(|(_, a)| joint_angle(a, j))
+            .fold(0.0_f64, |m, a| if a.abs() > m.abs() { a } else { m })
+    };
+    let mut corners: Vec<(usize, [f64; 2])> = Vec::new();
+    let mut faces: Vec<Vec<usize>> = Vec::new();
+    let mut edges: Vec<[usize; 2]> = Vec::new();
+    let mut letters: Vec<&str> = Vec::new();
+    let mut creases: Vec<(usize, usize)> = Vec::new();
+    let mut add = |panel: usize, outline: &[[f64; 2]], hinge: Option<(usize, usize)>| {
+        let first = corners.len();
+        let n = outline.len();
+        corners.extend(outline.iter().map(|&c| (panel, c)));
+        faces.push((first..first + n).collect());
+        for k in 0..n {
+            edges.push([first + k, first + (k + 1) % n]);
+            match hinge {
+                Some((j, at)) if at == k => {
+                    creases.push((edges.len() - 1, j));
+                    let sign = largest(j);
+                    letters.push(if sign > 0.0 {
+                        "V"
+                    } else if sign < 0.0 {
+                        "M"
+                    } else {
+                        "U"
+                    });
+                }
+                _ => letters.push("B"),
+            }
+        }
+    };
+    if let Some(fixed) = &fixed {
+        add(GROUND, fixed, None);
+    }
+    for outline in &outlines {
+        let hinge = (outline.panel != GROUND)
+            .then(|| hinge_of(outline.panel).map(|k| (outline.panel, k)))
+            .flatten();
+        add(outline.panel, &outline.corners, hinge);
+    }
+    let frame = |angles: &[f64], points: &mut PanelPoints| {
+        points.pose(angles);
+        let coords: Vec<[f64; 3]> = corners.iter().map(|&(panel, flat)| points.place(panel, flat)).collect();
+        let mut degrees = vec![0.0; edges.len()];
+        for &(e, j) in &creases {
+            degrees[e] = joint_angle(angles, j).to_degrees();
+        }
+        (coords, degrees)
+    };
+    let first: &[f64] = states.first().map_or(&[], |(_, a)| a);
+    let (coords, degrees) = frame(first, points);
+    let mut root = json!({
+        "file_spec": 1.1,
+        "file_creator": "nanofold",
+        "file_description": description,
+        "file_classes": ["animation"],
+        "frame_title": states.first().map_or(String::new(), |(t, _)| t.clone()),
+        "frame_classes": ["foldedForm"],
+        "frame_attributes": ["3D"],
+        "frame_unit": "um",
+        "vertices_coords": coords,
+        "edges_vertices": edges,
+        "edges_assignment": letters,
+        "edges_foldAngle": degrees,
+        "faces_vertices": faces,
+    });
+    let frames: Vec<Value> = states
+        .iter()
+        .skip(1)
+        .map(|(title, angles)| {
+            let (coords, degrees) = frame(angles, points);
+            json!({
+                "frame_title": title,
+                "frame_classes": ["foldedForm"],
+                "frame_attributes": ["3D"],
+                "frame_parent": 0,
+                "frame_inherit": true,
+                "vertices_coords": coords,
+                "edges_foldAngle": degrees,
+            })
+        })
+        .collect();
+    if !frames.is_empty() {
+        root["file_frames"] = json!(frames);
+    }
+    root
 }
 
 /// `modes.fold`: the folded equilibrium as the key frame's state, then each mode as a pair
