@@ -19,6 +19,7 @@ use std::time::Instant;
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;
+#[allow(dead_code)] // the marks study is the coverage example's
 #[path = "common/miura.rs"]
 mod miura;
 

@@ -1413,9 +1413,23 @@ fn run_fit(args: &FitArgs) -> Result<()> {
         );
     }
     for r in &report.residuals {
+        let pattern = match (r.periodicity_z, r.runs_z) {
+            (Some(periodic), Some(runs)) => format!(", periodicity z {periodic:.1}, runs z {runs:.1}"),
+            _ => String::new(),
+        };
         println!(
-            "  {}: {} samples, rms {:.3e}, max {:.3e}, σ {:.3e} ({})",
-            r.name, r.observations, r.rms, r.max_abs, r.noise, r.noise_source
+            "  {}: {} samples, rms {:.3e}, max {:.3e}, σ {:.3e} ({}){pattern}{}",
+            r.name,
+            r.observations,
+            r.rms,
+            r.max_abs,
+            r.noise,
+            r.noise_source,
+            if r.systematic {
+                " — not noise: the model does not describe it"
+            } else {
+                ""
+            }
         );
     }
     for warning in &report.warnings {

@@ -154,6 +154,15 @@ pub enum NumericalError {
         /// How singular, where.
         detail: String,
     },
+    /// A crease of a moving network turned past a half turn: its panels went through each
+    /// other, which nothing in the model stops.
+    #[error("crease {crease} turned to {angle_deg:.1}°, its panels through each other (past ±180°): nothing in this model stops them (a stiffer drag, or contact, would)")]
+    PanelsThrough {
+        /// The crease, by the file's edge index.
+        crease: usize,
+        /// Its angle there, degrees.
+        angle_deg: f64,
+    },
     /// A computation produced NaN or infinity.
     #[error("{what}: non-finite value ({detail})")]
     NonFinite {

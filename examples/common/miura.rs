@@ -69,7 +69,8 @@ pub fn exact_columns(document: &SceneDocument, angles: bool) -> Result<(Vec<f64>
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
     let model = scene.network().ok_or("the sheet is a network")?;
     let unit = model.unit * 1e6;
-    let (faces, vertices) = (&model.folding.pattern.faces, &model.folding.pattern.vertices);
+    // Marks are drawn in the file's coordinates times the unit, as the calibration guide says.
+    let (faces, vertices) = (&model.folding.pattern.faces, model.folding.pattern.file_vertices());
     let mut points = PanelPoints::new(&scene)?;
     let mut columns = Vec::new();
     let edges = scene.output_edges().ok_or("a pattern's creases")?.to_vec();
@@ -108,6 +109,66 @@ pub fn exact_columns(document: &SceneDocument, angles: bool) -> Result<(Vec<f64>
         }
     }
     Ok((run.times.clone(), columns))
+}
+
+/// The bundled sheet's marks (the file as it is, its drag coefficient 1.28 and hinge target
+/// 90°), simulated at `truth` = (drag coefficient, hinge target in degrees): the centres of
+/// `faces` tracked in x, y, z (σ 0.5 µm) at `samples` times to `t_end` s. Returns the
+/// document, its two free parameters, the times and the exact columns.
+pub fn marks_study(
+    truth: [f64; 2],
+    faces: &[usize],
+    t_end: f64,
+    samples: usize,
+) -> Result<(SceneDocument, Vec<FreeParameter>, Vec<f64>, ExactColumns), Failure> {
+    let document = SceneDocument::load("patterns/devices/miura_sheet.scene.json".as_ref())?;
+    let free = vec![
+        FreeParameter {
+            path: "environment.drag_coefficient".into(),
+            lower: 0.2,
+            upper: 5.0,
+        },
+        FreeParameter {
+            path: "hinge_defaults.target_angle_deg".into(),
+            lower: 45.0,
+            upper: 135.0,
+        },
+    ];
+    let parameters = resolve(&document, &free)?;
+    let scene = with_values(&document, &parameters, &truth).spec()?.build()?;
+    let times: Vec<f64> = (1..=samples).map(|k| t_end * k as f64 / samples as f64).collect();
+    let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
+    let model = scene.network().ok_or("the sheet is a network")?;
+    let unit = model.unit * 1e6;
+    let vertices = model.folding.pattern.file_vertices();
+    let mut points = PanelPoints::new(&scene)?;
+    let mut columns = Vec::new();
+    for &face in faces {
+        let corners = &model.folding.pattern.faces[face];
+        let share = 1.0 / corners.len() as f64;
+        let centre = corners.iter().fold([0.0, 0.0], |c, &v| {
+            [
+                c[0] + vertices[v][0] * unit * share,
+                c[1] + vertices[v][1] * unit * share,
+            ]
+        });
+        let panel = points.panel(face)?;
+        for (axis, letter) in ["x", "y", "z"].iter().enumerate() {
+            let values = run
+                .angles
+                .iter()
+                .map(|a| Some(points.position(a.as_slice(), panel, centre)[axis]))
+                .collect();
+            let name = format!("panel_{face}_{:.3}_{:.3}_{letter}_um", centre[0], centre[1]);
+            let observed = Observed::Point {
+                panel: face,
+                at: centre,
+                axis,
+            };
+            columns.push((MeasuredColumn { name, observed, values }, 0.5));
+        }
+    }
+    Ok((document, free, run.times.clone(), columns))
 }
 
 /// One noisy measurement of exact columns (each with its σ).

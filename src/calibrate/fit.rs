@@ -152,6 +152,7 @@ pub struct Combination {
 }
 
 /// Residuals of one measured column.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Serialize)]
 pub struct ColumnResiduals {
     /// The column.
@@ -166,6 +167,102 @@ pub struct ColumnResiduals {
     pub rms: f64,
     /// Largest |residual|.
     pub max_abs: f64,
+    /// The runs test of the residuals' signs in time order: (runs − expected)/its standard
+    /// deviation; far below 0 (too few runs: a drift) or far above (too many: an
+    /// oscillation) the residuals follow a pattern, not noise (absent with fewer than
+    /// [`RUNS_MIN_OBSERVATIONS`] observations or one sign only).
+    pub runs_z: Option<f64>,
+    /// Durbin–Watson's Σ(eₜ − eₜ₋₁)²/Σeₜ²: about 2 for independent noise, towards 0 for
+    /// residuals that drift.
+    pub durbin_watson: Option<f64>,
+    /// Fisher's test of the residuals' periodogram (its largest share against noise's),
+    /// its p-value as a normal z (0 where the test sees nothing): far above 0 the residuals
+    /// repeat a pattern (an oscillation the model has at another frequency or damping, or a
+    /// drift), not noise.
+    pub periodicity_z: Option<f64>,
+    /// With a given noise: the column's Σ(e/σ)² against χ² of its observations, as a
+    /// normal z; far above 0 the residuals are larger than the noise allows.
+    pub chi_square_z: Option<f64>,
+    /// Whether the residuals say the model does not describe this column: the runs test
+    /// beyond ±[`LACK_OF_FIT_Z`], or the periodicity or χ² z above it.
+    pub systematic: bool,
+}
+
+/// Fewest observations of a column whose residuals are tested for a pattern.
+pub const RUNS_MIN_OBSERVATIONS: usize = 10;
+
+/// How far (standard deviations) a column's runs test or χ² lies from what noise gives
+/// before the fit says the model does not describe it: 4, one column in 30 000 by chance.
+pub const LACK_OF_FIT_Z: f64 = 4.0;
+
+/// The runs test's z of residuals in time order (None without both signs or too few).
+fn runs_z(values: &[f64]) -> Option<f64> {
+    let signs: Vec<bool> = values.iter().filter(|r| **r != 0.0).map(|r| *r > 0.0).collect();
+    let n = signs.len();
+    let above = signs.iter().filter(|&&s| s).count() as f64;
+    let below = n as f64 - above;
+    if n < RUNS_MIN_OBSERVATIONS || above == 0.0 || below == 0.0 {
+        return None;
+    }
+    let runs = 1 + signs.windows(2).filter(|w| w[0] != w[1]).count();
+    let n = n as f64;
+    let expected = 2.0 * above * below / n + 1.0;
+    let variance = 2.0 * above * below * (2.0 * above * below - n) / (n * n * (n - 1.0));
+    (variance > 0.0).then(|| (runs as f64 - expected) / variance.sqrt())
+}
+
+/// Fisher's test for a periodic component in residuals taken in time order: the largest
+/// share g of the periodogram at the Fourier frequencies 1..m (m = ⌊(n − 1)/2⌋), whose
+/// p-value for Gaussian noise is at most m (1 − g)^(m − 1) (Fisher 1929, the first term of
+/// the exact series, exact where it matters, in the tail), as a one-sided normal z. A drift
+/// is a periodic component of the lowest frequency. Series longer than 2048 are averaged in
+/// consecutive blocks down to 2048 first (block means of noise are noise). None with too
+/// few values.
+fn periodicity_z(values: &[f64]) -> Option<f64> {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    const LONGEST: usize = 2048;
+    let series: Vec<f64> = if values.len() > LONGEST {
+        let block = values.len().div_ceil(LONGEST);
+        values
+            .chunks(block)
+            .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+            .collect()
+    } else {
+        values.to_vec()
+    };
+    let n = series.len();
+    let m = n.saturating_sub(1) / 2;
+    if n < RUNS_MIN_OBSERVATIONS || m < 2 {
+        return None;
+    }
+    let mean = series.iter().sum::<f64>() / n as f64;
+    let (mut largest, mut total) = (0.0_f64, 0.0);
+    for k in 1..=m {
+        let w = std::f64::consts::TAU * k as f64 / n as f64;
+        let (re, im) = series.iter().enumerate().fold((0.0, 0.0), |(re, im), (t, x)| {
+            let (s, c) = (w * t as f64).sin_cos();
+            (re + (x - mean) * c, im - (x - mean) * s)
+        });
+        let power = re * re + im * im;
+        largest = largest.max(power);
+        total += power;
+    }
+    if total <= 0.0 {
+        return None;
+    }
+    let g = largest / total;
+    // The bound is a bound: above one half it says nothing, and the z is 0.
+    let p = (m as f64 * (1.0 - g).powi(m as i32 - 1)).clamp(1e-300, 0.5);
+    Normal::new(0.0, 1.0)
+        .ok()
+        .map(|normal| normal.inverse_cdf(1.0 - p).min(38.0))
+}
+
+/// Durbin–Watson's statistic of residuals in time order.
+fn durbin_watson(values: &[f64]) -> Option<f64> {
+    let total: f64 = values.iter().map(|r| r * r).sum();
+    (values.len() >= RUNS_MIN_OBSERVATIONS && total > 0.0)
+        .then(|| values.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / total)
 }
 
 /// Everything a fit found. It serialises as `nanofold fit --json` prints it.
@@ -191,6 +288,9 @@ pub struct FitReport {
     pub weighted_sum_of_squares: f64,
     /// S / (n − m): ≈ 1 when the given noise is right (1 by construction when estimated).
     pub reduced_chi_square: f64,
+    /// Whether any column's residuals say the model does not describe it
+    /// ([`ColumnResiduals::systematic`]); the warnings name them.
+    pub lack_of_fit: bool,
     /// t₀.₉₇₅ with n − m degrees of freedom.
     pub t_quantile: f64,
     /// The parameters.
@@ -635,6 +735,26 @@ fn warnings(status: FitStatus, iterations: usize, given: bool, report: &FitRepor
             report.reduced_chi_square
         ));
     }
+    let systematic: Vec<&ColumnResiduals> = report.residuals.iter().filter(|c| c.systematic).collect();
+    if !systematic.is_empty() {
+        let named: Vec<String> = systematic
+            .iter()
+            .map(|c| match c.chi_square_z {
+                Some(z) if z > LACK_OF_FIT_Z => format!("{} (χ² {z:+.1} standard deviations over its noise)", c.name),
+                _ => format!(
+                    "{} (periodicity z {}, runs z {}, Durbin–Watson {})",
+                    c.name,
+                    c.periodicity_z.map_or("-".into(), |z| format!("{z:.1}")),
+                    c.runs_z.map_or("-".into(), |z| format!("{z:.1}")),
+                    c.durbin_watson.map_or("-".into(), |d| format!("{d:.2}"))
+                ),
+            })
+            .collect();
+        warnings.push(format!(
+            "the model does not describe {}: its residuals follow a pattern in time, not noise, so its estimates are the best of a wrong model and its intervals are not confidence intervals",
+            named.join(", ")
+        ));
+    }
     for p in report.parameters.iter().filter(|p| p.at_bound) {
         warnings.push(format!(
             "{} = {} sits on a bound: its interval is not a confidence interval",
@@ -690,13 +810,29 @@ fn column_residuals(problem: &Problem, at: &Evaluation, given: bool) -> Vec<Colu
             let count = column.values.iter().flatten().count();
             let values: Vec<f64> = (e..e + count).map(|k| at.residuals[k] * problem.sigma[c]).collect();
             e += count;
+            let sum_of_squares: f64 = values.iter().map(|r| r * r).sum();
+            let runs = runs_z(&values);
+            // Σ(e/σ)² of n values is χ²(n): mean n, variance 2n.
+            let chi_square_z = (given && count > 0).then(|| {
+                let n = count as f64;
+                (sum_of_squares / (problem.sigma[c] * problem.sigma[c]) - n) / (2.0 * n).sqrt()
+            });
+            let periodicity = periodicity_z(&values);
+            let systematic = runs.is_some_and(|z| z.abs() > LACK_OF_FIT_Z)
+                || periodicity.is_some_and(|z| z > LACK_OF_FIT_Z)
+                || chi_square_z.is_some_and(|z| z > LACK_OF_FIT_Z);
             ColumnResiduals {
                 name: column.name.clone(),
                 observations: count,
                 noise: problem.sigma[c],
                 noise_source: if given { "given" } else { "estimated" },
-                rms: (values.iter().map(|r| r * r).sum::<f64>() / count.max(1) as f64).sqrt(),
+                rms: (sum_of_squares / count.max(1) as f64).sqrt(),
                 max_abs: values.iter().fold(0.0, |a, r| a.max(r.abs())),
+                runs_z: runs,
+                periodicity_z: periodicity,
+                durbin_watson: durbin_watson(&values),
+                chi_square_z,
+                systematic,
             }
         })
         .collect()
@@ -1044,6 +1180,7 @@ fn statistics(problem: &Problem, u: &[f64], at: &Evaluation, given: bool, n: usi
         degrees_of_freedom: dof,
         weighted_sum_of_squares: sum_of_squares,
         reduced_chi_square: reduced,
+        lack_of_fit: residuals.iter().any(|c| c.systematic),
         t_quantile: t,
         parameters,
         correlated,
@@ -1156,5 +1293,54 @@ mod tests {
         }
         .validate()
         .is_ok());
+    }
+
+    /// Seeded standard normals (splitmix64 and Box–Muller).
+    fn noise(seed: u64, n: usize) -> Vec<f64> {
+        let mut state = seed;
+        let mut uniform = || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (((z ^ (z >> 31)) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|_| (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos())
+            .collect()
+    }
+
+    #[test]
+    fn noise_passes_the_pattern_tests_and_patterns_do_not() {
+        // Noise: every test near its null, in 200 series of 100.
+        let mut flagged = 0;
+        for seed in 0..200 {
+            let e = noise(seed, 100);
+            let (runs, periodic) = (runs_z(&e).unwrap(), periodicity_z(&e).unwrap());
+            flagged += usize::from(runs.abs() > LACK_OF_FIT_Z || periodic > LACK_OF_FIT_Z);
+            let dw = durbin_watson(&e).unwrap();
+            assert!((1.2..2.8).contains(&dw), "Durbin–Watson {dw}");
+        }
+        assert_eq!(flagged, 0, "noise flagged as a pattern");
+        // A sine of 1.5 σ in the noise (an oscillation the model misses): periodic.
+        let e: Vec<f64> = noise(7, 100)
+            .iter()
+            .enumerate()
+            .map(|(t, x)| x + 1.5 * (0.7 * t as f64).sin())
+            .collect();
+        assert!(periodicity_z(&e).unwrap() > LACK_OF_FIT_Z);
+        // A slow drift of 2 σ: too few runs, and periodic at the lowest frequencies.
+        let e: Vec<f64> = noise(8, 100)
+            .iter()
+            .enumerate()
+            .map(|(t, x)| 0.3 * x + (t as f64 / 25.0 - 2.0))
+            .collect();
+        assert!(runs_z(&e).unwrap() < -LACK_OF_FIT_Z);
+        assert!(periodicity_z(&e).unwrap() > LACK_OF_FIT_Z);
+        // Signs that alternate every sample: too many runs.
+        let e: Vec<f64> = (0..100).map(|t| if t % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        assert!(runs_z(&e).unwrap() > LACK_OF_FIT_Z);
+        // Too few to test.
+        assert!(runs_z(&[1.0, -1.0, 1.0]).is_none() && periodicity_z(&[1.0, 2.0]).is_none());
     }
 }

@@ -36,12 +36,23 @@ const NEWTON_SWITCH: f64 = 1e-4;
 pub fn restore(model: &NetworkModel, angles: &mut [f64], solver: &mut NormalSolver) -> Result<usize> {
     match restore_closure(&model.folding, angles, CLOSURE_TOL, solver)? {
         Some(iterations) => Ok(iterations),
-        // The residual where Newton gave up.
-        None => Err(NumericalError::ClosureNotConverged {
-            residual: worst_residual(model, angles),
-            iterations: 30,
+        None => {
+            // Past a half turn and more the crease's panels have gone through each other:
+            // the state is no folding any more, whatever its closure.
+            if let Some(c) = angles.iter().position(|r| r.abs() > std::f64::consts::PI + 0.5) {
+                return Err(NumericalError::PanelsThrough {
+                    crease: model.folding.pattern.creases[c],
+                    angle_deg: angles[c].to_degrees(),
+                }
+                .into());
+            }
+            // The residual where Newton gave up.
+            Err(NumericalError::ClosureNotConverged {
+                residual: worst_residual(model, angles),
+                iterations: 30,
+            }
+            .into())
         }
-        .into()),
     }
 }
 
