@@ -170,7 +170,7 @@ pub struct ColumnResiduals {
     /// The runs test of the residuals' signs in time order: (runs − expected)/its standard
     /// deviation; far below 0 (too few runs: a drift) or far above (too many: an
     /// oscillation) the residuals follow a pattern, not noise (absent with fewer than
-    /// [`RUNS_MIN_OBSERVATIONS`] observations or one sign only).
+    /// ten observations or one sign only).
     pub runs_z: Option<f64>,
     /// Durbin–Watson's Σ(eₜ − eₜ₋₁)²/Σeₜ²: about 2 for independent noise, towards 0 for
     /// residuals that drift.
@@ -184,7 +184,7 @@ pub struct ColumnResiduals {
     /// normal z; far above 0 the residuals are larger than the noise allows.
     pub chi_square_z: Option<f64>,
     /// Whether the residuals say the model does not describe this column: the runs test
-    /// beyond ±[`LACK_OF_FIT_Z`], or the periodicity or χ² z above it.
+    /// beyond ±4 (`LACK_OF_FIT_Z`), or the periodicity or χ² z above it.
     pub systematic: bool,
 }
 

@@ -264,7 +264,7 @@ fn motion_samples(response: &Response) -> Vec<(String, &[f64])> {
         .collect()
 }
 
-/// A network's `motion.fold` ([`motion_fold`]).
+/// A network's `motion.fold` (see `motion_fold`).
 pub fn network_motion_fold(model: &NetworkModel, response: &Response) -> Value {
     network_states_fold(
         model,
