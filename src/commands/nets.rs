@@ -551,7 +551,7 @@ pub fn closing_page(made: &NetPattern, name: &str, front_deg: Option<f64>, optio
         .latches
         .iter()
         .map(|l| l.progress)
-        .chain(run.presses.iter().map(|p| p.progress))
+        .chain(run.contacts.iter().map(|p| p.progress))
         .chain(run.jam.as_ref().map(|j| j.progress))
         .collect();
     let stride = run.frames.len().div_ceil(PAGE_FRAMES).max(1);
@@ -583,10 +583,13 @@ pub fn closing_page(made: &NetPattern, name: &str, front_deg: Option<f64>, optio
         &frames,
         &format!("{name}: its device {} ({})", run.outcome.label(), scene.name),
     );
-    let collision = run.jam.as_ref().map(|j| crate::dynamics::Collision {
-        time: j.time_s,
-        pair: j.faces.map(|f| format!("face {f}")),
-        point: nalgebra::Vector3::from(j.point_um.map(|x| x * 1e-6)),
+    let collision = run.jam.as_ref().and_then(|j| {
+        let hardest = j.contacts.iter().max_by(|a, b| a.force_n.total_cmp(&b.force_n))?;
+        Some(crate::dynamics::Collision {
+            time: j.time_s,
+            pair: j.faces.map(|f| format!("face {f}")),
+            point: nalgebra::Vector3::from(hardest.point_um.map(|x| x * 1e-6)),
+        })
     });
     crate::plot::scene_page::network_response_page(&scene.name, model, &motion, collision.as_ref())
 }

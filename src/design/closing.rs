@@ -1,36 +1,53 @@
 //! Whether a net's device closes (`docs/model.md#closing-a-net`): its quasi-static folding
-//! carried past the first contact, each seam latching where its two edges meet, until every
-//! seam is shut (`closes`), faces meet where no seam is (`jams`), or the drives are spent
-//! (`stalls`).
+//! carried through contact by mechanics. At every instant the device rests at the minimum
+//! of its hinge energy with the latched seams closed and touching faces apart (their
+//! contact forces the multipliers); a seam latches where its faces meet within the
+//! capture. It ends when every seam is shut (`closes`), when the drives are spent with
+//! faces held apart by contact forces (`jams`) or free (`stalls`), or where the balance
+//! jumps (`snaps`).
 
 use crate::dynamics::network::algorithms::update_poses;
+use crate::dynamics::network::contact_balance::{solve_step, BalanceStep};
+use crate::dynamics::network::face_contact::{FaceContacts, Feature, FeatureState};
 use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::Forcing;
 use crate::error::{NanofoldError, Result};
-use crate::geometry::surface_intersection::convex_faces_meet;
 use crate::pattern::net::NetPattern;
-use nalgebra::{DMatrix, DVector, Point3, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// The most any drive angle moves between two tests of the faces, rad (0.5°): a meeting
 /// that begins and ends inside a smaller turn is not seen.
 const MAX_STEP: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// A step is halved down to this turn, rad, before a jump of the balance is called a snap.
+const MIN_TURN: f64 = 1e-9;
+/// A balance that moves more than this many times its drives' turn (plus the floor, rad)
+/// in one step has jumped.
+const JUMP_RATIO: f64 = 20.0;
+const JUMP_FLOOR: f64 = 1e-6;
 /// A seam whose ends lie this close (a fraction of its length) has met edge to edge.
 const ALIGNED: f64 = 1e-9;
 /// Seams meeting together: within this of aligned at an event, they latch with it.
 const ALIGNED_TOGETHER: f64 = 1e-6;
 /// Faces are tested for meeting to this fraction of the net's size.
 const TOLERANCE: f64 = 1e-9;
+/// A contact with no force this far apart (a fraction of the size) has parted.
+const PART: f64 = 1e-7;
+/// Faces are held by contact when the balance without it moves a fold angle by more than
+/// this, rad.
+const HELD_MOVE: f64 = 1e-6;
 /// Bisection of an event's progress stops at this width.
 const LOCATE: f64 = 1e-15;
-/// A seam's ray within this of the other face's plane (the sine of their angle) has reached
-/// it: the faces met there.
-const PRESS_REACH: f64 = 1e-6;
 /// A run's frames are kept at least this far apart in progress (and at every event).
 const FRAME_SPACING: f64 = 0.005;
 /// The latched seams' equilibrium: Gauss–Newton steps and the step that ends them, rad.
 const SETTLE_ITERATIONS: usize = 200;
 const SETTLE_STEP: f64 = 1e-13;
+/// With contacts: the QPs of one balance, and the step that ends them, rad.
+const CONTACT_ITERATIONS: usize = 100;
+const CONTACT_STEP: f64 = 1e-12;
+/// Rounds of contacts and latches at one instant before the run says it cannot settle.
+const RESOLVE_ROUNDS: usize = 50;
 /// JᵀJ's eigenvalues below this share of its largest are zero (singular values below 1e-6
 /// of J's largest).
 const RANK_CUT: f64 = 1e-12;
@@ -41,7 +58,7 @@ const SINGULAR_STEP: f64 = 1e-4;
 const RANK_READ: f64 = 1e-6;
 /// A latched seam's rows: a hinge's five.
 const SEAM_ROWS: usize = 5;
-/// The rows count as held below this (over the net's size, or the sine of a press's angle).
+/// The rows count as held below this (over the net's size).
 const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
 const SETTLE_DAMPING: f64 = 0.3;
@@ -81,10 +98,14 @@ impl ClosingSettings {
 pub enum Outcome {
     /// Every seam latched.
     Closes,
-    /// Two faces met where no seam joins them (or a seam's edges too far apart to latch).
+    /// The drives reached their targets with seams open and faces held apart from closing
+    /// by contact forces.
     Jams,
-    /// The drives reached their targets with seams still open.
+    /// The drives reached their targets with seams open and no contact holding them.
     Stalls,
+    /// The balance jumped (the path lost its stability): a quasi-static run cannot follow a
+    /// snap-through, so it stops there and says when.
+    Snaps,
     /// No balance was found with the latched seams held (a singular state of their
     /// closures): the run stops there and says why; it does not count as closing.
     Undecided,
@@ -97,6 +118,7 @@ impl Outcome {
             Outcome::Closes => "closes",
             Outcome::Jams => "jams",
             Outcome::Stalls => "stalls",
+            Outcome::Snaps => "snaps",
             Outcome::Undecided => "undecided",
         }
     }
@@ -117,36 +139,66 @@ pub struct Latch {
     pub misalignment: f64,
 }
 
-/// Faces that met at a corner they share and press on each other.
-#[serde_with::skip_serializing_none]
+/// Two faces coming into contact: from then on the balance keeps them apart with a force.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Contact {
-    /// The two faces (FOLD face indices).
+    /// The two faces (FOLD face indices): the first pushed along the normal.
     pub faces: [usize; 2],
-    /// Their open seam, if they share one.
-    pub seam: Option<usize>,
+    /// What touches: "corner on face" or "edge on edge".
+    pub feature: &'static str,
     /// When, s.
     pub time_s: f64,
     /// How far along the drives' path.
     pub progress: f64,
-    /// The seam's misalignment then.
-    pub misalignment: Option<f64>,
+    /// Where, µm.
+    pub point_um: [f64; 3],
 }
 
-/// Faces meeting where no seam latches them.
-#[serde_with::skip_serializing_none]
+/// A contact force at the end of a run (or where it stopped).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactForce {
+    /// The two faces (FOLD face indices): the force pushes the first along the normal and
+    /// the second against it.
+    pub faces: [usize; 2],
+    /// What touches: "corner on face" or "edge on edge".
+    pub feature: &'static str,
+    /// The point of touch on the first face, µm.
+    pub point_um: [f64; 3],
+    /// The unit normal from the second face towards the first.
+    pub normal: [f64; 3],
+    /// How far apart the two faces are along the normal there, µm (≥ 0 up to the solver's
+    /// tolerance).
+    pub gap_um: f64,
+    /// The force, N (≥ 0).
+    pub force_n: f64,
+}
+
+/// A latched seam's force at one end, on its first face (its second feels the opposite).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeamForce {
+    /// The seam (its index in the net's `nanofold:seams`).
+    pub seam: usize,
+    /// Its two faces (FOLD face indices).
+    pub faces: [usize; 2],
+    /// The end's point on the first face, µm.
+    pub point_um: [f64; 3],
+    /// The force on the first face there, N.
+    pub force_n: [f64; 3],
+}
+
+/// Faces held from closing by contact forces when the drives were spent.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Jam {
-    /// The two faces (FOLD face indices).
+    /// The faces pressed hardest (FOLD face indices).
     pub faces: [usize; 2],
     /// When, s.
     pub time_s: f64,
     /// How far along the drives' path.
     pub progress: f64,
-    /// A point where they meet, µm.
-    pub point_um: [f64; 3],
-    /// Their seam's misalignment when they share one that was too far out of line to latch.
-    pub seam_misalignment: Option<f64>,
+    /// Every contact force then.
+    pub contacts: Vec<ContactForce>,
+    /// The latched seams' forces then (with the contacts they balance the hinges).
+    pub seams: Vec<SeamForce>,
 }
 
 /// The fold angles at one moment of a closing run.
@@ -166,24 +218,27 @@ pub struct ClosingFrame {
 pub struct ClosingReport {
     /// How it ended.
     pub outcome: Outcome,
-    /// When: the last latch (closes), the jam, or the end of the drives (stalls), s.
+    /// When: the last latch (closes), the end of the drives (jams, stalls), or where the
+    /// path lost its stability (snaps), s.
     pub time_s: f64,
     /// How far along the drives' path that was.
     pub progress: f64,
-    /// When faces first met (a latch or a jam), s.
+    /// When faces first met (a latch or a contact), s.
     pub first_contact_time_s: Option<f64>,
     /// Every latch in order.
     pub latches: Vec<Latch>,
-    /// Faces that met at a corner they share and pressed on (one face's edge resting on the
-    /// other face), in order: across a seam out of line (it latches if they slide within
-    /// the capture), or around a solid vertex.
-    pub presses: Vec<Contact>,
-    /// The jam.
+    /// Every contact as it began, in order.
+    pub contacts: Vec<Contact>,
+    /// The contact forces holding the faces apart at the end (outcome `jams`).
     pub jam: Option<Jam>,
+    /// The contact forces at the end of the run, whatever its outcome.
+    pub final_contacts: Vec<ContactForce>,
     /// Seams still open at the end, with their misalignment.
     pub open_seams: Vec<(usize, f64)>,
-    /// Why the run could not go on (outcome `undecided`).
+    /// Why the run could not go on (outcome `undecided` or `snaps`).
     pub undecided: Option<String>,
+    /// The drives at the end, one per crease column, rad.
+    pub final_drive: Vec<f64>,
     /// The start, every event (before and after its latches) and the end.
     pub frames: Vec<ClosingFrame>,
 }
@@ -262,31 +317,21 @@ impl NetClosingSummary {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum SeamState {
     Open,
-    /// Its faces press on each other out of line (see [`Press`]).
-    Pressed,
     Latched,
 }
 
-/// Two faces pressing at a corner they share: one face's edge from it (a ray) rests on the
-/// other face's plane (`sign` · n · ray ≥ 0 keeps it out). Across a seam met out of line,
-/// or faces around a solid vertex that meet there.
-#[derive(Debug, Clone, Copy)]
-struct Press {
-    /// The seam between the faces, when they have one still open.
-    seam: Option<usize>,
-    ray_face: usize,
-    /// The ray's pattern vertices on `ray_face`: the shared corner, then the edge's far end.
-    ray: [usize; 2],
-    plane_face: usize,
-    sign: f64,
-}
-
-/// What holds the faces during a run.
+/// What holds the faces during a run: latched seams (closure rows) and touching features
+/// (contact rows, each with the side it came from and its force).
 #[derive(Debug, Clone)]
 struct Holds {
     state: Vec<SeamState>,
     latched: Vec<usize>,
-    pressed: Vec<Press>,
+    /// Features in contact (indices into the net's features).
+    touching: Vec<usize>,
+    /// Each touching feature's force at the last balance, N.
+    forces: Vec<f64>,
+    /// The latched seams' row multipliers at the last balance with contacts, N·m.
+    seam_multipliers: Vec<f64>,
 }
 
 impl Holds {
@@ -294,57 +339,94 @@ impl Holds {
         Holds {
             state: vec![SeamState::Open; seams],
             latched: Vec::new(),
-            pressed: Vec::new(),
+            touching: Vec::new(),
+            forces: Vec::new(),
+            seam_multipliers: Vec::new(),
         }
     }
 
-    fn is_empty(&self) -> bool {
-        self.latched.is_empty() && self.pressed.is_empty()
-    }
-
-    fn latch(&mut self, k: usize) {
-        self.pressed.retain(|p| p.seam != Some(k));
+    fn latch(&mut self, k: usize, faces: [usize; 2], features: &[Feature]) {
         self.state[k] = SeamState::Latched;
         self.latched.push(k);
+        // The seam's rows hold its faces now: their contacts go.
+        let apart = |f: usize| {
+            let [a, b] = features[self.touching[f]].faces();
+            (a == faces[0] && b == faces[1]) || (a == faces[1] && b == faces[0])
+        };
+        let keep: Vec<usize> = (0..self.touching.len()).filter(|&f| !apart(f)).collect();
+        self.touching = keep.iter().map(|&f| self.touching[f]).collect();
+        self.forces = keep.iter().map(|&f| self.forces[f]).collect();
     }
 
-    fn press(&mut self, press: Press) {
-        if let Some(k) = press.seam {
-            self.state[k] = SeamState::Pressed;
+    fn touch(&mut self, feature: usize) {
+        if !self.touching.contains(&feature) {
+            self.touching.push(feature);
+            self.forces.push(0.0);
         }
-        self.pressed.push(press);
-    }
-
-    /// Lets go of the presses at `indices` (into `pressed`).
-    fn part(&mut self, indices: &[usize]) {
-        for &i in indices {
-            if let Some(k) = self.pressed[i].seam {
-                self.state[k] = SeamState::Open;
-            }
-        }
-        let mut k = 0;
-        self.pressed.retain(|_| {
-            k += 1;
-            !indices.contains(&(k - 1))
-        });
-    }
-
-    /// Whether the faces are a pressed seam's.
-    fn pressing(&self, [f, g]: [usize; 2]) -> bool {
-        self.pressed
-            .iter()
-            .any(|p| (p.ray_face == f && p.plane_face == g) || (p.ray_face == g && p.plane_face == f))
     }
 }
 
-/// A matrix's row space as JᵀJ's eigenpairs.
-type RowSpace = Vec<(f64, DVector<f64>)>;
+/// Each feature's orientation in a run: its normal kept continuous (an edge pair's crossing
+/// normal turns over as the edges pass parallel) and the side it came from (±1: where it
+/// was when last off the other face's plane, kept while it is over the other face; 0: never
+/// off it yet).
+#[derive(Debug, Clone)]
+struct Sides {
+    sign: Vec<f64>,
+    reference: Vec<Vector3<f64>>,
+}
+
+impl Sides {
+    fn new(features: usize) -> Sides {
+        Sides {
+            sign: vec![0.0; features],
+            reference: vec![Vector3::zeros(); features],
+        }
+    }
+
+    /// Feature `k` with its normal continuous.
+    fn continuous(&self, contacts: &FaceContacts, data: &NetworkData, k: usize) -> FeatureState {
+        let mut state = contacts.state(data, k);
+        if state.normal.dot(&self.reference[k]) < 0.0 {
+            state.normal = -state.normal;
+            state.distance = -state.distance;
+        }
+        state
+    }
+
+    /// Feature `k` turned to the side it came from: its distance is its gap.
+    fn state(&self, contacts: &FaceContacts, data: &NetworkData, k: usize) -> FeatureState {
+        let mut state = self.continuous(contacts, data, k);
+        if self.sign[k] < 0.0 {
+            state.normal = -state.normal;
+            state.distance = -state.distance;
+        }
+        state
+    }
+
+    /// Carries feature `k`'s orientation to the poses `data` holds.
+    fn update(&mut self, contacts: &FaceContacts, data: &NetworkData, k: usize, tolerance: f64) {
+        let state = self.continuous(contacts, data, k);
+        if !state.distance.is_finite() {
+            return;
+        }
+        self.reference[k] = state.normal;
+        // A feature coming over the other face exactly on its plane, as an edge turning in
+        // through the other face's edge does, keeps the side it came from.
+        if (!state.over || self.sign[k] == 0.0) && state.distance.abs() > tolerance {
+            self.sign[k] = state.distance.signum();
+        }
+    }
+}
 
 /// Stiffnesses over the largest.
 fn scaled(stiffness: &[f64]) -> DVector<f64> {
     let largest = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
     DVector::from_iterator(stiffness.len(), stiffness.iter().map(|k| k / largest))
 }
+
+/// A matrix's row space as JᵀJ's eigenpairs.
+type RowSpace = Vec<(f64, DVector<f64>)>;
 
 #[derive(Debug, Clone)]
 struct SeamEnds {
@@ -354,24 +436,13 @@ struct SeamEnds {
     length: f64,
 }
 
-#[derive(Debug, Clone)]
-struct FacePair {
-    faces: [usize; 2],
-    /// Corners that are copies of one solid vertex: (vertex of the first, of the second).
-    common: Vec<[usize; 2]>,
-    seam: Option<usize>,
-}
-
-/// A net's faces, seams and face pairs as a closing run tests them, for one network model
-/// of the net (built once, run for every sample).
+/// A net's faces, seams and contact features as a closing run tests them, for one network
+/// model of the net (built once, run for every sample).
 #[derive(Debug, Clone)]
 pub struct NetClosing {
-    faces: Vec<Vec<usize>>,
-    face_panel: Vec<usize>,
+    contacts: FaceContacts,
     file_face: Vec<usize>,
-    flat: Vec<Vector3<f64>>,
     seams: Vec<SeamEnds>,
-    pairs: Vec<FacePair>,
     /// Each panel's tree columns to the anchored panel.
     paths: Vec<Vec<usize>>,
     size: f64,
@@ -396,12 +467,8 @@ impl NetClosing {
                 "seams latch on a net (a tree of panels); this pattern closes loops of its own",
             ));
         }
-        let unit = model.unit;
-        let flat: Vec<Vector3<f64>> = pattern
-            .vertices
-            .iter()
-            .map(|p| Vector3::new(p[0] * unit, p[1] * unit, 0.0))
-            .collect();
+        let contacts = FaceContacts::new(model, &net.solid_vertex, |_, _| true);
+        let flat = &contacts.flat;
         let face_of_edge = |e: usize| {
             pattern.edge_faces[e]
                 .iter()
@@ -428,42 +495,14 @@ impl NetClosing {
                 }
             })
             .collect();
-        let faces = pattern.faces.clone();
-        let face_panel: Vec<usize> = (0..faces.len()).map(|f| pattern.panel_of_face[f]).collect();
-        let mut pairs = Vec::new();
-        for f in 0..faces.len() {
-            for g in f + 1..faces.len() {
-                if face_panel[f] == face_panel[g] {
-                    continue;
-                }
-                let common: Vec<[usize; 2]> = faces[f]
-                    .iter()
-                    .flat_map(|&v| {
-                        faces[g]
-                            .iter()
-                            .filter(move |&&w| solid[v] == solid[w])
-                            .map(move |&w| [v, w])
-                    })
-                    .collect();
-                let seam = seams.iter().position(|s| s.faces == [f, g] || s.faces == [g, f]);
-                pairs.push(FacePair {
-                    faces: [f, g],
-                    common,
-                    seam,
-                });
-            }
-        }
         let paths = (0..model.panels()).map(|p| model.path_columns(p).collect()).collect();
         Ok(NetClosing {
-            faces,
-            face_panel,
+            contacts,
             file_face: pattern.file_face.clone(),
-            flat,
             seams,
-            pairs,
             paths,
             size: model.size(),
-            unit,
+            unit: model.unit,
         })
     }
 
@@ -473,7 +512,7 @@ impl NetClosing {
     }
 
     fn place(&self, data: &NetworkData, face: usize, v: usize) -> Vector3<f64> {
-        data.place(self.face_panel[face], &self.flat[v])
+        self.contacts.place(data, face, v)
     }
 
     /// How far apart seam `k`'s edges' ends are, a fraction of its length.
@@ -486,77 +525,57 @@ impl NetClosing {
             / seam.length
     }
 
-    /// The face pairs whose interiors meet (with a point of each meeting), at the poses
-    /// `data` holds.
-    fn meeting_pairs(&self, data: &NetworkData) -> Vec<(usize, Point3<f64>)> {
+    /// The seam between faces `[f, g]`, if they have one.
+    fn seam_of(&self, [f, g]: [usize; 2]) -> Option<usize> {
+        self.seams.iter().position(|s| s.faces == [f, g] || s.faces == [g, f])
+    }
+
+    /// Whether anything happens at these poses: an open seam aligned, a seam whose faces
+    /// touch come within the capture, or a feature over another face crossed to the wrong
+    /// side of it.
+    fn event(&self, data: &NetworkData, holds: &Holds, sides: &Sides, capture: f64) -> bool {
         let tolerance = TOLERANCE * self.size;
-        let corners: Vec<Vec<Point3<f64>>> = (0..self.faces.len())
-            .map(|f| {
-                self.faces[f]
-                    .iter()
-                    .map(|&v| Point3::from(self.place(data, f, v)))
-                    .collect()
-            })
-            .collect();
-        let boxes: Vec<([f64; 3], [f64; 3])> = corners
-            .iter()
-            .map(|points| {
-                points
-                    .iter()
-                    .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
-                        ([0, 1, 2].map(|i| lo[i].min(p[i])), [0, 1, 2].map(|i| hi[i].max(p[i])))
-                    })
-            })
-            .collect();
-        let mut meeting = Vec::new();
-        for (k, pair) in self.pairs.iter().enumerate() {
-            let [f, g] = pair.faces;
-            if (0..3).any(|i| boxes[f].0[i] > boxes[g].1[i] + tolerance || boxes[g].0[i] > boxes[f].1[i] + tolerance) {
-                continue;
-            }
-            let shared = pair
-                .common
-                .iter()
-                .filter(|&&[v, w]| (self.place(data, f, v) - self.place(data, g, w)).norm() <= tolerance)
-                .count();
-            if let Some(point) = convex_faces_meet(&corners[f], &corners[g], shared, tolerance) {
-                meeting.push((k, point));
-            }
-        }
-        meeting
-    }
-
-    /// Whether anything happens at these poses: faces meeting (other than a pressed seam's),
-    /// an open seam aligned, or a pressed one come within the capture.
-    fn event(&self, data: &NetworkData, holds: &Holds, capture: f64) -> bool {
         (0..self.seams.len()).any(|k| {
-            let m = || self.misalignment(data, k);
-            match holds.state[k] {
-                SeamState::Open => m() <= ALIGNED,
-                SeamState::Pressed => m() <= capture,
-                SeamState::Latched => false,
+            holds.state[k] == SeamState::Open && {
+                let m = self.misalignment(data, k);
+                m <= ALIGNED || (m <= capture && self.seam_touching(holds, k))
             }
-        }) || self
-            .meeting_pairs(data)
-            .iter()
-            .any(|&(pair, _)| !holds.pressing(self.pairs[pair].faces))
+        }) || (0..self.contacts.features.len()).any(|k| {
+            sides.sign[k] != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
+                let state = sides.state(&self.contacts, data, k);
+                state.over && state.distance < -tolerance
+            }
+        })
     }
 
-    /// The rows that hold the faces, their residual and Jacobian in the fold angles at the
-    /// poses and twists `data` holds: each latched seam's first end on its copy (three rows)
-    /// and its second end's offset across the seam's line (two rows: along face a's normal
-    /// and across the edge in its plane), over the net's size, so a seam on its copy (a
-    /// hinge) has five independent rows wherever it is; each pressed seam's ray on the other
-    /// face's plane (one row).
-    fn hold_rows(&self, data: &NetworkData, holds: &Holds, columns: usize) -> (DVector<f64>, DMatrix<f64>) {
-        let rows = SEAM_ROWS * holds.latched.len() + holds.pressed.len();
+    /// Whether seam `k`'s faces touch.
+    fn seam_touching(&self, holds: &Holds, k: usize) -> bool {
+        holds
+            .touching
+            .iter()
+            .any(|&f| self.seam_of(self.contacts.features[f].faces()) == Some(k))
+    }
+
+    /// Whether feature `k`'s faces are held by a latched seam (it no longer watches them).
+    fn held_by_seam(&self, holds: &Holds, k: usize) -> bool {
+        self.seam_of(self.contacts.features[k].faces())
+            .is_some_and(|s| holds.state[s] == SeamState::Latched)
+    }
+
+    /// The latched seams' rows, their residual and Jacobian in the fold angles at the poses
+    /// and twists `data` holds: each seam's first end on its copy (three rows) and its
+    /// second end's offset across the seam's line (two rows: along face a's normal and
+    /// across the edge in its plane), over the net's size, so a seam on its copy (a hinge)
+    /// has five independent rows wherever it is.
+    fn seam_rows(&self, data: &NetworkData, holds: &Holds, columns: usize) -> (DVector<f64>, DMatrix<f64>) {
+        let rows = SEAM_ROWS * holds.latched.len();
         let mut residual = DVector::zeros(rows);
         let mut jacobian = DMatrix::zeros(rows, columns);
         for (i, &k) in holds.latched.iter().enumerate() {
             let seam = &self.seams[k];
             let [a, b] = seam.faces;
             let along = (self.place(data, a, seam.ends[1][0]) - self.place(data, a, seam.ends[0][0])).normalize();
-            let normal = data.rotation[self.face_panel[a]] * Vector3::z();
+            let normal = self.contacts.normal(data, a);
             let across = along.cross(&normal);
             let identity = nalgebra::Matrix3::identity();
             for (e, &[v, w]) in seam.ends.iter().enumerate() {
@@ -570,9 +589,8 @@ impl NetClosing {
                     residual[row + j] = d.dot(&(x - y)) / self.size;
                 }
                 for (point, face, sign) in [(x, a, 1.0), (y, b, -1.0)] {
-                    for &c in &self.paths[self.face_panel[face]] {
-                        let twist = &data.twist[c];
-                        let velocity = twist.angular.cross(&point) + twist.linear;
+                    for &c in &self.paths[self.contacts.face_panel[face]] {
+                        let velocity = data.twist[c].point_velocity(&point);
                         for (j, d) in directions.iter().enumerate() {
                             jacobian[(row + j, c)] += sign * d.dot(&velocity) / self.size;
                         }
@@ -580,26 +598,58 @@ impl NetClosing {
                 }
             }
         }
-        for (i, press) in holds.pressed.iter().enumerate() {
-            let row = SEAM_ROWS * holds.latched.len() + i;
-            let (normal, ray) = self.press_vectors(data, press);
-            residual[row] = press.sign * normal.dot(&ray);
-            for &c in &self.paths[self.face_panel[press.plane_face]] {
-                jacobian[(row, c)] += press.sign * data.twist[c].angular.cross(&normal).dot(&ray);
-            }
-            for &c in &self.paths[self.face_panel[press.ray_face]] {
-                jacobian[(row, c)] += press.sign * normal.dot(&data.twist[c].angular.cross(&ray));
-            }
-        }
         (residual, jacobian)
     }
 
-    /// A pressed seam's plane normal and unit ray, in the world.
-    fn press_vectors(&self, data: &NetworkData, press: &Press) -> (Vector3<f64>, Vector3<f64>) {
-        let normal = data.rotation[self.face_panel[press.plane_face]] * Vector3::z();
-        let [from, to] = press.ray;
-        let ray = (self.place(data, press.ray_face, to) - self.place(data, press.ray_face, from)).normalize();
-        (normal, ray)
+    /// The latched seams' forces from their multipliers: a row d·(x − y)/size with
+    /// multiplier μ pulls x (on the first face) by −μ d / size.
+    fn seam_forces(&self, data: &NetworkData, holds: &Holds) -> Vec<SeamForce> {
+        if holds.seam_multipliers.len() != SEAM_ROWS * holds.latched.len() {
+            return Vec::new();
+        }
+        let identity = nalgebra::Matrix3::<f64>::identity();
+        let mut forces = Vec::new();
+        for (i, &k) in holds.latched.iter().enumerate() {
+            let seam = &self.seams[k];
+            let [a, _] = seam.faces;
+            let along = (self.place(data, a, seam.ends[1][0]) - self.place(data, a, seam.ends[0][0])).normalize();
+            let normal = self.contacts.normal(data, a);
+            let across = along.cross(&normal);
+            let mu = &holds.seam_multipliers[SEAM_ROWS * i..SEAM_ROWS * (i + 1)];
+            let first: Vector3<f64> = (0..3).map(|j| identity.column(j) * mu[j]).sum::<Vector3<f64>>();
+            let second = normal * mu[3] + across * mu[4];
+            for (e, pull) in [(0, first), (1, second)] {
+                let x = self.place(data, a, seam.ends[e][0]);
+                let force = -pull / self.size;
+                forces.push(SeamForce {
+                    seam: k,
+                    faces: seam.faces.map(|f| self.file_face[f]),
+                    point_um: [x.x, x.y, x.z].map(|c| c * 1e6),
+                    force_n: [force.x, force.y, force.z],
+                });
+            }
+        }
+        forces
+    }
+
+    /// The touching features' gaps (on their sides, m) and rows.
+    fn contact_rows(
+        &self,
+        data: &NetworkData,
+        holds: &Holds,
+        sides: &Sides,
+        columns: usize,
+    ) -> (DVector<f64>, DMatrix<f64>) {
+        let mut gaps = DVector::zeros(holds.touching.len());
+        let mut rows = DMatrix::zeros(holds.touching.len(), columns);
+        let mut row = DVector::zeros(columns);
+        for (i, &k) in holds.touching.iter().enumerate() {
+            let state = sides.state(&self.contacts, data, k);
+            self.contacts.row(data, k, &state, &mut row);
+            gaps[i] = state.distance;
+            rows.row_mut(i).copy_from(&row.transpose());
+        }
+        (gaps, rows)
     }
 
     /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space): the null space the
@@ -630,9 +680,56 @@ impl NetClosing {
     }
 
     /// The quasi-static balance with `holds` held: the fold angles minimising
-    /// Σ ½ K (θ − r)² on their rows, from `theta` (Gauss–Newton on the rows, the energy
-    /// minimised in their null space). Returns whether it converged.
+    /// Σ ½ K (θ − r)² on the latched seams' closures with the touching faces apart, from
+    /// `theta`. Without contacts, Gauss–Newton on the closures with the energy minimised in
+    /// their null space (the direct path); with contacts, a sequence of Clarabel QPs whose
+    /// contact multipliers are left in `holds.forces`. Returns whether it converged.
+    #[allow(clippy::too_many_arguments)]
     fn settle(
+        &self,
+        model: &NetworkModel,
+        drive: &[f64],
+        stiffness: &[f64],
+        holds: &mut Holds,
+        sides: &Sides,
+        theta: &mut [f64],
+        data: &mut NetworkData,
+    ) -> bool {
+        if holds.touching.is_empty() {
+            return self.settle_closures(model, drive, stiffness, holds, theta, data);
+        }
+        let n = theta.len();
+        for _ in 0..CONTACT_ITERATIONS {
+            update_poses(model, theta, data);
+            let (closure, closure_rows) = self.seam_rows(data, holds, n);
+            let (gaps, contact_rows) = self.contact_rows(data, holds, sides, n);
+            let offset: Vec<f64> = (0..n).map(|c| theta[c] - drive[c]).collect();
+            let Ok(solution) = solve_step(&BalanceStep {
+                stiffness,
+                offset: &offset,
+                closures: (&closure_rows, &closure),
+                contacts: (&contact_rows, &gaps),
+                trust: SETTLE_DAMPING,
+                size: self.size,
+            }) else {
+                return false;
+            };
+            for c in 0..n {
+                theta[c] += solution.step[c];
+            }
+            holds.forces.copy_from_slice(solution.forces.as_slice());
+            holds.seam_multipliers = solution.closure_multipliers.iter().copied().collect();
+            if !solution.at_trust && solution.step.amax() <= CONTACT_STEP {
+                update_poses(model, theta, data);
+                return true;
+            }
+        }
+        update_poses(model, theta, data);
+        false
+    }
+
+    /// [`Self::settle`] with no contact: the direct path.
+    fn settle_closures(
         &self,
         model: &NetworkModel,
         drive: &[f64],
@@ -642,7 +739,7 @@ impl NetClosing {
         data: &mut NetworkData,
     ) -> bool {
         let n = theta.len();
-        if holds.is_empty() {
+        if holds.latched.is_empty() {
             theta.copy_from_slice(drive);
             update_poses(model, theta, data);
             return true;
@@ -656,7 +753,7 @@ impl NetClosing {
         let mut null_count = None;
         for _ in 0..SETTLE_ITERATIONS {
             update_poses(model, theta, data);
-            let (residual, jacobian) = self.hold_rows(data, holds, n);
+            let (residual, jacobian) = self.seam_rows(data, holds, n);
             let (row, null) = Self::row_and_null_space(&jacobian, null_count);
             if null_count.is_none() && residual.amax() <= RANK_READ {
                 null_count = Some(null.len());
@@ -692,83 +789,7 @@ impl NetClosing {
         }
         update_poses(model, theta, data);
         // Slow (linear) convergence at a rank-deficient point: held, and the steps small.
-        last_turn <= SINGULAR_STEP && self.hold_rows(data, holds, n).0.amax() <= SETTLE_HELD
-    }
-
-    /// The presses (indices into `holds.pressed`) whose faces the balance would rather part: moving along the
-    /// contact's gradient (within the other rows) lowers the hinges' energy.
-    fn parting(
-        &self,
-        data: &NetworkData,
-        holds: &Holds,
-        drive: &[f64],
-        stiffness: &[f64],
-        theta: &[f64],
-    ) -> Vec<usize> {
-        let n = theta.len();
-        let (_, jacobian) = self.hold_rows(data, holds, n);
-        let stiff = scaled(stiffness);
-        let gradient = DVector::from_iterator(n, (0..n).map(|c| stiff[c] * (theta[c] - drive[c])));
-        let first = SEAM_ROWS * holds.latched.len();
-        (0..holds.pressed.len())
-            .filter(|&i| {
-                let others: Vec<usize> = (0..jacobian.nrows()).filter(|&r| r != first + i).collect();
-                let contact = jacobian.row(first + i).transpose();
-                let apart = if others.is_empty() {
-                    contact.clone()
-                } else {
-                    let (_, null) = Self::row_and_null_space(&jacobian.select_rows(&others), None);
-                    null.iter().fold(DVector::zeros(n), |d, z| d + z * z.dot(&contact))
-                };
-                gradient.dot(&apart) < -1e-12 * gradient.norm() * apart.norm()
-            })
-            .collect()
-    }
-
-    /// Whether faces `pair` meeting are pressing at a corner they share: an edge of one from
-    /// that corner has reached the other's plane (the ray nearest it, within
-    /// [`PRESS_REACH`]), kept on the side it came from (its side at `before`).
-    fn press_of(
-        &self,
-        pair: &FacePair,
-        open_seam: Option<usize>,
-        before: &NetworkData,
-        now: &NetworkData,
-    ) -> Option<Press> {
-        let tolerance = TOLERANCE * self.size;
-        let [f, g] = pair.faces;
-        let edges_from = |face: usize, v: usize| {
-            let loop_ = &self.faces[face];
-            let k = loop_.iter().position(|&x| x == v).expect("a corner of the face");
-            [loop_[(k + 1) % loop_.len()], loop_[(k + loop_.len() - 1) % loop_.len()]]
-        };
-        pair.common
-            .iter()
-            .filter(|&&[v, w]| (self.place(now, f, v) - self.place(now, g, w)).norm() <= tolerance)
-            .flat_map(|&[v, w]| {
-                let from_f = edges_from(f, v).map(|far| (f, [v, far], g));
-                let from_g = edges_from(g, w).map(|far| (g, [w, far], f));
-                from_f.into_iter().chain(from_g)
-            })
-            .map(|(ray_face, ray, plane_face)| {
-                let candidate = Press {
-                    seam: open_seam,
-                    ray_face,
-                    ray,
-                    plane_face,
-                    sign: 1.0,
-                };
-                let side_of = |data: &NetworkData| {
-                    let (normal, ray) = self.press_vectors(data, &candidate);
-                    normal.dot(&ray)
-                };
-                let (was, is) = (side_of(before), side_of(now));
-                let sign = if was != 0.0 { was.signum() } else { (was - is).signum() };
-                (is.abs(), Press { sign, ..candidate })
-            })
-            .filter(|(reach, _)| *reach <= PRESS_REACH)
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(_, press)| press)
+        last_turn <= SINGULAR_STEP && self.seam_rows(data, holds, n).0.amax() <= SETTLE_HELD
     }
 
     /// Runs a net's device with `forcing` and `stiffness` (one per crease column; a sample
@@ -796,9 +817,9 @@ impl NetClosing {
             stiffness,
             capture: settings.capture_percent / 100.0,
             data: NetworkData::new(model),
-            before: NetworkData::new(model),
             drive: vec![0.0; n],
             theta: vec![0.0; n],
+            sides: Sides::new(self.contacts.features.len()),
             holds: Holds::new(self.seams.len()),
             report: ClosingReport {
                 outcome: Outcome::Stalls,
@@ -806,22 +827,32 @@ impl NetClosing {
                 progress: 0.0,
                 first_contact_time_s: None,
                 latches: Vec::new(),
-                presses: Vec::new(),
+                contacts: Vec::new(),
                 jam: None,
+                final_contacts: Vec::new(),
                 open_seams: Vec::new(),
                 undecided: None,
+                final_drive: Vec::new(),
                 frames: Vec::new(),
             },
         };
-        if let Err(why) = run.drive_through() {
-            // No balance holds the latched seams here: the run cannot say what the device
-            // does next, and says so (counted as not closing).
-            let u = run.report.frames.last().map_or(0.0, |f| f.progress);
-            run.end(Outcome::Undecided, u);
-            run.report.undecided = Some(why.to_string());
-            update_poses(model, &run.theta, &mut run.data);
-            run.report.open_seams = self.open(&run.data, &run.holds);
+        match run.drive_through() {
+            Ok(()) => {}
+            Err(Stop::Snap(u, why)) => {
+                run.end(Outcome::Snaps, u);
+                run.report.undecided = Some(why);
+            }
+            Err(Stop::NoBalance(u, why)) => {
+                // No balance holds the seams and contacts here: the run cannot say what the
+                // device does next, and says so (counted as not closing).
+                run.end(Outcome::Undecided, u);
+                run.report.undecided = Some(why);
+            }
         }
+        update_poses(model, &run.theta, &mut run.data);
+        run.report.open_seams = self.open(&run.data, &run.holds);
+        run.report.final_contacts = self.forces(&run.data, &run.holds, &run.sides);
+        run.report.final_drive = run.drive.clone();
         Ok(run.report)
     }
 
@@ -832,8 +863,31 @@ impl NetClosing {
             .collect()
     }
 
-    /// The quasi-static balance with the seams `latched` held, from the fold angles `start`:
-    /// the angles minimising Σ ½ K (θ − r)² (r = `drive`) on the seams' closures.
+    /// The touching features' forces as reported.
+    fn forces(&self, data: &NetworkData, holds: &Holds, sides: &Sides) -> Vec<ContactForce> {
+        holds
+            .touching
+            .iter()
+            .zip(&holds.forces)
+            .map(|(&k, &force)| {
+                let state = sides.state(&self.contacts, data, k);
+                let feature = self.contacts.features[k];
+                let normal = state.normal;
+                ContactForce {
+                    faces: feature.faces().map(|f| self.file_face[f]),
+                    feature: feature_name(&feature),
+                    point_um: [state.point.x, state.point.y, state.point.z].map(|x| x * 1e6),
+                    normal: [normal.x, normal.y, normal.z],
+                    gap_um: state.distance * 1e6,
+                    force_n: force,
+                }
+            })
+            .collect()
+    }
+
+    /// The quasi-static balance with the seams `latched` held (no contact), from the fold
+    /// angles `start`: the angles minimising Σ ½ K (θ − r)² (r = `drive`) on the seams'
+    /// closures.
     pub fn balance(
         &self,
         model: &NetworkModel,
@@ -865,8 +919,10 @@ impl NetClosing {
         let mut theta = start.to_vec();
         let mut data = NetworkData::new(model);
         let mut holds = Holds::new(self.seams.len());
-        latched.iter().for_each(|&k| holds.latch(k));
-        if !self.settle(model, drive, stiffness, &holds, &mut theta, &mut data) {
+        latched
+            .iter()
+            .for_each(|&k| holds.latch(k, self.seams[k].faces, &self.contacts.features));
+        if !self.settle_closures(model, drive, stiffness, &holds, &mut theta, &mut data) {
             return Err(NanofoldError::invalid(
                 "latched",
                 format!("{latched:?}"),
@@ -881,8 +937,8 @@ impl NetClosing {
     pub fn vertex_places(&self, model: &NetworkModel, theta: &[f64]) -> Vec<[f64; 3]> {
         let mut data = NetworkData::new(model);
         update_poses(model, theta, &mut data);
-        let mut places = vec![[f64::NAN; 3]; self.flat.len()];
-        for (f, face) in self.faces.iter().enumerate() {
+        let mut places = vec![[f64::NAN; 3]; self.contacts.flat.len()];
+        for (f, face) in self.contacts.faces.iter().enumerate() {
             for &v in face {
                 let x = self.place(&data, f, v) / self.unit;
                 places[v] = [x.x, x.y, x.z];
@@ -890,6 +946,22 @@ impl NetClosing {
         }
         places
     }
+}
+
+fn feature_name(feature: &Feature) -> &'static str {
+    match feature {
+        Feature::CornerOnFace { .. } => "corner on face",
+        Feature::EdgeOnCorner { .. } => "edge on a shared corner",
+        Feature::EdgeOnEdge { .. } => "edge on edge",
+    }
+}
+
+/// Why a run stopped before the end of its drives (at a progress).
+enum Stop {
+    /// The balance jumped: the path lost its stability there.
+    Snap(f64, String),
+    /// No balance was found.
+    NoBalance(f64, String),
 }
 
 /// One closing run's state: the angles, what holds the faces, the report so far.
@@ -900,40 +972,62 @@ struct Run<'a> {
     stiffness: &'a [f64],
     capture: f64,
     data: NetworkData,
-    /// The poses just before the event being resolved (which side a pressing edge came from).
-    before: NetworkData,
     drive: Vec<f64>,
     theta: Vec<f64>,
+    sides: Sides,
     holds: Holds,
     report: ClosingReport,
 }
 
 impl Run<'_> {
-    /// From flat to the end of the drives, the report filled; an error when no balance holds
-    /// the latched seams somewhere on the way.
-    fn drive_through(&mut self) -> Result<()> {
+    /// From flat to the end of the drives, the report filled.
+    fn drive_through(&mut self) -> std::result::Result<(), Stop> {
         let net = self.net;
         self.settle_at(0.0)?;
         self.keep_frame(0.0);
         let mut last_frame = 0.0;
         let mut u = 0.0;
+        let mut turn = MAX_STEP;
         while u < 1.0 {
-            let next = self.path.next(u, MAX_STEP);
+            let next = self.path.next(u, turn);
             let mut trial = self.theta.clone();
+            let mut holds = self.holds.clone();
             self.path.drive(next, &mut self.drive);
-            if !net.settle(
+            let settled = net.settle(
                 self.model,
                 &self.drive,
                 self.stiffness,
-                &self.holds,
+                &mut holds,
+                &self.sides,
                 &mut trial,
                 &mut self.data,
-            ) {
-                return Err(self.no_balance(next));
+            );
+            let jump = (0..trial.len())
+                .map(|c| (trial[c] - self.theta[c]).abs())
+                .fold(0.0, f64::max);
+            if !settled || jump > JUMP_RATIO * turn + JUMP_FLOOR {
+                // A balance that moves far more than its drives: halve the step until it
+                // follows, or the step is too small to say anything but that it jumped.
+                if turn > MIN_TURN {
+                    turn *= 0.5;
+                    continue;
+                }
+                return Err(if settled {
+                    Stop::Snap(
+                        u,
+                        format!(
+                            "the balance jumped by {jump:.3e} rad for a drive step of {turn:.1e} rad at progress {u:.9}: the path loses its stability (a snap-through)"
+                        ),
+                    )
+                } else {
+                    self.no_balance(next)
+                });
             }
-            if !net.event(&self.data, &self.holds, self.capture) {
-                self.let_go_of_parting(&mut trial, next)?;
+            turn = (turn * 2.0).min(MAX_STEP);
+            if !net.event(&self.data, &holds, &self.sides, self.capture) {
                 self.theta = trial;
+                self.holds = holds;
+                self.after_step();
                 u = next;
                 if u - last_frame >= FRAME_SPACING {
                     self.keep_frame(u);
@@ -941,8 +1035,7 @@ impl Run<'_> {
                 }
                 continue;
             }
-            u = self.locate(u, next, trial);
-            self.report.first_contact_time_s.get_or_insert(self.path.time(u));
+            u = self.locate(u, next, trial, holds);
             self.keep_frame(u);
             if self.resolve(u)? {
                 return Ok(());
@@ -950,10 +1043,69 @@ impl Run<'_> {
             last_frame = u;
         }
         update_poses(self.model, &self.theta, &mut self.data);
-        self.end(Outcome::Stalls, 1.0);
-        self.report.open_seams = net.open(&self.data, &self.holds);
+        let holding = self.held_by_contact();
+        self.end(if holding { Outcome::Jams } else { Outcome::Stalls }, 1.0);
+        if holding {
+            let contacts = net.forces(&self.data, &self.holds, &self.sides);
+            let hardest = contacts
+                .iter()
+                .max_by(|a, b| a.force_n.total_cmp(&b.force_n))
+                .map(|c| c.faces)
+                .unwrap_or_default();
+            self.report.jam = Some(Jam {
+                faces: hardest,
+                time_s: self.path.time(1.0),
+                progress: 1.0,
+                contacts,
+                seams: net.seam_forces(&self.data, &self.holds),
+            });
+        }
         self.keep_frame(1.0);
         Ok(())
+    }
+
+    /// Whether the contacts hold the faces where they are: without them (the latched seams
+    /// still held) the balance would move. Forces on contacts that hold nothing (a face
+    /// resting flush on another, or one of several rows sharing a load the seams carry) are
+    /// a split of a load that statics leaves open, not a jam.
+    fn held_by_contact(&self) -> bool {
+        if !self.holds.forces.iter().any(|&f| f > 0.0) {
+            return false;
+        }
+        let mut free = self.theta.clone();
+        let mut holds = self.holds.clone();
+        holds.touching.clear();
+        holds.forces.clear();
+        let mut data = NetworkData::new(self.model);
+        let settled = self
+            .net
+            .settle_closures(self.model, &self.drive, self.stiffness, &holds, &mut free, &mut data);
+        !settled || (0..free.len()).any(|c| (free[c] - self.theta[c]).abs() > HELD_MOVE)
+    }
+
+    /// After a step: features that parted or slid off the other face let go; features that
+    /// came over another face take the side they are on.
+    fn after_step(&mut self) {
+        let net = self.net;
+        let tolerance = TOLERANCE * net.size;
+        let mut keep = Vec::new();
+        for (i, &k) in self.holds.touching.iter().enumerate() {
+            let state = self.sides.state(&net.contacts, &self.data, k);
+            // A contact lets go once its faces part. One that slides off the other face's
+            // outline while still touching stays until they part (its plane held a little
+            // past the outline): let go at the outline, it would cross again at once.
+            if state.distance <= PART * net.size {
+                keep.push(i);
+            }
+        }
+        self.holds.forces = keep.iter().map(|&i| self.holds.forces[i]).collect();
+        self.holds.touching = keep.iter().map(|&i| self.holds.touching[i]).collect();
+        for k in 0..net.contacts.features.len() {
+            if self.holds.touching.contains(&k) {
+                continue;
+            }
+            self.sides.update(&net.contacts, &self.data, k, tolerance);
+        }
     }
 
     fn keep_frame(&mut self, u: f64) {
@@ -964,23 +1116,27 @@ impl Run<'_> {
         });
     }
 
-    fn no_balance(&self, u: f64) -> NanofoldError {
-        NanofoldError::invalid(
-            "seams",
-            format!("latched {:?}, {} pressed", self.holds.latched, self.holds.pressed.len()),
-            format!("the seams held hold no balance at progress {u:.6}"),
+    fn no_balance(&self, u: f64) -> Stop {
+        Stop::NoBalance(
+            u,
+            format!(
+                "no balance holds the {} latched seams and {} contacts at progress {u:.9}",
+                self.holds.latched.len(),
+                self.holds.touching.len()
+            ),
         )
     }
 
     /// The balance at progress `u` from the current angles.
-    fn settle_at(&mut self, u: f64) -> Result<()> {
+    fn settle_at(&mut self, u: f64) -> std::result::Result<(), Stop> {
         self.path.drive(u, &mut self.drive);
         let net = self.net;
         if net.settle(
             self.model,
             &self.drive,
             self.stiffness,
-            &self.holds,
+            &mut self.holds,
+            &self.sides,
             &mut self.theta,
             &mut self.data,
         ) {
@@ -990,124 +1146,85 @@ impl Run<'_> {
         }
     }
 
-    /// Presses whose faces would rather part let go, and the balance `trial` at `u` (the
-    /// drives already set) is found again without them.
-    fn let_go_of_parting(&mut self, trial: &mut [f64], u: f64) -> Result<()> {
-        let net = self.net;
-        let parting = net.parting(&self.data, &self.holds, &self.drive, self.stiffness, trial);
-        if parting.is_empty() {
-            return Ok(());
-        }
-        self.holds.part(&parting);
-        if net.settle(
-            self.model,
-            &self.drive,
-            self.stiffness,
-            &self.holds,
-            trial,
-            &mut self.data,
-        ) {
-            Ok(())
-        } else {
-            Err(self.no_balance(u))
-        }
-    }
-
     /// The first progress in (u, next] where something happens, `at_next` its balance at
-    /// `next`: bisected to [`LOCATE`]; the angles are left at it, `before` just short of it.
-    fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>) -> f64 {
+    /// `next`: bisected to [`LOCATE`]; the angles are left at it.
+    fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>, holds_next: Holds) -> f64 {
         let net = self.net;
-        let (mut lo, mut hi, mut at_hi) = (u, next, at_next);
+        let (mut lo, mut hi, mut at_hi, mut holds_hi) = (u, next, at_next, holds_next);
         while hi - lo > LOCATE * (1.0 + hi.abs()) {
             let mid = 0.5 * (lo + hi);
             let mut state = self.theta.clone();
+            let mut holds = self.holds.clone();
             self.path.drive(mid, &mut self.drive);
             net.settle(
                 self.model,
                 &self.drive,
                 self.stiffness,
-                &self.holds,
+                &mut holds,
+                &self.sides,
                 &mut state,
                 &mut self.data,
             );
-            if net.event(&self.data, &self.holds, self.capture) {
+            if net.event(&self.data, &holds, &self.sides, self.capture) {
                 hi = mid;
                 at_hi = state;
+                holds_hi = holds;
             } else {
                 lo = mid;
                 self.theta = state;
+                self.holds = holds;
             }
         }
-        update_poses(self.model, &self.theta, &mut self.before);
         self.theta = at_hi;
+        self.holds = holds_hi;
         hi
     }
 
-    /// Latches what meets in line, presses what meets at a shared corner, stops at anything
-    /// else (a jam). A latch moves the faces (they snap into line), so it looks again until
-    /// nothing new meets. Returns whether the run is over (closed or jammed).
-    fn resolve(&mut self, u: f64) -> Result<bool> {
+    /// Latches what meets in line (or touches within the capture), puts what crossed into
+    /// contact, and balances again until nothing new happens. Returns whether the run is
+    /// over (closed).
+    fn resolve(&mut self, u: f64) -> std::result::Result<bool, Stop> {
         let net = self.net;
-        loop {
+        let tolerance = TOLERANCE * net.size;
+        for _ in 0..RESOLVE_ROUNDS {
             self.path.drive(u, &mut self.drive);
             update_poses(self.model, &self.theta, &mut self.data);
-            let mut new: Vec<(usize, f64)> = (0..net.seams.len())
-                .filter_map(|k| {
-                    let m = net.misalignment(&self.data, k);
-                    let latches = match self.holds.state[k] {
-                        SeamState::Open => m <= ALIGNED_TOGETHER,
-                        SeamState::Pressed => m <= self.capture,
-                        SeamState::Latched => false,
-                    };
-                    latches.then_some((k, m))
-                })
-                .collect();
-            let mut pressed_now = false;
-            for (pair, point) in net.meeting_pairs(&self.data) {
-                let faces = net.pairs[pair].faces;
-                if self.holds.pressing(faces) {
+            let mut touched = Vec::new();
+            for k in 0..net.contacts.features.len() {
+                if self.sides.sign[k] == 0.0 || self.holds.touching.contains(&k) || net.held_by_seam(&self.holds, k) {
                     continue;
                 }
-                let seam = net.pairs[pair].seam.filter(|&k| self.holds.state[k] == SeamState::Open);
-                let misalignment = seam.map(|k| net.misalignment(&self.data, k));
-                let press = net.press_of(&net.pairs[pair], seam, &self.before, &self.data);
-                match (seam, misalignment, press) {
-                    (Some(k), Some(m), _) if m <= self.capture => {
-                        if !new.iter().any(|&(j, _)| j == k) {
-                            new.push((k, m));
-                        }
-                    }
-                    (_, _, Some(press)) if press.seam.is_none_or(|k| !new.iter().any(|&(j, _)| j == k)) => {
-                        self.holds.press(press);
-                        self.report.presses.push(Contact {
-                            faces: faces.map(|f| net.file_face[f]),
-                            seam,
-                            time_s: self.path.time(u),
-                            progress: u,
-                            misalignment,
-                        });
-                        pressed_now = true;
-                    }
-                    _ => {
-                        self.end(Outcome::Jams, u);
-                        self.report.jam = Some(Jam {
-                            faces: faces.map(|f| net.file_face[f]),
-                            time_s: self.path.time(u),
-                            progress: u,
-                            point_um: [point.x, point.y, point.z].map(|x| x * 1e6),
-                            seam_misalignment: misalignment,
-                        });
-                        self.report.open_seams = net.open(&self.data, &self.holds);
-                        return Ok(true);
-                    }
+                let state = self.sides.state(&net.contacts, &self.data, k);
+                if state.over && state.distance <= tolerance {
+                    touched.push((k, state));
                 }
             }
-            if new.is_empty() && !pressed_now {
+            for &(k, state) in &touched {
+                self.holds.touch(k);
+                let feature = net.contacts.features[k];
+                self.report.first_contact_time_s.get_or_insert(self.path.time(u));
+                self.report.contacts.push(Contact {
+                    faces: feature.faces().map(|f| net.file_face[f]),
+                    feature: feature_name(&feature),
+                    time_s: self.path.time(u),
+                    progress: u,
+                    point_um: [state.point.x, state.point.y, state.point.z].map(|x| x * 1e6),
+                });
+            }
+            let new: Vec<(usize, f64)> = (0..net.seams.len())
+                .filter(|&k| self.holds.state[k] == SeamState::Open)
+                .filter_map(|k| {
+                    let m = net.misalignment(&self.data, k);
+                    (m <= ALIGNED_TOGETHER || (m <= self.capture && net.seam_touching(&self.holds, k)))
+                        .then_some((k, m))
+                })
+                .collect();
+            if new.is_empty() && touched.is_empty() {
                 return Ok(false);
             }
-            new.sort_by_key(|&(k, _)| k);
-            for (k, m) in new {
-                self.holds.latch(k);
+            for &(k, m) in &new {
+                self.holds.latch(k, net.seams[k].faces, &net.contacts.features);
+                self.report.first_contact_time_s.get_or_insert(self.path.time(u));
                 self.report.latches.push(Latch {
                     seam: k,
                     faces: net.seams[k].faces.map(|f| net.file_face[f]),
@@ -1116,14 +1233,18 @@ impl Run<'_> {
                     misalignment: m,
                 });
             }
-            update_poses(self.model, &self.theta, &mut self.before);
             self.settle_at(u)?;
+            self.after_step();
             self.keep_frame(u);
             if self.holds.latched.len() == net.seams.len() {
                 self.end(Outcome::Closes, u);
                 return Ok(true);
             }
         }
+        Err(Stop::NoBalance(
+            u,
+            format!("contacts and latches still changing after {RESOLVE_ROUNDS} rounds at progress {u:.9}"),
+        ))
     }
 
     fn end(&mut self, outcome: Outcome, u: f64) {

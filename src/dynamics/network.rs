@@ -11,6 +11,8 @@
 pub(crate) mod algorithms;
 pub(crate) mod assemble;
 pub(crate) mod contact;
+pub(crate) mod contact_balance;
+pub(crate) mod face_contact;
 pub(crate) mod fitted;
 pub(crate) mod hessian;
 pub(crate) mod kkt;
