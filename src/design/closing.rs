@@ -46,6 +46,8 @@ const SETTLE_STEP: f64 = 1e-13;
 /// With contacts: the QPs of one balance, and the step that ends them, rad.
 const CONTACT_ITERATIONS: usize = 100;
 const CONTACT_STEP: f64 = 1e-12;
+/// The smallest share of a closure's or a contact's residual one step asks for.
+const MIN_SHARE: f64 = 1e-6;
 /// Rounds of contacts and latches at one instant before the run says it cannot settle.
 const RESOLVE_ROUNDS: usize = 50;
 /// JᵀJ's eigenvalues below this share of its largest are zero (singular values below 1e-6
@@ -701,25 +703,71 @@ impl NetClosing {
         let n = theta.len();
         for _ in 0..CONTACT_ITERATIONS {
             update_poses(model, theta, data);
-            let (closure, closure_rows) = self.seam_rows(data, holds, n);
+            let (seam_residual, seam_rows) = self.seam_rows(data, holds, n);
+            // The seams' rows as their row space: latched seams that close a solid hold more
+            // rows than the angles they fix (a box's 20 rows on 5 angles), and a linearised
+            // residual off that space would make the equalities inconsistent. Each kept row
+            // v asks v·d = −v·Eᵀe/λ, the Gauss–Newton step's share along it.
+            let (row_space, _) = Self::row_and_null_space(&seam_rows, None);
+            let strongest = row_space.iter().map(|(lambda, _)| *lambda).fold(0.0, f64::max);
+            let kept: Vec<&(f64, DVector<f64>)> = row_space
+                .iter()
+                .filter(|(lambda, _)| *lambda > RANK_CUT * strongest)
+                .collect();
+            let pulled = seam_rows.transpose() * &seam_residual;
+            let closure_rows = DMatrix::from_fn(kept.len(), n, |i, c| kept[i].1[c]);
+            let closure = DVector::from_iterator(kept.len(), kept.iter().map(|(lambda, v)| v.dot(&pulled) / lambda));
             let (gaps, contact_rows) = self.contact_rows(data, holds, sides, n);
             let offset: Vec<f64> = (0..n).map(|c| theta[c] - drive[c]).collect();
-            let Ok(solution) = solve_step(&BalanceStep {
-                stiffness,
-                offset: &offset,
-                closures: (&closure_rows, &closure),
-                contacts: (&contact_rows, &gaps),
-                trust: SETTLE_DAMPING,
-                size: self.size,
-            }) else {
-                return false;
+            // A closure far from held (a seam just latched, pulled into line) or a contact
+            // met deep is reached in parts when one linearised step cannot reach it past
+            // the others: the rows ask for a share α of their residual.
+            let mut share = 1.0;
+            let solution = loop {
+                let asked_closure = &closure * share;
+                let asked_gaps = gaps.map(|g| if g < 0.0 { g * share } else { g });
+                match solve_step(&BalanceStep {
+                    stiffness,
+                    offset: &offset,
+                    closures: (&closure_rows, &asked_closure),
+                    contacts: (&contact_rows, &asked_gaps),
+                    trust: SETTLE_DAMPING,
+                    size: self.size,
+                }) {
+                    Ok(solution) => break solution,
+                    Err(e) => {
+                        if std::env::var("NANOFOLD_DEBUG3").is_ok() {
+                            eprintln!("DEBUG3 share {share} {e}");
+                        }
+                        share *= 0.5;
+                        if share < MIN_SHARE {
+                            return false;
+                        }
+                    }
+                }
             };
+            if std::env::var("NANOFOLD_DEBUG2").is_ok() {
+                eprintln!(
+                    "DEBUG2 gaps {:?} rows {:?} step {:e} forces {:?} offset {:?}",
+                    gaps.as_slice(),
+                    contact_rows.as_slice(),
+                    solution.step.amax(),
+                    solution.forces.as_slice(),
+                    offset
+                );
+            }
             for c in 0..n {
                 theta[c] += solution.step[c];
             }
             holds.forces.copy_from_slice(solution.forces.as_slice());
-            holds.seam_multipliers = solution.closure_multipliers.iter().copied().collect();
-            if !solution.at_trust && solution.step.amax() <= CONTACT_STEP {
+            // The seams' own multipliers: μ_E = E Σ v μ_v / λ, the least-norm μ_E with
+            // Eᵀμ_E = Σ v μ_v.
+            let through = kept
+                .iter()
+                .zip(solution.closure_multipliers.iter())
+                .fold(DVector::zeros(n), |sum, ((lambda, v), mu)| sum + v * (mu / lambda));
+            holds.seam_multipliers = (&seam_rows * through).iter().copied().collect();
+            if share == 1.0 && !solution.at_trust && solution.step.amax() <= CONTACT_STEP {
                 update_poses(model, theta, data);
                 return true;
             }
@@ -1024,6 +1072,12 @@ impl Run<'_> {
                 });
             }
             turn = (turn * 2.0).min(MAX_STEP);
+            if std::env::var("NANOFOLD_DEBUG").is_ok() {
+                eprintln!(
+                    "DEBUG step {u} -> {next} touching {:?} forces {:?}",
+                    holds.touching, holds.forces
+                );
+            }
             if !net.event(&self.data, &holds, &self.sides, self.capture) {
                 self.theta = trial;
                 self.holds = holds;
@@ -1234,7 +1288,27 @@ impl Run<'_> {
                 });
             }
             self.settle_at(u)?;
+            if std::env::var("NANOFOLD_DEBUG").is_ok() {
+                update_poses(self.model, &self.theta, &mut self.data);
+                let gaps: Vec<(usize, f64, bool, f64)> = self
+                    .holds
+                    .touching
+                    .iter()
+                    .zip(&self.holds.forces)
+                    .map(|(&k, &f)| {
+                        let st = self.sides.state(&net.contacts, &self.data, k);
+                        (k, st.distance, st.over, f)
+                    })
+                    .collect();
+                eprintln!(
+                    "DEBUG resolve u {u} touched {:?} touching after settle {gaps:?}",
+                    touched.iter().map(|t| t.0).collect::<Vec<_>>()
+                );
+            }
             self.after_step();
+            if std::env::var("NANOFOLD_DEBUG").is_ok() {
+                eprintln!("DEBUG after_step touching {:?}", self.holds.touching);
+            }
             self.keep_frame(u);
             if self.holds.latched.len() == net.seams.len() {
                 self.end(Outcome::Closes, u);

@@ -12,6 +12,9 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use nalgebra::{DMatrix, DVector};
 
+/// The trust box's half-width in units of the step's own scale at most.
+const SCALED_TRUST: f64 = 1e3;
+
 /// A step's data, all in the fold angles' columns.
 #[derive(Debug, Clone)]
 pub struct BalanceStep<'a> {
@@ -55,28 +58,66 @@ pub fn solve_step(step: &BalanceStep) -> Result<BalanceSolution> {
         .max(f64::MIN_POSITIVE);
     let stiff: Vec<f64> = step.stiffness.iter().map(|k| k / largest).collect();
     let p = CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), stiff.clone());
-    let q: Vec<f64> = (0..n).map(|c| stiff[c] * step.offset[c]).collect();
     let (e_rows, e_values) = step.closures;
     let (g_rows, g_values) = step.contacts;
     let (m_e, m_g) = (e_rows.nrows(), g_rows.nrows());
+    // The step's own scale σ (the largest turn the offsets or any row's residual ask for):
+    // the QP is solved for d/σ with every row over its own size, so its tolerances are
+    // relative to the step however small it is (a contact met 1e-13 m deep asks a turn of
+    // 1e-9 rad, far below absolute tolerances on an O(1) problem).
+    let row_turn = |row: nalgebra::RowDVector<f64>, value: f64| {
+        let norm = row.norm();
+        if norm > 0.0 {
+            value.abs() / norm
+        } else {
+            0.0
+        }
+    };
+    let sigma = (0..m_e)
+        .map(|i| row_turn(e_rows.row(i).into_owned(), e_values[i]))
+        .chain((0..m_g).map(|i| row_turn(g_rows.row(i).into_owned(), g_values[i])))
+        .chain(step.offset.iter().map(|o| o.abs()))
+        .fold(0.0_f64, f64::max)
+        .min(step.trust);
+    if sigma == 0.0 {
+        // At the balance already, every row held: no step, and the forces are those that
+        // balance a zero offset.
+        return Ok(BalanceSolution {
+            step: DVector::zeros(n),
+            forces: DVector::zeros(m_g),
+            closure_multipliers: DVector::zeros(m_e),
+            at_trust: false,
+        });
+    }
+    let q: Vec<f64> = (0..n).map(|c| stiff[c] * step.offset[c] / sigma).collect();
     let rows = m_e + m_g + 2 * n;
     let mut a = DMatrix::zeros(rows, n);
     let mut b = vec![0.0; rows];
+    // Each row over β, its size in the scaled variables.
+    let mut beta = vec![1.0; rows];
     for i in 0..m_e {
-        a.row_mut(i).copy_from(&e_rows.row(i));
-        b[i] = -e_values[i];
+        let row = e_rows.row(i) * sigma;
+        beta[i] = row.norm().max(e_values[i].abs()).max(f64::MIN_POSITIVE);
+        a.row_mut(i).copy_from(&(row / beta[i]));
+        b[i] = -e_values[i] / beta[i];
     }
     for i in 0..m_g {
+        let row = g_rows.row(i) * (sigma / step.size);
+        let r = m_e + i;
+        beta[r] = row.norm().max(g_values[i].abs() / step.size).max(f64::MIN_POSITIVE);
         for c in 0..n {
-            a[(m_e + i, c)] = -g_rows[(i, c)] / step.size;
+            a[(r, c)] = -row[c] / beta[r];
         }
-        b[m_e + i] = g_values[i] / step.size;
+        b[r] = g_values[i] / step.size / beta[r];
     }
+    // The trust box in the scaled variables, at most a few decades of σ (a bound far out
+    // of scale stalls the interior point); a step that reaches it is not yet the balance's.
+    let bound = (step.trust / sigma).min(SCALED_TRUST);
     for c in 0..n {
         a[(m_e + m_g + c, c)] = 1.0;
         a[(m_e + m_g + n + c, c)] = -1.0;
-        b[m_e + m_g + c] = step.trust;
-        b[m_e + m_g + n + c] = step.trust;
+        b[m_e + m_g + c] = bound;
+        b[m_e + m_g + n + c] = bound;
     }
     let a = dense_to_csc(&a);
     let mut cones = Vec::new();
@@ -105,10 +146,14 @@ pub fn solve_step(step: &BalanceStep) -> Result<BalanceSolution> {
             .into())
         }
     }
-    let x = DVector::from_column_slice(&solver.solution.x);
-    let z = &solver.solution.z;
+    let x = DVector::from_column_slice(&solver.solution.x) * sigma;
+    // Back to the unscaled rows: z = σ² z' / β (the objective was divided by σ²: P d + q +
+    // Aᵀz = 0 with d = σ x and each row over β), then the energy's and the gaps' units.
+    let z: Vec<f64> = (0..m_e + m_g)
+        .map(|i| solver.solution.z[i] * sigma * sigma / beta[i])
+        .collect();
     let forces = DVector::from_iterator(m_g, (0..m_g).map(|i| z[m_e + i].max(0.0) * largest / step.size));
-    let at_trust = x.amax() >= step.trust * (1.0 - 1e-9);
+    let at_trust = x.amax() >= bound * sigma * (1.0 - 1e-9);
     let closure_multipliers = DVector::from_iterator(m_e, (0..m_e).map(|i| z[i] * largest));
     Ok(BalanceSolution {
         step: x,
@@ -159,5 +204,32 @@ mod tests {
         // K (r − θ) = 3 · 0.6 N·m over 2 m.
         assert!((solution.forces[0] - 0.9).abs() < 1e-8, "{}", solution.forces[0]);
         assert!(!solution.at_trust);
+    }
+
+    /// The same stop met 1e-13 deep at a hinge of 1e-9 N·m/rad: the step is the 5e-14 rad
+    /// that lifts it out (relative, not an absolute tolerance's worth), and the force the
+    /// torque that turn costs over the lever.
+    #[test]
+    fn a_contact_met_a_hair_deep_is_lifted_by_exactly_that_hair() {
+        let stiffness = [1e-9];
+        let offset = [0.0];
+        let closures = (DMatrix::zeros(0, 1), DVector::zeros(0));
+        let contacts = (DMatrix::from_element(1, 1, 2.0), DVector::from_element(1, -1e-13));
+        let solution = solve_step(&BalanceStep {
+            stiffness: &stiffness,
+            offset: &offset,
+            closures: (&closures.0, &closures.1),
+            contacts: (&contacts.0, &contacts.1),
+            trust: 0.3,
+            size: 1e-4,
+        })
+        .unwrap();
+        assert!((solution.step[0] - 5e-14).abs() <= 1e-9 * 5e-14, "{}", solution.step[0]);
+        let force = 1e-9 * 5e-14 / 2.0;
+        assert!(
+            (solution.forces[0] - force).abs() <= 1e-6 * force,
+            "{} against {force}",
+            solution.forces[0]
+        );
     }
 }

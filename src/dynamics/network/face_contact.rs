@@ -17,7 +17,7 @@ const PARALLEL_SINE: f64 = 1e-6;
 /// Copies of one point this close (a fraction of the size) have met: the edges from them
 /// measure contact there, and the corner and edge features at them (degenerate there)
 /// stand down.
-const MET: f64 = 1e-7;
+const MET: f64 = 1e-4;
 
 /// Where two faces can touch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -199,6 +199,9 @@ impl FaceContacts {
                             let copy = edge
                                 .iter()
                                 .find_map(|&v| other_edge.iter().find(|&&w| copies[w] == copies[v]).map(|&w| [v, w]));
+                            if copy.is_some() && std::env::var("NANOFOLD_NO_COPY_EDGES").is_ok() {
+                                continue;
+                            }
                             features.push(Feature::EdgeOnEdge {
                                 face: f,
                                 edge,
