@@ -1253,6 +1253,28 @@ impl Run<'_> {
                     touched.push((k, state));
                 }
             }
+            // One row per point of touch: a corner on a face and the edge from it meeting the
+            // same face there are one contact (two equal rows leave the QP's multipliers
+            // undetermined and its interior point stalling).
+            let mut kept: Vec<(usize, FeatureState)> = self
+                .holds
+                .touching
+                .iter()
+                .map(|&k| (k, self.sides.state(&net.contacts, &self.data, k)))
+                .collect();
+            touched.retain(|&(k, state)| {
+                let faces = net.contacts.features[k].faces();
+                let same = kept.iter().any(|&(j, other)| {
+                    let other_faces = net.contacts.features[j].faces();
+                    (other_faces == faces || other_faces == [faces[1], faces[0]])
+                        && (other.point - state.point).norm() <= tolerance
+                        && other.normal.cross(&state.normal).norm() <= 1e-9
+                });
+                if !same {
+                    kept.push((k, state));
+                }
+                !same
+            });
             for &(k, state) in &touched {
                 self.holds.touch(k);
                 let feature = net.contacts.features[k];
