@@ -8,6 +8,7 @@ pub(crate) mod broad_phase;
 pub mod kinematics;
 pub mod mesh;
 pub mod nets;
+pub mod plate_separation;
 pub mod point_group;
 pub mod polyhedron;
 pub mod precision;
