@@ -381,7 +381,14 @@ struct Sides {
 impl Sides {
     fn new(features: usize) -> Sides {
         Sides {
-            sign: vec![0.0; features],
+            sign: vec![
+                if std::env::var("NANOFOLD_PLATES").is_ok() {
+                    1.0
+                } else {
+                    0.0
+                };
+                features
+            ],
             reference: vec![Vector3::zeros(); features],
         }
     }
@@ -389,7 +396,7 @@ impl Sides {
     /// Feature `k` with its normal continuous.
     fn continuous(&self, contacts: &FaceContacts, data: &NetworkData, k: usize) -> FeatureState {
         let mut state = contacts.state(data, k);
-        if state.normal.dot(&self.reference[k]) < 0.0 {
+        if matches!(contacts.features[k], Feature::EdgeOnEdge { .. }) && state.normal.dot(&self.reference[k]) < 0.0 {
             state.normal = -state.normal;
             state.distance = -state.distance;
         }
@@ -1000,6 +1007,7 @@ fn feature_name(feature: &Feature) -> &'static str {
     match feature {
         Feature::CornerOnFace { .. } => "corner on face",
         Feature::EdgeOnCorner { .. } => "edge on a shared corner",
+        Feature::Plates { .. } => "plates",
         Feature::EdgeOnEdge { .. } => "edge on edge",
     }
 }

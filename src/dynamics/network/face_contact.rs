@@ -6,6 +6,7 @@
 
 use super::algorithms::NetworkData;
 use super::model::NetworkModel;
+use crate::geometry::plate_separation::{plate_separation, SeparatingAxis};
 use nalgebra::{DVector, Vector3};
 
 /// A feature counts as over the other face only this far (a fraction of the size) inside
@@ -18,6 +19,8 @@ const PARALLEL_SINE: f64 = 1e-6;
 /// measure contact there, and the corner and edge features at them (degenerate there)
 /// stand down.
 const MET: f64 = 1e-4;
+/// A corner two plates share is cut back by this share of its edges.
+const CUT: f64 = 1e-6;
 
 /// Where two faces can touch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,6 +53,16 @@ pub enum Feature {
         /// Its corner there.
         apex: usize,
     },
+    /// Faces `face` and `other` as two plates: their separation by the separating axis
+    /// test (one row per pair, whatever part meets), corners they share cut back.
+    Plates {
+        /// The first face.
+        face: usize,
+        /// The second.
+        other: usize,
+        /// Index into the pairs' cut outlines.
+        pair: usize,
+    },
     /// Edge `edge` of face `face` across edge `other_edge` of face `other`.
     EdgeOnEdge {
         /// The first face.
@@ -72,6 +85,7 @@ impl Feature {
         match *self {
             Feature::CornerOnFace { face, other, .. }
             | Feature::EdgeOnCorner { face, other, .. }
+            | Feature::Plates { face, other, .. }
             | Feature::EdgeOnEdge { face, other, .. } => [face, other],
         }
     }
@@ -105,6 +119,8 @@ pub struct FaceContacts {
     pub flat: Vec<Vector3<f64>>,
     /// Every feature.
     pub features: Vec<Feature>,
+    /// Each plate pair's two outlines in the flat sheet, m, corners they share cut back.
+    outlines: Vec<[Vec<Vector3<f64>>; 2]>,
     /// Each panel's tree columns to the anchored panel.
     paths: Vec<Vec<usize>>,
     size: f64,
@@ -214,12 +230,52 @@ impl FaceContacts {
                 }
             }
         }
+        let mut outlines = Vec::new();
+        if std::env::var("NANOFOLD_PLATES").is_ok() {
+            features.clear();
+            for f in 0..faces.len() {
+                for g in f + 1..faces.len() {
+                    let (p, q) = (face_panel[f], face_panel[g]);
+                    if p == q || hinged.contains(&(p.min(q), p.max(q))) || !keep(f, g) {
+                        continue;
+                    }
+                    // A corner one plate shares with the other (the same vertex, or a copy of
+                    // one of its corners) is cut back along both its edges: the plates touch
+                    // there for ever and the test would read that as contact.
+                    let cut = |own: &[usize], other: &[usize]| {
+                        let mut out = Vec::new();
+                        for k in 0..own.len() {
+                            let v = own[k];
+                            let here = flat[v];
+                            if other.iter().any(|&w| copies[w] == copies[v]) {
+                                let (previous, next) = (
+                                    flat[own[(k + own.len() - 1) % own.len()]],
+                                    flat[own[(k + 1) % own.len()]],
+                                );
+                                out.push(here + (previous - here) * CUT);
+                                out.push(here + (next - here) * CUT);
+                            } else {
+                                out.push(here);
+                            }
+                        }
+                        out
+                    };
+                    outlines.push([cut(&faces[f], &faces[g]), cut(&faces[g], &faces[f])]);
+                    features.push(Feature::Plates {
+                        face: f,
+                        other: g,
+                        pair: outlines.len() - 1,
+                    });
+                }
+            }
+        }
         let paths = (0..model.panels()).map(|p| model.path_columns(p).collect()).collect();
         FaceContacts {
             faces,
             face_panel,
             flat,
             features,
+            outlines,
             paths,
             size: model.size(),
         }
@@ -263,6 +319,30 @@ impl FaceContacts {
                     normal,
                     distance,
                     over,
+                }
+            }
+            Feature::Plates { face, other, pair } => {
+                let [a, b] = &self.outlines[pair];
+                let first: Vec<Vector3<f64>> = a.iter().map(|x| data.place(self.face_panel[face], x)).collect();
+                let second: Vec<Vector3<f64>> = b.iter().map(|x| data.place(self.face_panel[other], x)).collect();
+                let separation = plate_separation(&first, &second);
+                let u = separation.axis;
+                let point = *first
+                    .iter()
+                    .max_by(|x, y| u.dot(x).total_cmp(&u.dot(y)))
+                    .expect("corners");
+                let other_point = *second
+                    .iter()
+                    .min_by(|x, y| u.dot(x).total_cmp(&u.dot(y)))
+                    .expect("corners");
+                // The normal from the second plate towards the first is −u: distance = gap.
+                let _ = margin;
+                FeatureState {
+                    point,
+                    other_point,
+                    normal: -u,
+                    distance: separation.gap,
+                    over: true,
                 }
             }
             Feature::EdgeOnCorner {
@@ -358,6 +438,45 @@ impl FaceContacts {
         for (face, point, sign) in [(f, state.point, 1.0), (g, state.other_point, -1.0)] {
             for &c in &self.paths[self.face_panel[face]] {
                 out[c] += sign * state.normal.dot(&data.twist[c].point_velocity(&point));
+            }
+        }
+        if let Feature::Plates { face, other, pair } = self.features[k] {
+            // The axis turns too: gap = u·(b* − a*) with u = −normal, so d(gap) gains
+            // du·(b* − a*).
+            let u = -state.normal;
+            let lever = state.other_point - state.point;
+            let [a, b] = &self.outlines[pair];
+            let first: Vec<Vector3<f64>> = a.iter().map(|x| data.place(self.face_panel[face], x)).collect();
+            let second: Vec<Vector3<f64>> = b.iter().map(|x| data.place(self.face_panel[other], x)).collect();
+            let kind = plate_separation(&first, &second).kind;
+            let edge = |p: &[Vector3<f64>], i: usize| p[(i + 1) % p.len()] - p[i];
+            for (body, sign_body) in [(face, 0usize), (other, 1usize)] {
+                for &c in &self.paths[self.face_panel[body]] {
+                    let omega = data.twist[c].angular;
+                    let du = match kind {
+                        SeparatingAxis::NormalOfFirst | SeparatingAxis::EdgeOfFirst(_) if sign_body == 0 => {
+                            omega.cross(&u)
+                        }
+                        SeparatingAxis::NormalOfSecond | SeparatingAxis::EdgeOfSecond(_) if sign_body == 1 => {
+                            omega.cross(&u)
+                        }
+                        SeparatingAxis::Edges(i, j) => {
+                            let (e, h) = (edge(&first, i), edge(&second, j));
+                            let cross = e.cross(&h);
+                            let turned = if sign_body == 0 {
+                                omega.cross(&e).cross(&h)
+                            } else {
+                                e.cross(&omega.cross(&h))
+                            };
+                            let unit = cross.normalize();
+                            // The sign of u against e×f.
+                            let sign = if unit.dot(&u) >= 0.0 { 1.0 } else { -1.0 };
+                            (turned - unit * unit.dot(&turned)) * (sign / cross.norm())
+                        }
+                        _ => Vector3::zeros(),
+                    };
+                    out[c] += du.dot(&lever);
+                }
             }
         }
     }
