@@ -48,54 +48,10 @@ fn run(shape: &str, rank: usize, front: Option<f64>, capture_percent: f64) -> Ja
     }
 }
 
-/// How far two convex faces overlap along the line where their planes meet when they cross
-/// (each reaching past the other's plane by more than `tolerance` on both sides; 0 when
-/// they are apart or only touch), m.
-fn overlap(a: &[Vector3<f64>], b: &[Vector3<f64>], tolerance: f64) -> f64 {
-    let normal = |p: &[Vector3<f64>]| {
-        (0..p.len())
-            .map(|k| p[k].cross(&p[(k + 1) % p.len()]))
-            .sum::<Vector3<f64>>()
-            .normalize()
-    };
-    let (na, nb) = (normal(a), normal(b));
-    let line = na.cross(&nb);
-    if line.norm() < 1e-9 {
-        return 0.0;
-    }
-    let line = line.normalize();
-    // Each face's interval on the line: where its edges cross the other's plane.
-    let interval = |p: &[Vector3<f64>], n: &Vector3<f64>, on: &Vector3<f64>| {
-        let mut range = (f64::INFINITY, f64::NEG_INFINITY);
-        for k in 0..p.len() {
-            let (x, y) = (p[k], p[(k + 1) % p.len()]);
-            let (dx, dy) = (n.dot(&(x - on)), n.dot(&(y - on)));
-            if dx == 0.0 {
-                range = (range.0.min(line.dot(&x)), range.1.max(line.dot(&x)));
-            }
-            if dx * dy < 0.0 {
-                let z = x + (y - x) * (dx / (dx - dy));
-                range = (range.0.min(line.dot(&z)), range.1.max(line.dot(&z)));
-            }
-        }
-        range
-    };
-    let (ia, ib) = (interval(a, &nb, &b[0]), interval(b, &na, &a[0]));
-    // They cross only if each has points on both sides of the other's plane: a face lying
-    // on one side (an edge resting on the other face) touches, whatever the overlap.
-    let crosses = |p: &[Vector3<f64>], n: &Vector3<f64>, on: &Vector3<f64>| {
-        let side = |sign: f64| {
-            p.iter()
-                .map(|x| sign * n.dot(&(x - on)))
-                .fold(f64::NEG_INFINITY, f64::max)
-        };
-        side(1.0).min(side(-1.0))
-    };
-    let excursion = crosses(a, &nb, &b[0]).min(crosses(b, &na, &a[0]));
-    if excursion <= tolerance {
-        return 0.0;
-    }
-    (ia.1.min(ib.1) - ia.0.max(ib.0)).max(0.0)
+/// How deep two convex faces cross: the shortest shift along the separating axes that
+/// parts them (the separating axis test; 0 when they are apart or only touch), m.
+fn overlap(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
+    (-nanofold::geometry::plate_separation::plate_separation(a, b).gap).max(0.0)
 }
 
 /// A point of face `f`'s plane as an affine combination of three of its corners.
@@ -126,7 +82,7 @@ fn check_jam(j: &Jammed) -> f64 {
             if shared >= 2 {
                 continue;
             }
-            let depth = overlap(&corners(f, &places), &corners(g, &places), 1e-9 * j.size);
+            let depth = overlap(&corners(f, &places), &corners(g, &places));
             if depth > 1e-9 * j.size {
                 eprintln!("faces {f} and {g} overlap by {depth:e} m");
                 deepest = deepest.max(depth);
@@ -185,10 +141,10 @@ fn every_jam_rests_apart_pushing_and_in_balance_hinge_by_hinge() {
     // out of line and their hinges are held off their drives by contact.
     let mut jams = 0;
     for (rank, front) in [
-        (1, Some(0.0)),
+        (1, Some(90.0)),
+        (1, Some(45.0)),
         (2, Some(0.0)),
-        (2, Some(90.0)),
-        (5, Some(0.0)),
+        (5, Some(90.0)),
         (5, Some(45.0)),
     ] {
         let jammed = run("octahedron", rank, front, 1.0);

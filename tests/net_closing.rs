@@ -110,49 +110,29 @@ fn the_cube_closing_along_its_front_carries_on_to_the_lid_and_lands_on_the_cube(
 }
 
 #[test]
-fn the_cube_released_the_other_way_jams_on_its_lid_at_85_degrees() {
-    let (_, made, options) = latin_cross(Some(0.0));
+fn the_cube_released_the_other_way_closes_once_its_walls_meet_within_the_capture() {
+    // Released along 0° the north wall (freed first) and the lid lean 5° past square when
+    // the south wall reaches 90°. The east and west walls meet the north wall 2 sin 2.5° of
+    // their seams' length out of line, inside the 10 % capture, so they latch, pulled into
+    // line, and the lid follows onto the walls: the device ends as the cube. (The rule that
+    // stopped at first touch called this a jam at the lid.)
+    let (solid, made, options) = latin_cross(Some(0.0));
     let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
-    assert_eq!(run.outcome, Outcome::Jams, "{run:?}");
-    // The south wall, freed last, meets the lid's far edge at 85° (the squares' plane
-    // geometry: the lid leans 5° back from a north wall at 95°). The meeting is seen once
-    // the faces are within 1e-9 of the net's size: 4e-9 rad early at the lid's lever.
-    let freed_last = release_times(&made, 50.0, 0.0).into_iter().fold(0.0, f64::max);
-    let exact = freed_last + 85f64.to_radians() / TURN_RATE;
-    let jam = run.jam.as_ref().unwrap();
-    assert!(
-        (jam.time_s - exact).abs() <= 1e-9 * exact,
-        "{} against {exact}",
-        jam.time_s
-    );
-    let angles = &run.frames.last().unwrap().fold_angles;
-    assert!(
-        angles.iter().any(|a| (a - 85f64.to_radians()).abs() <= 1e-8),
-        "{angles:?}"
-    );
-    // The network dynamics' first contact is the same pair; its panel test decides a
-    // crossing only past a depth of the placements' spread, so it comes 7e-8 rad (6e-5 s)
-    // later, 1e-8 of the time.
+    assert_eq!(run.outcome, Outcome::Closes, "{run:?}");
+    let out_of_line = 2.0 * 2.5f64.to_radians().sin();
+    let misaligned = run
+        .latches
+        .iter()
+        .filter(|l| (l.misalignment - out_of_line).abs() <= 1e-8)
+        .count();
+    assert!(misaligned >= 2, "{:?}", run.latches);
     let scene = net_device(&made, "cube", &options).unwrap();
-    let simulated = simulate(&scene, &SimulationSettings::default()).unwrap();
-    let collision = simulated.simulation.response.collision.unwrap();
-    assert!(
-        (jam.time_s - collision.time).abs() <= 1e-8 * collision.time,
-        "{jam:?} against {collision:?}"
-    );
-    let mut names = jam.faces.map(|f| format!("face {f}")).to_vec();
-    let mut theirs = collision.pair.to_vec();
-    names.sort();
-    theirs.sort();
-    assert_eq!(names, theirs);
-    // The seam there (the lid's far edge and the south wall's top) is 2 sin 5° of its length
-    // out of line, past the 10 % capture.
-    let misaligned = 0.0;
-    assert!(
-        (misaligned - 2.0 * 5f64.to_radians().sin()).abs() <= 1e-8,
-        "{misaligned}"
-    );
-    assert!(run.latches.is_empty());
+    let model = scene.network().unwrap();
+    let places = NetClosing::new(&made, model)
+        .unwrap()
+        .vertex_places(model, &run.frames.last().unwrap().fold_angles);
+    let off = distance_from_solid(&solid, &made, &places);
+    assert!(off <= 1e-9, "{off}");
 }
 
 #[test]
@@ -163,11 +143,16 @@ fn a_narrower_capture_leaves_the_walls_meeting_out_of_line_pressed_not_latched()
     let (_, made, options) = latin_cross(Some(180.0));
     let narrow = ClosingSettings { capture_percent: 5.0 };
     let run = net_closing(&made, "cube", &options, &narrow).unwrap();
-    assert_eq!(run.outcome, Outcome::Stalls);
-    assert_eq!(run.contacts.len(), 2);
-    for press in &run.contacts {
-        assert!((0.0 - 2.0 * 2.5f64.to_radians().sin()).abs() <= 1e-9, "{press:?}");
-    }
+    assert_eq!(run.outcome, Outcome::Stalls, "{run:?}");
+    // The east and west walls touch the south wall's edges at the corners they share (one
+    // contact each) and stay out of line by the closed form: nothing latches them.
+    let out_of_line = 2.0 * 2.5f64.to_radians().sin();
+    assert_eq!(run.contacts.len(), 2, "{:?}", run.contacts);
+    let open: Vec<f64> = run.open_seams.iter().map(|&(_, m)| m).collect();
+    assert!(
+        open.iter().filter(|m| (*m - out_of_line).abs() <= 1e-8).count() >= 2,
+        "{open:?}"
+    );
     assert!(ClosingSettings { capture_percent: 0.0 }.validate().is_err());
     let error = net_closing(&made, "cube", &options, &ClosingSettings { capture_percent: 80.0 }).unwrap_err();
     assert!(error.to_string().contains("capture_percent"), "{error}");
@@ -337,11 +322,9 @@ fn without_variation_every_sampled_device_is_the_nominal_one() {
             outcomes.insert(release.outcome);
         }
     }
-    // The releases tried do not all end alike: the direction of the front decides.
-    assert!(
-        outcomes.contains(&Outcome::Closes) && outcomes.contains(&Outcome::Jams),
-        "{outcomes:?}"
-    );
+    // Each release was decided (with contact mechanics and a 10 % capture, the two most
+    // compact cube nets close along every front tried: their walls meet within the capture).
+    assert!(!outcomes.contains(&Outcome::Undecided), "{outcomes:?}");
 }
 
 #[test]
@@ -357,10 +340,9 @@ fn walls_meeting_beyond_the_capture_at_a_shared_corner_press_and_the_cube_stalls
     let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
     assert_eq!(run.outcome, Outcome::Stalls, "{run:?}");
     let out_of_line = 2.0 * 5f64.to_radians().sin();
-    assert_eq!(run.contacts.len(), 2);
-    for press in &run.contacts {
-        assert!((0.0 - out_of_line).abs() <= 1e-8, "{press:?}");
-    }
+    // One contact at each corner the south wall shares with the east and west walls; they
+    // carry no load the seams do not (the outcome is a stall, not a jam).
+    assert_eq!(run.contacts.len(), 2, "{:?}", run.contacts);
     let mut angles: Vec<f64> = run
         .frames
         .last()
