@@ -66,6 +66,23 @@ fn release_times(made: &NetPattern, unit_um: f64, front_deg: f64) -> Vec<f64> {
     passed.iter().map(|p| (p - first_freed) / ETCH_UM_PER_S).collect()
 }
 
+/// Contacts counted once per pair of faces and point of touch (several features of one
+/// meeting are one contact).
+fn meetings(contacts: &[Contact]) -> usize {
+    let mut seen: Vec<([usize; 2], [f64; 3])> = Vec::new();
+    for c in contacts {
+        let mut faces = c.faces;
+        faces.sort_unstable();
+        if !seen
+            .iter()
+            .any(|(f, p)| *f == faces && (0..3).all(|i| (p[i] - c.point_um[i]).abs() <= 1e-3))
+        {
+            seen.push((faces, c.point_um));
+        }
+    }
+    seen.len()
+}
+
 /// The bundled cube's etch rate (1.5 µm/min) and its hinges' ρ_c (20 µm): a ramp turns at
 /// a/ρ_c rad/s.
 const ETCH_UM_PER_S: f64 = 1.5 / 60.0;
@@ -147,7 +164,7 @@ fn a_narrower_capture_leaves_the_walls_meeting_out_of_line_pressed_not_latched()
     // The east and west walls touch the south wall's edges at the corners they share (one
     // contact each) and stay out of line by the closed form: nothing latches them.
     let out_of_line = 2.0 * 2.5f64.to_radians().sin();
-    assert_eq!(run.contacts.len(), 2, "{:?}", run.contacts);
+    assert_eq!(meetings(&run.contacts), 2, "{:?}", run.contacts);
     let open: Vec<f64> = run.open_seams.iter().map(|&(_, m)| m).collect();
     assert!(
         open.iter().filter(|m| (*m - out_of_line).abs() <= 1e-8).count() >= 2,
@@ -342,7 +359,7 @@ fn walls_meeting_beyond_the_capture_at_a_shared_corner_press_and_the_cube_stalls
     let out_of_line = 2.0 * 5f64.to_radians().sin();
     // One contact at each corner the south wall shares with the east and west walls; they
     // carry no load the seams do not (the outcome is a stall, not a jam).
-    assert_eq!(run.contacts.len(), 2, "{:?}", run.contacts);
+    assert_eq!(meetings(&run.contacts), 2, "{:?}", run.contacts);
     let mut angles: Vec<f64> = run
         .frames
         .last()

@@ -4,7 +4,8 @@
 //! gallery.svg).
 
 pub use crate::design::closing::{
-    ClosingReport, ClosingSettings, NetClosing, NetClosingSummary, Outcome, ReleaseResult,
+    ClosingReport, ClosingSettings, Contact, ContactForce, Jam, NetClosing, NetClosingSummary, Outcome, ReleaseResult,
+    SeamForce,
 };
 pub use crate::design::fabrication::{clopper_pearson, Variation, YieldEstimate};
 pub use crate::design::nets::{

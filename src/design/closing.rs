@@ -730,7 +730,35 @@ impl NetClosing {
             let pulled = seam_rows.transpose() * &seam_residual;
             let closure_rows = DMatrix::from_fn(kept.len(), n, |i, c| kept[i].1[c]);
             let closure = DVector::from_iterator(kept.len(), kept.iter().map(|(lambda, v)| v.dot(&pulled) / lambda));
-            let (gaps, contact_rows) = self.contact_rows(data, holds, sides, n);
+            let (all_gaps, all_rows) = self.contact_rows(data, holds, sides, n);
+            // One row per meeting: two touching features of one pair of faces whose rows are
+            // parallel (a corner on a face and the edge from it at the same point; an edge
+            // across an edge and the same edge turning into their corner) are one contact;
+            // two equal rows leave the QP's multipliers undetermined and its interior point
+            // stalling. The deepest of them stands for the rest.
+            let mut standing: Vec<usize> = Vec::new();
+            let mut stands_for = vec![usize::MAX; holds.touching.len()];
+            let mut order: Vec<usize> = (0..holds.touching.len()).collect();
+            order.sort_by(|&a, &b| all_gaps[a].total_cmp(&all_gaps[b]));
+            for i in order {
+                let faces = self.contacts.features[holds.touching[i]].faces();
+                let row = all_rows.row(i);
+                let same = standing.iter().position(|&j| {
+                    let other = self.contacts.features[holds.touching[j]].faces();
+                    let other_row = all_rows.row(j);
+                    (other == faces || other == [faces[1], faces[0]])
+                        && other_row.dot(&row).abs() >= (1.0 - PARALLEL_ROWS) * other_row.norm() * row.norm()
+                });
+                match same {
+                    Some(s) => stands_for[i] = s,
+                    None => {
+                        stands_for[i] = standing.len();
+                        standing.push(i);
+                    }
+                }
+            }
+            let gaps = DVector::from_iterator(standing.len(), standing.iter().map(|&i| all_gaps[i]));
+            let contact_rows = all_rows.select_rows(&standing);
             let offset: Vec<f64> = (0..n).map(|c| theta[c] - drive[c]).collect();
             // A closure far from held (a seam just latched, pulled into line) or a contact
             // met deep is reached in parts when one linearised step cannot reach it past
@@ -752,10 +780,7 @@ impl NetClosing {
                     size: self.size,
                 }) {
                     Ok(solution) => break solution,
-                    Err(e) => {
-                        if std::env::var("NANOFOLD_DEBUG3").is_ok() {
-                            eprintln!("DEBUG3 share {share} {e}");
-                        }
+                    Err(_) => {
                         share *= 0.5;
                         if share < MIN_SHARE {
                             return false;
@@ -763,20 +788,17 @@ impl NetClosing {
                     }
                 }
             };
-            if std::env::var("NANOFOLD_DEBUG2").is_ok() {
-                eprintln!(
-                    "DEBUG2 gaps {:?} rows {:?} step {:e} forces {:?} offset {:?}",
-                    gaps.as_slice(),
-                    contact_rows.as_slice(),
-                    solution.step.amax(),
-                    solution.forces.as_slice(),
-                    offset
-                );
-            }
             for c in 0..n {
                 theta[c] += solution.step[c];
             }
-            holds.forces.copy_from_slice(solution.forces.as_slice());
+            // The force on a meeting is its standing row's; the rows it stands for carry none.
+            for (i, force) in holds.forces.iter_mut().enumerate() {
+                *force = if standing[stands_for[i]] == i {
+                    solution.forces[stands_for[i]]
+                } else {
+                    0.0
+                };
+            }
             // The seams' own multipliers: μ_E = E Σ v μ_v / λ, the least-norm μ_E with
             // Eᵀμ_E = Σ v μ_v.
             let through = kept
@@ -1059,7 +1081,14 @@ impl Run<'_> {
             let next = self.path.next(u, turn);
             let mut trial = self.theta.clone();
             let mut holds = self.holds.clone();
+            self.path.drive(u, &mut self.drive);
+            let before = self.drive.clone();
             self.path.drive(next, &mut self.drive);
+            // A drive may itself jump (a hinge released with a step); the balance is
+            // measured against what its drives did.
+            let driven = (0..before.len())
+                .map(|c| (self.drive[c] - before[c]).abs())
+                .fold(turn, f64::max);
             let settled = net.settle(
                 self.model,
                 &self.drive,
@@ -1072,7 +1101,7 @@ impl Run<'_> {
             let jump = (0..trial.len())
                 .map(|c| (trial[c] - self.theta[c]).abs())
                 .fold(0.0, f64::max);
-            if !settled || jump > JUMP_RATIO * turn + JUMP_FLOOR {
+            if !settled || jump > JUMP_RATIO * driven + JUMP_FLOOR {
                 // A balance that moves far more than its drives: halve the step until it
                 // follows, or the step is too small to say anything but that it jumped.
                 if turn > MIN_TURN {
@@ -1091,12 +1120,6 @@ impl Run<'_> {
                 });
             }
             turn = (turn * 2.0).min(MAX_STEP);
-            if std::env::var("NANOFOLD_DEBUG").is_ok() {
-                eprintln!(
-                    "DEBUG step {u} -> {next} touching {:?} forces {:?}",
-                    holds.touching, holds.forces
-                );
-            }
             if !net.event(&self.data, &holds, &self.sides, self.capture) {
                 self.theta = trial;
                 self.holds = holds;
@@ -1287,38 +1310,6 @@ impl Run<'_> {
                     touched.push((k, state));
                 }
             }
-            // One row per meeting: two features of one pair of faces whose rows are parallel
-            // (a corner on a face and the edge from it at the same point; an edge across an
-            // edge and the same edge turning into their corner) are one contact, and two
-            // equal rows leave the QP's multipliers undetermined and its interior point
-            // stalling.
-            let n = self.theta.len();
-            let row_of = |k: usize, data: &NetworkData| {
-                let state = self.sides.state(&net.contacts, data, k);
-                let mut row = DVector::zeros(n);
-                net.contacts.row(data, k, &state, &mut row);
-                row
-            };
-            let mut kept: Vec<(usize, DVector<f64>)> = self
-                .holds
-                .touching
-                .iter()
-                .map(|&k| (k, row_of(k, &self.data)))
-                .collect();
-            let data = &self.data;
-            touched.retain(|&(k, _)| {
-                let faces = net.contacts.features[k].faces();
-                let row = row_of(k, data);
-                let same = kept.iter().any(|(j, other)| {
-                    let other_faces = net.contacts.features[*j].faces();
-                    (other_faces == faces || other_faces == [faces[1], faces[0]])
-                        && (other.dot(&row)).abs() >= (1.0 - PARALLEL_ROWS) * other.norm() * row.norm()
-                });
-                if !same {
-                    kept.push((k, row));
-                }
-                !same
-            });
             for &(k, state) in &touched {
                 self.holds.touch(k);
                 let feature = net.contacts.features[k];
@@ -1354,27 +1345,7 @@ impl Run<'_> {
                 });
             }
             self.settle_at(u)?;
-            if std::env::var("NANOFOLD_DEBUG").is_ok() {
-                update_poses(self.model, &self.theta, &mut self.data);
-                let gaps: Vec<(usize, f64, bool, f64)> = self
-                    .holds
-                    .touching
-                    .iter()
-                    .zip(&self.holds.forces)
-                    .map(|(&k, &f)| {
-                        let st = self.sides.state(&net.contacts, &self.data, k);
-                        (k, st.distance, st.over, f)
-                    })
-                    .collect();
-                eprintln!(
-                    "DEBUG resolve u {u} touched {:?} touching after settle {gaps:?}",
-                    touched.iter().map(|t| t.0).collect::<Vec<_>>()
-                );
-            }
             self.after_step();
-            if std::env::var("NANOFOLD_DEBUG").is_ok() {
-                eprintln!("DEBUG after_step touching {:?}", self.holds.touching);
-            }
             self.keep_frame(u);
             if self.holds.latched.len() == net.seams.len() {
                 self.end(Outcome::Closes, u);
