@@ -8,7 +8,7 @@
 
 use crate::dynamics::network::algorithms::update_poses;
 use crate::dynamics::network::contact_balance::{solve_step, BalanceStep};
-use crate::dynamics::network::face_contact::{FaceContacts, Feature, FeatureState};
+use crate::dynamics::network::face_contact::{FaceContacts, Feature, FeatureState, PlacedFaces};
 use crate::dynamics::network::{NetworkData, NetworkModel};
 use crate::dynamics::Forcing;
 use crate::error::{NanofoldError, Result};
@@ -31,6 +31,9 @@ const ALIGNED: f64 = 1e-9;
 const ALIGNED_TOGETHER: f64 = 1e-6;
 /// Faces are tested for meeting to this fraction of the net's size.
 const TOLERANCE: f64 = 1e-9;
+/// Pairs of faces closer than this (a fraction of the size; their bounding spheres' gap)
+/// have their contact features followed.
+const REACH: f64 = 0.05;
 /// A contact with no force this far apart (a fraction of the size) has parted.
 const PART: f64 = 1e-7;
 /// Faces are held by contact when the balance without it moves a fold angle by more than
@@ -382,26 +385,29 @@ impl Holds {
 struct Sides {
     sign: Vec<f64>,
     reference: Vec<Vector3<f64>>,
+    /// Whether each pair of faces is within [`REACH`] (its features followed); a pair out
+    /// of reach cannot touch, and its features' sides are read afresh when it comes back.
+    watched: Vec<bool>,
 }
 
 impl Sides {
-    fn new(features: usize) -> Sides {
+    fn new(contacts: &FaceContacts) -> Sides {
         Sides {
-            sign: vec![
-                if std::env::var("NANOFOLD_PLATES").is_ok() {
-                    1.0
-                } else {
-                    0.0
-                };
-                features
-            ],
-            reference: vec![Vector3::zeros(); features],
+            sign: vec![0.0; contacts.features.len()],
+            reference: vec![Vector3::zeros(); contacts.features.len()],
+            watched: vec![false; contacts.pairs.len()],
         }
     }
 
-    /// Feature `k` with its normal continuous.
-    fn continuous(&self, contacts: &FaceContacts, data: &NetworkData, k: usize) -> FeatureState {
-        let mut state = contacts.state(data, k);
+    /// The features of the pairs of faces within reach.
+    fn watched<'c>(&'c self, contacts: &'c FaceContacts) -> impl Iterator<Item = usize> + 'c {
+        (0..contacts.pairs.len())
+            .filter(|&p| self.watched[p])
+            .flat_map(move |p| contacts.pair_features[p].iter().copied())
+    }
+
+    /// Feature `k` at its `raw` state with its normal continuous.
+    fn continuous(&self, contacts: &FaceContacts, k: usize, mut state: FeatureState) -> FeatureState {
         if matches!(contacts.features[k], Feature::EdgeOnEdge { .. }) && state.normal.dot(&self.reference[k]) < 0.0 {
             state.normal = -state.normal;
             state.distance = -state.distance;
@@ -409,9 +415,10 @@ impl Sides {
         state
     }
 
-    /// Feature `k` turned to the side it came from: its distance is its gap.
-    fn state(&self, contacts: &FaceContacts, data: &NetworkData, k: usize) -> FeatureState {
-        let mut state = self.continuous(contacts, data, k);
+    /// Feature `k` at its `raw` state turned to the side it came from: its distance is its
+    /// gap.
+    fn oriented(&self, contacts: &FaceContacts, k: usize, raw: FeatureState) -> FeatureState {
+        let mut state = self.continuous(contacts, k, raw);
         if self.sign[k] < 0.0 {
             state.normal = -state.normal;
             state.distance = -state.distance;
@@ -419,9 +426,27 @@ impl Sides {
         state
     }
 
-    /// Carries feature `k`'s orientation to the poses `data` holds.
-    fn update(&mut self, contacts: &FaceContacts, data: &NetworkData, k: usize, tolerance: f64) {
-        let state = self.continuous(contacts, data, k);
+    /// Feature `k` with the faces `placed`, turned to the side it came from.
+    fn state(&self, contacts: &FaceContacts, placed: &PlacedFaces, k: usize) -> FeatureState {
+        self.oriented(contacts, k, contacts.state(placed, k))
+    }
+
+    /// Feature `k`'s orientation read afresh from its `raw` state (its pair was out of
+    /// reach, so it is on the side it is on).
+    fn refresh(&mut self, k: usize, raw: FeatureState, tolerance: f64) {
+        self.sign[k] = 0.0;
+        if !raw.distance.is_finite() {
+            return;
+        }
+        self.reference[k] = raw.normal;
+        if raw.distance.abs() > tolerance {
+            self.sign[k] = raw.distance.signum();
+        }
+    }
+
+    /// Carries feature `k`'s orientation to its `raw` state.
+    fn update(&mut self, contacts: &FaceContacts, k: usize, raw: FeatureState, tolerance: f64) {
+        let state = self.continuous(contacts, k, raw);
         if !state.distance.is_finite() {
             return;
         }
@@ -432,6 +457,13 @@ impl Sides {
             self.sign[k] = state.distance.signum();
         }
     }
+}
+
+/// Something that happens in a step: a seam meets, or a feature crosses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Happening {
+    Seam(usize),
+    Feature(usize),
 }
 
 /// Stiffnesses over the largest.
@@ -527,7 +559,7 @@ impl NetClosing {
     }
 
     fn place(&self, data: &NetworkData, face: usize, v: usize) -> Vector3<f64> {
-        self.contacts.place(data, face, v)
+        self.contacts.corner(data, face, v)
     }
 
     /// How far apart seam `k`'s edges' ends are, a fraction of its length.
@@ -545,22 +577,58 @@ impl NetClosing {
         self.seams.iter().position(|s| s.faces == [f, g] || s.faces == [g, f])
     }
 
-    /// Whether anything happens at these poses: an open seam aligned, a seam whose faces
-    /// touch come within the capture, or a feature over another face crossed to the wrong
-    /// side of it.
-    fn event(&self, data: &NetworkData, holds: &Holds, sides: &Sides, capture: f64) -> bool {
+    /// What happens at these poses: an open seam aligned, a seam whose faces touch come
+    /// within the capture, or a feature over another face crossed to the wrong side of it.
+    /// Only `among` these when given (a step's events, bisected); otherwise every watched
+    /// feature's raw state is left in `raw` for the step's bookkeeping.
+    fn events(
+        &self,
+        data: &NetworkData,
+        holds: &Holds,
+        sides: &Sides,
+        capture: f64,
+        among: Option<&[Happening]>,
+        raw: &mut [Option<FeatureState>],
+    ) -> Vec<Happening> {
         let tolerance = TOLERANCE * self.size;
-        (0..self.seams.len()).any(|k| {
+        let mut found = Vec::new();
+        let seam_meets = |k: usize| {
             holds.state[k] == SeamState::Open && {
                 let m = self.misalignment(data, k);
                 m <= ALIGNED || (m <= capture && self.seam_touching(holds, k))
             }
-        }) || (0..self.contacts.features.len()).any(|k| {
+        };
+        let placed = self.contacts.placed(data);
+        let crosses = |k: usize, state: &FeatureState| {
             sides.sign[k] != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
-                let state = sides.state(&self.contacts, data, k);
+                let state = sides.oriented(&self.contacts, k, *state);
                 state.over && state.distance < -tolerance
             }
-        })
+        };
+        match among {
+            Some(among) => {
+                for &happening in among {
+                    let happens = match happening {
+                        Happening::Seam(k) => seam_meets(k),
+                        Happening::Feature(k) => crosses(k, &self.contacts.state(&placed, k)),
+                    };
+                    if happens {
+                        found.push(happening);
+                    }
+                }
+            }
+            None => {
+                found.extend((0..self.seams.len()).filter(|&k| seam_meets(k)).map(Happening::Seam));
+                for k in sides.watched(&self.contacts) {
+                    let state = self.contacts.state(&placed, k);
+                    raw[k] = Some(state);
+                    if crosses(k, &state) {
+                        found.push(Happening::Feature(k));
+                    }
+                }
+            }
+        }
+        found
     }
 
     /// Whether seam `k`'s faces touch.
@@ -658,8 +726,9 @@ impl NetClosing {
         let mut gaps = DVector::zeros(holds.touching.len());
         let mut rows = DMatrix::zeros(holds.touching.len(), columns);
         let mut row = DVector::zeros(columns);
+        let placed = self.contacts.placed(data);
         for (i, &k) in holds.touching.iter().enumerate() {
-            let state = sides.state(&self.contacts, data, k);
+            let state = sides.state(&self.contacts, &placed, k);
             self.contacts.row(data, k, &state, &mut row);
             gaps[i] = state.distance;
             rows.row_mut(i).copy_from(&row.transpose());
@@ -906,7 +975,8 @@ impl NetClosing {
             data: NetworkData::new(model),
             drive: vec![0.0; n],
             theta: vec![0.0; n],
-            sides: Sides::new(self.contacts.features.len()),
+            sides: Sides::new(&self.contacts),
+            raw: vec![None; self.contacts.features.len()],
             holds: Holds::new(self.seams.len()),
             report: ClosingReport {
                 outcome: Outcome::Stalls,
@@ -952,12 +1022,13 @@ impl NetClosing {
 
     /// The touching features' forces as reported.
     fn forces(&self, data: &NetworkData, holds: &Holds, sides: &Sides) -> Vec<ContactForce> {
+        let placed = self.contacts.placed(data);
         holds
             .touching
             .iter()
             .zip(&holds.forces)
             .map(|(&k, &force)| {
-                let state = sides.state(&self.contacts, data, k);
+                let state = sides.state(&self.contacts, &placed, k);
                 let feature = self.contacts.features[k];
                 let normal = state.normal;
                 ContactForce {
@@ -1039,7 +1110,6 @@ fn feature_name(feature: &Feature) -> &'static str {
     match feature {
         Feature::CornerOnFace { .. } => "corner on face",
         Feature::EdgeOnCorner { .. } => "edge on a shared corner",
-        Feature::Plates { .. } => "plates",
         Feature::EdgeOnEdge { .. } => "edge on edge",
     }
 }
@@ -1064,6 +1134,8 @@ struct Run<'a> {
     theta: Vec<f64>,
     sides: Sides,
     holds: Holds,
+    /// Each feature's raw state at the poses last tested for events, if read there.
+    raw: Vec<Option<FeatureState>>,
     report: ClosingReport,
 }
 
@@ -1119,10 +1191,22 @@ impl Run<'_> {
                     self.no_balance(next)
                 });
             }
+            // A pair out of reach must not come to touch in one step unseen: shorten the step
+            // until it lands within reach first.
+            let unseen = (0..net.contacts.pairs.len())
+                .any(|p| !self.sides.watched[p] && net.contacts.pair_gap(&self.data, p) <= 0.0);
+            if unseen && turn > MIN_TURN {
+                turn *= 0.5;
+                continue;
+            }
             turn = (turn * 2.0).min(MAX_STEP);
-            if !net.event(&self.data, &holds, &self.sides, self.capture) {
+            let mut raw = std::mem::take(&mut self.raw);
+            raw.iter_mut().for_each(|r| *r = None);
+            let happenings = net.events(&self.data, &holds, &self.sides, self.capture, None, &mut raw);
+            if happenings.is_empty() {
                 self.theta = trial;
                 self.holds = holds;
+                self.raw = raw;
                 self.after_step();
                 u = next;
                 if u - last_frame >= FRAME_SPACING {
@@ -1131,7 +1215,10 @@ impl Run<'_> {
                 }
                 continue;
             }
-            u = self.locate(u, next, trial, holds);
+            // Read at `next`, not where the event is located.
+            raw.iter_mut().for_each(|r| *r = None);
+            self.raw = raw;
+            u = self.locate(u, next, trial, holds, &happenings);
             // Events that come back at once with nothing new resolved (a contact let go that
             // crosses again) would step the run along by rounding for ever: past a few,
             // the run stops and says where.
@@ -1200,8 +1287,9 @@ impl Run<'_> {
         let net = self.net;
         let tolerance = TOLERANCE * net.size;
         let mut keep = Vec::new();
+        let placed = net.contacts.placed(&self.data);
         for (i, &k) in self.holds.touching.iter().enumerate() {
-            let state = self.sides.state(&net.contacts, &self.data, k);
+            let state = self.sides.state(&net.contacts, &placed, k);
             // A contact lets go once its faces part. One that slides off the other face's
             // outline while still touching stays until they part (its plane held a little
             // past the outline): let go at the outline, it would cross again at once.
@@ -1211,12 +1299,28 @@ impl Run<'_> {
         }
         self.holds.forces = keep.iter().map(|&i| self.holds.forces[i]).collect();
         self.holds.touching = keep.iter().map(|&i| self.holds.touching[i]).collect();
-        for k in 0..net.contacts.features.len() {
-            if self.holds.touching.contains(&k) {
-                continue;
+        let reach = REACH * net.size;
+        for pair in 0..net.contacts.pairs.len() {
+            let near = net.contacts.pair_gap(&self.data, pair) <= reach;
+            let was = self.sides.watched[pair];
+            self.sides.watched[pair] = near;
+            for &k in &net.contacts.pair_features[pair] {
+                if !near || self.holds.touching.contains(&k) {
+                    continue;
+                }
+                // The step's events read every watched feature at these poses already.
+                let raw = match self.raw[k].take() {
+                    Some(raw) if was => raw,
+                    _ => net.contacts.state(&placed, k),
+                };
+                if was {
+                    self.sides.update(&net.contacts, k, raw, tolerance);
+                } else {
+                    self.sides.refresh(k, raw, tolerance);
+                }
             }
-            self.sides.update(&net.contacts, &self.data, k, tolerance);
         }
+        self.raw.iter_mut().for_each(|r| *r = None);
     }
 
     fn keep_frame(&mut self, u: f64) {
@@ -1259,7 +1363,9 @@ impl Run<'_> {
 
     /// The first progress in (u, next] where something happens, `at_next` its balance at
     /// `next`: bisected to [`LOCATE`]; the angles are left at it.
-    fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>, holds_next: Holds) -> f64 {
+    /// Only the `happenings` found at `next` are watched: what happens first in the step
+    /// is among what has happened by its end.
+    fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>, holds_next: Holds, happenings: &[Happening]) -> f64 {
         let net = self.net;
         let (mut lo, mut hi, mut at_hi, mut holds_hi) = (u, next, at_next, holds_next);
         while hi - lo > LOCATE * (1.0 + hi.abs()) {
@@ -1276,7 +1382,10 @@ impl Run<'_> {
                 &mut state,
                 &mut self.data,
             );
-            if net.event(&self.data, &holds, &self.sides, self.capture) {
+            if !net
+                .events(&self.data, &holds, &self.sides, self.capture, Some(happenings), &mut [])
+                .is_empty()
+            {
                 hi = mid;
                 at_hi = state;
                 holds_hi = holds;
@@ -1301,11 +1410,12 @@ impl Run<'_> {
             self.path.drive(u, &mut self.drive);
             update_poses(self.model, &self.theta, &mut self.data);
             let mut touched = Vec::new();
-            for k in 0..net.contacts.features.len() {
+            let placed = net.contacts.placed(&self.data);
+            for k in self.sides.watched(&net.contacts) {
                 if self.sides.sign[k] == 0.0 || self.holds.touching.contains(&k) || net.held_by_seam(&self.holds, k) {
                     continue;
                 }
-                let state = self.sides.state(&net.contacts, &self.data, k);
+                let state = self.sides.state(&net.contacts, &placed, k);
                 if state.over && state.distance <= tolerance {
                     touched.push((k, state));
                 }

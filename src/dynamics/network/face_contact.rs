@@ -6,7 +6,6 @@
 
 use super::algorithms::NetworkData;
 use super::model::NetworkModel;
-use crate::geometry::plate_separation::{plate_separation, SeparatingAxis};
 use nalgebra::{DVector, Vector3};
 
 /// A feature counts as over the other face only this far (a fraction of the size) inside
@@ -19,8 +18,6 @@ const PARALLEL_SINE: f64 = 1e-6;
 /// measure contact there, and the corner and edge features at them (degenerate there)
 /// stand down.
 const MET: f64 = 1e-4;
-/// A corner two plates share is cut back by this share of its edges.
-const CUT: f64 = 1e-6;
 
 /// Where two faces can touch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,16 +50,6 @@ pub enum Feature {
         /// Its corner there.
         apex: usize,
     },
-    /// Faces `face` and `other` as two plates: their separation by the separating axis
-    /// test (one row per pair, whatever part meets), corners they share cut back.
-    Plates {
-        /// The first face.
-        face: usize,
-        /// The second.
-        other: usize,
-        /// Index into the pairs' cut outlines.
-        pair: usize,
-    },
     /// Edge `edge` of face `face` across edge `other_edge` of face `other`.
     EdgeOnEdge {
         /// The first face.
@@ -85,7 +72,6 @@ impl Feature {
         match *self {
             Feature::CornerOnFace { face, other, .. }
             | Feature::EdgeOnCorner { face, other, .. }
-            | Feature::Plates { face, other, .. }
             | Feature::EdgeOnEdge { face, other, .. } => [face, other],
         }
     }
@@ -108,6 +94,13 @@ pub struct FeatureState {
     pub over: bool,
 }
 
+/// Every face's corners (in its loop's order) and unit normal at one set of poses, m.
+#[derive(Debug, Clone)]
+pub struct PlacedFaces {
+    corners: Vec<Vec<Vector3<f64>>>,
+    normals: Vec<Vector3<f64>>,
+}
+
 /// The faces of a network and their contact features.
 #[derive(Debug, Clone)]
 pub struct FaceContacts {
@@ -119,8 +112,12 @@ pub struct FaceContacts {
     pub flat: Vec<Vector3<f64>>,
     /// Every feature.
     pub features: Vec<Feature>,
-    /// Each plate pair's two outlines in the flat sheet, m, corners they share cut back.
-    outlines: Vec<[Vec<Vector3<f64>>; 2]>,
+    /// Each pair of faces that may touch (the lower face first).
+    pub pairs: Vec<[usize; 2]>,
+    /// Each pair's features.
+    pub pair_features: Vec<Vec<usize>>,
+    /// Each face's centre in the flat sheet and the radius of its corners about it, m.
+    bounds: Vec<(Vector3<f64>, f64)>,
     /// Each panel's tree columns to the anchored panel.
     paths: Vec<Vec<usize>>,
     size: f64,
@@ -215,9 +212,6 @@ impl FaceContacts {
                             let copy = edge
                                 .iter()
                                 .find_map(|&v| other_edge.iter().find(|&&w| copies[w] == copies[v]).map(|&w| [v, w]));
-                            if copy.is_some() && std::env::var("NANOFOLD_NO_COPY_EDGES").is_ok() {
-                                continue;
-                            }
                             features.push(Feature::EdgeOnEdge {
                                 face: f,
                                 edge,
@@ -230,60 +224,49 @@ impl FaceContacts {
                 }
             }
         }
-        let mut outlines = Vec::new();
-        if std::env::var("NANOFOLD_PLATES").is_ok() {
-            features.clear();
-            for f in 0..faces.len() {
-                for g in f + 1..faces.len() {
-                    let (p, q) = (face_panel[f], face_panel[g]);
-                    if p == q || hinged.contains(&(p.min(q), p.max(q))) || !keep(f, g) {
-                        continue;
-                    }
-                    // A corner one plate shares with the other (the same vertex, or a copy of
-                    // one of its corners) is cut back along both its edges: the plates touch
-                    // there for ever and the test would read that as contact.
-                    let cut = |own: &[usize], other: &[usize]| {
-                        let mut out = Vec::new();
-                        for k in 0..own.len() {
-                            let v = own[k];
-                            let here = flat[v];
-                            if other.iter().any(|&w| copies[w] == copies[v]) {
-                                let (previous, next) = (
-                                    flat[own[(k + own.len() - 1) % own.len()]],
-                                    flat[own[(k + 1) % own.len()]],
-                                );
-                                out.push(here + (previous - here) * CUT);
-                                out.push(here + (next - here) * CUT);
-                            } else {
-                                out.push(here);
-                            }
-                        }
-                        out
-                    };
-                    outlines.push([cut(&faces[f], &faces[g]), cut(&faces[g], &faces[f])]);
-                    features.push(Feature::Plates {
-                        face: f,
-                        other: g,
-                        pair: outlines.len() - 1,
-                    });
+        let paths = (0..model.panels()).map(|p| model.path_columns(p).collect()).collect();
+        let mut pairs: Vec<[usize; 2]> = Vec::new();
+        let mut pair_features: Vec<Vec<usize>> = Vec::new();
+        for (k, feature) in features.iter().enumerate() {
+            let [f, g] = feature.faces();
+            let pair = [f.min(g), f.max(g)];
+            match pairs.iter().position(|&p| p == pair) {
+                Some(i) => pair_features[i].push(k),
+                None => {
+                    pairs.push(pair);
+                    pair_features.push(vec![k]);
                 }
             }
         }
-        let paths = (0..model.panels()).map(|p| model.path_columns(p).collect()).collect();
+        let bounds = faces
+            .iter()
+            .map(|face| {
+                let centre = face.iter().map(|&v| flat[v]).sum::<Vector3<f64>>() / face.len() as f64;
+                let radius = face.iter().map(|&v| (flat[v] - centre).norm()).fold(0.0, f64::max);
+                (centre, radius)
+            })
+            .collect();
         FaceContacts {
             faces,
             face_panel,
             flat,
             features,
-            outlines,
+            pairs,
+            pair_features,
+            bounds,
             paths,
             size: model.size(),
         }
     }
 
     /// Where pattern vertex `v` of face `f` is, m.
-    pub fn place(&self, data: &NetworkData, f: usize, v: usize) -> Vector3<f64> {
+    pub fn corner(&self, data: &NetworkData, f: usize, v: usize) -> Vector3<f64> {
         data.place(self.face_panel[f], &self.flat[v])
+    }
+
+    /// Where flat point `x` of face `f` is, m.
+    fn place(&self, data: &NetworkData, f: usize, x: &Vector3<f64>) -> Vector3<f64> {
+        data.place(self.face_panel[f], x)
     }
 
     /// Face `f`'s unit normal (its flat +z carried by its panel).
@@ -291,8 +274,32 @@ impl FaceContacts {
         data.rotation[self.face_panel[f]] * Vector3::z()
     }
 
-    /// Feature `k` at the poses `data` holds.
-    pub fn state(&self, data: &NetworkData, k: usize) -> FeatureState {
+    /// How far apart pair `pair`'s faces are at least (their bounding spheres' gap), m: a
+    /// lower bound on the distance between any two of their points.
+    pub fn pair_gap(&self, data: &NetworkData, pair: usize) -> f64 {
+        let [f, g] = self.pairs[pair];
+        let ((cf, rf), (cg, rg)) = (self.bounds[f], self.bounds[g]);
+        (self.place(data, f, &cf) - self.place(data, g, &cg)).norm() - rf - rg
+    }
+
+    /// Every face's corners and normal at the poses `data` holds.
+    pub fn placed(&self, data: &NetworkData) -> PlacedFaces {
+        PlacedFaces {
+            corners: (0..self.faces.len())
+                .map(|f| self.faces[f].iter().map(|&v| self.corner(data, f, v)).collect())
+                .collect(),
+            normals: (0..self.faces.len()).map(|f| self.normal(data, f)).collect(),
+        }
+    }
+
+    /// Pattern vertex `v` of face `f` among the `placed` corners.
+    fn at(&self, placed: &PlacedFaces, f: usize, v: usize) -> Vector3<f64> {
+        let k = self.faces[f].iter().position(|&w| w == v).expect("a corner of the face");
+        placed.corners[f][k]
+    }
+
+    /// Feature `k` with the faces `placed`.
+    pub fn state(&self, placed: &PlacedFaces, k: usize) -> FeatureState {
         let margin = GATE_MARGIN * self.size;
         match self.features[k] {
             Feature::CornerOnFace {
@@ -301,12 +308,11 @@ impl FaceContacts {
                 other,
                 copy,
             } => {
-                let point = self.place(data, face, vertex);
-                let normal = self.normal(data, other);
-                let corners: Vec<Vector3<f64>> =
-                    self.faces[other].iter().map(|&w| self.place(data, other, w)).collect();
+                let point = self.at(placed, face, vertex);
+                let normal = placed.normals[other];
+                let corners = &placed.corners[other];
                 let distance = normal.dot(&(point - corners[0]));
-                let apart = copy.is_none_or(|w| (self.place(data, other, w) - point).norm() > MET * self.size);
+                let apart = copy.is_none_or(|w| (self.at(placed, other, w) - point).norm() > MET * self.size);
                 let over = apart
                     && (0..corners.len()).all(|i| {
                         let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
@@ -321,30 +327,6 @@ impl FaceContacts {
                     over,
                 }
             }
-            Feature::Plates { face, other, pair } => {
-                let [a, b] = &self.outlines[pair];
-                let first: Vec<Vector3<f64>> = a.iter().map(|x| data.place(self.face_panel[face], x)).collect();
-                let second: Vec<Vector3<f64>> = b.iter().map(|x| data.place(self.face_panel[other], x)).collect();
-                let separation = plate_separation(&first, &second);
-                let u = separation.axis;
-                let point = *first
-                    .iter()
-                    .max_by(|x, y| u.dot(x).total_cmp(&u.dot(y)))
-                    .expect("corners");
-                let other_point = *second
-                    .iter()
-                    .min_by(|x, y| u.dot(x).total_cmp(&u.dot(y)))
-                    .expect("corners");
-                // The normal from the second plate towards the first is −u: distance = gap.
-                let _ = margin;
-                FeatureState {
-                    point,
-                    other_point,
-                    normal: -u,
-                    distance: separation.gap,
-                    over: true,
-                }
-            }
             Feature::EdgeOnCorner {
                 face,
                 corner,
@@ -352,9 +334,9 @@ impl FaceContacts {
                 other,
                 apex: apex_vertex,
             } => {
-                let (apex, point) = (self.place(data, other, apex_vertex), self.place(data, face, far));
-                let met = (self.place(data, face, corner) - apex).norm() <= MET * self.size;
-                let normal = self.normal(data, other);
+                let (apex, point) = (self.at(placed, other, apex_vertex), self.at(placed, face, far));
+                let met = (self.at(placed, face, corner) - apex).norm() <= MET * self.size;
+                let normal = placed.normals[other];
                 let distance = normal.dot(&(point - apex));
                 let loop_ = &self.faces[other];
                 let k = loop_
@@ -362,8 +344,8 @@ impl FaceContacts {
                     .position(|&v| v == apex_vertex)
                     .expect("a corner of the face");
                 let (next, previous) = (loop_[(k + 1) % loop_.len()], loop_[(k + loop_.len() - 1) % loop_.len()]);
-                let first = self.place(data, other, next) - apex;
-                let second = self.place(data, other, previous) - apex;
+                let first = self.at(placed, other, next) - apex;
+                let second = self.at(placed, other, previous) - apex;
                 let within = point - normal * distance - apex;
                 let reach = margin * within.norm();
                 // Counter-clockwise about the normal from the corner's next edge to its
@@ -386,10 +368,10 @@ impl FaceContacts {
                 other_edge,
                 copy,
             } => {
-                let (p0, p1) = (self.place(data, face, edge[0]), self.place(data, face, edge[1]));
+                let (p0, p1) = (self.at(placed, face, edge[0]), self.at(placed, face, edge[1]));
                 let (q0, q1) = (
-                    self.place(data, other, other_edge[0]),
-                    self.place(data, other, other_edge[1]),
+                    self.at(placed, other, other_edge[0]),
+                    self.at(placed, other, other_edge[1]),
                 );
                 let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
                 let cross = d1.cross(&d2);
@@ -423,7 +405,7 @@ impl FaceContacts {
                         && t > mt
                         && t < 1.0 - mt
                         && copy.is_none_or(|[v, w]| {
-                            (self.place(data, face, v) - self.place(data, other, w)).norm() > MET * self.size
+                            (self.at(placed, face, v) - self.at(placed, other, w)).norm() > MET * self.size
                         }),
                 }
             }
@@ -438,45 +420,6 @@ impl FaceContacts {
         for (face, point, sign) in [(f, state.point, 1.0), (g, state.other_point, -1.0)] {
             for &c in &self.paths[self.face_panel[face]] {
                 out[c] += sign * state.normal.dot(&data.twist[c].point_velocity(&point));
-            }
-        }
-        if let Feature::Plates { face, other, pair } = self.features[k] {
-            // The axis turns too: gap = u·(b* − a*) with u = −normal, so d(gap) gains
-            // du·(b* − a*).
-            let u = -state.normal;
-            let lever = state.other_point - state.point;
-            let [a, b] = &self.outlines[pair];
-            let first: Vec<Vector3<f64>> = a.iter().map(|x| data.place(self.face_panel[face], x)).collect();
-            let second: Vec<Vector3<f64>> = b.iter().map(|x| data.place(self.face_panel[other], x)).collect();
-            let kind = plate_separation(&first, &second).kind;
-            let edge = |p: &[Vector3<f64>], i: usize| p[(i + 1) % p.len()] - p[i];
-            for (body, sign_body) in [(face, 0usize), (other, 1usize)] {
-                for &c in &self.paths[self.face_panel[body]] {
-                    let omega = data.twist[c].angular;
-                    let du = match kind {
-                        SeparatingAxis::NormalOfFirst | SeparatingAxis::EdgeOfFirst(_) if sign_body == 0 => {
-                            omega.cross(&u)
-                        }
-                        SeparatingAxis::NormalOfSecond | SeparatingAxis::EdgeOfSecond(_) if sign_body == 1 => {
-                            omega.cross(&u)
-                        }
-                        SeparatingAxis::Edges(i, j) => {
-                            let (e, h) = (edge(&first, i), edge(&second, j));
-                            let cross = e.cross(&h);
-                            let turned = if sign_body == 0 {
-                                omega.cross(&e).cross(&h)
-                            } else {
-                                e.cross(&omega.cross(&h))
-                            };
-                            let unit = cross.normalize();
-                            // The sign of u against e×f.
-                            let sign = if unit.dot(&u) >= 0.0 { 1.0 } else { -1.0 };
-                            (turned - unit * unit.dot(&turned)) * (sign / cross.norm())
-                        }
-                        _ => Vector3::zeros(),
-                    };
-                    out[c] += du.dot(&lever);
-                }
             }
         }
     }
