@@ -6,11 +6,21 @@ fn main() {
     let shape = args.get(1).map_or("cube", |s| s.as_str());
     let rank: usize = args.get(2).map_or(1, |s| s.parse().unwrap());
     let (name, solid) = open_solid(shape).unwrap();
-    let options = NetsOptions { top: rank, simulate: rank, fronts: 16, yield_samples: 50, unit_um: 50.0, ..NetsOptions::default() };
+    let options = NetsOptions {
+        top: rank,
+        simulate: rank,
+        fronts: 16,
+        yield_samples: 50,
+        unit_um: 50.0,
+        ..NetsOptions::default()
+    };
     let report = nets(&name, &solid, &options).unwrap();
     let (_, made) = best_net_patterns(&solid, &report, rank).unwrap().remove(rank - 1);
     for release in options.releases() {
-        let released = NetsOptions { front_deg: release, ..options.clone() };
+        let released = NetsOptions {
+            front_deg: release,
+            ..options.clone()
+        };
         let scene = net_device(&made, shape, &released).unwrap();
         let model = scene.network().unwrap();
         let closing = NetClosing::new(&made, model).unwrap();
@@ -23,9 +33,21 @@ fn main() {
             let run = closing.run(model, &forcing, &stiffness, &options.closing()).unwrap();
             times.push(t.elapsed().as_secs_f64() * 1e3);
             *outcomes.entry(format!("{:?}", run.outcome)).or_insert(0) += 1;
-            if t.elapsed().as_secs_f64() > 0.5 { println!("  slow sample {sample}: {:?} {:.0} ms {:?}", run.outcome, t.elapsed().as_secs_f64()*1e3, run.undecided); }
+            if t.elapsed().as_secs_f64() > 0.2 {
+                println!(
+                    "  slow sample {sample}: {:?} {:.0} ms {:?}",
+                    run.outcome,
+                    t.elapsed().as_secs_f64() * 1e3,
+                    run.undecided
+                );
+            }
         }
         times.sort_by(f64::total_cmp);
-        println!("front {release:?}: median {:.2} ms, max {:.1} ms, total {:.0} ms; {outcomes:?}", times[times.len()/2], times[times.len()-1], times.iter().sum::<f64>());
+        println!(
+            "front {release:?}: median {:.2} ms, max {:.1} ms, total {:.0} ms; {outcomes:?}",
+            times[times.len() / 2],
+            times[times.len() - 1],
+            times.iter().sum::<f64>()
+        );
     }
 }

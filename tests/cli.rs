@@ -1701,21 +1701,21 @@ fn the_bundled_cubes_closing_and_jam_come_back_through_the_nets_path() {
             theirs["meeting_at_contact"].as_array().map(Vec::len),
             "{bundled}"
         );
-        // The design study carries the run on: the closing cube latches its walls at that
-        // contact and its lid 4000 s later; the jamming one stops there.
+        // The design study carries the run on past that contact. The closing cube latches
+        // its walls there and its lid 4000 s later. The other (which the first-touch rule
+        // called a jam) has its lid pressed on a wall's edge: held by the contact force, it
+        // slides along the edge and latches within the capture later.
         let table: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("nets.json")).unwrap()).unwrap();
         let release = &table["nets"][0]["closing"]["releases"][0];
         let ended = release["time_s"].as_f64().unwrap();
+        assert_eq!(release["outcome"], "closes", "{bundled}: {release}");
+        assert_eq!(release["latched"], 7, "{bundled}: {release}");
+        assert!(ended > time(&theirs) * (1.0 + 1e-6), "{bundled}: {release}");
         if bundled == "cube_closes" {
-            assert_eq!(release["outcome"], "closes");
-            assert_eq!(release["latched"], 7);
             assert!(ended > time(&theirs) + 3999.0, "{release}");
-        } else {
-            assert!(dir.join("jam.html").exists());
-            assert_eq!(release["outcome"], "jams");
-            assert!((ended - time(&theirs)).abs() <= 1e-8 * ended, "{release}");
         }
+        assert!(!dir.join("jam.html").exists(), "{bundled}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

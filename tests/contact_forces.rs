@@ -7,8 +7,11 @@ use nalgebra::Vector3;
 use nanofold::commands::nets::*;
 
 /// A net's device and its run.
+/// Every pattern vertex placed at the fold angles, m.
+type Places = Box<dyn Fn(&[f64]) -> Vec<Vector3<f64>>>;
+
 struct Jammed {
-    places: Box<dyn Fn(&[f64]) -> Vec<Vector3<f64>>>,
+    places: Places,
     faces: Vec<Vec<usize>>,
     file_face: Vec<usize>,
     stiffness: Vec<f64>,

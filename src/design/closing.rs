@@ -21,6 +21,8 @@ use serde::{Deserialize, Serialize};
 const MAX_STEP: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// A step is halved down to this turn, rad, before a jump of the balance is called a snap.
 const MIN_TURN: f64 = 1e-9;
+/// A step whose balance is not found is halved at most this many times in a row.
+const UNSETTLED_HALVINGS: usize = 10;
 /// A balance that moves more than this many times its drives' turn (plus the floor, rad)
 /// in one step has jumped.
 const JUMP_RATIO: f64 = 20.0;
@@ -48,7 +50,23 @@ const SETTLE_ITERATIONS: usize = 200;
 const SETTLE_STEP: f64 = 1e-13;
 /// With contacts: the QPs of one balance, and the step that ends them, rad.
 const CONTACT_ITERATIONS: usize = 100;
+/// A balance with contacts not found in this many QP solves (iterations and their shares)
+/// is not found: constraints that the shares only creep towards do not hold together.
+const SETTLE_SOLVES: usize = 300;
+/// A run's QP solves in all: past these (a balance creeping along a contact at the rounding
+/// floor) it stops as undecided, so a study's time is bounded (about 0.5 s a run).
+const RUN_SOLVES: usize = 50_000;
 const CONTACT_STEP: f64 = 1e-12;
+/// A balance whose steps stay below this (rad, a point moved by about 1e-8 of the size) for
+/// [`FLOOR_ITERATIONS`] in a row has reached its rounding floor: contacts that nearly
+/// oppose (a face pinched between two) carry forces whose rows cancel, and the step
+/// wanders at the floor that leaves.
+const FLOOR_STEP: f64 = 1e-8;
+const FLOOR_ITERATIONS: usize = 10;
+/// A contact may sit this share of the tolerance deep.
+const CONTACT_SLACK: f64 = 0.1;
+/// A settled balance's contacts hold to this many times their slack.
+const LANDED_SLACK: f64 = 1.5;
 /// Events closer than this in progress are the same event come back.
 const REPEATED_EVENT: f64 = 1e-12;
 /// How many times an event may come back before the run stops.
@@ -388,14 +406,44 @@ struct Sides {
     /// Whether each pair of faces is within [`REACH`] (its features followed); a pair out
     /// of reach cannot touch, and its features' sides are read afresh when it comes back.
     watched: Vec<bool>,
+    /// Whether each pair was apart across a plane at the last accepted poses: its features'
+    /// sides are then those they had there, read from `last` when asked.
+    separated: Vec<bool>,
+    /// The faces at the last accepted poses.
+    last: Option<PlacedFaces>,
+    tolerance: f64,
+    /// The run's QP solves so far (bounded by [`RUN_SOLVES`]).
+    solves: std::cell::Cell<usize>,
 }
 
 impl Sides {
-    fn new(contacts: &FaceContacts) -> Sides {
+    fn new(contacts: &FaceContacts, tolerance: f64) -> Sides {
         Sides {
             sign: vec![0.0; contacts.features.len()],
             reference: vec![Vector3::zeros(); contacts.features.len()],
             watched: vec![false; contacts.pairs.len()],
+            separated: vec![false; contacts.pairs.len()],
+            last: None,
+            tolerance,
+            solves: std::cell::Cell::new(0),
+        }
+    }
+
+    /// Feature `k`'s side and normal reference: as carried, or, for a pair that was apart
+    /// across a plane, as read where it last was (apart, every feature is on its own side).
+    fn orientation(&self, contacts: &FaceContacts, k: usize) -> (f64, Vector3<f64>) {
+        match &self.last {
+            Some(last) if self.separated[contacts.feature_pair[k]] => {
+                let raw = contacts.state(last, k);
+                if !raw.distance.is_finite() {
+                    (0.0, Vector3::zeros())
+                } else if raw.distance.abs() > self.tolerance {
+                    (raw.distance.signum(), raw.normal)
+                } else {
+                    (0.0, raw.normal)
+                }
+            }
+            _ => (self.sign[k], self.reference[k]),
         }
     }
 
@@ -408,18 +456,24 @@ impl Sides {
 
     /// Feature `k` at its `raw` state with its normal continuous.
     fn continuous(&self, contacts: &FaceContacts, k: usize, mut state: FeatureState) -> FeatureState {
-        if matches!(contacts.features[k], Feature::EdgeOnEdge { .. }) && state.normal.dot(&self.reference[k]) < 0.0 {
+        self.continuous_from(contacts, k, self.orientation(contacts, k).1, &mut state);
+        state
+    }
+
+    fn continuous_from(&self, contacts: &FaceContacts, k: usize, reference: Vector3<f64>, state: &mut FeatureState) {
+        if matches!(contacts.features[k], Feature::EdgeOnEdge { .. }) && state.normal.dot(&reference) < 0.0 {
             state.normal = -state.normal;
             state.distance = -state.distance;
         }
-        state
     }
 
     /// Feature `k` at its `raw` state turned to the side it came from: its distance is its
     /// gap.
     fn oriented(&self, contacts: &FaceContacts, k: usize, raw: FeatureState) -> FeatureState {
-        let mut state = self.continuous(contacts, k, raw);
-        if self.sign[k] < 0.0 {
+        let (sign, reference) = self.orientation(contacts, k);
+        let mut state = raw;
+        self.continuous_from(contacts, k, reference, &mut state);
+        if sign < 0.0 {
             state.normal = -state.normal;
             state.distance = -state.distance;
         }
@@ -619,16 +673,35 @@ impl NetClosing {
             }
             None => {
                 found.extend((0..self.seams.len()).filter(|&k| seam_meets(k)).map(Happening::Seam));
-                for k in sides.watched(&self.contacts) {
-                    let state = self.contacts.state(&placed, k);
-                    raw[k] = Some(state);
-                    if crosses(k, &state) {
-                        found.push(Happening::Feature(k));
+                for pair in 0..self.contacts.pairs.len() {
+                    if !sides.watched[pair] || !self.pair_open(&placed, holds, pair) {
+                        continue;
+                    }
+                    for &k in &self.contacts.pair_features[pair] {
+                        let state = self.contacts.state(&placed, k);
+                        raw[k] = Some(state);
+                        if crosses(k, &state) {
+                            found.push(Happening::Feature(k));
+                        }
                     }
                 }
             }
         }
         found
+    }
+
+    /// Whether pair `pair`'s features can touch or cross at the faces `placed`: not held by
+    /// a latched seam, and either touching already or not apart across a plane.
+    fn pair_open(&self, placed: &PlacedFaces, holds: &Holds, pair: usize) -> bool {
+        let faces = self.contacts.pairs[pair];
+        if self
+            .seam_of(faces)
+            .is_some_and(|s| holds.state[s] == SeamState::Latched)
+        {
+            return false;
+        }
+        holds.touching.iter().any(|&k| self.contacts.feature_pair[k] == pair)
+            || !self.contacts.plane_separated(placed, pair, TOLERANCE * self.size)
     }
 
     /// Whether seam `k`'s faces touch.
@@ -783,6 +856,9 @@ impl NetClosing {
             return self.settle_closures(model, drive, stiffness, holds, theta, data);
         }
         let n = theta.len();
+        let mut at_floor = 0;
+        let mut solves = 0;
+        let mut previous_step: Option<DVector<f64>> = None;
         for _ in 0..CONTACT_ITERATIONS {
             update_poses(model, theta, data);
             let (seam_residual, seam_rows) = self.seam_rows(data, holds, n);
@@ -835,11 +911,17 @@ impl NetClosing {
             let mut share = 1.0;
             let solution = loop {
                 let asked_closure = &closure * share;
-                // Faces may sit within the tolerance of each other's planes, as the event
-                // tests read them: rows that meet at one point (a seam closing where a
-                // contact already holds) agree only to rounding at that depth.
-                let slack = TOLERANCE * self.size;
+                // Faces may sit a little within each other's planes: rows that meet at one
+                // point (a seam closing where a contact already holds) agree only to
+                // rounding at that depth. A tenth of the tolerance, so a contact held at its
+                // slack is within the tolerance however its faces' overlap is measured.
+                let slack = CONTACT_SLACK * TOLERANCE * self.size;
                 let asked_gaps = gaps.map(|g| if g < 0.0 { g * share + slack } else { g + slack });
+                solves += 1;
+                sides.solves.set(sides.solves.get() + 1);
+                if solves > SETTLE_SOLVES || sides.solves.get() > RUN_SOLVES {
+                    return false;
+                }
                 match solve_step(&BalanceStep {
                     stiffness,
                     offset: &offset,
@@ -857,9 +939,16 @@ impl NetClosing {
                     }
                 }
             };
-            for c in 0..n {
-                theta[c] += solution.step[c];
+            // A step that turns back on the last (contacts that nearly oppose, each
+            // linearisation overshooting the other's) is taken by half: the two-cycle closes.
+            let back = previous_step
+                .as_ref()
+                .is_some_and(|last: &DVector<f64>| last.dot(&solution.step) < 0.0);
+            let taken = if back { 0.5 } else { 1.0 };
+            for (angle, step) in theta.iter_mut().zip(solution.step.iter()) {
+                *angle += taken * step;
             }
+            previous_step = Some(solution.step.clone());
             // The force on a meeting is its standing row's; the rows it stands for carry none.
             for (i, force) in holds.forces.iter_mut().enumerate() {
                 *force = if standing[stands_for[i]] == i {
@@ -875,9 +964,24 @@ impl NetClosing {
                 .zip(solution.closure_multipliers.iter())
                 .fold(DVector::zeros(n), |sum, ((lambda, v), mu)| sum + v * (mu / lambda));
             holds.seam_multipliers = (&seam_rows * through).iter().copied().collect();
-            if share == 1.0 && !solution.at_trust && solution.step.amax() <= CONTACT_STEP {
+            let settled = share == 1.0 && !solution.at_trust;
+            at_floor = if settled && solution.step.amax() <= FLOOR_STEP {
+                at_floor + 1
+            } else {
+                0
+            };
+            if settled && (solution.step.amax() <= CONTACT_STEP || at_floor >= FLOOR_ITERATIONS) {
                 update_poses(model, theta, data);
-                return true;
+                // Where it lands, the contacts hold to their slack (a half step of a two-cycle
+                // may leave one deeper: iterate on).
+                let (landed, _) = self.contact_rows(data, holds, sides, n);
+                if standing
+                    .iter()
+                    .all(|&i| landed[i] >= -LANDED_SLACK * CONTACT_SLACK * TOLERANCE * self.size)
+                {
+                    return true;
+                }
+                at_floor = 0;
             }
         }
         update_poses(model, theta, data);
@@ -975,7 +1079,7 @@ impl NetClosing {
             data: NetworkData::new(model),
             drive: vec![0.0; n],
             theta: vec![0.0; n],
-            sides: Sides::new(&self.contacts),
+            sides: Sides::new(&self.contacts, TOLERANCE * self.size),
             raw: vec![None; self.contacts.features.len()],
             holds: Holds::new(self.seams.len()),
             report: ClosingReport {
@@ -1149,6 +1253,7 @@ impl Run<'_> {
         let mut u = 0.0;
         let mut turn = MAX_STEP;
         let (mut last_event, mut repeats) = (f64::NEG_INFINITY, 0);
+        let mut unsettled = 0;
         while u < 1.0 {
             let next = self.path.next(u, turn);
             let mut trial = self.theta.clone();
@@ -1173,10 +1278,12 @@ impl Run<'_> {
             let jump = (0..trial.len())
                 .map(|c| (trial[c] - self.theta[c]).abs())
                 .fold(0.0, f64::max);
+            unsettled = if settled { 0 } else { unsettled + 1 };
             if !settled || jump > JUMP_RATIO * driven + JUMP_FLOOR {
                 // A balance that moves far more than its drives: halve the step until it
-                // follows, or the step is too small to say anything but that it jumped.
-                if turn > MIN_TURN {
+                // follows, or the step is too small to say anything but that it jumped. A
+                // balance not found at all is tried on steps down to 1/1024 of the first.
+                if turn > MIN_TURN && unsettled <= UNSETTLED_HALVINGS {
                     turn *= 0.5;
                     continue;
                 }
@@ -1302,24 +1409,45 @@ impl Run<'_> {
         let reach = REACH * net.size;
         for pair in 0..net.contacts.pairs.len() {
             let near = net.contacts.pair_gap(&self.data, pair) <= reach;
-            let was = self.sides.watched[pair];
+            let (was, was_separated) = (self.sides.watched[pair], self.sides.separated[pair]);
             self.sides.watched[pair] = near;
+            self.sides.separated[pair] = false;
+            if !near {
+                continue;
+            }
+            if !net.pair_open(&placed, &self.holds, pair) {
+                // Apart (or held by a seam): its sides stay as they are here.
+                self.sides.separated[pair] = true;
+                continue;
+            }
             for &k in &net.contacts.pair_features[pair] {
-                if !near || self.holds.touching.contains(&k) {
+                if self.holds.touching.contains(&k) {
                     continue;
                 }
-                // The step's events read every watched feature at these poses already.
+                // The step's events read every open pair's features at these poses already.
                 let raw = match self.raw[k].take() {
-                    Some(raw) if was => raw,
-                    _ => net.contacts.state(&placed, k),
+                    Some(raw) => raw,
+                    None => net.contacts.state(&placed, k),
                 };
-                if was {
-                    self.sides.update(&net.contacts, k, raw, tolerance);
-                } else {
-                    self.sides.refresh(k, raw, tolerance);
+                if !was || was_separated {
+                    // Its sides as they were at the last accepted poses, where the pair was
+                    // out of reach or apart (no crossing there; a latch's pull since may
+                    // have carried it across), then carried here.
+                    match self.sides.last.as_ref() {
+                        Some(last) => {
+                            let before = net.contacts.state(last, k);
+                            self.sides.refresh(k, before, tolerance);
+                        }
+                        None => {
+                            self.sides.refresh(k, raw, tolerance);
+                            continue;
+                        }
+                    }
                 }
+                self.sides.update(&net.contacts, k, raw, tolerance);
             }
         }
+        self.sides.last = Some(placed);
         self.raw.iter_mut().for_each(|r| *r = None);
     }
 
@@ -1332,6 +1460,16 @@ impl Run<'_> {
     }
 
     fn no_balance(&self, u: f64) -> Stop {
+        if self.sides.solves.get() > RUN_SOLVES {
+            return Stop::NoBalance(
+                u,
+                format!(
+                    "the balance with {} latched seams and {} contacts still creeping after {RUN_SOLVES} QP solves at progress {u:.9}",
+                    self.holds.latched.len(),
+                    self.holds.touching.len()
+                ),
+            );
+        }
         Stop::NoBalance(
             u,
             format!(

@@ -135,7 +135,10 @@ pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
             return None;
         }
         // The held rows hold (else they are inconsistent: Clarabel's shares decide).
-        if held.iter().any(|&i| (a.row(i).dot(&d.transpose()) - b[i]).abs() > HELD_RESIDUAL * sigma) {
+        if held
+            .iter()
+            .any(|&i| (a.row(i).dot(&d.transpose()) - b[i]).abs() > HELD_RESIDUAL * sigma)
+        {
             return None;
         }
         let pulling = held
@@ -405,11 +408,21 @@ mod tests {
             free += held.forces.iter().filter(|&&f| f == 0.0).count();
             let clarabel = solve_step_with_clarabel(&step).unwrap();
             let scale = clarabel.step.amax();
-            assert!((&held.step - &clarabel.step).amax() <= 1e-7 * scale, "{} {}", held.step, clarabel.step);
+            assert!(
+                (&held.step - &clarabel.step).amax() <= 1e-7 * scale,
+                "{} {}",
+                held.step,
+                clarabel.step
+            );
             // Forces here are of order K·offset/lever = 1e-9·0.1/1e-4 = 1e-6 N; an inactive
             // contact's is zero on the direct path and an interior point's 1e-19.
             let force = clarabel.forces.amax().max(1e-6);
-            assert!((&held.forces - &clarabel.forces).amax() <= 1e-6 * force, "{} {}", held.forces, clarabel.forces);
+            assert!(
+                (&held.forces - &clarabel.forces).amax() <= 1e-6 * force,
+                "{} {}",
+                held.forces,
+                clarabel.forces
+            );
             let mu = clarabel.closure_multipliers.amax().max(1e-30);
             assert!(
                 (&held.closure_multipliers - &clarabel.closure_multipliers).amax() <= 1e-6 * mu,

@@ -116,6 +116,8 @@ pub struct FaceContacts {
     pub pairs: Vec<[usize; 2]>,
     /// Each pair's features.
     pub pair_features: Vec<Vec<usize>>,
+    /// Each feature's pair.
+    pub feature_pair: Vec<usize>,
     /// Each face's centre in the flat sheet and the radius of its corners about it, m.
     bounds: Vec<(Vector3<f64>, f64)>,
     /// Each panel's tree columns to the anchored panel.
@@ -238,6 +240,12 @@ impl FaceContacts {
                 }
             }
         }
+        let mut feature_pair = vec![0; features.len()];
+        for (i, members) in pair_features.iter().enumerate() {
+            for &k in members {
+                feature_pair[k] = i;
+            }
+        }
         let bounds = faces
             .iter()
             .map(|face| {
@@ -253,6 +261,7 @@ impl FaceContacts {
             features,
             pairs,
             pair_features,
+            feature_pair,
             bounds,
             paths,
             size: model.size(),
@@ -294,8 +303,26 @@ impl FaceContacts {
 
     /// Pattern vertex `v` of face `f` among the `placed` corners.
     fn at(&self, placed: &PlacedFaces, f: usize, v: usize) -> Vector3<f64> {
-        let k = self.faces[f].iter().position(|&w| w == v).expect("a corner of the face");
+        let k = self.faces[f]
+            .iter()
+            .position(|&w| w == v)
+            .expect("a corner of the face");
         placed.corners[f][k]
+    }
+
+    /// Whether pair `pair`'s faces are apart across a plane of one of them: every corner of
+    /// the other farther than `tolerance` from it, all on one side. Then no feature of the
+    /// pair touches or crosses (a point of one face is in its own plane, every point of the
+    /// other beyond the tolerance from it).
+    pub fn plane_separated(&self, placed: &PlacedFaces, pair: usize, tolerance: f64) -> bool {
+        let [f, g] = self.pairs[pair];
+        let apart = |plane: usize, other: usize| {
+            let (normal, origin) = (placed.normals[plane], placed.corners[plane][0]);
+            let mut sides = placed.corners[other].iter().map(|x| normal.dot(&(x - origin)));
+            let first = sides.next().unwrap_or(0.0);
+            first.abs() > tolerance && sides.all(|d| d.abs() > tolerance && d.signum() == first.signum())
+        };
+        apart(f, g) || apart(g, f)
     }
 
     /// Feature `k` with the faces `placed`.
