@@ -361,12 +361,16 @@ struct Holds {
     forces: Vec<f64>,
     /// The latched seams' row multipliers at the last balance with contacts, N·m.
     seam_multipliers: Vec<f64>,
+    /// Seams whose capture found no balance (contact holds their faces off the pull):
+    /// they latch only once they meet in line.
+    blocked: Vec<bool>,
 }
 
 impl Holds {
     fn new(seams: usize) -> Holds {
         Holds {
             state: vec![SeamState::Open; seams],
+            blocked: vec![false; seams],
             latched: Vec::new(),
             touching: Vec::new(),
             forces: Vec::new(),
@@ -445,6 +449,19 @@ impl Sides {
             }
             _ => (self.sign[k], self.reference[k]),
         }
+    }
+
+    /// Feature `k`'s side (see [`Sides::orientation`]).
+    fn side(&self, contacts: &FaceContacts, k: usize) -> f64 {
+        self.orientation(contacts, k).0
+    }
+
+    /// Stores feature `k`'s orientation as carried, for a feature that starts touching:
+    /// from here on its pair is open and its side is no longer read where it was apart.
+    fn commit(&mut self, contacts: &FaceContacts, k: usize) {
+        let (sign, reference) = self.orientation(contacts, k);
+        self.sign[k] = sign;
+        self.reference[k] = reference;
     }
 
     /// The features of the pairs of faces within reach.
@@ -649,12 +666,12 @@ impl NetClosing {
         let seam_meets = |k: usize| {
             holds.state[k] == SeamState::Open && {
                 let m = self.misalignment(data, k);
-                m <= ALIGNED || (m <= capture && self.seam_touching(holds, k))
+                m <= ALIGNED || (m <= capture && !holds.blocked[k] && self.seam_touching(holds, k))
             }
         };
         let placed = self.contacts.placed(data);
         let crosses = |k: usize, state: &FeatureState| {
-            sides.sign[k] != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
+            sides.side(&self.contacts, k) != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
                 let state = sides.oriented(&self.contacts, k, *state);
                 state.over && state.distance < -tolerance
             }
@@ -1544,13 +1561,18 @@ impl Run<'_> {
     fn resolve(&mut self, u: f64) -> std::result::Result<bool, Stop> {
         let net = self.net;
         let tolerance = TOLERANCE * net.size;
+        // Whether a round's contacts have yet to be balanced (its latches were undone).
+        let mut unbalanced = false;
         for _ in 0..RESOLVE_ROUNDS {
             self.path.drive(u, &mut self.drive);
             update_poses(self.model, &self.theta, &mut self.data);
             let mut touched = Vec::new();
             let placed = net.contacts.placed(&self.data);
             for k in self.sides.watched(&net.contacts) {
-                if self.sides.sign[k] == 0.0 || self.holds.touching.contains(&k) || net.held_by_seam(&self.holds, k) {
+                if self.sides.side(&net.contacts, k) == 0.0
+                    || self.holds.touching.contains(&k)
+                    || net.held_by_seam(&self.holds, k)
+                {
                     continue;
                 }
                 let state = self.sides.state(&net.contacts, &placed, k);
@@ -1559,6 +1581,9 @@ impl Run<'_> {
                 }
             }
             for &(k, state) in &touched {
+                // The side it touches from is the one it held (read where its pair was last
+                // apart, if it was): carried from here on.
+                self.sides.commit(&net.contacts, k);
                 self.holds.touch(k);
                 let feature = net.contacts.features[k];
                 self.report.first_contact_time_s.get_or_insert(self.path.time(u));
@@ -1574,15 +1599,39 @@ impl Run<'_> {
                 .filter(|&k| self.holds.state[k] == SeamState::Open)
                 .filter_map(|k| {
                     let m = net.misalignment(&self.data, k);
-                    (m <= ALIGNED_TOGETHER || (m <= self.capture && net.seam_touching(&self.holds, k)))
-                        .then_some((k, m))
+                    (m <= ALIGNED_TOGETHER
+                        || (m <= self.capture && !self.holds.blocked[k] && net.seam_touching(&self.holds, k)))
+                    .then_some((k, m))
                 })
                 .collect();
-            if new.is_empty() && touched.is_empty() {
+            if new.is_empty() && touched.is_empty() && !unbalanced {
                 return Ok(false);
             }
-            for &(k, m) in &new {
+            unbalanced = false;
+            let before = (self.holds.clone(), self.theta.clone());
+            for &(k, _) in &new {
                 self.holds.latch(k, net.seams[k].faces, &net.contacts.features);
+            }
+            if let Err(stop) = self.settle_at(u) {
+                // A capture's pull that contact holds off is no latch: the seams stay open,
+                // caught no more until they meet in line, and the balance is taken without.
+                let captured: Vec<usize> = new
+                    .iter()
+                    .filter(|&&(_, m)| m > ALIGNED_TOGETHER)
+                    .map(|&(k, _)| k)
+                    .collect();
+                if captured.is_empty() {
+                    return Err(stop);
+                }
+                (self.holds, self.theta) = before;
+                for &k in &captured {
+                    self.holds.blocked[k] = true;
+                }
+                update_poses(self.model, &self.theta, &mut self.data);
+                unbalanced = true;
+                continue;
+            }
+            for &(k, m) in &new {
                 self.report.first_contact_time_s.get_or_insert(self.path.time(u));
                 self.report.latches.push(Latch {
                     seam: k,
@@ -1592,7 +1641,6 @@ impl Run<'_> {
                     misalignment: m,
                 });
             }
-            self.settle_at(u)?;
             self.after_step();
             self.keep_frame(u);
             if self.holds.latched.len() == net.seams.len() {
