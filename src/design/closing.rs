@@ -451,11 +451,6 @@ impl Sides {
         }
     }
 
-    /// Feature `k`'s side (see [`Sides::orientation`]).
-    fn side(&self, contacts: &FaceContacts, k: usize) -> f64 {
-        self.orientation(contacts, k).0
-    }
-
     /// Stores feature `k`'s orientation as carried, for a feature that starts touching:
     /// from here on its pair is open and its side is no longer read where it was apart.
     fn commit(&mut self, contacts: &FaceContacts, k: usize) {
@@ -671,7 +666,7 @@ impl NetClosing {
         };
         let placed = self.contacts.placed(data);
         let crosses = |k: usize, state: &FeatureState| {
-            sides.side(&self.contacts, k) != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
+            sides.sign[k] != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
                 let state = sides.oriented(&self.contacts, k, *state);
                 state.over && state.distance < -tolerance
             }
@@ -1569,10 +1564,7 @@ impl Run<'_> {
             let mut touched = Vec::new();
             let placed = net.contacts.placed(&self.data);
             for k in self.sides.watched(&net.contacts) {
-                if self.sides.side(&net.contacts, k) == 0.0
-                    || self.holds.touching.contains(&k)
-                    || net.held_by_seam(&self.holds, k)
-                {
+                if self.sides.sign[k] == 0.0 || self.holds.touching.contains(&k) || net.held_by_seam(&self.holds, k) {
                     continue;
                 }
                 let state = self.sides.state(&net.contacts, &placed, k);
