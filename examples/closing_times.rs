@@ -16,7 +16,11 @@ fn main() {
     };
     let report = nets(&name, &solid, &options).unwrap();
     let (_, made) = best_net_patterns(&solid, &report, rank).unwrap().remove(rank - 1);
+    let only: Option<f64> = args.get(3).map(|s| s.parse().unwrap());
     for release in options.releases() {
+        if only.is_some_and(|f| release != Some(f)) {
+            continue;
+        }
         let released = NetsOptions {
             front_deg: release,
             ..options.clone()
@@ -28,11 +32,17 @@ fn main() {
         let mut times = Vec::new();
         let mut outcomes = std::collections::BTreeMap::new();
         for sample in 0..variation.samples {
+            if std::env::var("ONLY_SAMPLE").is_ok_and(|v| v.parse::<usize>().unwrap() != sample) {
+                continue;
+            }
             let (forcing, stiffness) = variation.device(&model.forcing, &model.stiffness(), sample);
             let t = Instant::now();
             let run = closing.run(model, &forcing, &stiffness, &options.closing()).unwrap();
             times.push(t.elapsed().as_secs_f64() * 1e3);
             *outcomes.entry(format!("{:?}", run.outcome)).or_insert(0) += 1;
+            if std::env::var("SHOW_UNDECIDED").is_ok() && run.outcome == Outcome::Undecided {
+                println!("  undecided sample {sample}: {:?}", run.undecided);
+            }
             if t.elapsed().as_secs_f64() > 0.2 {
                 println!(
                     "  slow sample {sample}: {:?} {:.0} ms {:?}",
@@ -45,8 +55,8 @@ fn main() {
         times.sort_by(f64::total_cmp);
         println!(
             "front {release:?}: median {:.2} ms, max {:.1} ms, total {:.0} ms; {outcomes:?}",
-            times[times.len() / 2],
-            times[times.len() - 1],
+            times.get(times.len() / 2).copied().unwrap_or(0.0),
+            times.last().copied().unwrap_or(0.0),
             times.iter().sum::<f64>()
         );
     }

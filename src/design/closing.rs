@@ -75,6 +75,23 @@ const MAX_REPEATS: usize = 20;
 const PARALLEL_ROWS: f64 = 1e-6;
 /// The smallest share of a closure's or a contact's residual one step asks for.
 const MIN_SHARE: f64 = 1e-6;
+/// The turn of a fold angle by which the contacts' curvature is differenced, rad.
+const CURVATURE_STEP: f64 = 1e-6;
+/// The weight of a held row's square added across it to K + W, over the stiffest hinge's
+/// and the curvature's softest share.
+const ACROSS_WEIGHT: f64 = 100.0;
+/// K + W of a step is kept at least this share of K (a softer balance is stepped as this
+/// stiff): below zero the balance is unstable.
+const STABILITY_FLOOR: f64 = 1e-3;
+/// Iterations in a row found unstable along the contacts before a balance is given up as
+/// passed a snap-through.
+const UNSTABLE_ITERATIONS: usize = 3;
+/// A contact row that misses its feature's move over a step by more than this share of
+/// the rows' moves narrows the trust box to [`TRUST_NARROWING`] of that step.
+const TRUST_MISS: f64 = 0.5;
+const TRUST_NARROWING: f64 = 0.25;
+/// Steps turning back on the last, in a row, that halve the step taken again.
+const MAX_TURNS: usize = 30;
 /// Rounds of contacts and latches at one instant before the run says it cannot settle.
 const RESOLVE_ROUNDS: usize = 50;
 /// JᵀJ's eigenvalues below this share of its largest are zero (singular values below 1e-6
@@ -364,6 +381,8 @@ struct Holds {
     /// Seams whose capture found no balance (contact holds their faces off the pull):
     /// they latch only once they meet in line.
     blocked: Vec<bool>,
+    /// Whether the last balance given up was unstable along its contacts (a snap-through).
+    unstable: bool,
 }
 
 impl Holds {
@@ -371,6 +390,7 @@ impl Holds {
         Holds {
             state: vec![SeamState::Open; seams],
             blocked: vec![false; seams],
+            unstable: false,
             latched: Vec::new(),
             touching: Vec::new(),
             forces: Vec::new(),
@@ -821,6 +841,99 @@ impl NetClosing {
         (gaps, rows)
     }
 
+    /// W = −Σ fᵢ ∇²gᵢ, the touching features' curvature weighted by their last forces (the
+    /// balance's Lagrangian Hessian less K), from central differences of their rows in each
+    /// fold angle; `None` while no contact pushes. With it, the balance's stiffness along
+    /// the surfaces the held rows leave free: the least eigenvalue of K^-1/2 (K + W) K^-1/2
+    /// there (below zero, the balance is unstable: the path has passed a snap-through). W
+    /// is returned with enough of each held row's square added that K + W is positive
+    /// across the rows (which leaves a held row's step unchanged), and clamped to K + W ≥
+    /// [`STABILITY_FLOOR`] K.
+    fn contact_curvature(
+        &self,
+        model: &NetworkModel,
+        theta: &[f64],
+        stiffness: &[f64],
+        holds: &Holds,
+        sides: &Sides,
+        closure_rows: &DMatrix<f64>,
+    ) -> Option<(DMatrix<f64>, f64)> {
+        if holds.forces.iter().all(|&f| f <= 0.0) {
+            return None;
+        }
+        let n = theta.len();
+        let mut curvature = DMatrix::zeros(n, n);
+        let mut data = NetworkData::new(model);
+        let mut shifted = theta.to_vec();
+        for c in 0..n {
+            shifted[c] = theta[c] + CURVATURE_STEP;
+            update_poses(model, &shifted, &mut data);
+            let (_, plus) = self.contact_rows(&data, holds, sides, n);
+            shifted[c] = theta[c] - CURVATURE_STEP;
+            update_poses(model, &shifted, &mut data);
+            let (_, minus) = self.contact_rows(&data, holds, sides, n);
+            shifted[c] = theta[c];
+            for (i, &force) in holds.forces.iter().enumerate() {
+                if force > 0.0 {
+                    for j in 0..n {
+                        curvature[(j, c)] -= force * (plus[(i, j)] - minus[(i, j)]) / (2.0 * CURVATURE_STEP);
+                    }
+                }
+            }
+        }
+        let mut curvature = (&curvature + curvature.transpose()) * 0.5;
+        let root: Vec<f64> = stiffness.iter().map(|k| k.sqrt()).collect();
+        let relative = |w: &DMatrix<f64>| DMatrix::from_fn(n, n, |i, j| w[(i, j)] / (root[i] * root[j]));
+        let softest = relative(&curvature).symmetric_eigen().eigenvalues.min().min(0.0);
+        update_poses(model, theta, &mut data);
+        let (_, rows) = self.contact_rows(&data, holds, sides, n);
+        let held: Vec<DVector<f64>> = (0..holds.forces.len())
+            .filter(|&i| holds.forces[i] > 0.0)
+            .map(|i| rows.row(i).transpose())
+            .chain((0..closure_rows.nrows()).map(|i| closure_rows.row(i).transpose()))
+            .filter_map(|row| {
+                let norm = row.norm();
+                (norm > 0.0).then(|| row / norm)
+            })
+            .collect();
+        // The stability: the least λ of (K + W) z = λ K z over the directions z the held
+        // rows leave free (Zᵀ(K + W)Z against ZᵀKZ, by its Cholesky factor).
+        let held_rows = DMatrix::from_fn(held.len(), n, |i, c| held[i][c]);
+        let (_, free) = Self::row_and_null_space(&held_rows, None);
+        let stability = if free.is_empty() {
+            1.0
+        } else {
+            let basis = DMatrix::from_columns(&free);
+            let hessian = &curvature + DMatrix::from_diagonal(&DVector::from_column_slice(stiffness));
+            let reduced = basis.transpose() * hessian * &basis;
+            let weight = basis.transpose() * DMatrix::from_diagonal(&DVector::from_column_slice(stiffness)) * &basis;
+            match weight.cholesky() {
+                Some(factor) => {
+                    let lower = factor.l();
+                    let inverse = lower.clone().try_inverse()?;
+                    (&inverse * reduced * inverse.transpose())
+                        .symmetric_eigen()
+                        .eigenvalues
+                        .min()
+                }
+                None => return None,
+            }
+        };
+        let stiffest = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
+        let across_weight = ACROSS_WEIGHT * (1.0 - softest) * stiffest;
+        for across in &held {
+            curvature += across * across.transpose() * across_weight;
+        }
+        let eigen = relative(&curvature).symmetric_eigen();
+        let clamped = DMatrix::from_diagonal(&eigen.eigenvalues.map(|l| l.max(STABILITY_FLOOR - 1.0)));
+        let clamped = &eigen.eigenvectors * clamped * eigen.eigenvectors.transpose();
+        let curvature = DMatrix::from_fn(n, n, |i, j| clamped[(i, j)] * root[i] * root[j]);
+        curvature
+            .iter()
+            .all(|x| x.is_finite())
+            .then_some((curvature, stability))
+    }
+
     /// JᵀJ's eigenvectors split: (row space with eigenvalues, null space): the null space the
     /// `null_count` smallest when given, else those below the cut. Rounding leaves JᵀJ's zero
     /// eigenvalues near 1e-16 of the largest (not its square), so the cut is well above that:
@@ -871,6 +984,15 @@ impl NetClosing {
         let mut at_floor = 0;
         let mut solves = 0;
         let mut previous_step: Option<DVector<f64>> = None;
+        let mut turned = 0;
+        // The trust box, narrowed where the contacts' rows foretold their last step badly
+        // (their curvature over the step beyond their own move) and widened back as they
+        // foretell it well.
+        let mut trust = SETTLE_DAMPING;
+        // Iterations in a row whose balance was unstable along the contacts.
+        let mut unstable = 0;
+        holds.unstable = false;
+        let mut foretold: Option<(Vec<f64>, Vec<f64>, f64)> = None;
         for _ in 0..CONTACT_ITERATIONS {
             update_poses(model, theta, data);
             let (seam_residual, seam_rows) = self.seam_rows(data, holds, n);
@@ -914,12 +1036,38 @@ impl NetClosing {
                     }
                 }
             }
+            if let Some((expected, moved, length)) = foretold.take() {
+                let slack = CONTACT_SLACK * TOLERANCE * self.size;
+                let (mut miss, mut scale) = (0.0_f64, slack);
+                for i in 0..expected.len() {
+                    if holds.forces[i] > 0.0 || all_gaps[i] <= slack {
+                        miss = miss.max((all_gaps[i] - expected[i]).abs());
+                        scale = scale.max(moved[i].abs());
+                    }
+                }
+                if miss > TRUST_MISS * scale {
+                    trust = TRUST_NARROWING * length;
+                } else if miss < TRUST_MISS * TRUST_NARROWING * scale {
+                    trust = (2.0 * trust).min(SETTLE_DAMPING);
+                }
+            }
             let gaps = DVector::from_iterator(standing.len(), standing.iter().map(|&i| all_gaps[i]));
             let contact_rows = all_rows.select_rows(&standing);
             let offset: Vec<f64> = (0..n).map(|c| theta[c] - drive[c]).collect();
             // A closure far from held (a seam just latched, pulled into line) or a contact
             // met deep is reached in parts when one linearised step cannot reach it past
             // the others: the rows ask for a share α of their residual.
+            let curved = self.contact_curvature(model, theta, stiffness, holds, sides, &closure_rows);
+            unstable = match &curved {
+                Some((_, stability)) if *stability < 0.0 => unstable + 1,
+                _ => 0,
+            };
+            holds.unstable = unstable >= UNSTABLE_ITERATIONS;
+            if holds.unstable {
+                update_poses(model, theta, data);
+                return false;
+            }
+            let curvature = curved.map(|(w, _)| w);
             let mut share = 1.0;
             let solution = loop {
                 let asked_closure = &closure * share;
@@ -936,10 +1084,11 @@ impl NetClosing {
                 }
                 match solve_step(&BalanceStep {
                     stiffness,
+                    curvature: curvature.as_ref(),
                     offset: &offset,
                     closures: (&closure_rows, &asked_closure),
                     contacts: (&contact_rows, &asked_gaps),
-                    trust: SETTLE_DAMPING,
+                    trust,
                     size: self.size,
                 }) {
                     Ok(solution) => break solution,
@@ -956,10 +1105,18 @@ impl NetClosing {
             let back = previous_step
                 .as_ref()
                 .is_some_and(|last: &DVector<f64>| last.dot(&solution.step) < 0.0);
-            let taken = if back { 0.5 } else { 1.0 };
+            // Each further turn back halves again: a wedge of nearly parallel contacts moves
+            // its corner far for a small turn of its rows, and the cycle only narrows.
+            turned = if back { turned + 1 } else { 0 };
+            let taken = 0.5_f64.powi(turned.min(MAX_TURNS) as i32);
             for (angle, step) in theta.iter_mut().zip(solution.step.iter()) {
                 *angle += taken * step;
             }
+            let moved: Vec<f64> = (0..holds.touching.len())
+                .map(|i| taken * all_rows.row(i).dot(&solution.step.transpose()))
+                .collect();
+            let expected = (0..holds.touching.len()).map(|i| all_gaps[i] + moved[i]).collect();
+            foretold = Some((expected, moved, taken * solution.step.amax()));
             previous_step = Some(solution.step.clone());
             // The force on a meeting is its standing row's; the rows it stands for carry none.
             for (i, force) in holds.forces.iter_mut().enumerate() {
@@ -1299,7 +1456,15 @@ impl Run<'_> {
                     turn *= 0.5;
                     continue;
                 }
-                return Err(if settled {
+                return Err(if !settled && holds.unstable {
+                    Stop::Snap(
+                        u,
+                        format!(
+                            "the balance along the contacts turns unstable at progress {u:.9} (time {:.6e} s): the path passes a snap-through",
+                            self.path.time(u)
+                        ),
+                    )
+                } else if settled {
                     Stop::Snap(
                         u,
                         format!(
@@ -1708,5 +1873,87 @@ impl<'a> DrivePath<'a> {
         } else {
             (u + turn / rate).min(next_break)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::commands::nets::{best_net_patterns, net_device, nets, open_solid, NetsOptions};
+
+    /// Every contact feature's row (the gap's derivative in the fold angles that the balance
+    /// and the contacts' curvature are built on) against central differences of its gap,
+    /// on the octahedron's two best nets at random fold angles.
+    #[test]
+    fn every_contact_row_is_its_gaps_derivative() {
+        let (name, solid) = open_solid("octahedron").unwrap();
+        let options = NetsOptions {
+            top: 2,
+            unit_um: 50.0,
+            ..NetsOptions::default()
+        };
+        let report = nets(&name, &solid, &options).unwrap();
+        let mut seed = 2024_u64;
+        let mut uniform = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut checked, mut worst) = (0, 0.0_f64);
+        for (_, made) in best_net_patterns(&solid, &report, 2).unwrap() {
+            let scene = net_device(&made, "octahedron", &options).unwrap();
+            let model = scene.network().unwrap();
+            let closing = NetClosing::new(&made, model).unwrap();
+            let contacts = &closing.contacts;
+            let n = model.stiffness().len();
+            let mut data = NetworkData::new(model);
+            let mut row = DVector::zeros(n);
+            let h = 1e-6;
+            for _ in 0..20 {
+                let theta: Vec<f64> = (0..n).map(|_| 0.2 + 1.6 * uniform()).collect();
+                update_poses(model, &theta, &mut data);
+                let placed = contacts.placed(&data);
+                let shifted = |c: usize, by: f64| {
+                    let mut t = theta.clone();
+                    t[c] += by;
+                    let mut d = NetworkData::new(model);
+                    update_poses(model, &t, &mut d);
+                    contacts.placed(&d)
+                };
+                let around: Vec<(PlacedFaces, PlacedFaces)> = (0..n).map(|c| (shifted(c, h), shifted(c, -h))).collect();
+                for k in 0..contacts.features.len() {
+                    let state = contacts.state(&placed, k);
+                    if !state.distance.is_finite() {
+                        continue;
+                    }
+                    contacts.row(&data, k, &state, &mut row);
+                    // The same side's distance at the shifted angles (an edge pair's
+                    // normal turned back to this one's).
+                    let gap = |at: &PlacedFaces| {
+                        let s = contacts.state(at, k);
+                        if s.normal.dot(&state.normal) < 0.0 {
+                            -s.distance
+                        } else {
+                            s.distance
+                        }
+                    };
+                    for (c, (plus, minus)) in around.iter().enumerate() {
+                        let difference = (gap(plus) - gap(minus)) / (2.0 * h);
+                        // The rows are of the order of the faces' size (m/rad); differences
+                        // lose about 1e-16 · size / h to rounding.
+                        let error = (row[c] - difference).abs() / model.size();
+                        worst = worst.max(error);
+                        assert!(
+                            error <= 1e-7,
+                            "feature {k} {:?} column {c}: row {:e}, differences {difference:e}",
+                            contacts.features[k],
+                            row[c]
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        eprintln!("{checked} derivatives checked (worst {worst:e})");
+        assert!(checked > 10_000, "{checked} derivatives checked (worst {worst:e})");
     }
 }
