@@ -383,6 +383,29 @@ struct Holds {
     blocked: Vec<bool>,
     /// Whether the last balance given up was unstable along its contacts (a snap-through).
     unstable: bool,
+    /// Why the last balance with contacts was given up.
+    failure: Option<SettleFailure>,
+}
+
+/// Why a balance with contacts was given up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SettleFailure {
+    /// Its QP solves ran out (this balance's or the run's).
+    Solves,
+    /// No share of the rows' residuals gave a QP step (the linearised rows cannot all hold).
+    NoStep,
+    /// Its iterations ran out with steps still above the floor.
+    Iterations,
+}
+
+impl SettleFailure {
+    fn describe(self) -> &'static str {
+        match self {
+            SettleFailure::Solves => "its QP solves ran out",
+            SettleFailure::NoStep => "the linearised closures and contacts cannot all hold",
+            SettleFailure::Iterations => "its steps did not settle",
+        }
+    }
 }
 
 impl Holds {
@@ -391,6 +414,7 @@ impl Holds {
             state: vec![SeamState::Open; seams],
             blocked: vec![false; seams],
             unstable: false,
+            failure: None,
             latched: Vec::new(),
             touching: Vec::new(),
             forces: Vec::new(),
@@ -992,6 +1016,7 @@ impl NetClosing {
         // Iterations in a row whose balance was unstable along the contacts.
         let mut unstable = 0;
         holds.unstable = false;
+        holds.failure = None;
         let mut foretold: Option<(Vec<f64>, Vec<f64>, f64)> = None;
         for _ in 0..CONTACT_ITERATIONS {
             update_poses(model, theta, data);
@@ -1080,6 +1105,7 @@ impl NetClosing {
                 solves += 1;
                 sides.solves.set(sides.solves.get() + 1);
                 if solves > SETTLE_SOLVES || sides.solves.get() > RUN_SOLVES {
+                    holds.failure = Some(SettleFailure::Solves);
                     return false;
                 }
                 match solve_step(&BalanceStep {
@@ -1095,6 +1121,7 @@ impl NetClosing {
                     Err(_) => {
                         share *= 0.5;
                         if share < MIN_SHARE {
+                            holds.failure = Some(SettleFailure::NoStep);
                             return false;
                         }
                     }
@@ -1153,6 +1180,7 @@ impl NetClosing {
                 at_floor = 0;
             }
         }
+        holds.failure = Some(SettleFailure::Iterations);
         update_poses(model, theta, data);
         false
     }
@@ -1472,7 +1500,7 @@ impl Run<'_> {
                         ),
                     )
                 } else {
-                    self.no_balance(next)
+                    self.no_balance(next, holds.failure)
                 });
             }
             // A pair out of reach must not come to touch in one step unseen: shorten the step
@@ -1636,7 +1664,7 @@ impl Run<'_> {
         });
     }
 
-    fn no_balance(&self, u: f64) -> Stop {
+    fn no_balance(&self, u: f64, failure: Option<SettleFailure>) -> Stop {
         if self.sides.solves.get() > RUN_SOLVES {
             return Stop::NoBalance(
                 u,
@@ -1650,9 +1678,10 @@ impl Run<'_> {
         Stop::NoBalance(
             u,
             format!(
-                "no balance holds the {} latched seams and {} contacts at progress {u:.9}",
+                "no balance holds the {} latched seams and {} contacts at progress {u:.9}{}",
                 self.holds.latched.len(),
-                self.holds.touching.len()
+                self.holds.touching.len(),
+                failure.map_or(String::new(), |f| format!(" ({})", f.describe()))
             ),
         )
     }
@@ -1672,7 +1701,7 @@ impl Run<'_> {
         ) {
             Ok(())
         } else {
-            Err(self.no_balance(u))
+            Err(self.no_balance(u, self.holds.failure))
         }
     }
 
