@@ -1050,8 +1050,11 @@ impl NetClosing {
                 let same = standing.iter().position(|&j| {
                     let other = self.contacts.features[holds.touching[j]].faces();
                     let other_row = all_rows.row(j);
-                    (other == faces || other == [faces[1], faces[0]])
-                        && other_row.dot(&row).abs() >= (1.0 - PARALLEL_ROWS) * other_row.norm() * row.norm()
+                    let alike = other_row.dot(&row);
+                    let parallel = alike.abs() >= (1.0 - PARALLEL_ROWS) * other_row.norm() * row.norm();
+                    // Of one pair of faces, parallel rows either way; of two pairs, rows
+                    // the same way (one face's edge met by two faces sharing it).
+                    parallel && ((other == faces || other == [faces[1], faces[0]]) || alike > 0.0)
                 });
                 match same {
                     Some(s) => stands_for[i] = s,
@@ -1118,7 +1121,10 @@ impl NetClosing {
                     size: self.size,
                 }) {
                     Ok(solution) => break solution,
-                    Err(_) => {
+                    Err(e) => {
+                        if std::env::var("NF_DEBUG").is_ok() {
+                            eprintln!("share {share}: {e}");
+                        }
                         share *= 0.5;
                         if share < MIN_SHARE {
                             holds.failure = Some(SettleFailure::NoStep);

@@ -51,10 +51,9 @@ pub struct BalanceSolution {
     pub at_trust: bool,
 }
 
-/// Solves one step: first directly, every contact row held as an equality (the active set
-/// the step began with), kept only if its forces come out non-negative and its step inside
-/// the trust box: then it satisfies all the QP's optimality conditions and, the energy
-/// being strictly convex, is the QP's one solution. Otherwise with Clarabel; a status other
+/// Solves one step: first directly by active sets ([`held_step`]: the rows held as
+/// equalities have non-negative forces and the others hold), which satisfies all the QP's
+/// optimality conditions and, the energy being strictly convex, is the QP's one solution. Otherwise with Clarabel; a status other
 /// than solved (or almost solved) is an error naming it.
 pub fn solve_step(step: &BalanceStep) -> Result<BalanceSolution> {
     match held_step(step) {
@@ -69,11 +68,12 @@ const HELD_RIDGE: f64 = 1e-13;
 const HELD_RESIDUAL: f64 = 1e-9;
 
 /// The step by active sets: the closures and a set of contacts held as equalities (with
-/// A = [E; G_held], b = [−e; −g_held], K d + c = Aᵀy gives A K⁻¹ Aᵀ y = b + A K⁻¹ c, K
-/// diagonal, c = K (θ − r)); a held contact pulling (y < 0) is let go, a free one crossed
+/// A = [E; G_held], b = [−e; −g_held], H d + c = Aᵀy gives A H⁻¹ Aᵀ y = b + A H⁻¹ c,
+/// H = K + W, c = K (θ − r)); a held contact pulling (y < 0) is let go, a free one crossed
 /// (G d < −g) is held, until neither: then every optimality condition of the QP holds and,
-/// the energy being strictly convex, d is its one solution. `None` when that takes more
-/// than a few rounds, the rows cannot all hold, or the step leaves the trust box.
+/// the energy being strictly convex, d is its one solution. The trust box's faces are rows
+/// like the contacts'. `None` when that takes more than a few rounds or the rows cannot
+/// all hold.
 pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
     let n = step.stiffness.len();
     let (e_rows, e_values) = step.closures;
@@ -117,10 +117,20 @@ pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
     };
     let sigma = step_scale(step);
     let bound = step.trust.min(SCALED_TRUST * sigma);
+    // The trust box's faces as rows after the contacts: ±d_c ≥ −bound.
+    let m = m + 2 * n;
+    let mut a = a.resize_vertically(m, 0.0);
+    let mut b = b.resize_vertically(m, 0.0);
+    for c in 0..n {
+        a[(m_e + m_g + c, c)] = 1.0;
+        a[(m_e + m_g + n + c, c)] = -1.0;
+        b[m_e + m_g + c] = -bound;
+        b[m_e + m_g + n + c] = -bound;
+    }
     // From the closures alone: contacts join as they are crossed (starting from all of
     // them held would ask rows the seams already fix to hold at their slack too).
     let mut held: Vec<usize> = (0..m_e).collect();
-    for _ in 0..=2 * m_g + 1 {
+    for _ in 0..=2 * (m_g + 2 * n) + 1 {
         let k = held.len();
         let mut schur = DMatrix::zeros(k, k);
         for (p, &i) in held.iter().enumerate() {
@@ -177,9 +187,7 @@ pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
             held.push(i);
             continue;
         }
-        if d.amax() >= bound * (1.0 - 1e-9) {
-            return None;
-        }
+        let at_trust = held.iter().any(|&i| i >= m_e + m_g);
         let mut forces = DVector::zeros(m_g);
         let mut closure_multipliers = DVector::zeros(m_e);
         for (p, &i) in held.iter().enumerate() {
@@ -187,7 +195,7 @@ pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
             // and the closures' multipliers are reported as μ = −y_E.
             if i < m_e {
                 closure_multipliers[i] = -y[p] / scale[i];
-            } else {
+            } else if i < m_e + m_g {
                 forces[i - m_e] = y[p] / scale[i];
             }
         }
@@ -195,7 +203,7 @@ pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
             step: d,
             forces,
             closure_multipliers,
-            at_trust: false,
+            at_trust,
         });
     }
     None
@@ -402,7 +410,8 @@ mod tests {
     }
 
     /// The held-rows step against Clarabel on random steps (5 hinges, a closure row, three
-    /// contacts, every other one with a curvature W): wherever the direct path accepts, the two agree on the step, the forces
+    /// contacts, every other one with a curvature W, half in a trust box the step reaches):
+    /// wherever the direct path accepts, the two agree on the step, the forces
     /// and the closure multipliers.
     #[test]
     fn the_held_rows_step_is_clarabels_step_where_it_is_taken() {
@@ -411,7 +420,7 @@ mod tests {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let (mut taken, mut refused, mut pressing, mut free, mut curved) = (0, 0, 0, 0, 0);
+        let (mut taken, mut refused, mut pressing, mut free, mut curved, mut boxed) = (0, 0, 0, 0, 0, 0);
         for trial in 0..400 {
             let n = 5;
             let stiffness: Vec<f64> = (0..n).map(|_| 1e-9 * (0.5 + uniform())).collect();
@@ -432,7 +441,8 @@ mod tests {
                 offset: &offset,
                 closures: (&e, &e_values),
                 contacts: (&g, &g_values),
-                trust: 1.0,
+                // Every other pair of steps in a box the free step leaves.
+                trust: if trial % 4 >= 2 { 0.03 } else { 1.0 },
                 size: 1e-4,
             };
             let Some(held) = held_step(&step) else {
@@ -441,6 +451,7 @@ mod tests {
             };
             taken += 1;
             curved += trial % 2;
+            boxed += usize::from(held.at_trust);
             pressing += held.forces.iter().filter(|&&f| f > 0.0).count();
             free += held.forces.iter().filter(|&&f| f == 0.0).count();
             let clarabel = solve_step_with_clarabel(&step).unwrap();
@@ -470,8 +481,8 @@ mod tests {
         }
         // Both kinds of contact are met, and the direct path answers nearly every step.
         assert!(
-            taken > 300 && curved > 150 && pressing > 100 && free > 100,
-            "taken {taken} ({curved} curved), refused {refused}; {pressing} pressing, {free} free"
+            taken > 300 && curved > 150 && boxed > 50 && pressing > 100 && free > 100,
+            "taken {taken} ({curved} curved, {boxed} at the box), refused {refused}; {pressing} pressing, {free} free"
         );
     }
 }
