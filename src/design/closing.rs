@@ -1121,10 +1121,7 @@ impl NetClosing {
                     size: self.size,
                 }) {
                     Ok(solution) => break solution,
-                    Err(e) => {
-                        if std::env::var("NF_DEBUG").is_ok() {
-                            eprintln!("share {share}: {e}");
-                        }
+                    Err(_) => {
                         share *= 0.5;
                         if share < MIN_SHARE {
                             holds.failure = Some(SettleFailure::NoStep);
