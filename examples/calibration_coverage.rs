@@ -13,6 +13,8 @@ use nanofold::read::measurement::{MeasuredColumn, Observed};
 use nanofold::read::SceneDocument;
 use std::time::Instant;
 
+#[path = "common/marks.rs"]
+mod marks;
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;

@@ -12,12 +12,15 @@ use nanofold::calibrate::{fit, resolve, with_values, FitReport, FitSettings, Fre
 use nanofold::dynamics::points::PanelPoints;
 use nanofold::dynamics::sensitivity::trajectory_sensitivities;
 use nanofold::dynamics::Method;
-use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
+use nanofold::read::measurement::Measurement;
 use nanofold::read::SceneDocument;
 use std::time::Instant;
 
+#[path = "common/marks.rs"]
+mod marks;
 #[path = "common/normal.rs"]
 mod normal;
+use marks::centre_columns;
 use normal::Normal;
 
 type Failure = Box<dyn std::error::Error>;
@@ -43,37 +46,13 @@ fn tracked(
     let times: Vec<f64> = (1..=100).map(|k| 5e-4 * k as f64 / 100.0).collect();
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
     let model = scene.network().ok_or("a network")?;
-    let unit = model.unit * 1e6;
-    let vertices = model.folding.pattern.file_vertices();
     let mut points = PanelPoints::new(&scene)?;
     let mut normal = Normal(7);
     let mut columns = Vec::new();
     for &face in faces {
-        let corners = &model.folding.pattern.faces[face];
-        let share = 1.0 / corners.len() as f64;
-        let centre = corners.iter().fold([0.0, 0.0], |c, &v| {
-            [
-                c[0] + vertices[v][0] * unit * share,
-                c[1] + vertices[v][1] * unit * share,
-            ]
-        });
-        let panel = points.panel(face)?;
-        for (axis, letter) in ["x", "y", "z"].iter().enumerate() {
-            let values = run
-                .angles
-                .iter()
-                .map(|a| Some(points.position(a.as_slice(), panel, centre)[axis] + 0.5 * normal.sample()))
-                .collect();
-            columns.push(MeasuredColumn {
-                name: format!("panel_{face}_{:.3}_{:.3}_{letter}_um", centre[0], centre[1]),
-                observed: Observed::Point {
-                    panel: face,
-                    at: centre,
-                    axis,
-                },
-                values,
-            });
-        }
+        columns.extend(centre_columns(model, &mut points, face, &run.angles, || {
+            0.5 * normal.sample()
+        })?);
     }
     Ok(Measurement {
         source: "tracked (synthetic)".into(),

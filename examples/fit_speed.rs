@@ -16,6 +16,8 @@ use nanofold::read::measurement::Measurement;
 use nanofold::read::SceneDocument;
 use std::time::Instant;
 
+#[path = "common/marks.rs"]
+mod marks;
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;

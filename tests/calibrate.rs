@@ -7,6 +7,8 @@ use nanofold::dynamics::Method;
 use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
 use nanofold::read::SceneDocument;
 
+#[path = "../examples/common/marks.rs"]
+mod marks;
 #[path = "../examples/common/normal.rs"]
 mod normal;
 use normal::Normal as Noise;

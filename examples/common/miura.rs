@@ -10,6 +10,7 @@ use nanofold::dynamics::Method;
 use nanofold::read::measurement::{MeasuredColumn, Measurement, Observed};
 use nanofold::read::SceneDocument;
 
+use super::marks::centre_columns;
 use super::normal::Normal;
 
 type Failure = Box<dyn std::error::Error>;
@@ -68,9 +69,8 @@ pub fn exact_columns(document: &SceneDocument, angles: bool) -> Result<(Vec<f64>
     let times: Vec<f64> = (1..=100).map(|k| 5e-4 * k as f64 / 100.0).collect();
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
     let model = scene.network().ok_or("the sheet is a network")?;
-    let unit = model.unit * 1e6;
     // Marks are drawn in the file's coordinates times the unit, as the calibration guide says.
-    let (faces, vertices) = (&model.folding.pattern.faces, model.folding.pattern.file_vertices());
+    let faces = &model.folding.pattern.faces;
     let mut points = PanelPoints::new(&scene)?;
     let mut columns = Vec::new();
     let edges = scene.output_edges().ok_or("a pattern's creases")?.to_vec();
@@ -84,28 +84,8 @@ pub fn exact_columns(document: &SceneDocument, angles: bool) -> Result<(Vec<f64>
         columns.push((MeasuredColumn { name, observed, values }, 0.5));
     }
     for face in [faces.len() / 2 + 1, faces.len() - 1] {
-        let corners = &faces[face];
-        let share = 1.0 / corners.len() as f64;
-        let centre = corners.iter().fold([0.0, 0.0], |c, &v| {
-            [
-                c[0] + vertices[v][0] * unit * share,
-                c[1] + vertices[v][1] * unit * share,
-            ]
-        });
-        let panel = points.panel(face)?;
-        for (axis, letter) in ["x", "y", "z"].iter().enumerate() {
-            let values = run
-                .angles
-                .iter()
-                .map(|a| Some(points.position(a.as_slice(), panel, centre)[axis]))
-                .collect();
-            let name = format!("panel_{face}_{}_{}_{letter}_um", centre[0], centre[1]);
-            let observed = Observed::Point {
-                panel: face,
-                at: centre,
-                axis,
-            };
-            columns.push((MeasuredColumn { name, observed, values }, 0.5));
+        for column in centre_columns(model, &mut points, face, &run.angles, || 0.0)? {
+            columns.push((column, 0.5));
         }
     }
     Ok((run.times.clone(), columns))
@@ -139,33 +119,11 @@ pub fn marks_study(
     let times: Vec<f64> = (1..=samples).map(|k| t_end * k as f64 / samples as f64).collect();
     let run = trajectory_sensitivities(&scene, &[], SENSITIVITY_STEP, &times, Method::Auto, 1e-10)?;
     let model = scene.network().ok_or("the sheet is a network")?;
-    let unit = model.unit * 1e6;
-    let vertices = model.folding.pattern.file_vertices();
     let mut points = PanelPoints::new(&scene)?;
     let mut columns = Vec::new();
     for &face in faces {
-        let corners = &model.folding.pattern.faces[face];
-        let share = 1.0 / corners.len() as f64;
-        let centre = corners.iter().fold([0.0, 0.0], |c, &v| {
-            [
-                c[0] + vertices[v][0] * unit * share,
-                c[1] + vertices[v][1] * unit * share,
-            ]
-        });
-        let panel = points.panel(face)?;
-        for (axis, letter) in ["x", "y", "z"].iter().enumerate() {
-            let values = run
-                .angles
-                .iter()
-                .map(|a| Some(points.position(a.as_slice(), panel, centre)[axis]))
-                .collect();
-            let name = format!("panel_{face}_{:.3}_{:.3}_{letter}_um", centre[0], centre[1]);
-            let observed = Observed::Point {
-                panel: face,
-                at: centre,
-                axis,
-            };
-            columns.push((MeasuredColumn { name, observed, values }, 0.5));
+        for column in centre_columns(model, &mut points, face, &run.angles, || 0.0)? {
+            columns.push((column, 0.5));
         }
     }
     Ok((document, free, run.times.clone(), columns))

@@ -121,16 +121,13 @@ pub fn states_fold(
         .map(|(title, fold_angles)| {
             panel_poses(model, fold_angles, &mut poses);
             let (angles, letters) = edge_arrays(pattern, fold_angles);
-            json!({
-                "frame_title": title,
-                "frame_classes": ["foldedForm"],
-                "frame_attributes": ["3D"],
-                "frame_parent": 0,
-                "frame_inherit": true,
-                "vertices_coords": vertex_positions(model, &poses).into_iter().map(|p| pattern.file_point_3d(p)).collect::<Vec<_>>(),
-                "edges_assignment": letters,
-                "edges_foldAngle": angles,
-            })
+            let coords: Vec<_> = vertex_positions(model, &poses)
+                .into_iter()
+                .map(|p| pattern.file_point_3d(p))
+                .collect();
+            let mut frame = inheriting_frame(title, json!(coords), json!(angles));
+            frame["edges_assignment"] = json!(letters);
+            frame
         })
         .collect();
     root["file_frames"] = json!(frames);
@@ -220,20 +217,27 @@ pub fn network_states_fold(model: &NetworkModel, frames: &[(String, &[f64])], de
                 })
                 .collect();
             let (angles, letters) = edge_arrays(pattern, fold_angles);
-            json!({
-                "frame_title": title,
-                "frame_classes": ["foldedForm"],
-                "frame_attributes": ["3D"],
-                "frame_parent": 0,
-                "frame_inherit": true,
-                "vertices_coords": coords,
-                "edges_assignment": letters,
-                "edges_foldAngle": angles,
-            })
+            let mut frame = inheriting_frame(title, json!(coords), json!(angles));
+            frame["edges_assignment"] = json!(letters);
+            frame
         })
         .collect();
     root["file_frames"] = json!(frames);
     root
+}
+
+/// A folded frame of a FOLD animation that inherits the key frame's edges and faces: its
+/// title, placed vertices and fold angles (degrees).
+fn inheriting_frame(title: &str, coords: Value, fold_angles_deg: Value) -> Value {
+    json!({
+        "frame_title": title,
+        "frame_classes": ["foldedForm"],
+        "frame_attributes": ["3D"],
+        "frame_parent": 0,
+        "frame_inherit": true,
+        "vertices_coords": coords,
+        "edges_foldAngle": fold_angles_deg,
+    })
 }
 
 /// Most frames of a motion animation.
@@ -435,15 +439,7 @@ fn plates_states_fold(
         .skip(1)
         .map(|(title, angles)| {
             let (coords, degrees) = frame(angles, points);
-            json!({
-                "frame_title": title,
-                "frame_classes": ["foldedForm"],
-                "frame_attributes": ["3D"],
-                "frame_parent": 0,
-                "frame_inherit": true,
-                "vertices_coords": coords,
-                "edges_foldAngle": degrees,
-            })
+            inheriting_frame(title, json!(coords), json!(degrees))
         })
         .collect();
     if !frames.is_empty() {
