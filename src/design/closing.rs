@@ -1043,7 +1043,12 @@ impl NetClosing {
             let mut standing: Vec<usize> = Vec::new();
             let mut stands_for = vec![usize::MAX; holds.touching.len()];
             let mut order: Vec<usize> = (0..holds.touching.len()).collect();
-            order.sort_by(|&a, &b| all_gaps[a].total_cmp(&all_gaps[b]));
+            // Deepest by the turn it asks (its gap over its row's size): of parallel rows the
+            // same way, holding that one holds the rest to first order.
+            let turn: Vec<f64> = (0..holds.touching.len())
+                .map(|i| all_gaps[i] / all_rows.row(i).norm().max(f64::MIN_POSITIVE))
+                .collect();
+            order.sort_by(|&a, &b| turn[a].total_cmp(&turn[b]));
             for i in order {
                 let faces = self.contacts.features[holds.touching[i]].faces();
                 let row = all_rows.row(i);
@@ -1893,7 +1898,9 @@ impl<'a> DrivePath<'a> {
             .unwrap_or(1.0)
             .min(1.0);
         let rate = if self.duration > 0.0 {
-            let t = u * self.duration;
+            // The rates hold between breaks: read them inside the stretch, not at its start
+            // (a ramp starting exactly there reads zero, rounded a hair before it).
+            let t = 0.5 * (u + next_break) * self.duration;
             (0..self.forcing.hinges.len())
                 .map(|i| (self.forcing.drive_rate(i, t) * self.duration).abs())
                 .fold(0.0, f64::max)
