@@ -1176,7 +1176,9 @@ impl<'a> DrivePath<'a> {
             .unwrap_or(1.0)
             .min(1.0);
         let rate = if self.duration > 0.0 {
-            let t = u * self.duration;
+            // The rates hold between breaks: read them inside the stretch, not at its start
+            // (a ramp starting exactly there reads zero, rounded a hair before it).
+            let t = 0.5 * (u + next_break) * self.duration;
             (0..self.forcing.hinges.len())
                 .map(|i| (self.forcing.drive_rate(i, t) * self.duration).abs())
                 .fold(0.0, f64::max)
@@ -1188,5 +1190,58 @@ impl<'a> DrivePath<'a> {
         } else {
             (u + turn / rate).min(next_break)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::forcing::{Actuation, HingeDrive};
+
+    /// Walking a ramp's path with [`DrivePath::next`], no drive turns more than the asked
+    /// turn in one step, wherever a hinge's ramp starts: a ramp released at a break must not
+    /// be stepped over whole (its rate read at the break's start rounds to before the
+    /// release). Release times swept over a decade; the drives' own change is the check.
+    #[test]
+    fn no_step_of_a_ramps_path_turns_a_drive_more_than_asked() {
+        let turn = 0.5_f64.to_radians();
+        let mut checked = 0;
+        for k in 1..=200 {
+            let release = 0.013 * k as f64;
+            let forcing = Forcing {
+                actuation: Actuation::Ramp { etch_rate: 1e-6 },
+                hinges: vec![
+                    HingeDrive {
+                        target: 1.2,
+                        radius_of_curvature: 1e-6 * release / 1.2,
+                        actuated: true,
+                        release_time: 0.0,
+                    },
+                    HingeDrive {
+                        target: -1.5,
+                        radius_of_curvature: 2e-6,
+                        actuated: true,
+                        release_time: release,
+                    },
+                ],
+            };
+            let path = DrivePath::new(&forcing);
+            let (mut before, mut after) = (vec![0.0; 2], vec![0.0; 2]);
+            let mut u = 0.0;
+            while u < 1.0 {
+                let next = path.next(u, turn);
+                assert!(next > u, "release {release} s: the path stops at {u}");
+                path.drive(u, &mut before);
+                path.drive(next, &mut after);
+                let moved = (0..2).map(|i| (after[i] - before[i]).abs()).fold(0.0, f64::max);
+                assert!(
+                    moved <= turn * (1.0 + 1e-9),
+                    "release {release} s: from progress {u} to {next} a drive turns {moved} rad"
+                );
+                u = next;
+                checked += 1;
+            }
+        }
+        assert!(checked > 10_000, "{checked} steps");
     }
 }
