@@ -1919,6 +1919,7 @@ impl<'a> DrivePath<'a> {
 mod tests {
     use super::*;
     use crate::commands::nets::{best_net_patterns, net_device, nets, open_solid, NetsOptions};
+    use crate::dynamics::forcing::{Actuation, HingeDrive};
 
     /// Every contact feature's row (the gap's derivative in the fold angles that the balance
     /// and the contacts' curvature are built on) against central differences of its gap,
@@ -1994,5 +1995,52 @@ mod tests {
         }
         eprintln!("{checked} derivatives checked (worst {worst:e})");
         assert!(checked > 10_000, "{checked} derivatives checked (worst {worst:e})");
+    }
+
+    /// Walking a ramp's path with [`DrivePath::next`], no drive turns more than the asked
+    /// turn in one step, wherever a hinge's ramp starts: a ramp released at a break must not
+    /// be stepped over whole (its rate read at the break's start rounds to before the
+    /// release). Release times swept over a decade; the drives' own change is the check.
+    #[test]
+    fn no_step_of_a_ramps_path_turns_a_drive_more_than_asked() {
+        let turn = 0.5_f64.to_radians();
+        let mut checked = 0;
+        for k in 1..=200 {
+            let release = 0.013 * k as f64;
+            let forcing = Forcing {
+                actuation: Actuation::Ramp { etch_rate: 1e-6 },
+                hinges: vec![
+                    HingeDrive {
+                        target: 1.2,
+                        radius_of_curvature: 1e-6 * release / 1.2,
+                        actuated: true,
+                        release_time: 0.0,
+                    },
+                    HingeDrive {
+                        target: -1.5,
+                        radius_of_curvature: 2e-6,
+                        actuated: true,
+                        release_time: release,
+                    },
+                ],
+            };
+            let path = DrivePath::new(&forcing);
+            let (mut before, mut after) = (vec![0.0; 2], vec![0.0; 2]);
+            let mut u = 0.0;
+            while u < 1.0 {
+                let next = path.next(u, turn);
+                assert!(next > u, "release {release} s: the path stops at {u}");
+                path.drive(u, &mut before);
+                path.drive(next, &mut after);
+                let moved = (0..2).map(|i| (after[i] - before[i]).abs()).fold(0.0, f64::max);
+                assert!(
+                    moved <= turn * (1.0 + 1e-9),
+                    "release {release} s: from progress {u} to {next} a drive turns {moved} rad"
+                );
+                u = next;
+                checked += 1;
+            }
+        }
+        assert!(checked > 10_000, "{checked} steps");
     }
 }
