@@ -8,7 +8,7 @@ fn main() {
     let (name, solid) = open_solid(shape).unwrap();
     let options = NetsOptions {
         top: rank,
-        simulate: rank,
+        simulate: 0,
         fronts: 16,
         yield_samples: 50,
         unit_um: 50.0,

@@ -56,7 +56,11 @@ const SETTLE_SOLVES: usize = 300;
 /// A run's QP solves in all: past these (a balance creeping along a contact at the rounding
 /// floor) it stops as undecided, so a study's time is bounded (about 0.5 s a run).
 const RUN_SOLVES: usize = 50_000;
-const CONTACT_STEP: f64 = 1e-12;
+/// A balance along contacts has converged once its step is below this (rad: a point moved
+/// by 1e-10 of the size, a tenth of the contact slack; the hinge torques then balance to
+/// about 1e-9 of a torque a drive asks). The held step's own rounding leaves steps near
+/// 1e-11, so a stricter bound would only count iterations at that floor.
+const CONTACT_STEP: f64 = 1e-10;
 /// A balance whose steps stay below this (rad, a point moved by about 1e-8 of the size) for
 /// [`FLOOR_ITERATIONS`] in a row has reached its rounding floor: contacts that nearly
 /// oppose (a face pinched between two) carry forces whose rows cancel, and the step
@@ -91,6 +95,8 @@ const UNSTABLE_ITERATIONS: usize = 3;
 const TRUST_MISS: f64 = 0.5;
 const TRUST_NARROWING: f64 = 0.25;
 /// Steps turning back on the last, in a row, that halve the step taken again.
+/// A step at most this share of the last is converging, not turning back.
+const CONVERGING: f64 = 0.1;
 const MAX_TURNS: usize = 30;
 /// Rounds of contacts and latches at one instant before the run says it cannot settle.
 const RESOLVE_ROUNDS: usize = 50;
@@ -873,6 +879,7 @@ impl NetClosing {
     /// is returned with enough of each held row's square added that K + W is positive
     /// across the rows (which leaves a held row's step unchanged), and clamped to K + W ≥
     /// [`STABILITY_FLOOR`] K.
+    #[allow(clippy::too_many_arguments)]
     fn contact_curvature(
         &self,
         model: &NetworkModel,
@@ -880,6 +887,7 @@ impl NetClosing {
         stiffness: &[f64],
         holds: &Holds,
         sides: &Sides,
+        rows: &DMatrix<f64>,
         closure_rows: &DMatrix<f64>,
     ) -> Option<(DMatrix<f64>, f64)> {
         if holds.forces.iter().all(|&f| f <= 0.0) {
@@ -889,19 +897,38 @@ impl NetClosing {
         let mut curvature = DMatrix::zeros(n, n);
         let mut data = NetworkData::new(model);
         let mut shifted = theta.to_vec();
-        for c in 0..n {
+        // Only the pushing contacts weigh in, and only the angles that move their faces.
+        let pushing: Vec<usize> = (0..holds.forces.len()).filter(|&i| holds.forces[i] > 0.0).collect();
+        let mut moving = vec![false; n];
+        for &i in &pushing {
+            for face in self.contacts.features[holds.touching[i]].faces() {
+                for &c in &self.paths[self.contacts.face_panel[face]] {
+                    moving[c] = true;
+                }
+            }
+        }
+        let mut rows_at = |shifted: &[f64], out: &mut DMatrix<f64>| {
+            update_poses(model, shifted, &mut data);
+            let placed = self.contacts.placed(&data);
+            let mut row = DVector::zeros(n);
+            for (p, &i) in pushing.iter().enumerate() {
+                let k = holds.touching[i];
+                let state = sides.state(&self.contacts, &placed, k);
+                self.contacts.row(&data, k, &state, &mut row);
+                out.row_mut(p).copy_from(&row.transpose());
+            }
+        };
+        let (mut plus, mut minus) = (DMatrix::zeros(pushing.len(), n), DMatrix::zeros(pushing.len(), n));
+        for c in (0..n).filter(|&c| moving[c]) {
             shifted[c] = theta[c] + CURVATURE_STEP;
-            update_poses(model, &shifted, &mut data);
-            let (_, plus) = self.contact_rows(&data, holds, sides, n);
+            rows_at(&shifted, &mut plus);
             shifted[c] = theta[c] - CURVATURE_STEP;
-            update_poses(model, &shifted, &mut data);
-            let (_, minus) = self.contact_rows(&data, holds, sides, n);
+            rows_at(&shifted, &mut minus);
             shifted[c] = theta[c];
-            for (i, &force) in holds.forces.iter().enumerate() {
-                if force > 0.0 {
-                    for j in 0..n {
-                        curvature[(j, c)] -= force * (plus[(i, j)] - minus[(i, j)]) / (2.0 * CURVATURE_STEP);
-                    }
+            for (p, &i) in pushing.iter().enumerate() {
+                let force = holds.forces[i];
+                for j in 0..n {
+                    curvature[(j, c)] -= force * (plus[(p, j)] - minus[(p, j)]) / (2.0 * CURVATURE_STEP);
                 }
             }
         }
@@ -909,8 +936,6 @@ impl NetClosing {
         let root: Vec<f64> = stiffness.iter().map(|k| k.sqrt()).collect();
         let relative = |w: &DMatrix<f64>| DMatrix::from_fn(n, n, |i, j| w[(i, j)] / (root[i] * root[j]));
         let softest = relative(&curvature).symmetric_eigen().eigenvalues.min().min(0.0);
-        update_poses(model, theta, &mut data);
-        let (_, rows) = self.contact_rows(&data, holds, sides, n);
         let held: Vec<DVector<f64>> = (0..holds.forces.len())
             .filter(|&i| holds.forces[i] > 0.0)
             .map(|i| rows.row(i).transpose())
@@ -1090,7 +1115,7 @@ impl NetClosing {
             // A closure far from held (a seam just latched, pulled into line) or a contact
             // met deep is reached in parts when one linearised step cannot reach it past
             // the others: the rows ask for a share α of their residual.
-            let curved = self.contact_curvature(model, theta, stiffness, holds, sides, &closure_rows);
+            let curved = self.contact_curvature(model, theta, stiffness, holds, sides, &all_rows, &closure_rows);
             unstable = match &curved {
                 Some((_, stability)) if *stability < 0.0 => unstable + 1,
                 _ => 0,
@@ -1137,9 +1162,11 @@ impl NetClosing {
             };
             // A step that turns back on the last (contacts that nearly oppose, each
             // linearisation overshooting the other's) is taken by half: the two-cycle closes.
-            let back = previous_step
-                .as_ref()
-                .is_some_and(|last: &DVector<f64>| last.dot(&solution.step) < 0.0);
+            // A step far shorter than the last is converging (a Newton correction may point
+            // back), not cycling.
+            let back = previous_step.as_ref().is_some_and(|last: &DVector<f64>| {
+                last.dot(&solution.step) < 0.0 && solution.step.amax() > CONVERGING * last.amax()
+            });
             // Each further turn back halves again: a wedge of nearly parallel contacts moves
             // its corner far for a small turn of its rows, and the cycle only narrows.
             turned = if back { turned + 1 } else { 0 };
@@ -1287,6 +1314,7 @@ impl NetClosing {
             sides: Sides::new(&self.contacts, TOLERANCE * self.size),
             raw: vec![None; self.contacts.features.len()],
             holds: Holds::new(self.seams.len()),
+            previous: None,
             report: ClosingReport {
                 outcome: Outcome::Stalls,
                 time_s: 0.0,
@@ -1445,6 +1473,9 @@ struct Run<'a> {
     holds: Holds,
     /// Each feature's raw state at the poses last tested for events, if read there.
     raw: Vec<Option<FeatureState>>,
+    /// The progress and angles one step back along the same holds (none past an event):
+    /// the path's secant from it starts the next balance.
+    previous: Option<(f64, Vec<f64>)>,
     report: ClosingReport,
 }
 
@@ -1459,9 +1490,24 @@ impl Run<'_> {
         let mut turn = MAX_STEP;
         let (mut last_event, mut repeats) = (f64::NEG_INFINITY, 0);
         let mut unsettled = 0;
+        let mut unpredicted = false;
         while u < 1.0 {
             let next = self.path.next(u, turn);
             let mut trial = self.theta.clone();
+            // Along contacts, from the path's secant: the balance then starts a step's
+            // curvature away, not its slope. A start so predicted that does not settle, or
+            // settles far off, is tried again from the last balance before anything else.
+            let predicted = match self.previous.as_ref() {
+                Some((before, angles)) if !self.holds.touching.is_empty() && !unpredicted => {
+                    let ahead = (next - u) / (u - before);
+                    for c in 0..trial.len() {
+                        trial[c] += ahead * (self.theta[c] - angles[c]);
+                    }
+                    true
+                }
+                _ => false,
+            };
+            unpredicted = false;
             let mut holds = self.holds.clone();
             self.path.drive(u, &mut self.drive);
             let before = self.drive.clone();
@@ -1483,6 +1529,10 @@ impl Run<'_> {
             let jump = (0..trial.len())
                 .map(|c| (trial[c] - self.theta[c]).abs())
                 .fold(0.0, f64::max);
+            if predicted && (!settled || jump > JUMP_RATIO * driven + JUMP_FLOOR) {
+                unpredicted = true;
+                continue;
+            }
             unsettled = if settled { 0 } else { unsettled + 1 };
             if !settled || jump > JUMP_RATIO * driven + JUMP_FLOOR {
                 // A balance that moves far more than its drives: halve the step until it
@@ -1524,7 +1574,9 @@ impl Run<'_> {
             raw.iter_mut().for_each(|r| *r = None);
             let happenings = net.events(&self.data, &holds, &self.sides, self.capture, None, &mut raw);
             if happenings.is_empty() {
-                self.theta = trial;
+                let before = std::mem::replace(&mut self.theta, trial);
+                self.previous = (self.holds.touching == holds.touching && self.holds.latched == holds.latched)
+                    .then_some((u, before));
                 self.holds = holds;
                 self.raw = raw;
                 self.after_step();
@@ -1538,6 +1590,7 @@ impl Run<'_> {
             // Read at `next`, not where the event is located.
             raw.iter_mut().for_each(|r| *r = None);
             self.raw = raw;
+            self.previous = None;
             u = self.locate(u, next, trial, holds, &happenings);
             // Events that come back at once with nothing new resolved (a contact let go that
             // crosses again) would step the run along by rounding for ever: past a few,

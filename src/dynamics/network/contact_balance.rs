@@ -57,156 +57,268 @@ pub struct BalanceSolution {
 /// than solved (or almost solved) is an error naming it.
 pub fn solve_step(step: &BalanceStep) -> Result<BalanceSolution> {
     match held_step(step) {
-        Some(solution) => Ok(solution),
-        None => solve_step_with_clarabel(step),
+        HeldStep::Solved(solution) => Ok(solution),
+        HeldStep::Infeasible => Err(NumericalError::QpStatus {
+            status: "PrimalInfeasible (by the dual active-set method)".into(),
+        }
+        .into()),
+        HeldStep::Unsure => solve_step_with_clarabel(step),
     }
 }
 
-/// The ridge added to the held rows' Schur complement, a share of its largest diagonal.
-const HELD_RIDGE: f64 = 1e-13;
+/// A row whose direction, projected off the held rows through H⁻¹, keeps less than this
+/// share of its own H⁻¹-norm depends on them.
+const DEPENDENT_ROW: f64 = 1e-12;
+/// A dependent row crossed by less than this share of the step's scale may be feasible
+/// within rounding: the direct path does not call it infeasible.
+const NEAR_FEASIBLE: f64 = 1e-5;
 /// A held row must hold to this share of the step's own scale.
 const HELD_RESIDUAL: f64 = 1e-9;
 
-/// The step by active sets: the closures and a set of contacts held as equalities (with
-/// A = [E; G_held], b = [−e; −g_held], H d + c = Aᵀy gives A H⁻¹ Aᵀ y = b + A H⁻¹ c,
-/// H = K + W, c = K (θ − r)); a held contact pulling (y < 0) is let go, a free one crossed
-/// (G d < −g) is held, until neither: then every optimality condition of the QP holds and,
-/// the energy being strictly convex, d is its one solution. The trust box's faces are rows
-/// like the contacts'. `None` when that takes more than a few rounds or the rows cannot
-/// all hold.
-pub(crate) fn held_step(step: &BalanceStep) -> Option<BalanceSolution> {
+/// What the direct path found.
+pub(crate) enum HeldStep {
+    /// The QP's solution.
+    Solved(BalanceSolution),
+    /// A row crossed that the held rows cannot let hold: the linearised rows have no common
+    /// point (the dual method's proof of it).
+    Infeasible,
+    /// Rounding left the answer unproven: Clarabel decides.
+    Unsure,
+}
+
+/// The step by the dual active-set method (Goldfarb & Idnani 1983): from the energy's
+/// minimum on the closures alone, the most crossed row is added by raising its multiplier
+/// t, the held rows' multipliers moving so they stay held (H d + c = Aᵀy, A = the held
+/// rows); a contact (or trust-box face) whose multiplier reaches zero first is let go.
+/// Each addition lowers no held row's hold and raises the energy, so it ends: every row
+/// holds with non-negative multipliers (the QP's one solution, the energy being strictly
+/// convex), or a crossed row depends on held rows whose multipliers cannot make room for
+/// it, which proves the rows infeasible. Rows are taken over their own norms, so rows in
+/// m/rad and dimensionless ones weigh alike.
+pub(crate) fn held_step(step: &BalanceStep) -> HeldStep {
     let n = step.stiffness.len();
     let (e_rows, e_values) = step.closures;
     let (g_rows, g_values) = step.contacts;
     let (m_e, m_g) = (e_rows.nrows(), g_rows.nrows());
-    let m = m_e + m_g;
     if step.stiffness.iter().any(|&k| !(k > 0.0 && k.is_finite())) {
-        return None;
+        return HeldStep::Unsure;
     }
-    // Each row over its own norm, so rows in m/rad and dimensionless ones weigh alike.
+    let sigma = step_scale(step);
+    let bound = step.trust.min(SCALED_TRUST * sigma);
+    // Rows a·d ≥ b (closures a·d = b), each over its norm; the trust box's faces
+    // ±d_c ≥ −bound after the contacts.
+    let m = m_e + m_g + 2 * n;
     let mut a = DMatrix::zeros(m, n);
     let mut b = DVector::zeros(m);
-    let mut scale = vec![1.0; m];
-    for i in 0..m {
+    let mut scale = vec![0.0; m];
+    scale[m_e + m_g..].fill(1.0);
+    for i in 0..m_e + m_g {
         let (row, value) = if i < m_e {
             (e_rows.row(i), -e_values[i])
         } else {
             (g_rows.row(i - m_e), -g_values[i - m_e])
         };
         let norm = row.norm();
-        if !(norm > 0.0 && norm.is_finite()) {
-            return None;
+        if i >= m_e && value == f64::NEG_INFINITY {
+            // A contact that cannot measure its gap here (two edges turned parallel: no
+            // crossing to measure) asks nothing of this step.
+            continue;
+        }
+        if !(norm.is_finite() && value.is_finite()) {
+            return HeldStep::Unsure;
+        }
+        if norm == 0.0 {
+            // A row no turn moves (the faces' meeting fixed by the anchor or the closures):
+            // it holds as it is, or never.
+            if value > 0.0 || (i < m_e && value < 0.0) {
+                return HeldStep::Infeasible;
+            }
+            continue;
         }
         scale[i] = norm;
         a.row_mut(i).copy_from(&(row / norm));
         b[i] = value / norm;
     }
-    // H⁻¹ with H = K + W; K⁻¹ (diagonal) without curvature.
-    let compliance: DMatrix<f64> = match step.curvature {
-        None => DMatrix::from_diagonal(&DVector::from_iterator(n, step.stiffness.iter().map(|k| 1.0 / k))),
-        Some(curvature) => {
-            let hessian = curvature + DMatrix::from_diagonal(&DVector::from_column_slice(step.stiffness));
-            hessian.cholesky()?.inverse()
-        }
-    };
-    // Unconstrained step −H⁻¹c, c = K (θ − r) (−(θ − r) without curvature); the rows
-    // correct it.
-    let free = match step.curvature {
-        None => DVector::from_iterator(n, step.offset.iter().map(|o| -o)),
-        Some(_) => -&compliance * DVector::from_iterator(n, (0..n).map(|c| step.stiffness[c] * step.offset[c])),
-    };
-    let sigma = step_scale(step);
-    let bound = step.trust.min(SCALED_TRUST * sigma);
-    // The trust box's faces as rows after the contacts: ±d_c ≥ −bound.
-    let m = m + 2 * n;
-    let mut a = a.resize_vertically(m, 0.0);
-    let mut b = b.resize_vertically(m, 0.0);
     for c in 0..n {
         a[(m_e + m_g + c, c)] = 1.0;
         a[(m_e + m_g + n + c, c)] = -1.0;
         b[m_e + m_g + c] = -bound;
         b[m_e + m_g + n + c] = -bound;
     }
-    // From the closures alone: contacts join as they are crossed (starting from all of
-    // them held would ask rows the seams already fix to hold at their slack too).
-    let mut held: Vec<usize> = (0..m_e).collect();
-    for _ in 0..=2 * (m_g + 2 * n) + 1 {
-        let k = held.len();
-        let mut schur = DMatrix::zeros(k, k);
-        for (p, &i) in held.iter().enumerate() {
-            for (q, &j) in held.iter().enumerate().take(p + 1) {
-                let value = (a.row(i) * &compliance).dot(&a.row(j));
-                schur[(p, q)] = value;
-                schur[(q, p)] = value;
+    // H⁻¹ with H = K + W.
+    let compliance: DMatrix<f64> = match step.curvature {
+        None => DMatrix::from_diagonal(&DVector::from_iterator(n, step.stiffness.iter().map(|k| 1.0 / k))),
+        Some(curvature) => {
+            let hessian = curvature + DMatrix::from_diagonal(&DVector::from_column_slice(step.stiffness));
+            match hessian.cholesky() {
+                Some(factor) => factor.inverse(),
+                None => return HeldStep::Unsure,
             }
         }
-        let right = DVector::from_iterator(k, held.iter().map(|&i| b[i] - a.row(i).dot(&free.transpose())));
-        // Rows that depend on others (contacts where the latched seams already fix the
-        // angles) leave the multipliers undetermined: a ridge of 1e-13 of the diagonal
-        // picks the least of them, and the rows must then still hold (checked below).
-        let largest = (0..k).map(|i| schur[(i, i)]).fold(0.0, f64::max);
-        for i in 0..k {
-            schur[(i, i)] += HELD_RIDGE * largest;
+    };
+    let gradient = DVector::from_iterator(n, (0..n).map(|c| step.stiffness[c] * step.offset[c]));
+    // The held rows' product M = A H⁻¹ Aᵀ and the multipliers that hold them at t = 0.
+    let held_solve = |held: &[usize], right: &DVector<f64>| -> Option<DVector<f64>> {
+        let k = held.len();
+        if k == 0 {
+            return Some(DVector::zeros(0));
         }
-        let y = if k == 0 {
-            DVector::zeros(0)
-        } else {
-            schur.cholesky()?.solve(&right)
-        };
-        let mut pushed = DVector::zeros(n);
+        let through = DMatrix::from_fn(n, k, |r, p| (compliance.row(r) * a.row(held[p]).transpose())[0]);
+        let product = DMatrix::from_fn(k, k, |p, q| a.row(held[p]).dot(&through.column(q).transpose()));
+        product.cholesky().map(|factor| factor.solve(right))
+    };
+    // d(y) = H⁻¹ (Aᵀ y − c); held rows: A H⁻¹ Aᵀ y = b + A H⁻¹ c.
+    let step_of = |held: &[usize], y: &DVector<f64>| -> DVector<f64> {
+        let mut pushed = -&gradient;
         for (p, &i) in held.iter().enumerate() {
             pushed += a.row(i).transpose() * y[p];
         }
-        let d = &free + &compliance * pushed;
-        if !d.iter().all(|x| x.is_finite()) {
-            return None;
+        &compliance * pushed
+    };
+    let free_gradient = &compliance * &gradient;
+    let mut held: Vec<usize> = Vec::new();
+    let mut y = DVector::zeros(0);
+    if m_e > 0 {
+        held = (0..m_e).filter(|&i| scale[i] > 0.0).collect();
+        let right = DVector::from_iterator(
+            held.len(),
+            held.iter().map(|&i| b[i] + a.row(i).dot(&free_gradient.transpose())),
+        );
+        match held_solve(&held, &right) {
+            Some(multipliers) => y = multipliers,
+            None => return HeldStep::Unsure,
         }
-        // The held rows hold (else they are inconsistent: Clarabel's shares decide).
-        if held
-            .iter()
-            .any(|&i| (a.row(i).dot(&d.transpose()) - b[i]).abs() > HELD_RESIDUAL * sigma)
-        {
-            return None;
-        }
-        let pulling = held
-            .iter()
-            .enumerate()
-            .filter(|&(p, &i)| i >= m_e && y[p] < 0.0)
-            .min_by(|x, y_| y[x.0].total_cmp(&y[y_.0]))
-            .map(|(p, _)| p);
-        if let Some(p) = pulling {
-            held.remove(p);
-            continue;
-        }
+    }
+    let mut d = step_of(&held, &y);
+    let tolerance = HELD_RESIDUAL * sigma;
+    for _ in 0..4 * m + 8 {
+        // The most crossed row not held.
         let crossed = (m_e..m)
-            .filter(|i| !held.contains(i))
+            .filter(|i| !held.contains(i) && scale[*i] > 0.0)
             .map(|i| (i, a.row(i).dot(&d.transpose()) - b[i]))
-            .filter(|&(_, over)| over < -HELD_RESIDUAL * sigma)
-            .min_by(|x, y_| x.1.total_cmp(&y_.1));
-        if let Some((i, _)) = crossed {
-            held.push(i);
-            continue;
-        }
-        let at_trust = held.iter().any(|&i| i >= m_e + m_g);
-        let mut forces = DVector::zeros(m_g);
-        let mut closure_multipliers = DVector::zeros(m_e);
-        for (p, &i) in held.iter().enumerate() {
-            // Back to the rows' own units: y over its row's norm. K d + c = Eᵀy_E + Gᵀf,
-            // and the closures' multipliers are reported as μ = −y_E.
-            if i < m_e {
-                closure_multipliers[i] = -y[p] / scale[i];
-            } else if i < m_e + m_g {
-                forces[i - m_e] = y[p] / scale[i];
+            .filter(|&(_, over)| over < -tolerance)
+            .min_by(|x, z| x.1.total_cmp(&z.1));
+        let Some((entering, _)) = crossed else {
+            // Rounding in nearly dependent held rows shows here: each must still hold.
+            if held
+                .iter()
+                .any(|&i| (a.row(i).dot(&d.transpose()) - b[i]).abs() > tolerance)
+            {
+                return HeldStep::Unsure;
+            }
+            return finish(step, &held, &y, d, &scale, m_e, m_g);
+        };
+        let row = a.row(entering).transpose();
+        // Raising the entering row's multiplier t moves the held ones by −t r and the step
+        // by t z, z = H⁻¹(a − Aᵀ r), with A H⁻¹ Aᵀ r = A H⁻¹ a (held rows stay held).
+        let mut t_total = 0.0;
+        loop {
+            let through = &compliance * &row;
+            let r = if held.is_empty() {
+                DVector::zeros(0)
+            } else {
+                let right =
+                    DVector::from_iterator(held.len(), held.iter().map(|&i| a.row(i).dot(&through.transpose())));
+                match held_solve(&held, &right) {
+                    Some(r) => r,
+                    None => return HeldStep::Unsure,
+                }
+            };
+            let mut z = through.clone();
+            for (p, &i) in held.iter().enumerate() {
+                z -= &compliance * a.row(i).transpose() * r[p];
+            }
+            let reach = row.dot(&z);
+            let full = if reach > DEPENDENT_ROW * row.dot(&through) {
+                Some(-(row.dot(&d) - b[entering]) / reach)
+            } else {
+                None
+            };
+            // The first held inequality whose multiplier the rise brings to zero.
+            let partial = held
+                .iter()
+                .enumerate()
+                .filter(|&(p, &i)| i >= m_e && r[p] > 0.0)
+                .map(|(p, _)| (p, y[p] / r[p]))
+                .min_by(|x, z| x.1.total_cmp(&z.1));
+            let t = match (full, partial) {
+                (None, None) => {
+                    // A row crossed by little that depends on the held rows: rounding in
+                    // the linearisation may be all that keeps it off (Clarabel decides).
+                    let crossing = -(row.dot(&d) - b[entering]);
+                    return if crossing < NEAR_FEASIBLE * sigma {
+                        HeldStep::Unsure
+                    } else {
+                        HeldStep::Infeasible
+                    };
+                }
+                (Some(f), None) => f,
+                (None, Some((_, q))) => q,
+                (Some(f), Some((_, q))) => f.min(q),
+            };
+            if !t.is_finite() {
+                return HeldStep::Unsure;
+            }
+            let t = t.max(0.0);
+            d += &z * t;
+            for p in 0..held.len() {
+                y[p] -= t * r[p];
+            }
+            t_total += t;
+            match (full, partial) {
+                (Some(f), partial) if partial.is_none_or(|(_, q)| f <= q) => {
+                    held.push(entering);
+                    y = y.push(t_total);
+                    break;
+                }
+                (_, Some((p, _))) => {
+                    held.remove(p);
+                    y = y.remove_row(p);
+                }
+                _ => return HeldStep::Unsure,
+            }
+            if !d.iter().all(|x| x.is_finite()) {
+                return HeldStep::Unsure;
             }
         }
-        return Some(BalanceSolution {
-            step: d,
-            forces,
-            closure_multipliers,
-            at_trust,
-        });
     }
-    None
+    HeldStep::Unsure
+}
+
+/// The direct path's answer checked (every held row holds, every row is on its side,
+/// multipliers of inequalities non-negative) and in the rows' own units.
+fn finish(
+    step: &BalanceStep,
+    held: &[usize],
+    y: &DVector<f64>,
+    d: DVector<f64>,
+    scale: &[f64],
+    m_e: usize,
+    m_g: usize,
+) -> HeldStep {
+    let n = step.stiffness.len();
+    if !d.iter().all(|x| x.is_finite()) || held.iter().enumerate().any(|(p, &i)| i >= m_e && y[p] < 0.0) {
+        return HeldStep::Unsure;
+    }
+    let at_trust = held.iter().any(|&i| i >= m_e + m_g);
+    let mut forces = DVector::zeros(m_g);
+    let mut closure_multipliers = DVector::zeros(m_e);
+    for (p, &i) in held.iter().enumerate() {
+        // Back to the rows' own units: y over its row's norm. K d + c = Eᵀy_E + Gᵀf, and
+        // the closures' multipliers are reported as μ = −y_E.
+        if i < m_e {
+            closure_multipliers[i] = -y[p] / scale[i];
+        } else if i < m_e + m_g {
+            forces[i - m_e] = y[p] / scale[i];
+        }
+    }
+    debug_assert_eq!(d.len(), n);
+    HeldStep::Solved(BalanceSolution {
+        step: d,
+        forces,
+        closure_multipliers,
+        at_trust,
+    })
 }
 
 /// The step's own scale σ: the largest turn the offsets or any row's residual ask for,
@@ -411,8 +523,8 @@ mod tests {
 
     /// The held-rows step against Clarabel on random steps (5 hinges, a closure row, three
     /// contacts, every other one with a curvature W, half in a trust box the step reaches):
-    /// wherever the direct path accepts, the two agree on the step, the forces
-    /// and the closure multipliers.
+    /// wherever the direct path accepts, the two agree on the step, the forces and the
+    /// closure multipliers; where it proves the rows infeasible, Clarabel finds no step.
     #[test]
     fn the_held_rows_step_is_clarabels_step_where_it_is_taken() {
         let mut seed = 12345_u64;
@@ -421,6 +533,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
         let (mut taken, mut refused, mut pressing, mut free, mut curved, mut boxed) = (0, 0, 0, 0, 0, 0);
+        let mut infeasible = 0;
         for trial in 0..400 {
             let n = 5;
             let stiffness: Vec<f64> = (0..n).map(|_| 1e-9 * (0.5 + uniform())).collect();
@@ -445,9 +558,18 @@ mod tests {
                 trust: if trial % 4 >= 2 { 0.03 } else { 1.0 },
                 size: 1e-4,
             };
-            let Some(held) = held_step(&step) else {
-                refused += 1;
-                continue;
+            let held = match held_step(&step) {
+                HeldStep::Solved(held) => held,
+                HeldStep::Infeasible => {
+                    // The dual method's proof of infeasibility: Clarabel finds no step either.
+                    infeasible += 1;
+                    assert!(solve_step_with_clarabel(&step).is_err(), "trial {trial}");
+                    continue;
+                }
+                HeldStep::Unsure => {
+                    refused += 1;
+                    continue;
+                }
             };
             taken += 1;
             curved += trial % 2;
@@ -481,8 +603,8 @@ mod tests {
         }
         // Both kinds of contact are met, and the direct path answers nearly every step.
         assert!(
-            taken > 300 && curved > 150 && boxed > 50 && pressing > 100 && free > 100,
-            "taken {taken} ({curved} curved, {boxed} at the box), refused {refused}; {pressing} pressing, {free} free"
+            taken > 300 && curved > 150 && boxed > 50 && pressing > 100 && free > 100 && infeasible > 0,
+            "taken {taken} ({curved} curved, {boxed} at the box), refused {refused}, infeasible {infeasible}; {pressing} pressing, {free} free"
         );
     }
 }
