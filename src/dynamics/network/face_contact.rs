@@ -94,6 +94,19 @@ pub struct FeatureState {
     pub over: bool,
 }
 
+impl FeatureState {
+    /// A point `distance` from a plane of unit `normal`, its foot there the other point.
+    fn on_plane(point: Vector3<f64>, normal: Vector3<f64>, distance: f64, over: bool) -> FeatureState {
+        FeatureState {
+            point,
+            other_point: point - normal * distance,
+            normal,
+            distance,
+            over,
+        }
+    }
+}
+
 /// Every face's corners (in its loop's order) and unit normal at one set of poses, m.
 #[derive(Debug, Clone)]
 pub struct PlacedFaces {
@@ -346,13 +359,7 @@ impl FaceContacts {
                         let along = b - a;
                         along.cross(&(point - a)).dot(&normal) >= margin * along.norm()
                     });
-                FeatureState {
-                    point,
-                    other_point: point - normal * distance,
-                    normal,
-                    distance,
-                    over,
-                }
+                FeatureState::on_plane(point, normal, distance, over)
             }
             Feature::EdgeOnCorner {
                 face,
@@ -380,13 +387,7 @@ impl FaceContacts {
                 let over = met
                     && first.normalize().cross(&within).dot(&normal) >= reach
                     && within.cross(&second.normalize()).dot(&normal) >= reach;
-                FeatureState {
-                    point,
-                    other_point: point - normal * distance,
-                    normal,
-                    distance,
-                    over,
-                }
+                FeatureState::on_plane(point, normal, distance, over)
             }
             Feature::EdgeOnEdge {
                 face,
