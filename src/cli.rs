@@ -1286,6 +1286,11 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
             study.devices,
             study.seconds
         );
+        let f = &study.failures;
+        println!(
+            "  varied devices that did not close: {} jam, {} stall, {} snap through, {} undecided",
+            f.jams, f.stalls, f.snaps, f.undecided
+        );
     }
     for row in report.nets.iter().take(options.top.max(options.simulate)) {
         let simulated = row.closing.as_ref().map_or(String::new(), |c| {

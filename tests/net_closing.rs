@@ -312,6 +312,19 @@ fn a_study_on_the_cores_equals_each_net_studied_alone_and_ranks_by_yield() {
         .collect();
     assert!(yields.windows(2).all(|w| w[0] >= w[1]), "{yields:?}");
     assert!(report.nets.iter().enumerate().all(|(k, r)| r.rank == k + 1));
+    // Every sampled device is counted once: closed, or in one class of failure; the study's
+    // classes are the releases' summed.
+    let mut summed = Failures::default();
+    for row in &simulated {
+        for release in &row.closing.as_ref().unwrap().releases {
+            let (estimate, failures) = (release.yield_estimate.unwrap(), release.failures.unwrap());
+            let failed = failures.jams + failures.stalls + failures.snaps + failures.undecided;
+            assert_eq!(estimate.closed + failed, estimate.samples, "{release:?}");
+            summed.add(&failures);
+        }
+    }
+    assert_eq!(study.failures, summed);
+    assert!(summed.stalls + summed.jams > 0, "{summed:?}");
 }
 
 #[test]

@@ -4,8 +4,8 @@
 //! gallery.svg).
 
 pub use crate::design::closing::{
-    ClosingReport, ClosingSettings, Contact, ContactForce, Jam, NetClosing, NetClosingSummary, Outcome, ReleaseResult,
-    SeamForce,
+    ClosingReport, ClosingSettings, Contact, ContactForce, Failures, Jam, NetClosing, NetClosingSummary, Outcome,
+    ReleaseResult, SeamForce,
 };
 pub use crate::design::fabrication::{clopper_pearson, Variation, YieldEstimate};
 pub use crate::design::nets::{
@@ -380,9 +380,18 @@ pub fn apply_releases(
         summaries.push((rank, NetClosingSummary::new(anchored, results)));
     }
     let variation = options.variation();
+    let mut failures = Failures::default();
+    for (_, summary) in &summaries {
+        for release in &summary.releases {
+            if let Some(counted) = &release.failures {
+                failures.add(counted);
+            }
+        }
+    }
     let study = Study {
         nets: summaries.len(),
         devices: summaries.len() * releases.len() * (1 + variation.samples),
+        failures,
         releases,
         variation,
         closing: options.closing(),
@@ -410,18 +419,20 @@ fn study_release(
     let settings = options.closing();
     let nominal = closing.run(model, &model.forcing, &model.stiffness(), &settings)?;
     let variation = options.variation();
-    let yield_estimate = if variation.samples > 0 {
+    let (yield_estimate, failures) = if variation.samples > 0 {
         let stiffness = model.stiffness();
-        let mut closed = 0;
+        let (mut closed, mut failures) = (0, Failures::default());
         for sample in 0..variation.samples {
             let (forcing, varied) = variation.device(&model.forcing, &stiffness, sample);
-            if closing.run(model, &forcing, &varied, &settings)?.outcome == Outcome::Closes {
+            let outcome = closing.run(model, &forcing, &varied, &settings)?.outcome;
+            if outcome == Outcome::Closes {
                 closed += 1;
             }
+            failures.count(outcome);
         }
-        Some(YieldEstimate::new(closed, variation.samples))
+        (Some(YieldEstimate::new(closed, variation.samples)), Some(failures))
     } else {
-        None
+        (None, None)
     };
     Ok(ReleaseResult {
         front_deg,
@@ -430,6 +441,7 @@ fn study_release(
         latched: nominal.latches.len(),
         jam_faces: nominal.jam.map(|j| j.faces),
         yield_estimate,
+        failures,
     })
 }
 

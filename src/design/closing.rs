@@ -313,6 +313,43 @@ pub struct ReleaseResult {
     /// The share of sampled devices that close (None: none sampled).
     #[serde(rename = "yield")]
     pub yield_estimate: Option<crate::design::fabrication::YieldEstimate>,
+    /// How the sampled devices that did not close ended (None: none sampled).
+    #[serde(default)]
+    pub failures: Option<Failures>,
+}
+
+/// The sampled devices that did not close, by how they ended.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Failures {
+    /// Held apart by contact forces with the drives spent.
+    pub jams: usize,
+    /// Drives spent with seams open, nothing holding them.
+    pub stalls: usize,
+    /// The path lost its stability.
+    pub snaps: usize,
+    /// No balance found.
+    pub undecided: usize,
+}
+
+impl Failures {
+    /// Counts one more device that ended with `outcome` (a closing counts nowhere).
+    pub fn count(&mut self, outcome: Outcome) {
+        match outcome {
+            Outcome::Closes => {}
+            Outcome::Jams => self.jams += 1,
+            Outcome::Stalls => self.stalls += 1,
+            Outcome::Snaps => self.snaps += 1,
+            Outcome::Undecided => self.undecided += 1,
+        }
+    }
+
+    /// Every count added.
+    pub fn add(&mut self, other: &Failures) {
+        self.jams += other.jams;
+        self.stalls += other.stalls;
+        self.snaps += other.snaps;
+        self.undecided += other.undecided;
+    }
 }
 
 /// A simulated net: every release tried and the best.

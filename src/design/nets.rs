@@ -2,7 +2,7 @@
 //! unfolding (or those met in a uniform sample), laid flat, tested for overlap, scored and
 //! ranked, the best that can be made checked for touching themselves.
 
-use crate::design::closing::{ClosingSettings, NetClosingSummary};
+use crate::design::closing::{ClosingSettings, Failures, NetClosingSummary};
 use crate::design::fabrication::Variation;
 use crate::error::{NanofoldError, Result};
 use crate::geometry::mesh::{MergeCoplanar, MeshReading};
@@ -345,6 +345,8 @@ pub struct Study {
     pub closing: ClosingSettings,
     /// Devices run (nominal and sampled).
     pub devices: usize,
+    /// The sampled devices that did not close, over every release, by how they ended.
+    pub failures: Failures,
     /// Seconds the study took.
     pub seconds: f64,
 }
