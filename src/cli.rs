@@ -1302,12 +1302,17 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
                 (Outcome::Jams, Some([a, b])) => format!("jams (faces {a}, {b}) at {:.6e} s", best.time_s),
                 (outcome, _) => format!("{} at {:.6e} s", outcome.label(), best.time_s),
             };
-            let yield_text = best.yield_estimate.map_or(String::new(), |y| {
-                format!(
+            let yield_text = match (c.fresh_yield, best.yield_estimate) {
+                (Some(y), Some(chosen)) => format!(
+                    ", yield on fresh devices {}/{} ({:.3}, 95% {:.3}–{:.3}; chosen at {}/{})",
+                    y.closed, y.samples, y.fraction, y.interval_95[0], y.interval_95[1], chosen.closed, chosen.samples
+                ),
+                (_, Some(y)) => format!(
                     ", yield {}/{} ({:.3}, 95% {:.3}–{:.3})",
                     y.closed, y.samples, y.fraction, y.interval_95[0], y.interval_95[1]
-                )
-            });
+                ),
+                _ => String::new(),
+            };
             format!(
                 "; best release {release}: {outcome}{yield_text}; closes in {} of {} releases",
                 c.closes_in,

@@ -293,7 +293,8 @@ fn a_study_on_the_cores_equals_each_net_studied_alone_and_ranks_by_yield() {
     heard.sort();
     assert_eq!(heard, (1..=16).map(|d| (d, 16)).collect::<Vec<_>>());
     let study = report.study.as_ref().unwrap();
-    assert_eq!((study.nets, study.devices), (4, 16 * 13));
+    // Four nets: four releases of 13 devices each, then 12 fresh ones for the best.
+    assert_eq!((study.nets, study.devices), (4, 4 * (4 * 13 + 12)));
     // Each net run alone, one release after another, is the same.
     let simulated: Vec<&NetRow> = report.nets.iter().filter(|r| r.closing.is_some()).collect();
     assert_eq!(simulated.len(), 4);
@@ -325,6 +326,37 @@ fn a_study_on_the_cores_equals_each_net_studied_alone_and_ranks_by_yield() {
     }
     assert_eq!(study.failures, summed);
     assert!(summed.stalls + summed.jams > 0, "{summed:?}");
+    // Each net's best release is reported from fresh devices (draw set 1), run again here
+    // by hand: the same count closes.
+    for row in &simulated {
+        let summary = row.closing.as_ref().unwrap();
+        let fresh = summary.fresh_yield.unwrap();
+        assert_eq!(fresh.samples, 12);
+        let made = best_net_patterns(&solid, &report, row.rank)
+            .unwrap()
+            .remove(row.rank - 1)
+            .1;
+        let released = NetsOptions {
+            front_deg: options.releases()[summary.best],
+            ..options.clone()
+        };
+        let scene = net_device(&made, "cube", &released).unwrap();
+        let model = scene.network().unwrap();
+        let closing = NetClosing::new(&made, model).unwrap();
+        let variation = options.variation().for_design(&row.folds, summary.best, 1);
+        let closed = (0..12)
+            .filter(|&k| {
+                let (forcing, stiffness) = variation.device(&model.forcing, &model.stiffness(), k);
+                closing
+                    .run(model, &forcing, &stiffness, &options.closing())
+                    .unwrap()
+                    .outcome
+                    == Outcome::Closes
+            })
+            .count();
+        assert_eq!(fresh.closed, closed, "rank {}", row.rank);
+        assert_eq!(summary.best_yield(), fresh.fraction);
+    }
 }
 
 #[test]

@@ -271,12 +271,12 @@ pub fn study_net(
     let releases = options
         .releases()
         .into_iter()
-        .map(|front| study_release(&made, &report.solid, rank, front, options))
+        .enumerate()
+        .map(|(release, front)| study_release(&made, &report.solid, rank, &row.folds, release, front, options))
         .collect::<Result<Vec<_>>>()?;
-    Ok(NetClosingSummary::new(
-        options.anchored_face.unwrap_or(made.centre_face),
-        releases,
-    ))
+    let mut summary = NetClosingSummary::new(options.anchored_face.unwrap_or(made.centre_face), releases);
+    summary.fresh_yield = fresh_yield(&made, &report.solid, rank, &row.folds, summary.best, options)?;
+    Ok(summary)
 }
 
 /// A ranked net's crease pattern (refused when it cannot be made).
@@ -345,7 +345,7 @@ pub fn study_release_of(
     })?;
     let made = net_of_folds(solid, name, folds)?;
     let rank = 0;
-    study_release(&made, name, rank, front, options)
+    study_release(&made, name, rank, folds, release, front, options)
 }
 
 /// A study's releases by rank from JSON (`[[rank, [release, …]], …]`), as a cluster's jobs
@@ -376,8 +376,39 @@ pub fn apply_releases(
                 format!("one per release of the options ({}), in their order", releases.len()),
             ));
         }
-        let anchored = options.anchored_face.unwrap_or(net_of(solid, report, row)?.centre_face);
-        summaries.push((rank, NetClosingSummary::new(anchored, results)));
+        let made = net_of(solid, report, row)?;
+        let anchored = options.anchored_face.unwrap_or(made.centre_face);
+        summaries.push((rank, NetClosingSummary::new(anchored, results), made, row.folds.clone()));
+    }
+    // Each best release's yield again, from fresh devices: run here, after the choice, one
+    // net per job on the machine's cores.
+    let fresh: Vec<std::sync::Mutex<Option<Result<Option<YieldEstimate>>>>> =
+        summaries.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(summaries.len().max(1));
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some((rank, summary, made, folds)) = summaries.get(k) else {
+                    break;
+                };
+                let result = fresh_yield(made, &report.solid, *rank, folds, summary.best, options);
+                *fresh[k].lock().expect("no job panics holding it") = Some(result);
+            });
+        }
+    });
+    let mut summaries: Vec<(usize, NetClosingSummary)> = summaries
+        .into_iter()
+        .map(|(rank, summary, _, _)| (rank, summary))
+        .collect();
+    for ((_, summary), slot) in summaries.iter_mut().zip(fresh) {
+        summary.fresh_yield = slot
+            .into_inner()
+            .expect("no job panics holding it")
+            .expect("every job ran")?;
     }
     let variation = options.variation();
     let mut failures = Failures::default();
@@ -390,7 +421,8 @@ pub fn apply_releases(
     }
     let study = Study {
         nets: summaries.len(),
-        devices: summaries.len() * releases.len() * (1 + variation.samples),
+        // Every release's nominal and sampled devices, and each net's fresh ones.
+        devices: summaries.len() * (releases.len() * (1 + variation.samples) + variation.samples),
         failures,
         releases,
         variation,
@@ -402,10 +434,13 @@ pub fn apply_releases(
 }
 
 /// One release of a net: the nominal device, then the sampled ones.
+#[allow(clippy::too_many_arguments)]
 fn study_release(
     made: &NetPattern,
     name: &str,
     rank: usize,
+    folds: &[usize],
+    release: usize,
     front_deg: Option<f64>,
     options: &NetsOptions,
 ) -> Result<ReleaseResult> {
@@ -416,24 +451,13 @@ fn study_release(
     let scene = net_device(made, &format!("{name}_net_{rank:03}"), &released)?;
     let model = scene.network().expect("a net's scene is a network");
     let closing = NetClosing::new(made, model)?;
-    let settings = options.closing();
-    let nominal = closing.run(model, &model.forcing, &model.stiffness(), &settings)?;
-    let variation = options.variation();
-    let (yield_estimate, failures) = if variation.samples > 0 {
-        let stiffness = model.stiffness();
-        let (mut closed, mut failures) = (0, Failures::default());
-        for sample in 0..variation.samples {
-            let (forcing, varied) = variation.device(&model.forcing, &stiffness, sample);
-            let outcome = closing.run(model, &forcing, &varied, &settings)?.outcome;
-            if outcome == Outcome::Closes {
-                closed += 1;
-            }
-            failures.count(outcome);
-        }
-        (Some(YieldEstimate::new(closed, variation.samples)), Some(failures))
-    } else {
-        (None, None)
-    };
+    let nominal = closing.run(model, &model.forcing, &model.stiffness(), &options.closing())?;
+    let (yield_estimate, failures) = sampled_devices(
+        &closing,
+        model,
+        &options.variation().for_design(folds, release, 0),
+        options,
+    )?;
     Ok(ReleaseResult {
         front_deg,
         outcome: nominal.outcome,
@@ -443,6 +467,54 @@ fn study_release(
         yield_estimate,
         failures,
     })
+}
+
+/// The yield of `variation`'s devices and how those that did not close ended (None: none
+/// sampled).
+fn sampled_devices(
+    closing: &NetClosing,
+    model: &crate::dynamics::network::NetworkModel,
+    variation: &Variation,
+    options: &NetsOptions,
+) -> Result<(Option<YieldEstimate>, Option<Failures>)> {
+    if variation.samples == 0 {
+        return Ok((None, None));
+    }
+    let (settings, stiffness) = (options.closing(), model.stiffness());
+    let (mut closed, mut failures) = (0, Failures::default());
+    for sample in 0..variation.samples {
+        let (forcing, varied) = variation.device(&model.forcing, &stiffness, sample);
+        let outcome = closing.run(model, &forcing, &varied, &settings)?.outcome;
+        if outcome == Outcome::Closes {
+            closed += 1;
+        }
+        failures.count(outcome);
+    }
+    Ok((Some(YieldEstimate::new(closed, variation.samples)), Some(failures)))
+}
+
+/// Release `best` of a net run again on fresh devices (draw set 1): its yield free of the
+/// choice among releases (None: none sampled).
+fn fresh_yield(
+    made: &NetPattern,
+    name: &str,
+    rank: usize,
+    folds: &[usize],
+    best: usize,
+    options: &NetsOptions,
+) -> Result<Option<YieldEstimate>> {
+    let variation = options.variation().for_design(folds, best, 1);
+    if variation.samples == 0 {
+        return Ok(None);
+    }
+    let released = NetsOptions {
+        front_deg: options.releases()[best],
+        ..options.clone()
+    };
+    let scene = net_device(made, &format!("{name}_net_{rank:03}"), &released)?;
+    let model = scene.network().expect("a net's scene is a network");
+    let closing = NetClosing::new(made, model)?;
+    Ok(sampled_devices(&closing, model, &variation, options)?.0)
 }
 
 /// Simulates the best `options.simulate` nets that can be made, every release of each
@@ -487,7 +559,8 @@ pub fn study_nets(
             scope.spawn(|| loop {
                 let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 let Some(&(n, r)) = jobs.get(k) else { break };
-                let result = study_release(&nets[n], &report.solid, ranks[n], releases[r], options);
+                let folds = &report.nets[ranks[n] - 1].folds;
+                let result = study_release(&nets[n], &report.solid, ranks[n], folds, r, releases[r], options);
                 *results[k].lock().expect("no job panics holding it") = Some(result);
                 progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, jobs.len());
             });
@@ -506,25 +579,29 @@ pub fn study_nets(
 }
 
 /// The ranked table as CSV: the scores, and for the nets simulated their best release
-/// (`step` or the front's direction), its nominal outcome, the yield with its 95 % interval
-/// and the number of releases that close.
+/// (`step` or the front's direction), its nominal outcome, its yield on fresh devices with
+/// its 95 % interval, the number of releases that close, and the yield it was chosen by.
 pub fn nets_csv(report: &NetsReport) -> String {
     let mut csv = String::from(
-        "rank,radius_of_gyration_um,leaves,seam_length_um,footprint_long_um,footprint_short_um,overlapping,touching,folds,best_release,outcome,yield,yield_low,yield_high,closes_in\n",
+        "rank,radius_of_gyration_um,leaves,seam_length_um,footprint_long_um,footprint_short_um,overlapping,touching,folds,best_release,outcome,yield,yield_low,yield_high,closes_in,yield_when_chosen\n",
     );
     for row in &report.nets {
         let simulated = row.closing.as_ref().map_or_else(
-            || ",,,,,".to_string(),
+            || ",,,,,,".to_string(),
             |c| {
                 let best = &c.releases[c.best];
                 let release = best.front_deg.map_or("step".to_string(), |phi| format!("front {phi}"));
-                let (fraction, [low, high]) = best
-                    .yield_estimate
+                // The yield reported is the fresh devices'; the one the release was chosen
+                // by (the highest of its releases', so optimistic) beside it.
+                let (fraction, [low, high]) = c
+                    .fresh_yield
+                    .or(best.yield_estimate)
                     .map_or((String::new(), [String::new(), String::new()]), |y| {
                         (y.fraction.to_string(), y.interval_95.map(|x| format!("{x:.6}")))
                     });
+                let chosen = best.yield_estimate.map_or(String::new(), |y| y.fraction.to_string());
                 format!(
-                    "{release},{},{fraction},{low},{high},{}",
+                    "{release},{},{fraction},{low},{high},{},{chosen}",
                     best.outcome.label(),
                     c.closes_in
                 )

@@ -364,6 +364,9 @@ pub struct NetClosingSummary {
     pub best: usize,
     /// Releases whose nominal device closes.
     pub closes_in: usize,
+    /// The best release's yield from fresh devices, independent of those it was chosen
+    /// on (None: none sampled): the yield to report, free of the choice's optimism.
+    pub fresh_yield: Option<crate::design::fabrication::YieldEstimate>,
 }
 
 impl NetClosingSummary {
@@ -391,13 +394,16 @@ impl NetClosingSummary {
             releases,
             best,
             closes_in,
+            fresh_yield: None,
         }
     }
 
-    /// The best release's yield (its nominal outcome, 1 or 0, when none was sampled).
+    /// The best release's yield: from fresh devices when they were run, else from those it
+    /// was chosen on (its nominal outcome, 1 or 0, when none was sampled).
     pub fn best_yield(&self) -> f64 {
         let best = &self.releases[self.best];
-        best.yield_estimate
+        self.fresh_yield
+            .or(best.yield_estimate)
             .map_or(if best.outcome == Outcome::Closes { 1.0 } else { 0.0 }, |y| y.fraction)
     }
 }

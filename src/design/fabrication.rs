@@ -55,6 +55,24 @@ impl Variation {
         Ok(())
     }
 
+    /// This variation's draws for one design: the device population of `net` (its folds)
+    /// released the `release`-th way, in draw set `set` (0: the devices a best release is
+    /// chosen on; 1: fresh devices its yield is then reported from). Different designs and
+    /// sets get independent draws; the same design and set, the same devices in any order.
+    pub fn for_design(&self, net: &[usize], release: usize, set: u64) -> Variation {
+        // FNV-1a over the design's numbers, then one splitmix64 round.
+        let mut key: u64 = 0xCBF2_9CE4_8422_2325;
+        for word in net.iter().map(|&f| f as u64).chain([u64::MAX, release as u64, set]) {
+            for byte in word.to_le_bytes() {
+                key = (key ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01B3);
+            }
+        }
+        Variation {
+            seed: Normal::new(self.seed ^ key).next_word(),
+            ..*self
+        }
+    }
+
     /// Device `sample` of this variation: every hinge's stiffness times (1 + s_K z) and its
     /// drive's stress times (1 + s_σ z′), z and z′ standard normal (each factor at least
     /// 0.05).
@@ -90,13 +108,18 @@ impl Normal {
         }
     }
 
-    fn uniform(&mut self) -> f64 {
+    /// splitmix64's next 64 bits.
+    fn next_word(&mut self) -> u64 {
         self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.state;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn uniform(&mut self) -> f64 {
         // 53 random bits in (0, 1].
-        (((z ^ (z >> 31)) >> 11) as f64 + 1.0) / (1u64 << 53) as f64
+        ((self.next_word() >> 11) as f64 + 1.0) / (1u64 << 53) as f64
     }
 
     fn draw(&mut self) -> f64 {
@@ -244,5 +267,57 @@ mod tests {
         }
         .validate()
         .is_err());
+    }
+
+    /// Designs draw independently: device k of one net and release is uncorrelated with
+    /// device k of another release, another net or the fresh set, and the same design and
+    /// set give the same devices.
+    #[test]
+    fn each_design_and_draw_set_has_its_own_devices() {
+        let forcing = Forcing {
+            actuation: crate::dynamics::Actuation::Step,
+            hinges: vec![
+                crate::dynamics::HingeDrive {
+                    target: 1.0,
+                    radius_of_curvature: 2.0,
+                    actuated: true,
+                    release_time: 0.0,
+                };
+                5
+            ],
+        };
+        let variation = Variation {
+            samples: 2000,
+            stiffness_spread_percent: 2.0,
+            stress_spread_percent: 2.0,
+            seed: 7,
+        };
+        let net = [1, 2, 3, 5, 8];
+        let designs = [
+            variation.for_design(&net, 0, 0),
+            variation.for_design(&net, 1, 0),
+            variation.for_design(&[1, 2, 3, 5, 9], 0, 0),
+            variation.for_design(&net, 0, 1),
+        ];
+        let first_stiffness = |v: &Variation| -> Vec<f64> {
+            (0..v.samples)
+                .map(|k| v.device(&forcing, &[1.0; 5], k).1[0] - 1.0)
+                .collect()
+        };
+        let draws: Vec<Vec<f64>> = designs.iter().map(first_stiffness).collect();
+        // The correlation of device k's first hinge across designs: 2000 pairs, so
+        // independent draws give |r| below 4/sqrt(2000) = 0.09 (common numbers give 1).
+        let correlation = |a: &[f64], b: &[f64]| {
+            let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
+            dot(a, b) / (dot(a, a) * dot(b, b)).sqrt()
+        };
+        for i in 0..draws.len() {
+            for j in 0..i {
+                let r = correlation(&draws[i], &draws[j]);
+                assert!(r.abs() < 0.09, "designs {i} and {j}: r = {r}");
+            }
+        }
+        assert_eq!(variation.for_design(&net, 1, 0), designs[1]);
+        assert_eq!(first_stiffness(&variation.for_design(&net, 1, 0)), draws[1]);
     }
 }

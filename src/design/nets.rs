@@ -343,7 +343,8 @@ pub struct Study {
     pub variation: Variation,
     /// How seams latch.
     pub closing: ClosingSettings,
-    /// Devices run (nominal and sampled).
+    /// Devices run: each release's nominal and sampled ones, and each net's fresh ones for
+    /// its best release.
     pub devices: usize,
     /// The sampled devices that did not close, over every release, by how they ended.
     pub failures: Failures,
