@@ -382,33 +382,16 @@ pub fn apply_releases(
     }
     // Each best release's yield again, from fresh devices: run here, after the choice, one
     // net per job on the machine's cores.
-    let fresh: Vec<std::sync::Mutex<Option<Result<Option<YieldEstimate>>>>> =
-        summaries.iter().map(|_| std::sync::Mutex::new(None)).collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(summaries.len().max(1));
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some((rank, summary, made, folds)) = summaries.get(k) else {
-                    break;
-                };
-                let result = fresh_yield(made, &report.solid, *rank, folds, summary.best, options);
-                *fresh[k].lock().expect("no job panics holding it") = Some(result);
-            });
-        }
+    let fresh = on_cores(summaries.len(), &|k| {
+        let (rank, summary, made, folds) = &summaries[k];
+        fresh_yield(made, &report.solid, *rank, folds, summary.best, options)
     });
     let mut summaries: Vec<(usize, NetClosingSummary)> = summaries
         .into_iter()
         .map(|(rank, summary, _, _)| (rank, summary))
         .collect();
-    for ((_, summary), slot) in summaries.iter_mut().zip(fresh) {
-        summary.fresh_yield = slot
-            .into_inner()
-            .expect("no job panics holding it")
-            .expect("every job ran")?;
+    for ((_, summary), result) in summaries.iter_mut().zip(fresh) {
+        summary.fresh_yield = result?;
     }
     let variation = options.variation();
     let mut failures = Failures::default();
@@ -517,6 +500,36 @@ fn fresh_yield(
     Ok(sampled_devices(&closing, model, &variation, options)?.0)
 }
 
+/// Jobs 0..count run on the machine's cores (each worker takes the next job left), their
+/// answers in job order.
+fn on_cores<T: Send>(count: usize, job: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
+    let answers: Vec<std::sync::Mutex<Option<T>>> = (0..count).map(|_| std::sync::Mutex::new(None)).collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(count.max(1));
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                if k >= count {
+                    break;
+                }
+                let answer = job(k);
+                *answers[k].lock().expect("no job panics holding it") = Some(answer);
+            });
+        }
+    });
+    answers
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .expect("no job panics holding it")
+                .expect("every job ran")
+        })
+        .collect()
+}
+
 /// Simulates the best `options.simulate` nets that can be made, every release of each
 /// (`options.releases()`), on the machine's cores; `progress(done, total)` hears of each
 /// release finished. The table gets each net's closing (and is ranked again by yield when
@@ -547,31 +560,16 @@ pub fn study_nets(
     let jobs: Vec<(usize, usize)> = (0..nets.len())
         .flat_map(|n| (0..releases.len()).map(move |r| (n, r)))
         .collect();
-    let results: Vec<std::sync::Mutex<Option<Result<ReleaseResult>>>> =
-        jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len().max(1));
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(n, r)) = jobs.get(k) else { break };
-                let folds = &report.nets[ranks[n] - 1].folds;
-                let result = study_release(&nets[n], &report.solid, ranks[n], folds, r, releases[r], options);
-                *results[k].lock().expect("no job panics holding it") = Some(result);
-                progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, jobs.len());
-            });
-        }
+    let results = on_cores(jobs.len(), &|k| {
+        let (n, r) = jobs[k];
+        let folds = &report.nets[ranks[n] - 1].folds;
+        let result = study_release(&nets[n], &report.solid, ranks[n], folds, r, releases[r], options);
+        progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1, jobs.len());
+        result
     });
     let mut by_net: Vec<Vec<ReleaseResult>> = vec![Vec::new(); nets.len()];
-    for ((n, _), slot) in jobs.iter().zip(results) {
-        let result = slot
-            .into_inner()
-            .expect("no job panics holding it")
-            .expect("every job ran");
+    for ((n, _), result) in jobs.iter().zip(results) {
         by_net[*n].push(result?);
     }
     let by_rank = ranks.iter().copied().zip(by_net).collect();

@@ -186,6 +186,22 @@ pub fn clopper_pearson(successes: usize, trials: usize, confidence: f64) -> [f64
 mod tests {
     use super::*;
 
+    /// `hinges` step drives to 1 rad with ρ_c 2.
+    fn step_drives(hinges: usize) -> Forcing {
+        Forcing {
+            actuation: crate::dynamics::Actuation::Step,
+            hinges: vec![
+                crate::dynamics::HingeDrive {
+                    target: 1.0,
+                    radius_of_curvature: 2.0,
+                    actuated: true,
+                    release_time: 0.0,
+                };
+                hinges
+            ],
+        }
+    }
+
     #[test]
     fn the_interval_holds_its_closed_forms_at_the_ends() {
         // None of n: the upper end solves (1 − p)^n = α/2; all of n: the lower p^n = α/2.
@@ -213,18 +229,7 @@ mod tests {
 
     #[test]
     fn sampled_factors_have_the_spread_asked_for() {
-        let forcing = Forcing {
-            actuation: crate::dynamics::Actuation::Step,
-            hinges: vec![
-                crate::dynamics::HingeDrive {
-                    target: 1.0,
-                    radius_of_curvature: 2.0,
-                    actuated: true,
-                    release_time: 0.0,
-                };
-                4
-            ],
-        };
+        let forcing = step_drives(4);
         let variation = Variation {
             samples: 4000,
             stiffness_spread_percent: 10.0,
@@ -274,18 +279,7 @@ mod tests {
     /// set give the same devices.
     #[test]
     fn each_design_and_draw_set_has_its_own_devices() {
-        let forcing = Forcing {
-            actuation: crate::dynamics::Actuation::Step,
-            hinges: vec![
-                crate::dynamics::HingeDrive {
-                    target: 1.0,
-                    radius_of_curvature: 2.0,
-                    actuated: true,
-                    release_time: 0.0,
-                };
-                5
-            ],
-        };
+        let forcing = step_drives(5);
         let variation = Variation {
             samples: 2000,
             stiffness_spread_percent: 2.0,
