@@ -365,7 +365,9 @@ pub struct NetClosingSummary {
     /// Releases whose nominal device closes.
     pub closes_in: usize,
     /// The best release's yield from fresh devices, independent of those it was chosen
-    /// on (None: none sampled): the yield to report, free of the choice's optimism.
+    /// on (None: none sampled, and left out of the JSON): the yield to report, free of the
+    /// choice's optimism.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub fresh_yield: Option<crate::design::fabrication::YieldEstimate>,
 }
 
