@@ -1058,6 +1058,45 @@ fn print_model(response: &Response) {
     }
 }
 
+/// A slow release carried through contact, or why it stopped at the first one.
+fn print_released(scene: &Scene, simulation: &nanofold::dynamics::simulate::Simulation) {
+    use nanofold::dynamics::simulate::{first_contact_only, ModelKind};
+    let response = &simulation.response;
+    match (&simulation.released, scene.network()) {
+        (Some(run), _) => {
+            let ended = match run.outcome.label() {
+                "jams" => "jams (held by contact forces)",
+                other => other,
+            };
+            println!(
+                "  carried through contact: {} at t = {:.6e} s; {} seams latched, {} contacts met",
+                ended,
+                run.time_s,
+                run.latches.len(),
+                run.contacts.len()
+            );
+            if let Some(why) = &run.undecided {
+                println!("  why it stopped: {why}");
+            }
+            for open in &run.open_seams {
+                println!("  seam {} open, its ends {:.3e} of its length apart", open.0, open.1);
+            }
+            for c in run.final_contacts.iter().filter(|c| c.force_n > 0.0) {
+                println!(
+                    "  face {} pressed on face {} ({}) at ({:.2}, {:.2}, {:.2}) µm with {:.3e} N",
+                    c.faces[0], c.faces[1], c.feature, c.point_um[0], c.point_um[1], c.point_um[2], c.force_n
+                );
+            }
+        }
+        (None, Some(model)) if response.model == ModelKind::QuasiStatic && response.collision.is_some() => {
+            if let Some(why) = first_contact_only(model) {
+                println!("  the run ends at its first contact: {why}");
+            }
+        }
+        _ => {}
+    }
+}
+
 fn print_contact(response: &Response) {
     match &response.collision {
         Some(c) => println!(
@@ -1536,6 +1575,7 @@ fn run_simulate_with(args: &SimulateArgs, progress: ProgressObserver) -> Result<
         let degrees: Vec<String> = last.angles.iter().map(|a| format!("{:.3}°", a.to_degrees())).collect();
         println!("  angles at t = {:.6e} s: {}", last.time, degrees.join(", "));
     }
+    print_released(&scene, simulation);
     if let Some(report) = &simulation.network {
         if report.meeting_at_contact.len() > 1 {
             let pairs: Vec<String> = report

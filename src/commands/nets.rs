@@ -227,6 +227,7 @@ pub fn net_scene(
         "anchored_face": anchored,
         "actuation": actuation,
         "environment": {"drag": true},
+        "seams": made.seams,
         "time": {"t_end_s": t_end_s}
     }))
 }

@@ -10,6 +10,7 @@
 
 pub(crate) mod algorithms;
 pub(crate) mod assemble;
+pub mod closing;
 pub(crate) mod contact;
 pub(crate) mod contact_balance;
 pub(crate) mod face_contact;

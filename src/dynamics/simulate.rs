@@ -6,8 +6,9 @@
 use super::closed::{ClosedPlant, ClosedReport};
 use super::contact::Collision;
 use super::integrate::{integrate, output_times, IntegrationOptions, Method, ProgressObserver, IMPLICIT_RATIO};
+use super::network::closing::{ClosingReport, ClosingSettings, NetClosing};
 use super::network::plant::NetworkRunReport;
-use super::network::{NetworkPlant, ReducedPlant};
+use super::network::{NetworkModel, NetworkPlant, ReducedPlant};
 use super::plant::{Plant, Sample, TimeScales};
 use super::quasi_static::{quasi_static_deviation, quasi_static_path};
 use super::scene::{Scene, System};
@@ -185,6 +186,30 @@ pub struct Simulation {
     pub closed: Option<ClosedReport>,
     /// A network's branch, closure residuals and energy balance.
     pub network: Option<NetworkRunReport>,
+    /// A tree of panels released slowly, carried through its contacts: how it ended, its
+    /// latches, contacts and forces (`docs/model.md#slow-release-through-contact`).
+    pub released: Option<ClosingReport>,
+}
+
+/// Why a network's slow release stops at its first contact instead of going on through it
+/// with the contact engine (None: it goes on).
+pub fn first_contact_only(model: &NetworkModel) -> Option<&'static str> {
+    if !model.folding.stars.is_empty() {
+        Some("the pattern closes loops of its own (the contact engine follows trees of panels)")
+    } else if model.reduction.is_some() {
+        Some("the scene moves on fitted curves")
+    } else if model.substrate_contact {
+        Some("the substrate is a contact (the contact engine has faces only)")
+    } else if model
+        .forcing
+        .hinges
+        .iter()
+        .any(|h| h.target.abs() >= std::f64::consts::PI)
+    {
+        Some("a drive folds its crease flat (a crease's own limit, which the contact engine does not watch)")
+    } else {
+        None
+    }
 }
 
 /// Runs a scene: the dynamics, or the quasi-static path when the model is chosen so (`auto`:
@@ -206,58 +231,72 @@ pub fn simulate_scene(scene: &Scene, settings: &SimulationSettings) -> Result<Si
     let collisions = !settings.ignore_collisions;
     match &scene.system {
         System::Strip(chain) => {
-            let response = run(
+            let (response, _) = run(
                 &StripPlant::new(chain, collisions),
                 &StripPlant::new(chain, false),
                 settings,
                 &times,
+                None,
             )?;
             Ok(Simulation {
                 response,
                 closed: None,
                 network: None,
+                released: None,
             })
         }
         System::Closed(chain) => {
-            let response = run(
+            let (response, _) = run(
                 &ClosedPlant::new(chain, collisions),
                 &ClosedPlant::new(chain, false),
                 settings,
                 &times,
+                None,
             )?;
             let closed = Some(chain.report(&response.samples)?);
             Ok(Simulation {
                 response,
                 closed,
                 network: None,
+                released: None,
             })
         }
         System::Network(model) => {
-            let (response, network) = match &model.reduction {
+            let (response, network, released) = match &model.reduction {
                 Some(reduction) => {
                     let plant = ReducedPlant::new(model, reduction, collisions)?;
-                    let response = run(&plant, &plant.without_contacts(), settings, &times)?;
+                    let (response, _) = run(&plant, &plant.without_contacts(), settings, &times, None)?;
                     let report = plant.report(&response.samples, response.collision.is_some())?;
-                    (response, report)
+                    (response, report, None)
                 }
                 None => {
                     let plant = NetworkPlant::new(model, collisions)?;
-                    let response = run(&plant, &plant.without_contacts(), settings, &times)?;
+                    let engine = (collisions && first_contact_only(model).is_none() && plant.dof() == model.columns())
+                        .then_some(&**model);
+                    let (response, released) = run(&plant, &plant.without_contacts(), settings, &times, engine)?;
                     let report = plant.report(&response.samples, response.collision.is_some())?;
-                    (response, report)
+                    (response, report, released)
                 }
             };
             Ok(Simulation {
                 response,
                 closed: None,
                 network: Some(network),
+                released,
             })
         }
     }
 }
 
-/// One run of a plant (`check` is the same plant without contacts, for the model's check).
-fn run<P: Plant>(plant: &P, check: &P, settings: &SimulationSettings, times: &[f64]) -> Result<Response> {
+/// One run of a plant (`check` is the same plant without contacts, for the model's check);
+/// a tree of panels given as `engine` goes on through its contacts when quasi-static.
+fn run<P: Plant>(
+    plant: &P,
+    check: &P,
+    settings: &SimulationSettings,
+    times: &[f64],
+    engine: Option<&NetworkModel>,
+) -> Result<(Response, Option<ClosingReport>)> {
     let started = Instant::now();
     let t_end = times.last().copied().unwrap_or(0.0);
     let scales = plant.time_scales()?;
@@ -277,6 +316,7 @@ fn run<P: Plant>(plant: &P, check: &P, settings: &SimulationSettings, times: &[f
         rhs_evaluations: 0,
         seconds: 0.0,
     };
+    let mut released = None;
     match kind {
         ModelKind::Dynamic => {
             let method = settings.method.resolve(&scales);
@@ -304,19 +344,65 @@ fn run<P: Plant>(plant: &P, check: &P, settings: &SimulationSettings, times: &[f
             response.samples = run.samples;
         }
         ModelKind::QuasiStatic => {
-            let path = quasi_static_path(plant, times)?;
-            response.samples = path.samples;
-            response.collision = path.collision;
-            response.steps = path.scans;
+            match engine {
+                Some(model) => {
+                    let (samples, report, solves) = released_path(plant, model, t_end, times)?;
+                    response.samples = samples;
+                    response.steps = solves;
+                    response.collision = NetClosing::of_scene(model)?
+                        .first_meeting(model, &report)
+                        .map(|(time, pair, point)| Collision { time, pair, point });
+                    released = Some(report);
+                }
+                None => {
+                    let path = quasi_static_path(plant, times)?;
+                    response.samples = path.samples;
+                    response.collision = path.collision;
+                    response.steps = path.scans;
+                }
+            }
             // The check of the model: a short dynamic run from rest.
             let (window, method, options) = settings.check_run(&scales, t_end);
             let checked = integrate(check, method, &output_times(window, 201), options)?;
             response.measured_quasi_static_error = Some((window, quasi_static_deviation(check, &checked.samples)?));
         }
     }
-    if let Some(c) = &response.collision {
-        response.t_end = c.time;
+    match &released {
+        // Through contact: the run ends where the engine's path does.
+        Some(report) => response.t_end = report.time_s.min(t_end),
+        None => {
+            if let Some(c) = &response.collision {
+                response.t_end = c.time;
+            }
+        }
     }
     response.seconds = started.elapsed().as_secs_f64();
-    Ok(response)
+    Ok((response, released))
+}
+
+/// A tree of panels' slow release through its contacts and seams, sampled at `times` (up
+/// to where it ends): (samples, the engine's report, its QP solves).
+fn released_path<P: Plant>(
+    plant: &P,
+    model: &NetworkModel,
+    t_end: f64,
+    times: &[f64],
+) -> Result<(Vec<Sample>, ClosingReport, usize)> {
+    let closing = NetClosing::of_scene(model)?;
+    let path = closing.run_until(
+        model,
+        &model.forcing,
+        &model.stiffness(),
+        &ClosingSettings::default(),
+        t_end,
+        Some(times),
+    )?;
+    let mut ws = plant.workspace();
+    let samples = path
+        .samples
+        .iter()
+        .map(|s| plant.sample(s.time_s, &s.fold_angles, &s.rates, &[], &mut ws))
+        .collect::<Result<Vec<_>>>()?;
+    plant.check_samples(&samples)?;
+    Ok((samples, path.report, path.qp_solves))
 }

@@ -248,3 +248,127 @@ pub fn net_pattern(solid: &Polyhedron, net: &FlatNet, name: &str) -> Result<NetP
         centre_face,
     })
 }
+
+/// Seams named on a sheet of panels (a scene's `seams`): each a pair of the paper's
+/// boundary edges that meet once folded, and which pattern vertices they make one point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeamGluing {
+    /// Each seam's two edges (pattern edge indices).
+    pub edges: Vec<[usize; 2]>,
+    /// Each pattern vertex's point once every seam is shut (numbered from 0; a vertex on
+    /// no seam is a point of its own).
+    pub point: Vec<usize>,
+}
+
+/// Two edges of one seam may differ in length by this share of their length (plus the
+/// file's own precision): a file written at six significant digits.
+const SEAM_LENGTH_MATCH: f64 = 1e-6;
+
+impl SeamGluing {
+    /// The seams `edges` (FOLD edge indices) of `pattern`, validated: each pair two
+    /// different boundary edges of different faces, of one length, every edge in one seam
+    /// at most. The ends meet as the surface closes without turning over: walked with its
+    /// face (counter-clockwise), one edge's start meets the other's end.
+    pub fn new(pattern: &CreasePattern, edges: &[[usize; 2]]) -> Result<SeamGluing> {
+        let field = |k: usize| format!("seams[{k}]");
+        let mut used = vec![None; pattern.edges.len()];
+        let mut parent: Vec<usize> = (0..pattern.vertices.len()).collect();
+        fn root(parent: &mut [usize], mut v: usize) -> usize {
+            while parent[v] != v {
+                parent[v] = parent[parent[v]];
+                v = parent[v];
+            }
+            v
+        }
+        for (k, &[e, f]) in edges.iter().enumerate() {
+            for edge in [e, f] {
+                if edge >= pattern.edges.len() {
+                    return Err(NanofoldError::invalid(
+                        field(k),
+                        format!("[{e}, {f}]"),
+                        format!("the pattern has edges 0 to {}", pattern.edges.len() - 1),
+                    ));
+                }
+                if pattern.kinds[edge] != EdgeKind::Boundary {
+                    return Err(NanofoldError::invalid(
+                        field(k),
+                        format!("[{e}, {f}]"),
+                        format!("edge {edge} is not on the paper's boundary (a seam joins two cut edges)"),
+                    ));
+                }
+                if let Some(other) = used[edge] {
+                    return Err(NanofoldError::invalid(
+                        field(k),
+                        format!("[{e}, {f}]"),
+                        format!("edge {edge} is already in seams[{other}]"),
+                    ));
+                }
+                used[edge] = Some(k);
+            }
+            if e == f {
+                return Err(NanofoldError::invalid(
+                    field(k),
+                    format!("[{e}, {f}]"),
+                    "a seam joins two different edges",
+                ));
+            }
+            // Each edge as its face walks it: (start, end, face).
+            let walked = |edge: usize| {
+                let [a, b] = pattern.edges[edge];
+                match pattern.edge_faces[edge] {
+                    [Some(face), _] => (a, b, face),
+                    [None, Some(face)] => (b, a, face),
+                    [None, None] => (a, b, usize::MAX),
+                }
+            };
+            let ((a0, a1, face_e), (b0, b1, face_f)) = (walked(e), walked(f));
+            if face_e == usize::MAX || face_f == usize::MAX {
+                return Err(NanofoldError::invalid(
+                    field(k),
+                    format!("[{e}, {f}]"),
+                    "a seam's edges bound a face",
+                ));
+            }
+            if pattern.panel_of_face[face_e] == pattern.panel_of_face[face_f] {
+                return Err(NanofoldError::invalid(
+                    field(k),
+                    format!("[{e}, {f}]"),
+                    "both edges bound one panel: a seam joins two panels",
+                ));
+            }
+            let length = |[p, q]: [usize; 2]| {
+                let (x, y) = (pattern.vertices[p], pattern.vertices[q]);
+                (x[0] - y[0]).hypot(x[1] - y[1])
+            };
+            let (le, lf) = (length(pattern.edges[e]), length(pattern.edges[f]));
+            if (le - lf).abs() > SEAM_LENGTH_MATCH * le.max(lf) + pattern.length_precision {
+                return Err(NanofoldError::invalid(
+                    field(k),
+                    format!("[{e}, {f}]: lengths {le} and {lf}"),
+                    format!(
+                        "a seam's edges meet end to end, so their lengths agree to {SEAM_LENGTH_MATCH:e} of the length"
+                    ),
+                ));
+            }
+            for (v, w) in [(a0, b1), (a1, b0)] {
+                let (rv, rw) = (root(&mut parent, v), root(&mut parent, w));
+                parent[rv] = rw;
+            }
+        }
+        let mut number = vec![usize::MAX; parent.len()];
+        let mut point = vec![0; parent.len()];
+        let mut next = 0;
+        for v in 0..parent.len() {
+            let r = root(&mut parent, v);
+            if number[r] == usize::MAX {
+                number[r] = next;
+                next += 1;
+            }
+            point[v] = number[r];
+        }
+        Ok(SeamGluing {
+            edges: edges.to_vec(),
+            point,
+        })
+    }
+}

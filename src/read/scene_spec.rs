@@ -626,6 +626,10 @@ pub struct NetworkSpec<P> {
     /// How the closures are kept (default: exactly, every crease a coordinate).
     #[serde(default)]
     pub constraint: Option<NetworkConstraintSpec>,
+    /// Pairs of the paper's boundary edges (FOLD edge indices) that latch when they meet:
+    /// a net's seams (a tree of panels only).
+    #[serde(default)]
+    pub seams: Vec<[usize; 2]>,
     /// The time span.
     pub time: TimeSpec,
     /// What to record.
@@ -690,6 +694,7 @@ impl<P> NetworkSpec<P> {
             environment: self.environment,
             substrate: self.substrate,
             constraint: self.constraint,
+            seams: self.seams,
             time: self.time,
             outputs: self.outputs,
         })

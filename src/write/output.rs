@@ -399,6 +399,7 @@ pub fn response_summary(scene: &Scene, settings: &SimulationSettings, simulation
         seconds: response.seconds,
         closed,
         network,
+        released: simulation.released.clone(),
     }
 }
 

@@ -585,6 +585,9 @@ pub struct ResponseSummary {
     /// A network's figures.
     #[serde(flatten)]
     pub network: Option<NetworkRunSummary>,
+    /// A tree of panels released slowly through its contacts: how it ended, its latches,
+    /// contacts and forces, the frames at its events.
+    pub released: Option<crate::dynamics::network::closing::ClosingReport>,
 }
 
 /// The time scales a run's model was chosen from, s.

@@ -210,6 +210,19 @@ pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
             "the panel's mass overflows or vanishes in double precision: check length_unit_um, plates.thickness_um and the density",
         ));
     }
+    if !spec.seams.is_empty() {
+        if !model.folding.stars.is_empty() {
+            return Err(NanofoldError::invalid(
+                "seams",
+                format!("{} pairs", spec.seams.len()),
+                "seams latch on a tree of panels (a net); this pattern closes loops of its own",
+            ));
+        }
+        model.seams = Some(crate::pattern::net::SeamGluing::new(
+            &model.folding.pattern,
+            &spec.seams,
+        )?);
+    }
     if let Some(constraint) = &spec.constraint {
         match constraint.source {
             NetworkSource::Poly => model.reduction = Some(reduce(&model, constraint)?),

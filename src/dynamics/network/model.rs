@@ -125,6 +125,9 @@ pub struct NetworkModel {
     /// The fitted curves a one-DOF network moves on instead of its exact closures, when the
     /// scene chooses them (`constraint.source` "poly").
     pub reduction: Option<super::fitted::FittedReduction>,
+    /// The seams a tree of panels latches as it closes (a scene's `seams`; None: faces
+    /// only push on each other).
+    pub seams: Option<crate::pattern::net::SeamGluing>,
 }
 
 /// The inputs of [`NetworkModel::new`], in SI units.
@@ -292,6 +295,7 @@ impl NetworkModel {
             substrate_contact,
             mass_pattern: Vec::new(),
             reduction: None,
+            seams: None,
         };
         let mut mass_pattern = Vec::new();
         for &p in &model.order[1..] {
