@@ -27,11 +27,11 @@ $bin fit patterns/bridge_step.scene.json patterns/measurements/bridge_step_measu
 cp "$out/fit/fit.svg" docs/fit_bridge_step.svg
 $bin nets octahedron --top 11 --unit-um 50 --out "$out/nets" > /dev/null
 cp "$out/nets/gallery.svg" docs/nets_octahedron_gallery.svg
-for scene in cube_closes cube_jams miura_sheet; do
+for scene in cube_closes cube_lid_first miura_sheet; do
   $bin simulate "patterns/devices/$scene.scene.json" --out "$out/$scene" > /dev/null
 done
 cp "$out/cube_closes/snapshots.svg" docs/cube_closes_snapshots.svg
-cp "$out/cube_jams/snapshots.svg" docs/cube_jams_snapshots.svg
+cp "$out/cube_lid_first/snapshots.svg" docs/cube_lid_first_snapshots.svg
 cp "$out/miura_sheet/response.svg" docs/miura_sheet_response.svg
 # The closed chain's timing figure, likewise from a kept report (README's poly-against-exact
 # table quotes it).

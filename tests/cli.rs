@@ -1656,7 +1656,7 @@ fn the_bundled_cubes_closing_and_jam_come_back_through_the_nets_path() {
     // The cube's most compact net is the Latin cross; laid by `nets` its hub-to-lid arm runs
     // along −x where the bundled cube_net.fold's runs along +y, so the bundled front along
     // +y (closes) is 180° here and −y (jams) is 0°. Squares of 100 µm, hinges to 95°.
-    for (bundled, front) in [("cube_closes", "180"), ("cube_jams", "0")] {
+    for (bundled, front) in [("cube_closes", "180"), ("cube_lid_first", "0")] {
         let dir = temp_dir(&format!("nets-{bundled}"));
         let made = nanofold()
             .args([

@@ -153,7 +153,7 @@ fn the_docs_figures_are_current() {
     // Devices of many panels.
     for (scene, figure) in [
         ("cube_closes", "snapshots"),
-        ("cube_jams", "snapshots"),
+        ("cube_lid_first", "snapshots"),
         ("miura_sheet", "response"),
     ] {
         run(&["simulate", &format!("patterns/devices/{scene}.scene.json")], scene);

@@ -329,7 +329,7 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
         );
     }
 
-    let jams = scene_file("patterns/devices/cube_jams.scene.json");
+    let jams = scene_file("patterns/devices/cube_lid_first.scene.json");
     let run = simulate_scene(&jams, &SimulationSettings::default()).unwrap();
     let contact = run.response.collision.unwrap();
     assert_eq!(
@@ -456,7 +456,7 @@ fn a_network_scene_must_start_rigid() {
 /// equilibrium; nanofold reads both back (the key frame carries a state).
 #[test]
 fn network_fold_animations_hold_rigid_sheets() {
-    let scene = scene_file("patterns/devices/cube_jams.scene.json");
+    let scene = scene_file("patterns/devices/cube_lid_first.scene.json");
     let model = network(&scene);
     let run = simulate_scene(&scene, &SimulationSettings::default()).unwrap();
     let motion = nanofold::write::network_motion_fold(model, &run.response);

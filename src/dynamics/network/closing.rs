@@ -712,7 +712,8 @@ impl NetClosing {
                 let m = self.misalignment(data, k);
                 m <= ALIGNED
                     || (m <= capture
-                        && ((!holds.blocked[k] && self.seam_touching(holds, k)) || self.seam_passed(data, sides, k)))
+                        && !holds.blocked[k]
+                        && (self.seam_touching(holds, k) || self.seam_passed(data, sides, k)))
             }
         };
         let placed = self.contacts.placed(data);
@@ -1526,6 +1527,7 @@ fn feature_name(feature: &Feature) -> &'static str {
         Feature::CornerOnFace { .. } => "corner on face",
         Feature::EdgeOnCorner { .. } => "edge on a shared corner",
         Feature::EdgeOnEdge { .. } => "edge on edge",
+        Feature::EdgeMiddleOnFace { .. } => "seam edge across a face",
     }
 }
 
@@ -2013,7 +2015,9 @@ impl Run<'_> {
                 .filter_map(|k| {
                     let m = net.misalignment(&self.data, k);
                     (m <= ALIGNED_TOGETHER
-                        || (m <= self.capture && !self.holds.blocked[k] && net.seam_touching(&self.holds, k)))
+                        || (m <= self.capture
+                            && !self.holds.blocked[k]
+                            && (net.seam_touching(&self.holds, k) || net.seam_passed(&self.data, &self.sides, k))))
                     .then_some((k, m))
                 })
                 .collect();

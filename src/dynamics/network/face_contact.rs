@@ -64,6 +64,20 @@ pub enum Feature {
         /// the edges from it measure the contact there.
         copy: Option<[usize; 2]>,
     },
+    /// The middle of edge `edge` of face `face`, both of whose ends are copies of corners
+    /// of face `other` (`copies`, in order): a seam's edge, as long as the face it may cross
+    /// is wide, whose corners stay on that face's outline and whose partner edge runs
+    /// parallel to it, so that neither a corner nor an edge crossing sees it go through.
+    EdgeMiddleOnFace {
+        /// The face the edge belongs to.
+        face: usize,
+        /// The edge (pattern vertices).
+        edge: [usize; 2],
+        /// The face it may cross.
+        other: usize,
+        /// The other face's copies of the edge's ends.
+        copies: [usize; 2],
+    },
 }
 
 impl Feature {
@@ -72,7 +86,8 @@ impl Feature {
         match *self {
             Feature::CornerOnFace { face, other, .. }
             | Feature::EdgeOnCorner { face, other, .. }
-            | Feature::EdgeOnEdge { face, other, .. } => [face, other],
+            | Feature::EdgeOnEdge { face, other, .. }
+            | Feature::EdgeMiddleOnFace { face, other, .. } => [face, other],
         }
     }
 }
@@ -218,6 +233,17 @@ impl FaceContacts {
                         }
                     }
                 }
+                for edge in edges(f) {
+                    let copy = |v: usize| faces[g].iter().copied().find(|&w| copies[w] == copies[v] && w != v);
+                    if let (Some(a), Some(b)) = (copy(edge[0]), copy(edge[1])) {
+                        features.push(Feature::EdgeMiddleOnFace {
+                            face: f,
+                            edge,
+                            other: g,
+                            copies: [a, b],
+                        });
+                    }
+                }
                 if f < g {
                     for edge in edges(f) {
                         for other_edge in edges(g) {
@@ -354,6 +380,25 @@ impl FaceContacts {
                 let distance = normal.dot(&(point - corners[0]));
                 let apart = copy.is_none_or(|w| (self.at(placed, other, w) - point).norm() > MET * self.size);
                 let over = apart
+                    && (0..corners.len()).all(|i| {
+                        let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+                        let along = b - a;
+                        along.cross(&(point - a)).dot(&normal) >= margin * along.norm()
+                    });
+                FeatureState::on_plane(point, normal, distance, over)
+            }
+            Feature::EdgeMiddleOnFace {
+                face,
+                edge,
+                other,
+                copies,
+            } => {
+                let point = (self.at(placed, face, edge[0]) + self.at(placed, face, edge[1])) * 0.5;
+                let normal = placed.normals[other];
+                let corners = &placed.corners[other];
+                let distance = normal.dot(&(point - corners[0]));
+                let middle = (self.at(placed, other, copies[0]) + self.at(placed, other, copies[1])) * 0.5;
+                let over = (middle - point).norm() > MET * self.size
                     && (0..corners.len()).all(|i| {
                         let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
                         let along = b - a;
