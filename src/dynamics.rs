@@ -28,9 +28,9 @@ pub mod sensitivity;
 pub mod simulate;
 pub(crate) mod spec;
 pub(crate) mod strip;
-pub use integrate::Method;
+pub use integrate::{output_times, Method};
 pub use plant::Plant;
-pub use quasi_static::quasi_static_deviation;
+pub use quasi_static::{quasi_static_deviation, quasi_static_path, QuasiStaticPath};
 pub use strip::StripPlant;
 
 pub use contact::Collision;

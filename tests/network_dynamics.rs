@@ -291,6 +291,16 @@ fn the_corner_cube_through_the_network_keeps_its_step_times() {
     }
 }
 
+/// The first contact of a slow release as the plant's own locator finds it (the run up to
+/// there, without the contact engine).
+fn first_contact(scene: &Scene) -> (nanofold::dynamics::Collision, Vec<f64>) {
+    let plant = NetworkPlant::new(network(scene), true).unwrap();
+    let times = nanofold::dynamics::output_times(scene.t_end, scene.outputs.samples);
+    let path = nanofold::dynamics::quasi_static_path(&plant, &times).unwrap();
+    let last = path.samples.last().unwrap().angles.as_slice().to_vec();
+    (path.collision.unwrap(), last)
+}
+
 /// The etch front's arithmetic: along +y the south wall's crease is passed first (t = 0), the
 /// east, west and north ones after 100 µm (4000 s at 1.5 µm/min), the lid's after 200 µm;
 /// each ramps to 95° in ρ_c θ / a = 1326.5 s. The walls released together meet the first one
@@ -299,7 +309,7 @@ fn the_corner_cube_through_the_network_keeps_its_step_times() {
 /// (y, z) = (1 + cos 95° + cos 190°, sin 95° + sin 190°) side lengths, which the south wall's
 /// plane reaches at atan(z / −y) = 85.0°.
 #[test]
-fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
+fn the_cubes_first_contact_comes_where_the_etch_front_and_plane_geometry_put_it() {
     let ramp = 20.0 * 95f64.to_radians() / 1.5 * 60.0;
     let closes = scene_file("patterns/devices/cube_closes.scene.json");
     let release: Vec<f64> = network(&closes).forcing.hinges.iter().map(|h| h.release_time).collect();
@@ -307,9 +317,7 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
     for (got, want) in release.iter().zip(expected) {
         assert!((got - want).abs() < 1e-9 * 8000.0, "{release:?}");
     }
-    let run = simulate_scene(&closes, &SimulationSettings::default()).unwrap();
-    let contact = run.response.collision.unwrap();
-    let angles = &run.response.samples.last().unwrap().angles;
+    let (contact, angles) = first_contact(&closes);
     // The south wall stands at 95°; the east, west and north walls rise together and meet it
     // and each other at the cube's four corners as they pass 90°, all at one moment.
     assert!((angles[0] - 95f64.to_radians()).abs() < 1e-9);
@@ -321,7 +329,10 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
         );
     }
     assert!((contact.time - (4000.0 + ramp * 90.0 / 95.0)).abs() < 1e-6 * contact.time);
-    let meeting = run.network.unwrap().meeting_at_contact;
+    let plant = NetworkPlant::new(network(&closes), true).unwrap();
+    let times = nanofold::dynamics::output_times(closes.t_end, closes.outputs.samples);
+    let path = nanofold::dynamics::quasi_static_path(&plant, &times).unwrap();
+    let meeting = plant.report(&path.samples, true).unwrap().meeting_at_contact;
     for vertex in 0..4 {
         assert!(
             meeting.iter().any(|[_, b]| b.ends_with(&format!("at vertex {vertex}"))),
@@ -329,9 +340,8 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
         );
     }
 
-    let jams = scene_file("patterns/devices/cube_lid_first.scene.json");
-    let run = simulate_scene(&jams, &SimulationSettings::default()).unwrap();
-    let contact = run.response.collision.unwrap();
+    let lid_first = scene_file("patterns/devices/cube_lid_first.scene.json");
+    let (contact, angles) = first_contact(&lid_first);
     assert_eq!(
         contact.pair,
         ["face 1".to_string(), "face 5".to_string()],
@@ -342,7 +352,7 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
         95f64.to_radians().sin() + 190f64.to_radians().sin(),
     );
     let blocked = z.atan2(-y);
-    let south = run.response.samples.last().unwrap().angles[0];
+    let south = angles[0];
     assert!(
         (south - blocked).abs() < 1e-6,
         "{} vs {}",
@@ -350,6 +360,100 @@ fn the_cube_closes_or_jams_by_the_etch_fronts_direction() {
         blocked.to_degrees()
     );
     assert!((contact.time - (8000.0 + ramp * south / 95f64.to_radians())).abs() < 1e-6 * contact.time);
+}
+
+/// Past the first contact (`docs/model.md#slow-release-through-contact`): frictionless, the
+/// contact engine meets the cube's walls where the plant's own locator does (to 1e-9 of the
+/// time) and closes it when the lid's hinge reaches 90° (released after 200 µm of etch,
+/// turning at a/ρ_c: 8000 s + (π/2) ρ_c / a), every hinge at 90° and every seam latched.
+/// Released the other way, the south wall meets the lid's overhanging edge at 85° and
+/// pushes it back; the cube closes when the south wall reaches 90°, as late as the same
+/// closed form.
+#[test]
+fn simulate_carries_the_cube_through_contact_to_its_closing() {
+    let turn_rate = (1.5 / 60.0) / 20.0;
+    let closes_at = 8000.0 + (std::f64::consts::PI / 2.0) / turn_rate;
+    for (name, first) in [("cube_closes", "walls"), ("cube_lid_first", "lid")] {
+        let scene = scene_file(&format!("patterns/devices/{name}.scene.json"));
+        let run = simulate_scene(&scene, &SimulationSettings::default()).unwrap();
+        let released = run.released.as_ref().expect("a tree of panels goes on through contact");
+        assert_eq!(released.outcome.label(), "closes", "{name}: {released:?}");
+        assert_eq!(released.latches.len(), 7, "{name}");
+        assert!(
+            (released.time_s - closes_at).abs() <= 1e-9 * closes_at,
+            "{name}: closed at {} s, the closed form {closes_at} s",
+            released.time_s
+        );
+        assert!((run.response.t_end - closes_at).abs() <= 1e-9 * closes_at);
+        let last = run.response.samples.last().unwrap();
+        assert!((last.time - released.time_s).abs() <= 1e-9 * closes_at);
+        for angle in last.angles.iter() {
+            assert!((angle - std::f64::consts::FRAC_PI_2).abs() <= 1e-9, "{name}: {angle}");
+        }
+        // The first meeting: the walls at 90° (4000 s + 90/95 of a ramp), or the south wall
+        // reaching the lid's edge at the angle plane geometry gives (8000 s + that share).
+        let ramp = 95f64.to_radians() / turn_rate;
+        let met = match first {
+            "walls" => 4000.0 + ramp * 90.0 / 95.0,
+            _ => {
+                let (y, z) = (
+                    1.0 + 95f64.to_radians().cos() + 190f64.to_radians().cos(),
+                    95f64.to_radians().sin() + 190f64.to_radians().sin(),
+                );
+                8000.0 + ramp * z.atan2(-y) / 95f64.to_radians()
+            }
+        };
+        let engine = released.first_contact_time_s.unwrap();
+        assert!(
+            (engine - met).abs() <= 1e-9 * met,
+            "{name}: the engine first met at {engine} s, the closed form at {met} s"
+        );
+        assert!((run.response.collision.as_ref().unwrap().time - engine).abs() == 0.0);
+        // Before it, the run is today's quasi-static path: the plant's own locator finds
+        // the walls' meeting at the same time.
+        if first == "walls" {
+            let (contact, _) = first_contact(&scene);
+            assert!(
+                (engine - contact.time).abs() <= 1e-9 * contact.time,
+                "{name}: the engine first met at {engine} s, the plant's locator at {} s",
+                contact.time
+            );
+        }
+        // The samples' rates are the path's slope: against differences of the angles
+        // between samples with no event or ramp's start or end between them.
+        let samples = &run.response.samples;
+        let mut checked = 0;
+        for pair in samples.windows(3) {
+            let (a, b, c) = (&pair[0], &pair[1], &pair[2]);
+            // Events, and where a hinge's ramp starts or ends.
+            let ramp = 95f64.to_radians() / turn_rate;
+            let breaks = network(&scene)
+                .forcing
+                .hinges
+                .iter()
+                .flat_map(|h| [h.release_time, h.release_time + ramp]);
+            let events = released
+                .latches
+                .iter()
+                .map(|l| l.time_s)
+                .chain(released.contacts.iter().map(|c| c.time_s))
+                .chain(breaks);
+            if events.clone().any(|t| t > a.time && t <= c.time) {
+                continue;
+            }
+            for h in 0..b.angles.len() {
+                let slope = (c.angles[h] - a.angles[h]) / (c.time - a.time);
+                assert!(
+                    (b.rates[h] - slope).abs() <= 1e-6 * turn_rate + 1e-3 * slope.abs(),
+                    "{name} at {} s, hinge {h}: rate {} against the difference {slope}",
+                    b.time,
+                    b.rates[h]
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 100, "{name}: {checked} samples checked");
+    }
 }
 
 fn network_error(edit: impl Fn(&mut serde_json::Value)) -> String {

@@ -44,8 +44,8 @@ const HELD_MOVE: f64 = 1e-6;
 /// A sample's rates difference the balance over this turn of the drives either side, rad
 /// (its truncation error near 1e-8 of the rate, the balances' own about 1e-6).
 const RATE_TURN: f64 = 1e-4;
-/// The progress differenced where no drive moves.
-const RATE_PROGRESS: f64 = 1e-6;
+/// The most progress differenced (where the drives barely move).
+const RATE_PROGRESS: f64 = 1e-5;
 /// Bisection of an event's progress stops at this width.
 const LOCATE: f64 = 1e-15;
 /// A run's frames are kept at least this far apart in progress (and at every event).
@@ -718,10 +718,13 @@ impl NetClosing {
         };
         let placed = self.contacts.placed(data);
         let crosses = |k: usize, state: &FeatureState| {
-            sides.sign[k] != 0.0 && !holds.touching.contains(&k) && !self.held_by_seam(holds, k) && {
-                let state = sides.oriented(&self.contacts, k, *state);
-                state.over && state.distance < -tolerance
-            }
+            sides.orientation(&self.contacts, k).0 != 0.0
+                && !holds.touching.contains(&k)
+                && !self.held_by_seam(holds, k)
+                && {
+                    let state = sides.oriented(&self.contacts, k, *state);
+                    state.over && state.distance < -tolerance
+                }
         };
         match among {
             Some(among) => {
@@ -1838,16 +1841,15 @@ impl Run<'_> {
     }
 
     /// dθ/dt at progress `u`: the balance with the same holds settled a small turn of the
-    /// drives either side, differenced (one-sided at the path's ends or where one side
-    /// finds no balance; the secant from the last sample where neither does).
+    /// drives either side, differenced; one-sided where a drive starts or stops within
+    /// that turn (the path's slope jumps there), at the path's ends, or where one side
+    /// finds no balance; the secant from the last sample where neither does.
     fn rates_at(&self, u: f64) -> Vec<f64> {
         let n = self.theta.len();
-        let ahead = self.path.next(u, RATE_TURN) - u;
-        let h = if ahead > 0.0 { ahead } else { RATE_PROGRESS };
+        let ahead = (self.path.next(u, RATE_TURN) - u).min(RATE_PROGRESS);
+        let last_break = self.path.breaks.iter().copied().filter(|&b| b <= u).fold(0.0, f64::max);
+        let behind = (u - last_break).min(RATE_PROGRESS);
         let settled_at = |v: f64| -> Option<Vec<f64>> {
-            if !(0.0..=1.0).contains(&v) {
-                return None;
-            }
             let mut drive = vec![0.0; n];
             self.path.drive(v, &mut drive);
             let mut theta = self.theta.clone();
@@ -1865,24 +1867,37 @@ impl Run<'_> {
                 )
                 .then_some(theta)
         };
-        let (after, before) = (settled_at(u + h), settled_at(u - h));
-        let (span, from, to): (f64, &[f64], &[f64]) = match (&before, &after) {
-            (Some(b), Some(a)) => (2.0 * h, b, a),
-            (None, Some(a)) => (h, &self.theta, a),
-            (Some(b), None) => (h, b, &self.theta),
-            (None, None) => match self.samples.last() {
-                Some(last) if self.path.time(u) > last.time_s => {
-                    let dt = self.path.time(u) - last.time_s;
-                    return (0..n).map(|c| (self.theta[c] - last.fold_angles[c]) / dt).collect();
-                }
-                _ => return vec![0.0; n],
-            },
-        };
-        let dt = self.path.time(u + 0.5 * span) - self.path.time(u - 0.5 * span);
-        if !(dt > 0.0) {
-            return vec![0.0; n];
+        let h = ahead.min(behind);
+        let central = (h > 0.0 && h >= 0.5 * ahead.max(behind))
+            .then(|| settled_at(u - h).zip(settled_at(u + h)))
+            .flatten()
+            .map(|(before, after)| (u - h, before, u + h, after));
+        let differenced = central
+            .or_else(|| {
+                (ahead > 0.0)
+                    .then(|| settled_at(u + ahead))
+                    .flatten()
+                    .map(|a| (u, self.theta.clone(), u + ahead, a))
+            })
+            .or_else(|| {
+                (behind > 0.0)
+                    .then(|| settled_at(u - behind))
+                    .flatten()
+                    .map(|b| (u - behind, b, u, self.theta.clone()))
+            });
+        if let Some((from_u, from, to_u, to)) = differenced {
+            let dt = self.path.time(to_u) - self.path.time(from_u);
+            if dt > 0.0 {
+                return (0..n).map(|c| (to[c] - from[c]) / dt).collect();
+            }
         }
-        (0..n).map(|c| (to[c] - from[c]) / dt).collect()
+        match self.samples.last() {
+            Some(last) if self.path.time(u) > last.time_s => {
+                let dt = self.path.time(u) - last.time_s;
+                (0..n).map(|c| (self.theta[c] - last.fold_angles[c]) / dt).collect()
+            }
+            _ => vec![0.0; n],
+        }
     }
 
     fn keep_frame(&mut self, u: f64) {
@@ -1987,7 +2002,10 @@ impl Run<'_> {
             let mut touched = Vec::new();
             let placed = net.contacts.placed(&self.data);
             for k in self.sides.watched(&net.contacts) {
-                if self.sides.sign[k] == 0.0 || self.holds.touching.contains(&k) || net.held_by_seam(&self.holds, k) {
+                if self.sides.orientation(&net.contacts, k).0 == 0.0
+                    || self.holds.touching.contains(&k)
+                    || net.held_by_seam(&self.holds, k)
+                {
                     continue;
                 }
                 let state = self.sides.state(&net.contacts, &placed, k);
@@ -2256,7 +2274,7 @@ mod tests {
                     },
                 ],
             };
-            let path = DrivePath::new(&forcing);
+            let path = DrivePath::new(&forcing, f64::INFINITY);
             let (mut before, mut after) = (vec![0.0; 2], vec![0.0; 2]);
             let mut u = 0.0;
             while u < 1.0 {
