@@ -515,3 +515,36 @@ fn a_study_jobs_bad_net_release_or_results_are_refused_by_name() {
     let bad = serde_json::json!([[1, [{"front_deg": 0.0, "outcome": "flies"}]]]);
     assert!(message(releases_from_json(&bad).unwrap_err()).contains("outcome"));
 }
+
+/// A scene's seams name only edge pairs; which ends meet comes from the faces' turning
+/// (walked counter-clockwise, one edge's start meets the other's end). On every net of
+/// the cube and the octahedron, and the dodecahedron's 30 best, those ends make the same
+/// points as the solid's own vertices.
+#[test]
+fn seams_named_by_edges_alone_close_onto_the_solids_vertices() {
+    use nanofold::pattern::net::SeamGluing;
+    for (shape, count) in [("cube", 11), ("octahedron", 11), ("dodecahedron", 30)] {
+        let (name, solid) = open_solid(shape).unwrap();
+        let options = NetsOptions {
+            top: count,
+            simulate: 0,
+            ..NetsOptions::default()
+        };
+        let report = nets(&name, &solid, &options).unwrap();
+        let made = best_net_patterns(&solid, &report, count).unwrap();
+        assert_eq!(made.len(), count, "{shape}");
+        for (_, net) in made {
+            let gluing = SeamGluing::new(&net.pattern, &net.seams).unwrap();
+            let n = net.solid_vertex.len();
+            for a in 0..n {
+                for b in 0..n {
+                    assert_eq!(
+                        gluing.point[a] == gluing.point[b],
+                        net.solid_vertex[a] == net.solid_vertex[b],
+                        "{shape}: vertices {a} and {b}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -537,6 +537,60 @@ fn bad_network_scenes_get_errors_that_name_the_field() {
     }
 }
 
+/// A scene's seams are pairs of boundary edges of two panels, of one length, each edge in
+/// one seam, on a tree of panels; anything else is refused by name and value.
+#[test]
+fn bad_seams_are_refused_by_name() {
+    use serde_json::json;
+    let cases = [
+        (json!([[7, 19]]), "seams[0]`: [7, 19] (the pattern has edges 0 to 18)"),
+        (json!([[0, 5]]), "edge 0 is not on the paper's boundary"),
+        (json!([[7, 7]]), "a seam joins two different edges"),
+        (
+            json!([[7, 8], [8, 9]]),
+            "seams[1]`: [8, 9] (edge 8 is already in seams[0])",
+        ),
+        (json!([[5, 6]]), "both edges bound one panel"),
+        (json!([[7, -1]]), "seams"),
+    ];
+    for (seams, expected) in cases {
+        let message = network_error(|v| v["seams"] = seams.clone());
+        assert!(message.contains(expected), "expected {expected:?} in: {message}");
+    }
+    // Edges of different lengths: the lid stretched to 1.5 sides.
+    let dir = std::env::temp_dir().join(format!("nanofold-seams-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut fold: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/devices/cube_net.fold").unwrap()).unwrap();
+    fold["vertices_coords"][12] = json!([1, 3.5]);
+    fold["vertices_coords"][13] = json!([0, 3.5]);
+    std::fs::write(dir.join("cube_net.fold"), fold.to_string()).unwrap();
+    let text = std::fs::read_to_string("patterns/devices/cube_closes.scene.json").unwrap();
+    let message = match nanofold::read::parse_scene(&text, "test", "test", &dir).and_then(|s| s.build()) {
+        Ok(_) => panic!("a seam of a 1.5 edge and a 1 edge was accepted"),
+        Err(e) => full_message(&e),
+    };
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(
+        message.contains("seams[4]`: [9, 13]: lengths 1 and 1.5 (") && message.contains("their lengths agree"),
+        "{message}"
+    );
+    // A pattern that closes loops of its own has no seams to name.
+    let mut miura: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("patterns/devices/miura_sheet.scene.json").unwrap()).unwrap();
+    miura["seams"] = json!([[0, 1]]);
+    let message = match nanofold::read::parse_scene(&miura.to_string(), "test", "test", Path::new("patterns/devices"))
+        .and_then(|s| s.build())
+    {
+        Ok(_) => panic!("seams on a sheet with loops were accepted"),
+        Err(e) => full_message(&e),
+    };
+    assert!(
+        message.contains("invalid `seams`") && message.contains("closes loops of its own"),
+        "{message}"
+    );
+}
+
 /// A start that is not a rigid state is refused by name, and nothing runs.
 #[test]
 fn a_network_scene_must_start_rigid() {

@@ -281,6 +281,13 @@ impl SeamGluing {
             v
         }
         for (k, &[e, f]) in edges.iter().enumerate() {
+            if e == f {
+                return Err(NanofoldError::invalid(
+                    field(k),
+                    format!("[{e}, {f}]"),
+                    "a seam joins two different edges",
+                ));
+            }
             for edge in [e, f] {
                 if edge >= pattern.edges.len() {
                     return Err(NanofoldError::invalid(
@@ -304,13 +311,6 @@ impl SeamGluing {
                     ));
                 }
                 used[edge] = Some(k);
-            }
-            if e == f {
-                return Err(NanofoldError::invalid(
-                    field(k),
-                    format!("[{e}, {f}]"),
-                    "a seam joins two different edges",
-                ));
             }
             // Each edge as its face walks it: (start, end, face).
             let walked = |edge: usize| {
