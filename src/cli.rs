@@ -1059,8 +1059,8 @@ fn print_model(response: &Response) {
 }
 
 /// A slow release carried through contact, or why it stopped at the first one.
-fn print_released(scene: &Scene, simulation: &nanofold::dynamics::simulate::Simulation) {
-    use nanofold::dynamics::simulate::{first_contact_only, ModelKind};
+fn print_released(scene: &Scene, simulation: &nanofold::prelude::Simulation) {
+    use nanofold::prelude::first_contact_only;
     let response = &simulation.response;
     match (&simulation.released, scene.network()) {
         (Some(run), _) => {

@@ -14,7 +14,9 @@ pub use crate::commands::{modes, open_scene, simulate, ModesReport, SimulationRe
 pub use crate::constraints::{sweep_samples, ConstraintPoly, ConstraintReport, CurveSamples, Setup};
 pub use crate::dynamics::integrate::{Method, ProgressObserver};
 pub use crate::dynamics::scene::{Scene, System};
-pub use crate::dynamics::simulate::{simulate_scene, ModelChoice, ModelKind, Response, Simulation, SimulationSettings};
+pub use crate::dynamics::simulate::{
+    first_contact_only, simulate_scene, ModelChoice, ModelKind, Response, Simulation, SimulationSettings,
+};
 pub use crate::error::{NanofoldError, NumericalError, Result};
 pub use crate::folding::PatternVerdict;
 pub use crate::folding::{CheckSettings, FoldSettings};

@@ -168,3 +168,111 @@ fn every_jam_rests_apart_pushing_and_in_balance_hinge_by_hinge() {
     }
     assert!(jams >= 6, "{jams} jams to check");
 }
+
+/// A flap driven into a wall that stands across its path (`docs/model.md#slow-release-through-contact`):
+/// a base of 2 × 1 sides, a wall of 1 × 1 on its north edge driven to r_w = 90°, a flap of
+/// 2 × 2 on its south edge driven to r_f. The flap's face meets the wall's top edge where
+/// its plane passes through it: θ_f = π − θ_w / 2, at 2 ℓ cos(θ_w / 2) from the flap's hinge,
+/// the force's arm about the wall's hinge ℓ cos(θ_w / 2). The hinges then balance with
+/// K_f (r_f − θ_f) = 2 K_w (r_w − θ_w): linear in θ_w, so the rest and the force
+/// f = K_f (r_f − θ_f) / (2 ℓ cos(θ_w / 2)) (the flap's torque over its lever arm) are
+/// closed forms.
+fn flap_and_wall(flap_target_deg: f64) -> (nanofold::dynamics::simulate::Simulation, Vec<f64>) {
+    use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, SimulationSettings};
+    let dir = std::env::temp_dir().join(format!("nanofold-flap-{}-{flap_target_deg}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fold = serde_json::json!({
+        "file_spec": 1.1,
+        "frame_classes": ["creasePattern"],
+        "vertices_coords": [[-0.5, 0], [1.5, 0], [1.5, 1], [1, 1], [0, 1], [-0.5, 1], [1, 2], [0, 2], [-0.5, -2], [1.5, -2]],
+        "edges_vertices": [[0, 1], [4, 3], [1, 2], [2, 3], [4, 5], [5, 0], [3, 6], [6, 7], [7, 4], [8, 9], [9, 1], [0, 8]],
+        "edges_assignment": ["V", "V", "B", "B", "B", "B", "B", "B", "B", "B", "B", "B"],
+        "faces_vertices": [[0, 1, 2, 3, 4, 5], [4, 3, 6, 7], [8, 9, 1, 0]]
+    });
+    std::fs::write(dir.join("flap.fold"), fold.to_string()).unwrap();
+    let hinge = |crease: usize, target: f64| {
+        serde_json::json!({
+            "crease": crease, "hinge_length_um": 20, "actuated": true, "target_angle_deg": target,
+            "radius_of_curvature_um": 20,
+            "layers": [{"material": "SiN", "thickness_um": 0.2}, {"material": "Cr", "thickness_um": 0.1}]
+        })
+    };
+    let scene = serde_json::json!({
+        "name": "flap",
+        "pattern": "flap.fold",
+        "length_unit_um": 100,
+        "materials": {
+            "SiN": {"youngs_modulus_gpa": 300, "poisson_ratio": 0.28, "density_g_cm3": 3.27},
+            "Cr": {"youngs_modulus_gpa": 140, "poisson_ratio": 0.21, "density_g_cm3": 7.19}
+        },
+        "plates": {"thickness_um": 0.2, "material": "SiN"},
+        "hinges": [hinge(0, flap_target_deg), hinge(1, 90.0)],
+        "anchored_face": 0,
+        "actuation": {"kind": "step"},
+        "environment": {"drag": true},
+        "time": {"t_end_s": 0.01}
+    });
+    let built = nanofold::read::parse_scene(&scene.to_string(), "flap", "flap", &dir)
+        .and_then(|s| s.build())
+        .unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let settings = SimulationSettings {
+        model: ModelChoice::QuasiStatic,
+        ..SimulationSettings::default()
+    };
+    let stiffness = built.network().unwrap().stiffness();
+    (simulate_scene(&built, &settings).unwrap(), stiffness)
+}
+
+#[test]
+fn a_flap_driven_into_a_standing_wall_stops_with_its_torque_over_its_lever_arm() {
+    use std::f64::consts::PI;
+    let (run, stiffness) = flap_and_wall(170.0);
+    let released = run.released.as_ref().expect("a tree of panels goes on through contact");
+    assert_eq!(released.outcome.label(), "jams", "{released:?}");
+    let (k_f, k_w) = (stiffness[0], stiffness[1]);
+    let (r_f, r_w) = (170f64.to_radians(), 90f64.to_radians());
+    let wall = (2.0 * k_w * r_w + k_f * (PI - r_f)) / (0.5 * k_f + 2.0 * k_w);
+    let flap = PI - 0.5 * wall;
+    let side = 100e-6;
+    let force = k_f * (r_f - flap) / (2.0 * side * (0.5 * wall).cos());
+    let angles = run.response.samples.last().unwrap().angles.as_slice().to_vec();
+    assert!(
+        (angles[0] - flap).abs() <= 1e-9,
+        "flap at {} against {}",
+        angles[0],
+        flap
+    );
+    assert!(
+        (angles[1] - wall).abs() <= 1e-9,
+        "wall at {} against {}",
+        angles[1],
+        wall
+    );
+    // Both top corners of the wall press on the flap: one contact (parallel rows), the whole
+    // force on it.
+    let total: f64 = released.final_contacts.iter().map(|c| c.force_n).sum();
+    eprintln!(
+        "flap {:.9}° (closed form {:.9}°), wall {:.9}° ({:.9}°), force {total:.9e} N ({force:.9e} N)",
+        angles[0].to_degrees(),
+        flap.to_degrees(),
+        angles[1].to_degrees(),
+        wall.to_degrees()
+    );
+    assert!(
+        (total - force).abs() <= 1e-9 * force,
+        "contact force {total} N against the closed form {force} N"
+    );
+    // The wall's balance gives the same force through its own arm.
+    let through_wall = k_w * (r_w - wall) / (side * (0.5 * wall).cos());
+    assert!((through_wall - force).abs() <= 1e-12 * force);
+    // The flap's drive turned down short of the wall (120° < 135°): nothing holds it, and it
+    // rests at its drive with the wall at 90°.
+    let (run, _) = flap_and_wall(120.0);
+    let released = run.released.as_ref().unwrap();
+    assert_eq!(released.outcome.label(), "rests", "{released:?}");
+    assert!(released.final_contacts.iter().all(|c| c.force_n <= 0.0));
+    let angles = run.response.samples.last().unwrap().angles.as_slice().to_vec();
+    assert!((angles[0] - 120f64.to_radians()).abs() <= 1e-12);
+    assert!((angles[1] - r_w).abs() <= 1e-12);
+}
