@@ -1342,10 +1342,30 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
                 (outcome, _) => format!("{} at {:.6e} s", outcome.label(), best.time_s),
             };
             let yield_text = match (c.fresh_yield, best.yield_estimate) {
-                (Some(y), Some(chosen)) => format!(
-                    ", yield on fresh devices {}/{} ({:.3}, 95% {:.3}–{:.3}; chosen at {}/{})",
-                    y.closed, y.samples, y.fraction, y.interval_95[0], y.interval_95[1], chosen.closed, chosen.samples
-                ),
+                (Some(y), Some(chosen)) => {
+                    let captures: Vec<String> = c
+                        .capture_yields
+                        .iter()
+                        .map(|k| {
+                            format!(
+                                "{}/{} at {} %",
+                                k.yield_estimate.closed, k.yield_estimate.samples, k.capture_percent
+                            )
+                        })
+                        .collect();
+                    format!(
+                        ", yield on fresh devices {}/{} ({:.3}, 95% {:.3}–{:.3}; chosen at {}/{}{}{})",
+                        y.closed,
+                        y.samples,
+                        y.fraction,
+                        y.interval_95[0],
+                        y.interval_95[1],
+                        chosen.closed,
+                        chosen.samples,
+                        if captures.is_empty() { "" } else { "; the same devices " },
+                        captures.join(", ")
+                    )
+                }
                 (_, Some(y)) => format!(
                     ", yield {}/{} ({:.3}, 95% {:.3}–{:.3})",
                     y.closed, y.samples, y.fraction, y.interval_95[0], y.interval_95[1]

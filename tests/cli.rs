@@ -1544,8 +1544,18 @@ fn nets_ranks_the_cubes_eleven_and_writes_each_best_net_as_fold() {
         assert_eq!(release["yield"]["samples"], 4);
     }
     assert_eq!(report["nets"][3]["closing"], serde_json::Value::Null);
-    // Three nets, one release of a nominal and 4 varied devices each, then 4 fresh ones.
-    assert_eq!(report["study"]["devices"], 3 * (5 + 4));
+    // Three nets, one release of a nominal and 4 varied devices each, then 4 fresh ones at
+    // each of the captures 10, 5 and 20 %.
+    assert_eq!(report["study"]["devices"], 3 * (5 + 3 * 4));
+    for net in &report["nets"].as_array().unwrap()[..3] {
+        let captures: Vec<f64> = net["closing"]["capture_yields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["capture_percent"].as_f64().unwrap())
+            .collect();
+        assert_eq!(captures, [5.0, 20.0], "{net}");
+    }
     assert_eq!(report["symmetry_order"], 48);
     assert_eq!(report["search"], "enumerated");
     let rg: Vec<f64> = report["nets"]

@@ -293,8 +293,9 @@ fn a_study_on_the_cores_equals_each_net_studied_alone_and_ranks_by_yield() {
     heard.sort();
     assert_eq!(heard, (1..=16).map(|d| (d, 16)).collect::<Vec<_>>());
     let study = report.study.as_ref().unwrap();
-    // Four nets: four releases of 13 devices each, then 12 fresh ones for the best.
-    assert_eq!((study.nets, study.devices), (4, 4 * (4 * 13 + 12)));
+    // Four nets: four releases of 13 devices each, then 12 fresh ones for the best at each
+    // of three captures.
+    assert_eq!((study.nets, study.devices), (4, 4 * (4 * 13 + 3 * 12)));
     // Each net run alone, one release after another, is the same.
     let simulated: Vec<&NetRow> = report.nets.iter().filter(|r| r.closing.is_some()).collect();
     assert_eq!(simulated.len(), 4);

@@ -213,7 +213,8 @@ def test_a_nets_study_on_the_cluster_equals_the_one_on_this_machines_cores(clien
     on_cores = nanofold.nets("octahedron", **keywords)
     on_cluster = nanofold.nets("octahedron", client=client, progress=False, **keywords)
     assert report_without_times(on_cluster.to_dict()) == report_without_times(on_cores.to_dict())
-    # Three nets: three releases of a nominal and 4 varied devices each, then 4 fresh ones.
-    assert on_cluster.to_dict()["study"]["devices"] == 3 * (3 * 5 + 4)
+    # Three nets: three releases of a nominal and 4 varied devices each, then 4 fresh ones
+    # at each of three captures.
+    assert on_cluster.to_dict()["study"]["devices"] == 3 * (3 * 5 + 3 * 4)
     assert on_cluster.table.equals(on_cores.table)
 

@@ -4,8 +4,8 @@
 //! gallery.svg).
 
 pub use crate::design::closing::{
-    ClosingReport, ClosingSettings, Contact, ContactForce, Failures, Jam, NetClosing, NetClosingSummary, Outcome,
-    ReleaseResult, SeamForce,
+    CaptureYield, ClosingReport, ClosingSettings, Contact, ContactForce, Failures, Jam, NetClosing, NetClosingSummary,
+    Outcome, ReleaseResult, SeamForce,
 };
 pub use crate::design::fabrication::{clopper_pearson, Variation, YieldEstimate};
 pub use crate::design::nets::{
@@ -276,7 +276,8 @@ pub fn study_net(
         .map(|(release, front)| study_release(&made, &report.solid, rank, &row.folds, release, front, options))
         .collect::<Result<Vec<_>>>()?;
     let mut summary = NetClosingSummary::new(options.anchored_face.unwrap_or(made.centre_face), releases);
-    summary.fresh_yield = fresh_yield(&made, &report.solid, rank, &row.folds, summary.best, options)?;
+    (summary.fresh_yield, summary.capture_yields) =
+        fresh_yield(&made, &report.solid, rank, &row.folds, summary.best, options)?;
     Ok(summary)
 }
 
@@ -392,7 +393,7 @@ pub fn apply_releases(
         .map(|(rank, summary, _, _)| (rank, summary))
         .collect();
     for ((_, summary), result) in summaries.iter_mut().zip(fresh) {
-        summary.fresh_yield = result?;
+        (summary.fresh_yield, summary.capture_yields) = result?;
     }
     let variation = options.variation();
     let mut failures = Failures::default();
@@ -405,8 +406,10 @@ pub fn apply_releases(
     }
     let study = Study {
         nets: summaries.len(),
-        // Every release's nominal and sampled devices, and each net's fresh ones.
-        devices: summaries.len() * (releases.len() * (1 + variation.samples) + variation.samples),
+        // Every release's nominal and sampled devices, and each net's fresh ones at each
+        // capture.
+        devices: summaries.len()
+            * (releases.len() * (1 + variation.samples) + variation.samples * options.captures().len()),
         failures,
         releases,
         variation,
@@ -478,7 +481,8 @@ fn sampled_devices(
 }
 
 /// Release `best` of a net run again on fresh devices (draw set 1): its yield free of the
-/// choice among releases (None: none sampled).
+/// choice among releases (None: none sampled), and the same devices' at half and twice the
+/// capture.
 fn fresh_yield(
     made: &NetPattern,
     name: &str,
@@ -486,10 +490,10 @@ fn fresh_yield(
     folds: &[usize],
     best: usize,
     options: &NetsOptions,
-) -> Result<Option<YieldEstimate>> {
+) -> Result<(Option<YieldEstimate>, Vec<CaptureYield>)> {
     let variation = options.variation().for_design(folds, best, 1);
     if variation.samples == 0 {
-        return Ok(None);
+        return Ok((None, Vec::new()));
     }
     let released = NetsOptions {
         front_deg: options.releases()[best],
@@ -498,7 +502,21 @@ fn fresh_yield(
     let scene = net_device(made, &format!("{name}_net_{rank:03}"), &released)?;
     let model = scene.network().expect("a net's scene is a network");
     let closing = NetClosing::new(made, model)?;
-    Ok(sampled_devices(&closing, model, &variation, options)?.0)
+    let fresh = sampled_devices(&closing, model, &variation, options)?.0;
+    let mut others = Vec::new();
+    for &capture_percent in options.captures().iter().skip(1) {
+        let captured = NetsOptions {
+            capture_percent,
+            ..options.clone()
+        };
+        if let (Some(yield_estimate), _) = sampled_devices(&closing, model, &variation, &captured)? {
+            others.push(CaptureYield {
+                capture_percent,
+                yield_estimate,
+            });
+        }
+    }
+    Ok((fresh, others))
 }
 
 /// Jobs 0..count run on the machine's cores (each worker takes the next job left), their

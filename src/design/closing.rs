@@ -81,6 +81,21 @@ pub struct NetClosingSummary {
     /// choice's optimism.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fresh_yield: Option<crate::design::fabrication::YieldEstimate>,
+    /// The same fresh devices latched with half and twice the capture (those within its
+    /// range, above 0 and at most 50 %): how the yield moves with that stated parameter, a
+    /// paired comparison (empty when none were sampled, and left out of the JSON).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub capture_yields: Vec<CaptureYield>,
+}
+
+/// The best release's fresh devices at another capture.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CaptureYield {
+    /// The capture, % of a seam's length.
+    pub capture_percent: f64,
+    /// The share of the fresh devices that close with it.
+    #[serde(rename = "yield")]
+    pub yield_estimate: crate::design::fabrication::YieldEstimate,
 }
 
 impl NetClosingSummary {
@@ -109,6 +124,7 @@ impl NetClosingSummary {
             best,
             closes_in,
             fresh_yield: None,
+            capture_yields: Vec::new(),
         }
     }
 

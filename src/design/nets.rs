@@ -212,6 +212,18 @@ impl NetsOptions {
         }
     }
 
+    /// The captures a best release's fresh devices are run with, %: the chosen one first,
+    /// then half and twice it where they lie above 0 and at most 50 %.
+    pub fn captures(&self) -> Vec<f64> {
+        std::iter::once(self.capture_percent)
+            .chain(
+                [0.5 * self.capture_percent, 2.0 * self.capture_percent]
+                    .into_iter()
+                    .filter(|&c| c > 0.0 && c <= 50.0),
+            )
+            .collect()
+    }
+
     /// How seams latch.
     pub fn closing(&self) -> ClosingSettings {
         ClosingSettings {
@@ -499,4 +511,29 @@ pub fn best_net_patterns(solid: &Polyhedron, report: &NetsReport, top: usize) ->
             ))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fresh devices' captures: the chosen one, then half and twice it within (0, 50] %.
+    #[test]
+    fn the_capture_study_runs_half_and_twice_the_capture_where_they_are_allowed() {
+        let at = |capture_percent: f64| {
+            NetsOptions {
+                capture_percent,
+                ..NetsOptions::default()
+            }
+            .captures()
+        };
+        assert_eq!(at(10.0), [10.0, 5.0, 20.0]);
+        assert_eq!(at(25.0), [25.0, 12.5, 50.0]);
+        assert_eq!(at(30.0), [30.0, 15.0]);
+        for capture in [0.1, 1.0, 10.0, 25.0, 30.0, 50.0] {
+            for c in at(capture) {
+                assert!(ClosingSettings { capture_percent: c }.validate().is_ok(), "{c}");
+            }
+        }
+    }
 }
