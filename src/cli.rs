@@ -1330,6 +1330,28 @@ fn run_nets(args: &NetsArgs) -> Result<()> {
             "  varied devices that did not close: {} jam, {} stall, {} snap through, {} undecided",
             f.jams, f.stalls, f.snaps, f.undecided
         );
+        if let Some(fidelity) = &study.fidelity {
+            let shown = |name: &str, r: &Option<nanofold::commands::nets::RankCorrelation>| {
+                r.map(|r| {
+                    format!(
+                        "{name} ρ = {:.2} (95% {:.2} to {:.2})",
+                        r.rho, r.interval_95[0], r.interval_95[1]
+                    )
+                })
+            };
+            let parts: Vec<String> = [
+                shown("radius of gyration", &fidelity.radius_of_gyration),
+                shown("leaves", &fidelity.leaves),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            println!(
+                "  yield ranked against compactness over {} nets (Spearman): {}",
+                study.nets,
+                parts.join("; ")
+            );
+        }
     }
     for row in report.nets.iter().take(options.top.max(options.simulate)) {
         let simulated = row.closing.as_ref().map_or(String::new(), |c| {

@@ -4,4 +4,5 @@
 
 pub mod closing;
 pub mod fabrication;
+pub mod fidelity;
 pub mod nets;

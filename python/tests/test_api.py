@@ -295,6 +295,38 @@ def test_a_nets_study_closes_the_cube_along_the_bundled_front_and_gives_yields()
     assert table.loc[0, "outcome"] == "closes"
 
 
+def test_a_studys_fidelity_is_pandas_spearman_of_its_yields_against_compactness():
+    import pandas as pd
+
+    r = nanofold.nets("cube", top=6, simulate=6, fronts=2, unit_um=50, overdrive_deg=5, yield_samples=6)
+    d = r.to_dict()
+    rows = [n for n in d["nets"] if n.get("closing")]
+    assert len(rows) == 6
+
+    def best(closing):
+        chosen = closing.get("fresh_yield") or closing["releases"][closing["best"]]["yield"]
+        return chosen["fraction"]
+
+    frame = pd.DataFrame({"y": [best(n["closing"]) for n in rows],
+                          "rg": [n["radius_of_gyration_um"] for n in rows],
+                          "leaves": [float(n["leaves"]) for n in rows]})
+    # pandas ranks ties at their mean too; its correlation of ranks is an independent one.
+    theirs = frame.corr(method="spearman")
+    fidelity = d["study"].get("fidelity")
+    if frame["y"].nunique() == 1:
+        assert fidelity is None
+    else:
+        for key, column in [("radius_of_gyration", "rg"), ("leaves", "leaves")]:
+            if frame[column].nunique() == 1:
+                assert key not in fidelity
+                continue
+            ours = fidelity[key]
+            assert ours["pairs"] == 6
+            assert abs(ours["rho"] - theirs.loc["y", column]) < 1e-12, (key, ours, theirs)
+            low, high = ours["interval_95"]
+            assert -1 <= low <= ours["rho"] <= high <= 1
+
+
 def test_nets_refuse_bad_shapes_and_settings_by_name():
     with pytest.raises(nanofold.InvalidFieldError, match="top"):
         nanofold.nets("cube", top=1000)

@@ -8,6 +8,7 @@ pub use crate::design::closing::{
     Outcome, ReleaseResult, SeamForce,
 };
 pub use crate::design::fabrication::{clopper_pearson, Variation, YieldEstimate};
+pub use crate::design::fidelity::{spearman, Fidelity, RankCorrelation};
 pub use crate::design::nets::{
     apply_study, best_net_patterns, nets, NetRow, NetsOptions, NetsReport, RankBy, Search, Study, MAX_ENUMERATED_TREES,
     MAX_SAMPLED_TREES, MAX_WRITTEN_NETS,
@@ -411,6 +412,7 @@ pub fn apply_releases(
         devices: summaries.len()
             * (releases.len() * (1 + variation.samples) + variation.samples * options.captures().len()),
         failures,
+        fidelity: None,
         releases,
         variation,
         closing: options.closing(),

@@ -360,6 +360,10 @@ pub struct Study {
     pub devices: usize,
     /// The sampled devices that did not close, over every release, by how they ended.
     pub failures: Failures,
+    /// The simulated nets' yields ranked against their compactness (None: fewer than 4
+    /// nets, or yields that do not vary; filled by [`apply_study`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fidelity: Option<crate::design::fidelity::Fidelity>,
     /// Seconds the study took.
     pub seconds: f64,
 }
@@ -367,12 +371,26 @@ pub struct Study {
 /// Puts the simulated closings into the table (`summaries` by rank) and, when ranking by
 /// yield, ranks again: the simulated nets by their best release's yield (then releases that
 /// close, then the earlier rank), the others after them in their order.
-pub fn apply_study(report: &mut NetsReport, summaries: Vec<(usize, NetClosingSummary)>, study: Study) {
+pub fn apply_study(report: &mut NetsReport, summaries: Vec<(usize, NetClosingSummary)>, mut study: Study) {
     for (rank, summary) in summaries {
         if let Some(row) = report.nets.iter_mut().find(|r| r.rank == rank) {
             row.closing = Some(summary);
         }
     }
+    let simulated: Vec<&NetRow> = report.nets.iter().filter(|r| r.closing.is_some()).collect();
+    let yields: Vec<f64> = simulated
+        .iter()
+        .filter_map(|r| r.closing.as_ref().map(NetClosingSummary::best_yield))
+        .collect();
+    let against = |score: &dyn Fn(&NetRow) -> f64| {
+        let scores: Vec<f64> = simulated.iter().map(|r| score(r)).collect();
+        crate::design::fidelity::spearman(&yields, &scores)
+    };
+    let fidelity = crate::design::fidelity::Fidelity {
+        radius_of_gyration: against(&|r| r.radius_of_gyration_um),
+        leaves: against(&|r| r.leaves as f64),
+    };
+    study.fidelity = (fidelity.radius_of_gyration.is_some() || fidelity.leaves.is_some()).then_some(fidelity);
     if report.rank_by == RankBy::Yield {
         let score = |row: &NetRow| {
             row.closing
