@@ -358,7 +358,8 @@ pub fn releases_from_json(value: &serde_json::Value) -> Result<Vec<(usize, Vec<R
 }
 
 /// Puts every simulated net's releases (by rank, in `options.releases()` order) into the
-/// table as [`study_nets`] does; `seconds` is what the study took.
+/// table as [`study_nets`] does; `seconds` is what the releases took (the fresh devices'
+/// runs here are added to it).
 pub fn apply_releases(
     solid: &Polyhedron,
     report: &mut NetsReport,
@@ -385,6 +386,7 @@ pub fn apply_releases(
     }
     // Each best release's yield again, from fresh devices: run here, after the choice, one
     // net per job on the machine's cores.
+    let fresh_started = std::time::Instant::now();
     let fresh = on_cores(summaries.len(), &|k| {
         let (rank, summary, made, folds) = &summaries[k];
         fresh_yield(made, &report.solid, *rank, folds, summary.best, options)
@@ -416,7 +418,7 @@ pub fn apply_releases(
         releases,
         variation,
         closing: options.closing(),
-        seconds,
+        seconds: seconds + fresh_started.elapsed().as_secs_f64(),
     };
     apply_study(report, summaries, study);
     Ok(())
@@ -523,7 +525,7 @@ fn fresh_yield(
 
 /// Jobs 0..count run on the machine's cores (each worker takes the next job left), their
 /// answers in job order.
-fn on_cores<T: Send>(count: usize, job: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
+pub fn on_cores<T: Send>(count: usize, job: &(dyn Fn(usize) -> T + Sync)) -> Vec<T> {
     let answers: Vec<std::sync::Mutex<Option<T>>> = (0..count).map(|_| std::sync::Mutex::new(None)).collect();
     let next = std::sync::atomic::AtomicUsize::new(0);
     let workers = std::thread::available_parallelism()
