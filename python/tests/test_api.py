@@ -295,6 +295,16 @@ def test_a_nets_study_closes_the_cube_along_the_bundled_front_and_gives_yields()
     assert table.loc[0, "outcome"] == "closes"
 
 
+def test_a_slow_release_goes_on_through_contact_to_the_closed_cube():
+    r = nanofold.simulate("patterns/devices/cube_lid_first.scene.json")
+    assert r.model == "quasi_static"
+    # The south wall meets the lid at 85° (8000 s + 85/95 of a 1326.5 s ramp), pushes it
+    # back, and the cube closes as the south wall reaches 90° (8000 s + 1256.6 s).
+    assert abs(r.collision["time_s"] - 9186.8239) < 1e-3
+    assert r.released["outcome"] == "closes" and len(r.released["latches"]) == 7
+    assert abs(r.released["time_s"] - (8000 + 0.5 * math.pi / (1.5 / 60 / 20))) < 1e-6
+
+
 def test_a_studys_fidelity_is_pandas_spearman_of_its_yields_against_compactness():
     import pandas as pd
 
