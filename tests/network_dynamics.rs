@@ -321,12 +321,8 @@ fn the_cubes_first_contact_comes_where_the_etch_front_and_plane_geometry_put_it(
     // The south wall stands at 95°; the east, west and north walls rise together and meet it
     // and each other at the cube's four corners as they pass 90°, all at one moment.
     assert!((angles[0] - 95f64.to_radians()).abs() < 1e-9);
-    for wall in 1..4 {
-        assert!(
-            (angles[wall].to_degrees() - 90.0).abs() < 1e-6,
-            "{}",
-            angles[wall].to_degrees()
-        );
+    for wall in &angles[1..4] {
+        assert!((wall.to_degrees() - 90.0).abs() < 1e-6, "{}", wall.to_degrees());
     }
     assert!((contact.time - (4000.0 + ramp * 90.0 / 95.0)).abs() < 1e-6 * contact.time);
     let plant = NetworkPlant::new(network(&closes), true).unwrap();

@@ -358,13 +358,13 @@ impl SeamGluing {
         let mut number = vec![usize::MAX; parent.len()];
         let mut point = vec![0; parent.len()];
         let mut next = 0;
-        for v in 0..parent.len() {
+        for (v, place) in point.iter_mut().enumerate() {
             let r = root(&mut parent, v);
             if number[r] == usize::MAX {
                 number[r] = next;
                 next += 1;
             }
-            point[v] = number[r];
+            *place = number[r];
         }
         Ok(SeamGluing {
             edges: edges.to_vec(),

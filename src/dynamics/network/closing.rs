@@ -1316,13 +1316,13 @@ impl NetClosing {
         sample_times: Option<&[f64]>,
     ) -> Result<ReleasedPath> {
         settings.validate()?;
-        if !(t_end > 0.0) {
+        if t_end.is_nan() || t_end <= 0.0 {
             return Err(NanofoldError::invalid("t_end", t_end, "must be a time > 0 s"));
         }
         let path = DrivePath::new(forcing, t_end);
         let stops: Vec<f64> = match sample_times {
             Some(times) if path.span > 0.0 => {
-                if let Some(w) = times.windows(2).find(|w| !(w[0] < w[1])) {
+                if let Some(w) = times.windows(2).find(|w| w[0] >= w[1] || w[0].is_nan() || w[1].is_nan()) {
                     return Err(NanofoldError::invalid(
                         "sample_times",
                         format!("{} then {}", w[0], w[1]),
