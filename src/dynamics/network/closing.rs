@@ -1322,7 +1322,10 @@ impl NetClosing {
         let path = DrivePath::new(forcing, t_end);
         let stops: Vec<f64> = match sample_times {
             Some(times) if path.span > 0.0 => {
-                if let Some(w) = times.windows(2).find(|w| w[0] >= w[1] || w[0].is_nan() || w[1].is_nan()) {
+                if let Some(w) = times
+                    .windows(2)
+                    .find(|w| w[0] >= w[1] || w[0].is_nan() || w[1].is_nan())
+                {
                     return Err(NanofoldError::invalid(
                         "sample_times",
                         format!("{} then {}", w[0], w[1]),
