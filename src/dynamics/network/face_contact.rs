@@ -109,6 +109,16 @@ pub struct FeatureState {
     pub over: bool,
 }
 
+/// Whether `point`'s foot lies inside the face of `corners` (counter-clockwise about
+/// `normal`) by at least `margin` from every edge.
+fn inside_outline(corners: &[Vector3<f64>], normal: &Vector3<f64>, point: &Vector3<f64>, margin: f64) -> bool {
+    (0..corners.len()).all(|i| {
+        let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+        let along = b - a;
+        along.cross(&(point - a)).dot(normal) >= margin * along.norm()
+    })
+}
+
 impl FeatureState {
     /// A point `distance` from a plane of unit `normal`, its foot there the other point.
     fn on_plane(point: Vector3<f64>, normal: Vector3<f64>, distance: f64, over: bool) -> FeatureState {
@@ -379,12 +389,7 @@ impl FaceContacts {
                 let corners = &placed.corners[other];
                 let distance = normal.dot(&(point - corners[0]));
                 let apart = copy.is_none_or(|w| (self.at(placed, other, w) - point).norm() > MET * self.size);
-                let over = apart
-                    && (0..corners.len()).all(|i| {
-                        let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
-                        let along = b - a;
-                        along.cross(&(point - a)).dot(&normal) >= margin * along.norm()
-                    });
+                let over = apart && inside_outline(corners, &normal, &point, margin);
                 FeatureState::on_plane(point, normal, distance, over)
             }
             Feature::EdgeMiddleOnFace {
@@ -398,12 +403,8 @@ impl FaceContacts {
                 let corners = &placed.corners[other];
                 let distance = normal.dot(&(point - corners[0]));
                 let middle = (self.at(placed, other, copies[0]) + self.at(placed, other, copies[1])) * 0.5;
-                let over = (middle - point).norm() > MET * self.size
-                    && (0..corners.len()).all(|i| {
-                        let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
-                        let along = b - a;
-                        along.cross(&(point - a)).dot(&normal) >= margin * along.norm()
-                    });
+                let over =
+                    (middle - point).norm() > MET * self.size && inside_outline(corners, &normal, &point, margin);
                 FeatureState::on_plane(point, normal, distance, over)
             }
             Feature::EdgeOnCorner {
