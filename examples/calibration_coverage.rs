@@ -4,7 +4,7 @@
 //! range). Prints each study's coverage per parameter and the time per fit.
 //!
 //! `cargo run --release --example calibration_coverage [RUNS] [STUDY]` (default 100, every
-//! study; STUDY is `bridge`, `corner`, `marks` or `miura`)
+//! study; STUDY is `bridge`, `corner`, `marks`, `miura` or `cube`)
 
 use nanofold::calibrate::{fit, resolve, with_values, FitSettings, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::sensitivity::trajectory_sensitivities;
@@ -18,6 +18,8 @@ mod marks;
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;
+#[path = "common/cube.rs"]
+mod cube;
 #[path = "common/miura.rs"]
 mod miura;
 
@@ -173,6 +175,20 @@ fn main() -> Result<(), Failure> {
             exact,
         };
         run(&sheet, runs)?;
+    }
+    if wanted("cube") {
+        // A slow release through contact, fitted from the file's 95° and 1.
+        let document = cube::lid_first()?;
+        let exact = cube::exact_columns(&document, &cube::TRUTH)?;
+        let study = Study {
+            name: "lid-first cube, its last wall filmed (walls' target and stiffness)",
+            document,
+            free: cube::free(),
+            truth: cube::TRUTH.to_vec(),
+            times: cube::times(),
+            exact,
+        };
+        run(&study, runs)?;
     }
     Ok(())
 }

@@ -4,6 +4,11 @@
 //! hinge 2 unobserved after 45 µs (a tracker that lost it). A stand-in for a tracked video
 //! until one is measured; README's "Calibrating from a measurement" fits it.
 //!
+//! Writes patterns/measurements/cube_lid_first_filmed.csv too: a film of the lid-first
+//! cube's last wall rising (`examples/common/cube.rs`: 200 frames from 8 000 s to 9 300 s,
+//! every crease to 0.5°) released slowly with the walls' target at 97° and their stiffness
+//! 1.6 times the lid's; the calibration guide fits it through the contact.
+//!
 //! `cargo run --release --example synthesize_measurement`
 
 use nanofold::calibrate::{resolve, with_values, FreeParameter, SENSITIVITY_STEP};
@@ -11,6 +16,8 @@ use nanofold::dynamics::sensitivity::trajectory_sensitivities;
 use nanofold::dynamics::Method;
 use nanofold::read::SceneDocument;
 
+#[path = "common/cube.rs"]
+mod cube;
 #[path = "common/normal.rs"]
 mod normal;
 use normal::Normal;
@@ -48,6 +55,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "wrote patterns/measurements/bridge_step_measured.csv ({} rows)",
         run.times.len()
+    );
+    let film = cube::lid_first()?;
+    let columns = cube::exact_columns(&film, &cube::TRUTH)?;
+    let mut normal = Normal(97);
+    let mut text = format!(
+        "# The lid-first cube's last wall, released slowly with the walls' target at {} deg and their\n# stiffness {} times the lid's, every crease with {} deg Gaussian noise (examples/synthesize_measurement.rs).\ntime_s",
+        cube::TRUTH[0],
+        cube::TRUTH[1],
+        cube::SIGMA_DEG
+    );
+    for (column, _) in &columns {
+        text += &format!(",{}", column.name);
+    }
+    text.push('\n');
+    for (i, t) in cube::times().iter().enumerate() {
+        text += &format!("{t:.3}");
+        for (column, sigma) in &columns {
+            let angle = column.values[i].ok_or("every frame is simulated")?;
+            text += &format!(",{:.4}", angle + sigma * normal.sample());
+        }
+        text.push('\n');
+    }
+    std::fs::write("patterns/measurements/cube_lid_first_filmed.csv", text)?;
+    println!(
+        "wrote patterns/measurements/cube_lid_first_filmed.csv ({} rows)",
+        cube::times().len()
     );
     Ok(())
 }

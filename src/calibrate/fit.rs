@@ -521,7 +521,7 @@ impl Problem<'_> {
             return Err(NanofoldError::invalid(
                 format!("{}: time_s", self.measurement.source),
                 missing,
-                "the simulation gives no state at this time (before the motion's start)",
+                "the simulation gives no state at this time (before the motion's start, or past where a slow release stopped: a snap-through or a balance not found)",
             ));
         }
         let columns = &self.measurement.columns;

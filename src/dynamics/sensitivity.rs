@@ -24,6 +24,7 @@ use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, DVector};
 use sides::{held_accelerations, Side, SideScratch};
 
+mod released;
 mod sides;
 
 /// The motion and its sensitivities at the requested times.
@@ -61,7 +62,10 @@ fn stencil(values: [f64; POINTS], epsilon: f64) -> f64 {
 /// Integrates `base` and the sensitivity of its output angles to each parameter whose
 /// perturbed scenes (at u + kε, k in [`STENCIL`]) are `perturbed[j]`, from the start to the last of
 /// `times` (increasing, the first ≥ 0), without contacts, by `method` (`Auto`: from the
-/// time scales) at relative tolerance `rtol`.
+/// time scales) at relative tolerance `rtol`. A tree of panels released slowly (its
+/// forcing lasts ≥ [`super::simulate::QUASI_STATIC_RATIO`] fastest periods) instead follows
+/// the contact engine's balance through its contacts and seams, and its sensitivities come
+/// from the balance's KKT conditions (`released`; `method` and `rtol` do not apply).
 pub fn trajectory_sensitivities(
     base: &Scene,
     perturbed: &[[Scene; POINTS]],
@@ -109,6 +113,24 @@ pub fn trajectory_sensitivities(
         System::Network(model) if model.reduction.is_some() => {
             let plants = pairs!(Network, reduced_plant);
             run(&reduced_plant(model)?, &plants, epsilon, times, (method, rtol, true))
+        }
+        System::Network(model) if network_plant(model)?.time_scales()?.ratio >= super::simulate::QUASI_STATIC_RATIO => {
+            // A slow release: the balance's own sensitivities along the engine's path.
+            if let Some(reason) = super::simulate::first_contact_only(model) {
+                return Err(NanofoldError::invalid(
+                    "actuation",
+                    "a slow release",
+                    format!("its sensitivities follow the contact engine, which this scene is not for: {reason}"),
+                ));
+            }
+            let mut models = Vec::with_capacity(perturbed.len());
+            for (j, scenes) in perturbed.iter().enumerate() {
+                match (&scenes[0].system, &scenes[1].system) {
+                    (System::Network(minus), System::Network(plus)) => models.push([&**minus, &**plus]),
+                    _ => return Err(mismatch(j)),
+                }
+            }
+            released::released_sensitivities(model, &models, epsilon, times)
         }
         System::Network(model) => {
             let plants = pairs!(Network, network_plant);
@@ -167,7 +189,7 @@ fn run<P: Plant>(
         return Err(NanofoldError::invalid(
             "actuation",
             format!("a forcing of {:.1e} fastest periods", scales.ratio),
-            "sensitivities are integrated with the dynamics, and this scene's slow forcing takes the quasi-static path, whose sensitivities are not built: fit a step response",
+            "this scene's slow forcing takes the quasi-static path, whose sensitivities are built for trees of panels (a network scene's slow release, through the contact engine) and not for strips, closed chains or fitted curves: fit a step response",
         ));
     }
     let method = method.resolve(&scales);

@@ -283,6 +283,31 @@ pub struct PathSample {
     /// Their rates along the path, rad/s: central differences of the balance in time with
     /// the same seams and contacts held (one-sided at the path's ends).
     pub rates: Vec<f64>,
+    /// What held the faces there.
+    pub held: HeldRows,
+}
+
+/// What holds the faces at a state of a run: the latched seams and the contacts pressing
+/// (force > 0), each with the side it came from, so that the same rows can be read again
+/// at other fold angles or on another model of the same net ([`NetClosing::held_rows`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HeldRows {
+    /// The latched seams, in the order they latched.
+    pub latched: Vec<usize>,
+    /// The pressing features: (feature, side ±1, normal reference, force N).
+    pressing: Vec<(usize, f64, Vector3<f64>, f64)>,
+}
+
+impl HeldRows {
+    /// How many contacts press.
+    pub fn pressing_count(&self) -> usize {
+        self.pressing.len()
+    }
+
+    /// The pressing contacts' forces, N.
+    pub fn forces(&self) -> Vec<f64> {
+        self.pressing.iter().map(|p| p.3).collect()
+    }
 }
 
 /// A run with its states at asked times ([`NetClosing::run_until`]).
@@ -1315,12 +1340,43 @@ impl NetClosing {
         t_end: f64,
         sample_times: Option<&[f64]>,
     ) -> Result<ReleasedPath> {
+        self.run_sampled(model, forcing, stiffness, settings, t_end, sample_times, false)
+    }
+
+    /// The state at every one of `times` (s, ascending, the last > 0) the device reaches
+    /// in balance: as [`NetClosing::run_until`] up to its end, then, past a closing, the
+    /// closed device following its drives with every seam held, and past the drives' end
+    /// (closed, jammed, stalled or at rest) the last balance, which nothing moves any more.
+    /// A run that snaps or cannot decide gives no state past where it stopped.
+    pub fn states_at(
+        &self,
+        model: &NetworkModel,
+        forcing: &Forcing,
+        stiffness: &[f64],
+        settings: &ClosingSettings,
+        times: &[f64],
+    ) -> Result<ReleasedPath> {
+        let t_end = times.last().copied().unwrap_or(0.0);
+        self.run_sampled(model, forcing, stiffness, settings, t_end, Some(times), true)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_sampled(
+        &self,
+        model: &NetworkModel,
+        forcing: &Forcing,
+        stiffness: &[f64],
+        settings: &ClosingSettings,
+        t_end: f64,
+        sample_times: Option<&[f64]>,
+        held_on: bool,
+    ) -> Result<ReleasedPath> {
         settings.validate()?;
         if t_end.is_nan() || t_end <= 0.0 {
             return Err(NanofoldError::invalid("t_end", t_end, "must be a time > 0 s"));
         }
         let path = DrivePath::new(forcing, t_end);
-        let stops: Vec<f64> = match sample_times {
+        let stops: Vec<(f64, f64)> = match sample_times {
             Some(times) if path.span > 0.0 => {
                 if let Some(w) = times
                     .windows(2)
@@ -1335,7 +1391,7 @@ impl NetClosing {
                 times
                     .iter()
                     .filter(|&&t| t >= 0.0 && t <= path.span)
-                    .map(|t| t / path.span)
+                    .map(|&t| (t / path.span, t))
                     .collect()
             }
             _ => Vec::new(),
@@ -1392,10 +1448,21 @@ impl NetClosing {
                 run.report.undecided = Some(why);
             }
         }
-        // The state where the run ended, when it ended before the last asked time.
         let u_end = run.report.progress;
-        if sample_times.is_some() && run.samples.last().is_none_or(|s| s.time_s < run.path.time(u_end)) {
-            run.stops = vec![u_end];
+        if held_on {
+            if run.report.outcome == Outcome::Closes {
+                run.follow_closed();
+            }
+            let spent = run.stops.is_empty() && run.path.span >= forcing.duration();
+            if spent && !matches!(run.report.outcome, Outcome::Snaps | Outcome::Undecided) {
+                let span = run.path.span;
+                for &t in sample_times.unwrap_or(&[]).iter().filter(|&&t| t > span) {
+                    run.push_sample(t, vec![0.0; n]);
+                }
+            }
+        } else if sample_times.is_some() && run.samples.last().is_none_or(|s| s.time_s < run.path.time(u_end)) {
+            // The state where the run ended, when it ended before the last asked time.
+            run.stops = vec![(u_end, run.path.time(u_end))];
             run.sample_stops(u_end);
         }
         update_poses(model, &run.theta, &mut run.data);
@@ -1486,6 +1553,78 @@ impl NetClosing {
         Ok(theta)
     }
 
+    /// The rows `held` holds at fold angles `theta`: each latched seam's five rows (over
+    /// the size), then each pressing contact's gap on its side (over the size), with their
+    /// derivatives in the fold angles (one column per crease). Pressing contacts whose rows
+    /// are parallel to one already read (one meeting seen by two features) are left out,
+    /// as the balance leaves them: (residuals, rows, the contacts kept).
+    pub fn held_rows(
+        &self,
+        model: &NetworkModel,
+        theta: &[f64],
+        held: &HeldRows,
+    ) -> Result<(DVector<f64>, DMatrix<f64>, Vec<usize>)> {
+        let n = model.columns();
+        if theta.len() != n {
+            return Err(NanofoldError::invalid(
+                "fold_angles",
+                theta.len(),
+                format!("one per crease ({n})"),
+            ));
+        }
+        if let Some(&k) = held.latched.iter().find(|&&k| k >= self.seams.len()) {
+            return Err(NanofoldError::invalid(
+                "latched",
+                k,
+                format!("the net has {} seams", self.seams.len()),
+            ));
+        }
+        if let Some(p) = held.pressing.iter().find(|p| p.0 >= self.contacts.features.len()) {
+            return Err(NanofoldError::invalid(
+                "pressing",
+                p.0,
+                format!("the net has {} contact features", self.contacts.features.len()),
+            ));
+        }
+        let mut data = NetworkData::new(model);
+        update_poses(model, theta, &mut data);
+        let mut holds = Holds::new(self.seams.len());
+        held.latched
+            .iter()
+            .for_each(|&k| holds.latch(k, self.seams[k].faces, &self.contacts.features));
+        let (seam_residual, seam_rows) = self.seam_rows(&data, &holds, n);
+        let mut sides = Sides::new(&self.contacts, TOLERANCE * self.size);
+        for &(k, side, reference, force) in &held.pressing {
+            sides.sign[k] = side;
+            sides.reference[k] = reference;
+            holds.touching.push(k);
+            holds.forces.push(force);
+        }
+        let (gaps, rows) = self.contact_rows(&data, &holds, &sides, n);
+        let mut kept: Vec<usize> = Vec::new();
+        for i in 0..rows.nrows() {
+            let row = rows.row(i);
+            let parallel = kept.iter().any(|&j| {
+                let other = rows.row(j);
+                other.dot(&row).abs() >= (1.0 - PARALLEL_ROWS) * other.norm() * row.norm()
+            });
+            if !parallel && row.norm() > 0.0 {
+                kept.push(i);
+            }
+        }
+        let count = seam_rows.nrows() + kept.len();
+        let mut residual = DVector::zeros(count);
+        let mut jacobian = DMatrix::zeros(count, n);
+        residual.rows_mut(0, seam_rows.nrows()).copy_from(&seam_residual);
+        jacobian.rows_mut(0, seam_rows.nrows()).copy_from(&seam_rows);
+        for (r, &i) in kept.iter().enumerate() {
+            let at = seam_rows.nrows() + r;
+            residual[at] = gaps[i] / self.size;
+            jacobian.row_mut(at).copy_from(&(rows.row(i) / self.size));
+        }
+        Ok((residual, jacobian, kept))
+    }
+
     /// Where a run's faces first met: (time s, the two panels' names, the point in m): the
     /// first contact's point, or the middle of the first latching seam's first edge.
     pub fn first_meeting(
@@ -1565,8 +1704,9 @@ struct Run<'a> {
     report: ClosingReport,
     /// Frames every [`FRAME_SPACING`] of the path (else only at events and `stops`).
     spaced: bool,
-    /// Progresses still to sample, ascending.
-    stops: Vec<f64>,
+    /// Progresses still to sample, ascending, with the times asked (recorded as asked, not
+    /// as the progress maps back).
+    stops: Vec<(f64, f64)>,
     samples: Vec<PathSample>,
 }
 
@@ -1585,8 +1725,8 @@ impl Run<'_> {
         let mut unsettled = 0;
         let mut unpredicted = false;
         while u < 1.0 {
-            let next = match self.stops.first() {
-                Some(&stop) if stop > u => self.path.next(u, turn).min(stop),
+            let next = match self.stops.first().map(|s| s.0) {
+                Some(stop) if stop > u => self.path.next(u, turn).min(stop),
                 _ => self.path.next(u, turn),
             };
             let mut trial = self.theta.clone();
@@ -1829,18 +1969,60 @@ impl Run<'_> {
 
     /// The state at every asked progress reached by `u`, with its rates.
     fn sample_stops(&mut self, u: f64) {
-        while let Some(&stop) = self.stops.first() {
+        while let Some(&(stop, time_s)) = self.stops.first() {
             if stop > u {
                 break;
             }
             self.stops.remove(0);
             let rates = self.rates_at(u);
-            self.samples.push(PathSample {
-                time_s: self.path.time(u),
-                fold_angles: self.theta.clone(),
-                rates,
-            });
+            self.push_sample(time_s, rates);
         }
+    }
+
+    /// Past a closing, the closed device at every stop still asked, its drives going on
+    /// with every seam held, while a balance is found.
+    fn follow_closed(&mut self) {
+        while let Some(&(stop, _)) = self.stops.first() {
+            self.path.drive(stop, &mut self.drive);
+            let mut trial = self.theta.clone();
+            let mut holds = self.holds.clone();
+            let settled = self.net.settle(
+                self.model,
+                &self.drive,
+                self.stiffness,
+                &mut holds,
+                &self.sides,
+                &mut trial,
+                &mut self.data,
+            );
+            if !settled {
+                return;
+            }
+            self.theta = trial;
+            self.holds = holds;
+            self.sample_stops(stop);
+        }
+    }
+
+    /// Records the state as the sample at `time_s`.
+    fn push_sample(&mut self, time_s: f64, rates: Vec<f64>) {
+        let pressing = (0..self.holds.touching.len())
+            .filter(|&i| self.holds.forces[i] > 0.0)
+            .map(|i| {
+                let k = self.holds.touching[i];
+                let (side, reference) = self.sides.orientation(&self.net.contacts, k);
+                (k, side, reference, self.holds.forces[i])
+            })
+            .collect();
+        self.samples.push(PathSample {
+            time_s,
+            fold_angles: self.theta.clone(),
+            rates,
+            held: HeldRows {
+                latched: self.holds.latched.clone(),
+                pressing,
+            },
+        });
     }
 
     /// dθ/dt at progress `u`: the balance with the same holds settled a small turn of the
