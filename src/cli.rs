@@ -1082,8 +1082,14 @@ fn print_released(scene: &Scene, simulation: &nanofold::prelude::Simulation) {
                 println!("  seam {} open, its ends {:.3e} of its length apart", open.0, open.1);
             }
             for c in run.final_contacts.iter().filter(|c| c.force_n > 0.0) {
+                let friction = c.friction_n.iter().map(|f| f * f).sum::<f64>().sqrt();
+                let held = if friction > 0.0 {
+                    format!(", friction {friction:.3e} N")
+                } else {
+                    String::new()
+                };
                 println!(
-                    "  face {} pressed on face {} ({}) at ({:.2}, {:.2}, {:.2}) µm with {:.3e} N",
+                    "  face {} pressed on face {} ({}) at ({:.2}, {:.2}, {:.2}) µm with {:.3e} N{held}",
                     c.faces[0], c.faces[1], c.feature, c.point_um[0], c.point_um[1], c.point_um[2], c.force_n
                 );
             }

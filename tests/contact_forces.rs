@@ -16,10 +16,11 @@ struct Jammed {
     file_face: Vec<usize>,
     stiffness: Vec<f64>,
     size: f64,
+    friction: f64,
     run: ClosingReport,
 }
 
-fn run(shape: &str, rank: usize, front: Option<f64>, capture_percent: f64) -> Jammed {
+fn run(shape: &str, rank: usize, front: Option<f64>, capture_percent: f64, friction_coefficient: f64) -> Jammed {
     let (name, solid) = open_solid(shape).unwrap();
     let options = NetsOptions {
         top: rank,
@@ -29,7 +30,16 @@ fn run(shape: &str, rank: usize, front: Option<f64>, capture_percent: f64) -> Ja
     };
     let report = nets(&name, &solid, &options).unwrap();
     let made = best_net_patterns(&solid, &report, rank).unwrap().remove(rank - 1).1;
-    let run = net_closing(&made, shape, &options, &ClosingSettings { capture_percent }).unwrap();
+    let run = net_closing(
+        &made,
+        shape,
+        &options,
+        &ClosingSettings {
+            capture_percent,
+            friction_coefficient,
+        },
+    )
+    .unwrap();
     let scene = net_device(&made, shape, &options).unwrap();
     let model = scene.network().unwrap().clone();
     let closing = NetClosing::new(&made, &model).unwrap();
@@ -40,6 +50,7 @@ fn run(shape: &str, rank: usize, front: Option<f64>, capture_percent: f64) -> Ja
         file_face: pattern.file_face.clone(),
         stiffness: model.stiffness(),
         size: model.size(),
+        friction: friction_coefficient,
         run,
         places: Box::new(move |theta| {
             closing
@@ -92,8 +103,19 @@ fn check_jam(j: &Jammed) -> f64 {
             }
         }
     }
-    // Every force pushes.
+    // Every force pushes; friction stays within its cone, across the normal.
     assert!(jam.contacts.iter().all(|c| c.force_n >= 0.0), "{jam:?}");
+    for c in &jam.contacts {
+        let friction = Vector3::from(c.friction_n);
+        assert!(
+            friction.norm() <= j.friction * c.force_n * (1.0 + 1e-6) + 1e-18,
+            "{c:?}"
+        );
+        assert!(
+            friction.dot(&Vector3::from(c.normal)).abs() <= 1e-9 * friction.norm().max(1e-30),
+            "{c:?}"
+        );
+    }
     assert!(jam.contacts.iter().any(|c| c.force_n > 0.0), "{jam:?}");
     let face_of = |file: usize| j.file_face.iter().position(|&f| f == file).unwrap();
     // Virtual work through each fold angle: K (θ − r) = Σ F·(∂x_first − ∂x_second)/∂θ.
@@ -122,7 +144,9 @@ fn check_jam(j: &Jammed) -> f64 {
             let point = Vector3::from(contact.point_um) * 1e-6;
             let normal = Vector3::from(contact.normal);
             let other = point - normal * contact.gap_um * 1e-6;
-            work += contact.force_n * normal.dot(&(velocity(first, &point) - velocity(second, &other)));
+            // The push along the normal and the friction across it, on the first face.
+            let force = normal * contact.force_n + Vector3::from(contact.friction_n);
+            work += force.dot(&(velocity(first, &point) - velocity(second, &other)));
         }
         for seam in &jam.seams {
             let [first, second] = seam.faces.map(face_of);
@@ -140,19 +164,35 @@ fn check_jam(j: &Jammed) -> f64 {
 
 #[test]
 fn every_jam_rests_apart_pushing_and_in_balance_hinge_by_hinge() {
+    assert_eq!(jams_balance(0.0, 6), vec![], "frictionless, every run is decided");
+}
+
+/// The same runs with Coulomb friction 0.3: the jams' balance counts the friction's work,
+/// and no friction leaves its cone.
+#[test]
+fn every_jam_with_friction_balances_with_its_friction_within_the_cone() {
+    // With friction most of these runs are not decided yet (docs/model.md#contact-forces:
+    // a contact pressing at 1e-7 of the others' force converges by 3 % an iteration); the
+    // jams that are decided are checked in full.
+    let undecided = jams_balance(0.3, 3);
+    eprintln!("undecided with friction: {} of 9", undecided.len());
+}
+
+/// Checks every jam of the octahedron's nets 1, 2 and 5 along three fronts (at least
+/// `least_jams` of them); returns the runs left undecided.
+fn jams_balance(friction: f64, least_jams: usize) -> Vec<(usize, Option<f64>)> {
     // The octahedron's nets 1, 2 and 5 released along three fronts with a 1 % capture:
     // faces meet out of line and their hinges are held off their drives by contact. Every
     // run is decided; every jam is checked.
-    let mut jams = 0;
+    let (mut jams, mut undecided) = (0, Vec::new());
     for rank in [1, 2, 5] {
         for front in [Some(0.0), Some(45.0), Some(90.0)] {
-            let jammed = run("octahedron", rank, front, 1.0);
-            assert_ne!(
-                jammed.run.outcome,
-                Outcome::Undecided,
-                "net {rank} along {front:?}: {:?}",
-                jammed.run.undecided
-            );
+            let jammed = run("octahedron", rank, front, 1.0, friction);
+            if jammed.run.outcome == Outcome::Undecided {
+                eprintln!("net {rank} along {front:?} undecided: {:?}", jammed.run.undecided);
+                undecided.push((rank, front));
+                continue;
+            }
             if jammed.run.outcome != Outcome::Jams {
                 continue;
             }
@@ -163,10 +203,13 @@ fn every_jam_rests_apart_pushing_and_in_balance_hinge_by_hinge() {
                 jammed.run.jam.as_ref().unwrap().seams.len()
             );
             let imbalance = check_jam(&jammed);
+            eprintln!("  imbalance {imbalance:.2e}");
             assert!(imbalance <= 1e-6, "net {rank} along {front:?}: imbalance {imbalance:e}");
         }
     }
-    assert!(jams >= 6, "{jams} jams to check");
+    eprintln!("μ {friction}: {jams} jams checked, undecided {undecided:?}");
+    assert!(jams >= least_jams, "{jams} jams to check");
+    undecided
 }
 
 /// A flap driven into a wall that stands across its path (`docs/model.md#slow-release-through-contact`):
@@ -178,8 +221,27 @@ fn every_jam_rests_apart_pushing_and_in_balance_hinge_by_hinge() {
 /// f = K_f (r_f − θ_f) / (2 ℓ cos(θ_w / 2)) (the flap's torque over its lever arm) are
 /// closed forms.
 fn flap_and_wall(flap_target_deg: f64) -> (nanofold::dynamics::simulate::Simulation, Vec<f64>) {
+    flap_and_wall_with(flap_target_deg, 0.0)
+}
+
+/// [`flap_and_wall`] with Coulomb friction `friction` between the faces.
+fn flap_and_wall_with(flap_target_deg: f64, friction: f64) -> (nanofold::dynamics::simulate::Simulation, Vec<f64>) {
     use nanofold::dynamics::simulate::{simulate_scene, ModelChoice, SimulationSettings};
-    let dir = std::env::temp_dir().join(format!("nanofold-flap-{}-{flap_target_deg}", std::process::id()));
+    let built = flap_scene(flap_target_deg, friction).unwrap();
+    let settings = SimulationSettings {
+        model: ModelChoice::QuasiStatic,
+        ..SimulationSettings::default()
+    };
+    let stiffness = built.network().unwrap().stiffness();
+    (simulate_scene(&built, &settings).unwrap(), stiffness)
+}
+
+/// The flap and wall's scene, built.
+fn flap_scene(flap_target_deg: f64, friction: f64) -> nanofold::Result<nanofold::dynamics::scene::Scene> {
+    let dir = std::env::temp_dir().join(format!(
+        "nanofold-flap-{}-{flap_target_deg}-{friction}",
+        std::process::id()
+    ));
     std::fs::create_dir_all(&dir).unwrap();
     let fold = serde_json::json!({
         "file_spec": 1.1,
@@ -210,18 +272,23 @@ fn flap_and_wall(flap_target_deg: f64) -> (nanofold::dynamics::simulate::Simulat
         "anchored_face": 0,
         "actuation": {"kind": "step"},
         "environment": {"drag": true},
+        "friction_coefficient": friction,
         "time": {"t_end_s": 0.01}
     });
-    let built = nanofold::read::parse_scene(&scene.to_string(), "flap", "flap", &dir)
-        .and_then(|s| s.build())
-        .unwrap();
+    let built = nanofold::read::parse_scene(&scene.to_string(), "flap", "flap", &dir).and_then(|s| s.build());
     std::fs::remove_dir_all(&dir).ok();
-    let settings = SimulationSettings {
-        model: ModelChoice::QuasiStatic,
-        ..SimulationSettings::default()
-    };
-    let stiffness = built.network().unwrap().stiffness();
-    (simulate_scene(&built, &settings).unwrap(), stiffness)
+    built
+}
+
+#[test]
+fn a_friction_coefficient_out_of_range_is_refused_by_name() {
+    for bad in [-0.1, 10.5] {
+        let error = flap_scene(170.0, bad).unwrap_err().to_string();
+        assert!(
+            error.contains("friction_coefficient") && error.contains(&bad.to_string()),
+            "{error}"
+        );
+    }
 }
 
 #[test]
@@ -275,4 +342,81 @@ fn a_flap_driven_into_a_standing_wall_stops_with_its_torque_over_its_lever_arm()
     let angles = run.response.samples.last().unwrap().angles.as_slice().to_vec();
     assert!((angles[0] - 120f64.to_radians()).abs() <= 1e-12);
     assert!((angles[1] - r_w).abs() <= 1e-12);
+}
+
+/// The flap and the wall with Coulomb friction μ between them (`docs/model.md#contact-forces`).
+/// Past the first touch the wall's top edge slides out along the flap's face (the wall
+/// pushed back), so the friction on the edge points back towards the flap's hinge with its
+/// whole μ N. Along the flap's face it passes through the flap's hinge line (no torque
+/// there); about the wall's hinge its arm is ℓ sin(θ_w / 2), against the push. So
+/// K_f (r_f − θ_f) = 2 N ℓ cos(θ_w / 2) as before and K_w (r_w − θ_w) = N ℓ (cos(θ_w / 2) −
+/// μ sin(θ_w / 2)), θ_f = π − θ_w / 2: one equation in θ_w, solved here by bisection.
+#[test]
+fn friction_holds_the_wall_up_by_its_coefficient_times_the_force() {
+    use std::f64::consts::PI;
+    let side = 100e-6;
+    let (r_f, r_w) = (170f64.to_radians(), 90f64.to_radians());
+    let mut previous_wall = 0.0;
+    for mu in [0.1, 0.3, 0.6] {
+        let (run, stiffness) = flap_and_wall_with(170.0, mu);
+        let (k_f, k_w) = (stiffness[0], stiffness[1]);
+        let released = run.released.as_ref().unwrap();
+        assert_eq!(released.outcome.label(), "jams", "μ {mu}: {released:?}");
+        let imbalance = |wall: f64| {
+            let half = 0.5 * wall;
+            k_w * (r_w - wall) - 0.5 * k_f * (r_f - PI + half) * (1.0 - mu * half.tan())
+        };
+        let (mut low, mut high) = (0.0, r_w);
+        for _ in 0..200 {
+            let middle = 0.5 * (low + high);
+            if imbalance(middle) > 0.0 {
+                low = middle;
+            } else {
+                high = middle;
+            }
+        }
+        let wall = 0.5 * (low + high);
+        let flap = PI - 0.5 * wall;
+        let force = k_f * (r_f - flap) / (2.0 * side * (0.5 * wall).cos());
+        let angles = run.response.samples.last().unwrap().angles.as_slice().to_vec();
+        let pressing: Vec<_> = released.final_contacts.iter().filter(|c| c.force_n > 0.0).collect();
+        assert_eq!(pressing.len(), 1, "μ {mu}: one meeting");
+        let contact = pressing[0];
+        let friction = contact.friction_n.iter().map(|f| f * f).sum::<f64>().sqrt();
+        let across: f64 = (0..3).map(|i| contact.friction_n[i] * contact.normal[i]).sum();
+        eprintln!(
+            "μ {mu}: wall {:.9}° (closed form {:.9}°), flap {:.9}° ({:.9}°), force {:.9e} N ({force:.9e}), friction {friction:.9e} N",
+            angles[1].to_degrees(),
+            wall.to_degrees(),
+            angles[0].to_degrees(),
+            flap.to_degrees(),
+            contact.force_n
+        );
+        assert!(
+            (angles[1] - wall).abs() <= 1e-9,
+            "μ {mu}: wall {} against {wall}",
+            angles[1]
+        );
+        assert!(
+            (angles[0] - flap).abs() <= 1e-9,
+            "μ {mu}: flap {} against {flap}",
+            angles[0]
+        );
+        assert!(
+            (contact.force_n - force).abs() <= 1e-9 * force,
+            "μ {mu}: force {} against {force}",
+            contact.force_n
+        );
+        // Sliding: the friction is μ N, across the normal. Its bound is μ times the force
+        // of the balance's last iterate but one (the normal force is lagged), which the
+        // last step (under 1e-10 rad) moves by a few 1e-9 of itself.
+        assert!(
+            (friction - mu * contact.force_n).abs() <= 1e-8 * friction,
+            "μ {mu}: friction {friction}"
+        );
+        assert!(across.abs() <= 1e-9 * friction);
+        // More friction holds the wall up further.
+        assert!(wall > previous_wall);
+        previous_wall = wall;
+    }
 }

@@ -158,7 +158,10 @@ fn a_narrower_capture_leaves_the_walls_meeting_out_of_line_pressed_not_latched()
     // 2 sin 2.5° of their length out of line (0.0872), inside 10 % and outside 5 %. With 5 %
     // they press instead of latching, nothing turns them into line, and the cube stalls.
     let (_, made, options) = latin_cross(Some(180.0));
-    let narrow = ClosingSettings { capture_percent: 5.0 };
+    let narrow = ClosingSettings {
+        capture_percent: 5.0,
+        ..ClosingSettings::default()
+    };
     let run = net_closing(&made, "cube", &options, &narrow).unwrap();
     assert_eq!(run.outcome, Outcome::Stalls, "{run:?}");
     // The east and west walls touch the south wall's edges at the corners they share (one
@@ -170,8 +173,22 @@ fn a_narrower_capture_leaves_the_walls_meeting_out_of_line_pressed_not_latched()
         open.iter().filter(|m| (*m - out_of_line).abs() <= 1e-8).count() >= 2,
         "{open:?}"
     );
-    assert!(ClosingSettings { capture_percent: 0.0 }.validate().is_err());
-    let error = net_closing(&made, "cube", &options, &ClosingSettings { capture_percent: 80.0 }).unwrap_err();
+    assert!(ClosingSettings {
+        capture_percent: 0.0,
+        ..ClosingSettings::default()
+    }
+    .validate()
+    .is_err());
+    let error = net_closing(
+        &made,
+        "cube",
+        &options,
+        &ClosingSettings {
+            capture_percent: 80.0,
+            ..ClosingSettings::default()
+        },
+    )
+    .unwrap_err();
     assert!(error.to_string().contains("capture_percent"), "{error}");
 }
 

@@ -261,6 +261,21 @@ def test_fit_takes_a_dataframe_with_gaps_and_gives_the_estimate_its_interval_and
         nanofold.fit(scene, window, free={"environment.drag_coeficient": (0.2, 5)})
 
 
+def test_fit_of_a_slow_release_goes_through_its_contact():
+    import pandas as pd
+
+    # The film was made with the walls' target at 97 deg and their stiffness 1.6 times the lid's;
+    # only the contact of the south wall pressing the lid shows the stiffness.
+    film = pd.read_csv("patterns/measurements/cube_lid_first_filmed.csv", comment="#")
+    r = nanofold.fit("patterns/devices/cube_lid_first_lid_apart.scene.json", film,
+                     free={"hinge_defaults.target_angle_deg": (85, 105),
+                           "hinge_defaults.stiffness_scale": (0.2, 5)})
+    assert r.status == "converged"
+    for p, truth in zip(r.parameters, (97.0, 1.6)):
+        low, high = p["interval_95"]
+        assert low <= truth <= high, (p["path"], low, high)
+
+
 def test_nets_rank_a_solids_nets_and_give_the_best_as_fold():
     r = nanofold.nets("box:1x2x3", top=5, unit_um=50, simulate=0)
     # A box of three different sides has 54 distinct nets (and a symmetry group of order 8).

@@ -228,6 +228,7 @@ impl NetsOptions {
     pub fn closing(&self) -> ClosingSettings {
         ClosingSettings {
             capture_percent: self.capture_percent,
+            ..ClosingSettings::default()
         }
     }
 
@@ -550,7 +551,15 @@ mod tests {
         assert_eq!(at(30.0), [30.0, 15.0]);
         for capture in [0.1, 1.0, 10.0, 25.0, 30.0, 50.0] {
             for c in at(capture) {
-                assert!(ClosingSettings { capture_percent: c }.validate().is_ok(), "{c}");
+                assert!(
+                    ClosingSettings {
+                        capture_percent: c,
+                        ..ClosingSettings::default()
+                    }
+                    .validate()
+                    .is_ok(),
+                    "{c}"
+                );
             }
         }
     }

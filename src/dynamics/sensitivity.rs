@@ -116,6 +116,13 @@ pub fn trajectory_sensitivities(
         }
         System::Network(model) if network_plant(model)?.time_scales()?.ratio >= super::simulate::QUASI_STATIC_RATIO => {
             // A slow release: the balance's own sensitivities along the engine's path.
+            if model.friction_coefficient > 0.0 {
+                return Err(NanofoldError::invalid(
+                    "friction_coefficient",
+                    model.friction_coefficient,
+                    "a slow release's sensitivities come from its frictionless balance: with friction its state depends on the path, whose derivatives are not built",
+                ));
+            }
             if let Some(reason) = super::simulate::first_contact_only(model) {
                 return Err(NanofoldError::invalid(
                     "actuation",

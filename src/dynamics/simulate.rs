@@ -393,7 +393,10 @@ fn released_path<P: Plant>(
         model,
         &model.forcing,
         &model.stiffness(),
-        &ClosingSettings::default(),
+        &ClosingSettings {
+            friction_coefficient: model.friction_coefficient,
+            ..ClosingSettings::default()
+        },
         t_end,
         Some(times),
     )?;

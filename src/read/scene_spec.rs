@@ -630,6 +630,10 @@ pub struct NetworkSpec<P> {
     /// a net's seams (a tree of panels only).
     #[serde(default)]
     pub seams: Vec<[usize; 2]>,
+    /// Coulomb's coefficient of friction between touching faces, for a slow release through
+    /// contact (default 0: frictionless; at most 10).
+    #[serde(default)]
+    pub friction_coefficient: Option<f64>,
     /// The time span.
     pub time: TimeSpec,
     /// What to record.
@@ -695,6 +699,7 @@ impl<P> NetworkSpec<P> {
             substrate: self.substrate,
             constraint: self.constraint,
             seams: self.seams,
+            friction_coefficient: self.friction_coefficient,
             time: self.time,
             outputs: self.outputs,
         })

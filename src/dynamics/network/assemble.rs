@@ -223,6 +223,16 @@ pub fn network(spec: &NetworkSpec<CreasePattern>) -> Result<NetworkModel> {
             &spec.seams,
         )?);
     }
+    if let Some(friction) = spec.friction_coefficient {
+        if !(0.0..=10.0).contains(&friction) {
+            return Err(NanofoldError::invalid(
+                "friction_coefficient",
+                friction,
+                "Coulomb's coefficient between faces: from 0 (frictionless) to 10",
+            ));
+        }
+        model.friction_coefficient = friction;
+    }
     if let Some(constraint) = &spec.constraint {
         match constraint.source {
             NetworkSource::Poly => model.reduction = Some(reduce(&model, constraint)?),

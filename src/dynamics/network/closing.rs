@@ -7,7 +7,7 @@
 //! jumps (`snaps`).
 
 use super::algorithms::update_poses;
-use super::contact_balance::{solve_step, BalanceStep};
+use super::contact_balance::{solve_step, BalanceStep, FrictionRows};
 use super::face_contact::{FaceContacts, Feature, FeatureState, PlacedFaces};
 use super::{NetworkData, NetworkModel};
 use crate::dynamics::Forcing;
@@ -72,6 +72,12 @@ const CONTACT_STEP: f64 = 1e-10;
 /// wanders at the floor that leaves.
 const FLOOR_STEP: f64 = 1e-8;
 const FLOOR_ITERATIONS: usize = 10;
+/// With friction: balances on lagged normal forces repeated at most this many times, until
+/// the forces agree with those their friction was bounded by to this share of the largest.
+const FRICTION_ROUNDS: usize = 30;
+const FRICTION_AGREED: f64 = 1e-8;
+/// Aitken's extrapolation of the rounds is trusted for change ratios below this.
+const AITKEN_LARGEST: f64 = 0.995;
 /// A contact may sit this share of the tolerance deep.
 const CONTACT_SLACK: f64 = 0.1;
 /// A settled balance's contacts hold to this many times their slack.
@@ -120,18 +126,24 @@ const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
 const SETTLE_DAMPING: f64 = 0.3;
 
-/// How seams latch.
+/// How seams latch and faces touch.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ClosingSettings {
     /// A seam latches when its faces meet with its two edges' ends at most this far apart,
     /// in % of the seam's length (above 0, at most 50): the solder or adhesive on the seam
     /// pulls them into line. Faces that meet farther apart jam.
     pub capture_percent: f64,
+    /// Coulomb's coefficient of friction between touching faces (0: frictionless, the
+    /// default; at most 10).
+    pub friction_coefficient: f64,
 }
 
 impl Default for ClosingSettings {
     fn default() -> Self {
-        ClosingSettings { capture_percent: 10.0 }
+        ClosingSettings {
+            capture_percent: 10.0,
+            friction_coefficient: 0.0,
+        }
     }
 }
 
@@ -143,6 +155,13 @@ impl ClosingSettings {
                 "capture_percent",
                 self.capture_percent,
                 "a share of the seam's length above 0 and at most 50 %",
+            ));
+        }
+        if !(0.0..=10.0).contains(&self.friction_coefficient) {
+            return Err(NanofoldError::invalid(
+                "friction_coefficient",
+                self.friction_coefficient,
+                "Coulomb's coefficient between faces: from 0 (frictionless) to 10",
             ));
         }
         Ok(())
@@ -232,6 +251,9 @@ pub struct ContactForce {
     pub gap_um: f64,
     /// The force, N (≥ 0).
     pub force_n: f64,
+    /// The friction across the normal on the first face, N (at most the coefficient times
+    /// the force; 0 without friction).
+    pub friction_n: [f64; 3],
 }
 
 /// A latched seam's force at one end, on its first face (its second feels the opposite).
@@ -369,6 +391,11 @@ struct Holds {
     touching: Vec<usize>,
     /// Each touching feature's force at the last balance, N.
     forces: Vec<f64>,
+    /// The friction at the last balance: (feature, force across its normal on the first
+    /// face, N).
+    friction: Vec<(usize, Vector3<f64>)>,
+    /// Where a step's slip is counted from (its start; none: where the balance starts).
+    origin: Option<Vec<f64>>,
     /// The latched seams' row multipliers at the last balance with contacts, N·m.
     seam_multipliers: Vec<f64>,
     /// Seams whose capture found no balance (contact holds their faces off the pull):
@@ -410,6 +437,8 @@ impl Holds {
             failure: None,
             latched: Vec::new(),
             touching: Vec::new(),
+            friction: Vec::new(),
+            origin: None,
             forces: Vec::new(),
             seam_multipliers: Vec::new(),
         }
@@ -455,6 +484,8 @@ struct Sides {
     tolerance: f64,
     /// The run's QP solves so far (bounded by [`RUN_SOLVES`]).
     solves: std::cell::Cell<usize>,
+    /// Coulomb's coefficient between faces (0: frictionless).
+    friction: f64,
     /// Each seam's end offsets (first face's corner less the second's) at the last accepted
     /// poses: a seam whose offsets turn back has passed through line within the step.
     seam_offsets: Vec<[Vector3<f64>; 2]>,
@@ -470,6 +501,7 @@ impl Sides {
             last: None,
             tolerance,
             solves: std::cell::Cell::new(0),
+            friction: 0.0,
             seam_offsets: Vec::new(),
         }
     }
@@ -901,6 +933,63 @@ impl NetClosing {
         (gaps, rows)
     }
 
+    /// Coulomb friction at the standing contacts whose meetings pressed at the last iterate
+    /// (`meeting_forces`, one per standing contact): each one's
+    /// two slip rows across its normal, its slip since `origin` (linearised, m), μ times its
+    /// force, and (feature, its two directions); `None` when none presses.
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    fn friction_rows(
+        &self,
+        data: &NetworkData,
+        holds: &Holds,
+        sides: &Sides,
+        standing: &[usize],
+        meeting_forces: &[f64],
+        theta: &[f64],
+        origin: &[f64],
+    ) -> Option<(
+        DMatrix<f64>,
+        DVector<f64>,
+        DVector<f64>,
+        Vec<(usize, [Vector3<f64>; 2])>,
+    )> {
+        let pressed: Vec<usize> = (0..standing.len()).filter(|&s| meeting_forces[s] > 0.0).collect();
+        if pressed.is_empty() {
+            return None;
+        }
+        let pressing: Vec<usize> = pressed.iter().map(|&s| standing[s]).collect();
+        let n = theta.len();
+        let placed = self.contacts.placed(data);
+        let mut rows = DMatrix::zeros(2 * pressing.len(), n);
+        let mut row = DVector::zeros(n);
+        let mut frames = Vec::with_capacity(pressing.len());
+        for (p, &i) in pressing.iter().enumerate() {
+            let k = holds.touching[i];
+            let state = sides.state(&self.contacts, &placed, k);
+            let normal = state.normal;
+            // Any two directions across the normal.
+            let axis = if normal.x.abs() < 0.9 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            };
+            let first = normal.cross(&axis).normalize();
+            let second = normal.cross(&first);
+            for (j, direction) in [first, second].iter().enumerate() {
+                self.contacts.row_along(data, k, &state, direction, &mut row);
+                rows.row_mut(2 * p + j).copy_from(&row.transpose());
+            }
+            frames.push((k, [first, second]));
+        }
+        let moved = DVector::from_iterator(n, (0..n).map(|c| theta[c] - origin[c]));
+        let slip = &rows * moved;
+        let bounds = DVector::from_iterator(
+            pressed.len(),
+            pressed.iter().map(|&s| sides.friction * meeting_forces[s]),
+        );
+        Some((rows, slip, bounds, frames))
+    }
+
     /// W = −Σ fᵢ ∇²gᵢ, the touching features' curvature weighted by their last forces (the
     /// balance's Lagrangian Hessian less K), from central differences of their rows in each
     /// fold angle; `None` while no contact pushes. With it, the balance's stiffness along
@@ -927,11 +1016,23 @@ impl NetClosing {
         let mut curvature = DMatrix::zeros(n, n);
         let mut data = NetworkData::new(model);
         let mut shifted = theta.to_vec();
-        // Only the pushing contacts weigh in, and only the angles that move their faces.
-        let pushing: Vec<usize> = (0..holds.forces.len()).filter(|&i| holds.forces[i] > 0.0).collect();
+        // Only the pushing contacts weigh in, and only the angles that move their faces; a
+        // friction weighs in as a push along its own direction (its rows' curvature
+        // weighted by its size: the Lagrangian's −Σ φ ∇²s).
+        let weighted: Vec<(usize, Option<Vector3<f64>>, f64)> = (0..holds.forces.len())
+            .filter(|&i| holds.forces[i] > 0.0)
+            .map(|i| (holds.touching[i], None, holds.forces[i]))
+            .chain(
+                holds
+                    .friction
+                    .iter()
+                    .filter(|(k, phi)| phi.norm() > 0.0 && holds.touching.contains(k))
+                    .map(|(k, phi)| (*k, Some(phi.normalize()), phi.norm())),
+            )
+            .collect();
         let mut moving = vec![false; n];
-        for &i in &pushing {
-            for face in self.contacts.features[holds.touching[i]].faces() {
+        for &(k, _, _) in &weighted {
+            for face in self.contacts.features[k].faces() {
                 for &c in &self.paths[self.contacts.face_panel[face]] {
                     moving[c] = true;
                 }
@@ -941,22 +1042,23 @@ impl NetClosing {
             update_poses(model, shifted, &mut data);
             let placed = self.contacts.placed(&data);
             let mut row = DVector::zeros(n);
-            for (p, &i) in pushing.iter().enumerate() {
-                let k = holds.touching[i];
+            for (p, &(k, direction, _)) in weighted.iter().enumerate() {
                 let state = sides.state(&self.contacts, &placed, k);
-                self.contacts.row(&data, k, &state, &mut row);
+                match direction {
+                    None => self.contacts.row(&data, k, &state, &mut row),
+                    Some(direction) => self.contacts.row_along(&data, k, &state, &direction, &mut row),
+                }
                 out.row_mut(p).copy_from(&row.transpose());
             }
         };
-        let (mut plus, mut minus) = (DMatrix::zeros(pushing.len(), n), DMatrix::zeros(pushing.len(), n));
+        let (mut plus, mut minus) = (DMatrix::zeros(weighted.len(), n), DMatrix::zeros(weighted.len(), n));
         for c in (0..n).filter(|&c| moving[c]) {
             shifted[c] = theta[c] + CURVATURE_STEP;
             rows_at(&shifted, &mut plus);
             shifted[c] = theta[c] - CURVATURE_STEP;
             rows_at(&shifted, &mut minus);
             shifted[c] = theta[c];
-            for (p, &i) in pushing.iter().enumerate() {
-                let force = holds.forces[i];
+            for (p, &(_, _, force)) in weighted.iter().enumerate() {
                 for j in 0..n {
                     curvature[(j, c)] -= force * (plus[(p, j)] - minus[(p, j)]) / (2.0 * CURVATURE_STEP);
                 }
@@ -1073,7 +1175,23 @@ impl NetClosing {
         holds.unstable = false;
         holds.failure = None;
         let mut foretold: Option<(Vec<f64>, Vec<f64>, f64)> = None;
-        for _ in 0..CONTACT_ITERATIONS {
+        let origin = holds.origin.take().unwrap_or_else(|| theta.to_vec());
+        let mut lagged: Vec<(usize, f64)> = holds
+            .touching
+            .iter()
+            .copied()
+            .zip(holds.forces.iter().copied())
+            .collect();
+        let mut rounds = 0;
+        // The last round's change of the forces, by feature (for Aitken's extrapolation).
+        let mut last_change: Option<Vec<(usize, f64)>> = None;
+        // With friction, each round of lagged forces has the iterations of one balance.
+        let iterations = if sides.friction > 0.0 {
+            CONTACT_ITERATIONS * FRICTION_ROUNDS
+        } else {
+            CONTACT_ITERATIONS
+        };
+        for _ in 0..iterations {
             update_poses(model, theta, data);
             let (seam_residual, seam_rows) = self.seam_rows(data, holds, n);
             // The seams' rows as their row space: latched seams that close a solid hold more
@@ -1104,6 +1222,11 @@ impl NetClosing {
                 .map(|i| all_gaps[i] / all_rows.row(i).norm().max(f64::MIN_POSITIVE))
                 .collect();
             order.sort_by(|&a, &b| turn[a].total_cmp(&turn[b]));
+            if sides.friction > 0.0 {
+                // With friction a meeting keeps the feature that pressed for it: its slip
+                // rows are the ones its friction was bounded on.
+                order.sort_by_key(|&i| holds.forces[i] <= 0.0);
+            }
             for i in order {
                 let faces = self.contacts.features[holds.touching[i]].faces();
                 let row = all_rows.row(i);
@@ -1156,6 +1279,24 @@ impl NetClosing {
                 return false;
             }
             let curvature = curved.map(|(w, _)| w);
+            // A meeting's force is its features' together: which one stands for it may
+            // change from one iterate to the next. Friction is bounded by the forces of the
+            // last converged balance (`lagged`; a meeting new since then by its last
+            // iterate's), so each balance is a convex problem the iterations converge on.
+            let meeting_forces: Vec<f64> = (0..standing.len())
+                .map(|s| {
+                    (0..holds.touching.len())
+                        .filter(|&i| stands_for[i] == s)
+                        .map(|i| {
+                            let feature = holds.touching[i];
+                            lagged.iter().find(|l| l.0 == feature).map_or(holds.forces[i], |l| l.1)
+                        })
+                        .sum()
+                })
+                .collect();
+            let friction = (sides.friction > 0.0)
+                .then(|| self.friction_rows(data, holds, sides, &standing, &meeting_forces, theta, &origin))
+                .flatten();
             let mut share = 1.0;
             let solution = loop {
                 let asked_closure = &closure * share;
@@ -1179,6 +1320,11 @@ impl NetClosing {
                     contacts: (&contact_rows, &asked_gaps),
                     trust,
                     size: self.size,
+                    friction: friction.as_ref().map(|(rows, slip, bounds, _)| FrictionRows {
+                        slip_rows: rows,
+                        slip,
+                        bounds,
+                    }),
                 }) {
                     Ok(solution) => break solution,
                     Err(_) => {
@@ -1218,6 +1364,17 @@ impl NetClosing {
                     0.0
                 };
             }
+            holds.friction = match &friction {
+                Some((_, _, _, frames)) => frames
+                    .iter()
+                    .enumerate()
+                    .map(|(p, (k, [t1, t2]))| {
+                        let phi = &solution.friction_forces;
+                        (*k, t1 * phi[2 * p] + t2 * phi[2 * p + 1])
+                    })
+                    .collect(),
+                None => Vec::new(),
+            };
             // The seams' own multipliers: μ_E = E Σ v μ_v / λ, the least-norm μ_E with
             // Eᵀμ_E = Σ v μ_v.
             let through = kept
@@ -1240,7 +1397,58 @@ impl NetClosing {
                     .iter()
                     .all(|&i| landed[i] >= -LANDED_SLACK * CONTACT_SLACK * TOLERANCE * self.size)
                 {
-                    return true;
+                    // With friction, balanced on the forces it was bounded by: again on the
+                    // new ones until they agree.
+                    // Against the largest force, or one that a hinge's torque over a drive
+                    // step gives at the net's size (a contact just met presses at rounding).
+                    let stiffest = stiffness.iter().fold(0.0_f64, |m, &k| m.max(k));
+                    let largest = holds
+                        .forces
+                        .iter()
+                        .fold(stiffest * MAX_STEP / self.size, |m, &f| m.max(f));
+                    let moved = holds
+                        .touching
+                        .iter()
+                        .zip(&holds.forces)
+                        .map(|(k, f)| (f - lagged.iter().find(|l| l.0 == *k).map_or(0.0, |l| l.1)).abs())
+                        .fold(0.0_f64, f64::max);
+                    if sides.friction == 0.0 || moved <= FRICTION_AGREED * largest {
+                        return true;
+                    }
+                    rounds += 1;
+                    if rounds >= FRICTION_ROUNDS {
+                        break;
+                    }
+                    // The rounds converge linearly (a wedge's friction raising its own
+                    // normal force: changes shrinking by 2 % a round were seen), so the
+                    // next forces are extrapolated along the change by Aitken's Δ²: by
+                    // 1/(1 − r), r the ratio of this round's change to the last's.
+                    let change: Vec<(usize, f64)> = holds
+                        .touching
+                        .iter()
+                        .zip(&holds.forces)
+                        .map(|(&k, &f)| (k, f - lagged.iter().find(|l| l.0 == k).map_or(0.0, |l| l.1)))
+                        .collect();
+                    let ratio = last_change.as_ref().and_then(|last| {
+                        let same = last.len() == change.len() && last.iter().zip(&change).all(|(a, b)| a.0 == b.0);
+                        let (dot, norm) = last
+                            .iter()
+                            .zip(&change)
+                            .fold((0.0, 0.0), |(d, m), (a, b)| (d + a.1 * b.1, m + a.1 * a.1));
+                        (same && norm > 0.0).then_some(dot / norm)
+                    });
+                    let reach = match ratio {
+                        Some(r) if r > 0.0 && r < AITKEN_LARGEST => 1.0 / (1.0 - r),
+                        _ => 1.0,
+                    };
+                    lagged = change
+                        .iter()
+                        .map(|&(k, d)| {
+                            let before = lagged.iter().find(|l| l.0 == k).map_or(0.0, |l| l.1);
+                            (k, (before + reach * d).max(0.0))
+                        })
+                        .collect();
+                    last_change = Some(change);
                 }
                 at_floor = 0;
             }
@@ -1416,7 +1624,10 @@ impl NetClosing {
             data: NetworkData::new(model),
             drive: vec![0.0; n],
             theta: vec![0.0; n],
-            sides: Sides::new(&self.contacts, TOLERANCE * self.size),
+            sides: Sides {
+                friction: settings.friction_coefficient,
+                ..Sides::new(&self.contacts, TOLERANCE * self.size)
+            },
             raw: vec![None; self.contacts.features.len()],
             holds: Holds::new(self.seams.len()),
             previous: None,
@@ -1501,6 +1712,11 @@ impl NetClosing {
                     normal: [normal.x, normal.y, normal.z],
                     gap_um: state.distance * 1e6,
                     force_n: force,
+                    friction_n: holds
+                        .friction
+                        .iter()
+                        .find(|f| f.0 == k)
+                        .map_or([0.0; 3], |f| [f.1.x, f.1.y, f.1.z]),
                 }
             })
             .collect()
@@ -1745,6 +1961,8 @@ impl Run<'_> {
             };
             unpredicted = false;
             let mut holds = self.holds.clone();
+            // The step's slip counts from the last balance, not from its predicted start.
+            holds.origin = Some(self.theta.clone());
             self.path.drive(u, &mut self.drive);
             let before = self.drive.clone();
             self.path.drive(next, &mut self.drive);

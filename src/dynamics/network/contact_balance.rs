@@ -15,6 +15,9 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use nalgebra::{DMatrix, DVector};
 
+/// Clarabel's tolerances for a step with friction cones whose solve stalls at 1e-12
+/// (relative to the step's scale).
+const FRICTION_TOLERANCE: f64 = 1e-10;
 /// The trust box's half-width in units of the step's own scale at most.
 const SCALED_TRUST: f64 = 1e3;
 
@@ -36,6 +39,23 @@ pub struct BalanceStep<'a> {
     pub trust: f64,
     /// The length that scales gaps (the size), m.
     pub size: f64,
+    /// Coulomb friction at the contacts, if any.
+    pub friction: Option<FrictionRows<'a>>,
+}
+
+/// Coulomb friction at the pressing contacts, the normal forces lagged from the last
+/// iterate: each contact k dissipates μ Nₖ ‖Tₖ (θ − θ₀)‖ over the step from θ₀, Tₖ its two
+/// slip rows (the relative motion of its points across its normal, m/rad). Its share of
+/// the QP is μ Nₖ sₖ with (sₖ, Tₖ d + oₖ) in a second-order cone, oₖ = Tₖ (θ − θ₀) the slip
+/// so far, so the step's stationarity has friction opposing the slip, at most μ Nₖ.
+#[derive(Debug, Clone)]
+pub struct FrictionRows<'a> {
+    /// Two rows per contact, m/rad.
+    pub slip_rows: &'a DMatrix<f64>,
+    /// The slip since the step's start, two per contact, m.
+    pub slip: &'a DVector<f64>,
+    /// μ Nₖ per contact, N.
+    pub bounds: &'a DVector<f64>,
 }
 
 /// A solved step.
@@ -49,6 +69,9 @@ pub struct BalanceSolution {
     pub closure_multipliers: DVector<f64>,
     /// Whether a trust bound was reached (the step is not yet the balance's).
     pub at_trust: bool,
+    /// Each friction contact's force across its normal, N (two components along its slip
+    /// rows' directions; empty without friction).
+    pub friction_forces: DVector<f64>,
 }
 
 /// Solves one step: first directly by active sets ([`held_step`]: the rows held as
@@ -56,6 +79,10 @@ pub struct BalanceSolution {
 /// optimality conditions and, the energy being strictly convex, is the QP's one solution. Otherwise with Clarabel; a status other
 /// than solved (or almost solved) is an error naming it.
 pub fn solve_step(step: &BalanceStep) -> Result<BalanceSolution> {
+    if step.friction.is_some() {
+        // The cones are Clarabel's: the direct path has equalities and bounds only.
+        return solve_step_with_clarabel(step);
+    }
     match held_step(step) {
         HeldStep::Solved(solution) => Ok(solution),
         HeldStep::Infeasible => Err(NumericalError::QpStatus {
@@ -314,6 +341,7 @@ fn finish(
     }
     debug_assert_eq!(d.len(), n);
     HeldStep::Solved(BalanceSolution {
+        friction_forces: DVector::zeros(0),
         step: d,
         forces,
         closure_multipliers,
@@ -346,11 +374,16 @@ pub(crate) fn solve_step_with_clarabel(step: &BalanceStep) -> Result<BalanceSolu
         .fold(0.0_f64, |m, &k| m.max(k))
         .max(f64::MIN_POSITIVE);
     let stiff: Vec<f64> = step.stiffness.iter().map(|k| k / largest).collect();
+    let m_f = step.friction.as_ref().map_or(0, |f| f.bounds.len());
     let p = match step.curvature {
-        None => CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), stiff.clone()),
-        Some(curvature) => {
-            // The upper triangle of (K + W) / largest.
-            let mut hessian = curvature / largest;
+        None if m_f == 0 => CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), stiff.clone()),
+        _ => {
+            // The upper triangle of (K + W) / largest; a friction contact's cone height
+            // carries no energy of its own (zero columns).
+            let mut hessian = DMatrix::zeros(n + m_f, n + m_f);
+            if let Some(curvature) = step.curvature {
+                hessian.view_mut((0, 0), (n, n)).copy_from(&(curvature / largest));
+            }
             for c in 0..n {
                 hessian[(c, c)] += stiff[c];
             }
@@ -373,18 +406,31 @@ pub(crate) fn solve_step_with_clarabel(step: &BalanceStep) -> Result<BalanceSolu
             forces: DVector::zeros(m_g),
             closure_multipliers: DVector::zeros(m_e),
             at_trust: false,
+            friction_forces: DVector::zeros(2 * m_f),
         });
     }
-    let q: Vec<f64> = (0..n).map(|c| stiff[c] * step.offset[c] / sigma).collect();
-    let rows = m_e + m_g + 2 * n;
-    let mut a = DMatrix::zeros(rows, n);
+    // The variables: the step d/σ, then one cone height sₖ per friction contact (its slip
+    // over the size), costing μ Nₖ size / (largest σ²) each in the objective scaled by
+    // largest σ².
+    let columns = n + m_f;
+    let mut q: Vec<f64> = (0..n).map(|c| stiff[c] * step.offset[c] / sigma).collect();
+    if let Some(friction) = &step.friction {
+        q.extend(
+            friction
+                .bounds
+                .iter()
+                .map(|b| b * step.size / (largest * sigma * sigma)),
+        );
+    }
+    let rows = m_e + m_g + 2 * n + 3 * m_f;
+    let mut a = DMatrix::zeros(rows, columns);
     let mut b = vec![0.0; rows];
     // Each row over β, its size in the scaled variables.
     let mut beta = vec![1.0; rows];
     for i in 0..m_e {
         let row = e_rows.row(i) * sigma;
         beta[i] = row.norm().max(e_values[i].abs()).max(f64::MIN_POSITIVE);
-        a.row_mut(i).copy_from(&(row / beta[i]));
+        a.view_mut((i, 0), (1, n)).copy_from(&(row / beta[i]));
         b[i] = -e_values[i] / beta[i];
     }
     for i in 0..m_g {
@@ -405,34 +451,78 @@ pub(crate) fn solve_step_with_clarabel(step: &BalanceStep) -> Result<BalanceSolu
         b[m_e + m_g + c] = bound;
         b[m_e + m_g + n + c] = bound;
     }
+    // Each friction contact's cone: (sₖ, (Tₖ σx + oₖ)/size) ∈ SOC(3), as z = b − A x.
+    let cone_start = m_e + m_g + 2 * n;
+    if let Some(friction) = &step.friction {
+        for k in 0..m_f {
+            let r = cone_start + 3 * k;
+            a[(r, n + k)] = -1.0;
+            for j in 0..2 {
+                for c in 0..n {
+                    a[(r + 1 + j, c)] = -friction.slip_rows[(2 * k + j, c)] * sigma / step.size;
+                }
+                b[r + 1 + j] = friction.slip[2 * k + j] / step.size;
+            }
+        }
+    }
     let a = dense_to_csc(&a);
     let mut cones = Vec::new();
     if m_e > 0 {
         cones.push(SupportedConeT::ZeroConeT(m_e));
     }
     cones.push(SupportedConeT::NonnegativeConeT(m_g + 2 * n));
-    let settings = DefaultSettingsBuilder::default()
-        .verbose(false)
-        .tol_gap_abs(1e-12)
-        .tol_gap_rel(1e-12)
-        .tol_feas(1e-12)
-        .build()
-        .map_err(|e| NumericalError::QpSetup {
-            message: format!("{e:?}"),
-        })?;
-    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-        .map_err(|e| NumericalError::QpSetup { message: e.to_string() })?;
-    solver.solve();
-    match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-        other => {
-            return Err(NumericalError::QpStatus {
-                status: format!("{other:?}"),
+    for _ in 0..m_f {
+        cones.push(SupportedConeT::SecondOrderConeT(3));
+    }
+    // With cones, a contact that sticks sits at a cone's apex, where the interior point's
+    // progress may stall short of 1e-12 (of the step's own scale): then it is solved again
+    // to 1e-10.
+    let tolerances: &[f64] = if m_f > 0 {
+        &[1e-12, FRICTION_TOLERANCE]
+    } else {
+        &[1e-12]
+    };
+    let mut solved = None;
+    for &tolerance in tolerances {
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .tol_gap_abs(tolerance)
+            .tol_gap_rel(tolerance)
+            .tol_feas(tolerance)
+            .build()
+            .map_err(|e| NumericalError::QpSetup {
+                message: format!("{e:?}"),
+            })?;
+        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
+            .map_err(|e| NumericalError::QpSetup { message: e.to_string() })?;
+        solver.solve();
+        match solver.solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {
+                solved = Some(solver);
+                break;
             }
-            .into())
+            SolverStatus::InsufficientProgress | SolverStatus::MaxIterations if tolerance < FRICTION_TOLERANCE => {}
+            other => {
+                return Err(NumericalError::QpStatus {
+                    status: format!("{other:?}"),
+                }
+                .into())
+            }
         }
     }
-    let x = DVector::from_column_slice(&solver.solution.x) * sigma;
+    let solver = solved.ok_or_else(|| NumericalError::QpStatus {
+        status: "InsufficientProgress".into(),
+    })?;
+    let x = DVector::from_column_slice(&solver.solution.x[..n]) * sigma;
+    // A cone's multiplier across it is the slip's force on the scaled row: back in newtons
+    // (K (θ − r + d) = Gᵀf + Tᵀφ, as the contacts' forces; |φₖ| ≤ μ Nₖ).
+    let friction_forces = DVector::from_iterator(
+        2 * m_f,
+        (0..m_f).flat_map(|k| {
+            let z = &solver.solution.z;
+            [1, 2].map(|j| z[cone_start + 3 * k + j] * largest * sigma * sigma / step.size)
+        }),
+    );
     // Back to the unscaled rows: z = σ² z' / β (the objective was divided by σ²: P d + q +
     // Aᵀz = 0 with d = σ x and each row over β), then the energy's and the gaps' units.
     let z: Vec<f64> = (0..m_e + m_g)
@@ -446,6 +536,7 @@ pub(crate) fn solve_step_with_clarabel(step: &BalanceStep) -> Result<BalanceSolu
         forces,
         closure_multipliers,
         at_trust,
+        friction_forces,
     })
 }
 
@@ -485,12 +576,55 @@ mod tests {
             contacts: (&contacts.0, &contacts.1),
             trust: 10.0,
             size: 1.0,
+            friction: None,
         })
         .unwrap();
         assert!((solution.step[0] - 0.4).abs() < 1e-9, "{}", solution.step[0]);
         // K (r − θ) = 3 · 0.6 N·m over 2 m.
         assert!((solution.forces[0] - 0.9).abs() < 1e-8, "{}", solution.forces[0]);
         assert!(!solution.at_trust);
+    }
+
+    /// One hinge of 3 N·m/rad driven 1 rad on, its contact sliding 2 m per radian against
+    /// a friction of at most F: past 3 N·m > 2F it slides until K (r − θ) = 2F (θ = 1 − 2F/3),
+    /// below it sticks (no step), and the cone's multiplier is the friction that holds.
+    #[test]
+    fn friction_lets_a_hinge_slide_past_its_bound_and_holds_it_below() {
+        let stiffness = [3.0];
+        let offset = [-1.0];
+        let closures = (DMatrix::zeros(0, 1), DVector::zeros(0));
+        let contacts = (DMatrix::zeros(0, 1), DVector::zeros(0));
+        let slip_rows = DMatrix::from_row_slice(2, 1, &[2.0, 0.0]);
+        let slip = DVector::zeros(2);
+        for (bound, step, friction) in [(0.9, 0.4, -0.9), (2.0, 0.0, -1.5)] {
+            let bounds = DVector::from_element(1, bound);
+            let solution = solve_step(&BalanceStep {
+                stiffness: &stiffness,
+                curvature: None,
+                offset: &offset,
+                closures: (&closures.0, &closures.1),
+                contacts: (&contacts.0, &contacts.1),
+                trust: 10.0,
+                size: 1.0,
+                friction: Some(FrictionRows {
+                    slip_rows: &slip_rows,
+                    slip: &slip,
+                    bounds: &bounds,
+                }),
+            })
+            .unwrap();
+            assert!(
+                (solution.step[0] - step).abs() < 1e-8,
+                "F {bound}: step {}",
+                solution.step[0]
+            );
+            // K (θ − r + d) = Tᵀφ: the friction on the slip row.
+            assert!(
+                (solution.friction_forces[0] - friction).abs() < 1e-7 && solution.friction_forces[1].abs() < 1e-7,
+                "F {bound}: friction {:?}",
+                solution.friction_forces
+            );
+        }
     }
 
     /// The same stop met 1e-13 deep at a hinge of 1e-9 N·m/rad: the step is the 5e-14 rad
@@ -510,6 +644,7 @@ mod tests {
             contacts: (&contacts.0, &contacts.1),
             trust: 0.3,
             size: 1e-4,
+            friction: None,
         })
         .unwrap();
         assert!((solution.step[0] - 5e-14).abs() <= 1e-9 * 5e-14, "{}", solution.step[0]);
@@ -557,6 +692,7 @@ mod tests {
                 // Every other pair of steps in a box the free step leaves.
                 trust: if trial % 4 >= 2 { 0.03 } else { 1.0 },
                 size: 1e-4,
+                friction: None,
             };
             let held = match held_step(&step) {
                 HeldStep::Solved(held) => held,

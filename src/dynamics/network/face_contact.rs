@@ -489,11 +489,24 @@ impl FaceContacts {
     /// d(distance)/dθ of feature `k` at `state` (poses and twists in `data`): the normal
     /// component of the first face's velocity at the point less the second's.
     pub fn row(&self, data: &NetworkData, k: usize, state: &FeatureState, out: &mut DVector<f64>) {
+        self.row_along(data, k, state, &state.normal, out);
+    }
+
+    /// The rate of the feature's two points' relative motion along `direction` per fold
+    /// angle (m/rad): its gap's row along the normal, its slip's rows across it.
+    pub fn row_along(
+        &self,
+        data: &NetworkData,
+        k: usize,
+        state: &FeatureState,
+        direction: &Vector3<f64>,
+        out: &mut DVector<f64>,
+    ) {
         out.fill(0.0);
         let [f, g] = self.features[k].faces();
         for (face, point, sign) in [(f, state.point, 1.0), (g, state.other_point, -1.0)] {
             for &c in &self.paths[self.face_panel[face]] {
-                out[c] += sign * state.normal.dot(&data.twist[c].point_velocity(&point));
+                out[c] += sign * direction.dot(&data.twist[c].point_velocity(&point));
             }
         }
     }

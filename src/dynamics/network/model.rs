@@ -128,6 +128,9 @@ pub struct NetworkModel {
     /// The seams a tree of panels latches as it closes (a scene's `seams`; None: faces
     /// only push on each other).
     pub seams: Option<crate::pattern::net::SeamGluing>,
+    /// Coulomb's coefficient of friction between touching faces (a scene's
+    /// `friction_coefficient`; 0: frictionless).
+    pub friction_coefficient: f64,
 }
 
 /// The inputs of [`NetworkModel::new`], in SI units.
@@ -296,6 +299,7 @@ impl NetworkModel {
             mass_pattern: Vec::new(),
             reduction: None,
             seams: None,
+            friction_coefficient: 0.0,
         };
         let mut mass_pattern = Vec::new();
         for &p in &model.order[1..] {
