@@ -4,7 +4,7 @@
 //! range). Prints each study's coverage per parameter and the time per fit.
 //!
 //! `cargo run --release --example calibration_coverage [RUNS] [STUDY]` (default 100, every
-//! study; STUDY is `bridge`, `corner`, `marks`, `miura` or `cube`)
+//! study; STUDY is `bridge`, `corner`, `marks`, `miura`, `bridge_ramp` or `cube`)
 
 use nanofold::calibrate::{fit, resolve, with_values, FitSettings, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::sensitivity::trajectory_sensitivities;
@@ -175,6 +175,19 @@ fn main() -> Result<(), Failure> {
             exact,
         };
         run(&sheet, runs)?;
+    }
+    if wanted("bridge_ramp") {
+        // A strip released slowly: its quasi-static path, the Jacobian from its balance.
+        let ramp = angles_study(
+            "bridge etch ramp, hinges 0 and 3, 100 samples to 1 500 s",
+            "patterns/bridge_ramp.scene.json",
+            vec![
+                free("hinges[*].target_angle_deg", 45.0, 135.0),
+                free("hinges[*].radius_of_curvature_um", 10.0, 40.0),
+            ],
+            (&[0, 3], 1500.0, 100, 0.5),
+        )?;
+        run(&ramp, runs)?;
     }
     if wanted("cube") {
         // A slow release through contact, fitted from the file's 95° and 1.

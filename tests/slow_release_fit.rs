@@ -181,3 +181,78 @@ fn a_filmed_slow_release_of_the_cube_is_fitted_through_its_contact() {
         );
     }
 }
+
+/// A strip's and a closed chain's etch ramps: the quasi-static path's sensitivities from its
+/// balance (`balanced`) against Richardson-extrapolated central differences of whole runs.
+#[test]
+fn balance_sensitivities_of_a_strip_and_a_closed_chain_match_whole_run_differences() {
+    for (file, free, t_end) in [
+        (
+            "patterns/bridge_ramp.scene.json",
+            vec![
+                free("hinges[*].target_angle_deg", 45.0, 135.0),
+                free("hinges[*].radius_of_curvature_um", 10.0, 40.0),
+            ],
+            1800.0,
+        ),
+        (
+            "patterns/corner_cube_step2_ramp.scene.json",
+            vec![
+                free("hinges[1].target_angle_deg", 60.0, 120.0),
+                free("hinges[1].radius_of_curvature_um", 10.0, 40.0),
+            ],
+            3000.0,
+        ),
+    ] {
+        let document = SceneDocument::load(file.as_ref()).unwrap();
+        let parameters = resolve(&document, &free).unwrap();
+        let start: Vec<f64> = parameters.iter().map(|p| p.start).collect();
+        let build = |values: &[f64]| scene_at(&document, &parameters, values);
+        let eps = SENSITIVITY_STEP;
+        let perturbed: Vec<[_; STENCIL.len()]> = (0..parameters.len())
+            .map(|j| {
+                std::array::from_fn(|k| {
+                    let mut at = start.clone();
+                    at[j] = start[j] + STENCIL[k] * eps * parameters[j].scale;
+                    build(&at)
+                })
+            })
+            .collect();
+        let t: Vec<f64> = (1..=40).map(|k| t_end * k as f64 / 40.0 - 1.0).collect();
+        let run = trajectory_sensitivities(&build(&start), &perturbed, eps, &t, Method::Auto, 1e-8).unwrap();
+        let plain =
+            |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, &t, Method::Auto, 1e-8).unwrap();
+        for j in 0..parameters.len() {
+            let difference = |step: f64| {
+                let mut at = start.clone();
+                at[j] = start[j] + step * parameters[j].scale;
+                let plus = plain(&at);
+                at[j] = start[j] - step * parameters[j].scale;
+                let minus = plain(&at);
+                (0..plus.times.len().min(minus.times.len()))
+                    .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
+                    .collect::<Vec<_>>()
+            };
+            let h = 1e-4;
+            let (wide, narrow) = (difference(2.0 * h), difference(h));
+            let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
+            for i in 0..narrow.len().min(run.times.len()) {
+                for k in 0..narrow[i].len() {
+                    let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
+                    worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
+                    largest = largest.max(fd.abs());
+                }
+            }
+            eprintln!(
+                "{file} {}: {} samples, max |S| {largest:.4e}, max |S - FD| {worst:.3e}",
+                parameters[j].path,
+                run.times.len()
+            );
+            assert!(
+                largest > 0.0 && worst <= 1e-6 * largest,
+                "{file} {}: {worst:e} against {largest:e}",
+                parameters[j].path
+            );
+        }
+    }
+}

@@ -24,6 +24,7 @@ use crate::error::{NanofoldError, Result};
 use nalgebra::{DMatrix, DVector};
 use sides::{held_accelerations, Side, SideScratch};
 
+mod balanced;
 mod released;
 mod sides;
 
@@ -62,10 +63,12 @@ fn stencil(values: [f64; POINTS], epsilon: f64) -> f64 {
 /// Integrates `base` and the sensitivity of its output angles to each parameter whose
 /// perturbed scenes (at u + kε, k in [`STENCIL`]) are `perturbed[j]`, from the start to the last of
 /// `times` (increasing, the first ≥ 0), without contacts, by `method` (`Auto`: from the
-/// time scales) at relative tolerance `rtol`. A tree of panels released slowly (its
-/// forcing lasts ≥ [`super::simulate::QUASI_STATIC_RATIO`] fastest periods) instead follows
-/// the contact engine's balance through its contacts and seams, and its sensitivities come
-/// from the balance's KKT conditions (`released`; `method` and `rtol` do not apply).
+/// time scales) at relative tolerance `rtol`. A scene released slowly (its forcing lasts
+/// ≥ [`super::simulate::QUASI_STATIC_RATIO`] fastest periods) takes the quasi-static path
+/// as `simulate` does, and its sensitivities come from its balance (`method` and `rtol` do
+/// not apply): a tree of panels through the contact engine's contacts and seams, by the
+/// balance's KKT conditions (`released`); a strip, a closed chain or fitted curves to their
+/// first contact (`balanced`). A pattern with loops of its own is refused.
 pub fn trajectory_sensitivities(
     base: &Scene,
     perturbed: &[[Scene; POINTS]],
@@ -123,12 +126,18 @@ pub fn trajectory_sensitivities(
                     "a slow release's sensitivities come from its frictionless balance: with friction its state depends on the path, whose derivatives are not built",
                 ));
             }
-            if let Some(reason) = super::simulate::first_contact_only(model) {
+            if !model.folding.stars.is_empty() {
                 return Err(NanofoldError::invalid(
                     "actuation",
                     "a slow release",
-                    format!("its sensitivities follow the contact engine, which this scene is not for: {reason}"),
+                    "the pattern closes loops of its own: the sensitivities of its balance on its closures are not built (fit a step response, or its fitted curves)",
                 ));
+            }
+            if super::simulate::first_contact_only(model).is_some() {
+                // Not for the contact engine (substrate contact, a crease driven flat): the
+                // quasi-static path to its first contact, as `simulate` runs it.
+                let plants = pairs!(Network, network_plant);
+                return run(&network_plant(model)?, &plants, epsilon, times, (method, rtol, true));
             }
             let mut models = Vec::with_capacity(perturbed.len());
             for (j, scenes) in perturbed.iter().enumerate() {
@@ -193,11 +202,8 @@ fn run<P: Plant>(
     grid.extend_from_slice(times);
     let scales = base.time_scales()?;
     if scales.ratio >= super::simulate::QUASI_STATIC_RATIO {
-        return Err(NanofoldError::invalid(
-            "actuation",
-            format!("a forcing of {:.1e} fastest periods", scales.ratio),
-            "this scene's slow forcing takes the quasi-static path, whose sensitivities are built for trees of panels (a network scene's slow release, through the contact engine) and not for strips, closed chains or fitted curves: fit a step response",
-        ));
+        // A slow forcing: the quasi-static path, its sensitivities from its balance.
+        return balanced::balanced_sensitivities(base, perturbed, epsilon, times);
     }
     let method = method.resolve(&scales);
     let options = IntegrationOptions {
