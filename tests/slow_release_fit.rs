@@ -1,5 +1,6 @@
-//! Fitting a slow release carried through contact: the balance's KKT sensitivities against
-//! central differences of whole runs, and a synthetic etch-ramp measurement of a cube fitted.
+//! Fitting slow releases: the balance's sensitivities (a tree of panels' KKT conditions
+//! through contact; a strip's and a closed chain's quasi-static balance) against central
+//! differences of whole runs, and a synthetic etch-ramp film of a cube fitted.
 
 use nanofold::calibrate::{
     fit, resolve, with_values, FitSettings, FitStatus, FreeParameter, ResolvedParameter, SENSITIVITY_STEP,
@@ -35,16 +36,17 @@ fn scene_at(document: &SceneDocument, parameters: &[ResolvedParameter], values: 
         .unwrap()
 }
 
-#[test]
-fn kkt_sensitivities_of_the_lid_first_cube_match_central_differences_of_whole_runs() {
-    let document = lid_first();
-    let free = [
-        free("hinge_defaults.target_angle_deg", 80.0, 110.0),
-        free("hinge_defaults.stiffness_scale", 0.2, 5.0),
-    ];
-    let parameters = resolve(&document, &free).unwrap();
+/// The sensitivities of `document`'s run at `times` to `free` (at the file's values), and
+/// for each parameter the largest gap to Richardson-extrapolated central differences of
+/// whole runs (steps 1e-4 and 2e-4 of its scale) with the differences' largest value.
+fn against_whole_runs(
+    document: &SceneDocument,
+    free: &[FreeParameter],
+    times: &[f64],
+) -> (nanofold::dynamics::sensitivity::TrajectorySensitivity, Vec<(f64, f64)>) {
+    let parameters = resolve(document, free).unwrap();
     let start: Vec<f64> = parameters.iter().map(|p| p.start).collect();
-    let build = |values: &[f64]| scene_at(&document, &parameters, values);
+    let build = |values: &[f64]| scene_at(document, &parameters, values);
     let eps = SENSITIVITY_STEP;
     let perturbed: Vec<[_; STENCIL.len()]> = (0..parameters.len())
         .map(|j| {
@@ -55,52 +57,55 @@ fn kkt_sensitivities_of_the_lid_first_cube_match_central_differences_of_whole_ru
             })
         })
         .collect();
+    let run = trajectory_sensitivities(&build(&start), &perturbed, eps, times, Method::Auto, 1e-8).unwrap();
+    assert_eq!(run.times.len(), times.len(), "every asked time has a state");
+    let plain = |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, times, Method::Auto, 1e-8).unwrap();
+    let gaps = (0..parameters.len())
+        .map(|j| {
+            let difference = |step: f64| {
+                let mut at = start.clone();
+                at[j] = start[j] + step * parameters[j].scale;
+                let plus = plain(&at);
+                at[j] = start[j] - step * parameters[j].scale;
+                let minus = plain(&at);
+                (0..times.len())
+                    .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
+                    .collect::<Vec<_>>()
+            };
+            let h = 1e-4;
+            let (wide, narrow) = (difference(2.0 * h), difference(h));
+            let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
+            for i in 0..times.len() {
+                for k in 0..narrow[i].len() {
+                    let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
+                    worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
+                    largest = largest.max(fd.abs());
+                }
+            }
+            eprintln!("{}: max |S| {largest:.4e}, max |S - FD| {worst:.3e}", free[j].path);
+            (worst, largest)
+        })
+        .collect();
+    (run, gaps)
+}
+
+/// The lid-first cube's walls' target and stiffness at 131 times: every 100 s, every 5 s
+/// through the south wall's push, and past the closing.
+#[test]
+fn kkt_sensitivities_of_the_lid_first_cube_match_central_differences_of_whole_runs() {
+    let free = [
+        free("hinge_defaults.target_angle_deg", 80.0, 110.0),
+        free("hinge_defaults.stiffness_scale", 0.2, 5.0),
+    ];
     let mut t: Vec<f64> = (1..=91).map(|k| 100.0 * k as f64).collect();
     t.extend((0..12).map(|k| 9195.0 + 5.0 * k as f64));
     t.extend((0..28).map(|k| 9300.0 + 100.0 * k as f64));
-    let started = std::time::Instant::now();
-    let run = trajectory_sensitivities(&build(&start), &perturbed, eps, &t, Method::Auto, 1e-8).unwrap();
-    eprintln!(
-        "sensitivity run {:?}, {} samples, {} QP solves",
-        started.elapsed(),
-        run.times.len(),
-        run.steps
-    );
-    let plain = |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, &t, Method::Auto, 1e-8).unwrap();
-    for j in 0..parameters.len() {
-        let difference = |step: f64| {
-            let mut at = start.clone();
-            at[j] = start[j] + step * parameters[j].scale;
-            let plus = plain(&at);
-            at[j] = start[j] - step * parameters[j].scale;
-            let minus = plain(&at);
-            (0..run.times.len().min(plus.times.len()).min(minus.times.len()))
-                .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
-                .collect::<Vec<_>>()
-        };
-        let h = 1e-4;
-        let (wide, narrow) = (difference(2.0 * h), difference(h));
-        assert_eq!(
-            narrow.len(),
-            t.len(),
-            "every asked time has a state, past the closing too"
-        );
-        let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
-        for i in 0..narrow.len() {
-            for k in 0..5 {
-                let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
-                worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
-                largest = largest.max(fd.abs());
-            }
-        }
-        eprintln!(
-            "{}: max |S| {largest:.4e}, max |S - FD| {worst:.3e}",
-            parameters[j].path
-        );
+    let (run, gaps) = against_whole_runs(&lid_first(), &free, &t);
+    for (parameter, (worst, largest)) in free.iter().zip(gaps) {
         assert!(
             largest > 0.0 && worst <= 1e-6 * largest,
             "{}: {worst:e} against {largest:e}",
-            parameters[j].path
+            parameter.path
         );
     }
     // The stiffness shows only while the wall presses the lid: before, every hinge is at its
@@ -205,53 +210,13 @@ fn balance_sensitivities_of_a_strip_and_a_closed_chain_match_whole_run_differenc
         ),
     ] {
         let document = SceneDocument::load(file.as_ref()).unwrap();
-        let parameters = resolve(&document, &free).unwrap();
-        let start: Vec<f64> = parameters.iter().map(|p| p.start).collect();
-        let build = |values: &[f64]| scene_at(&document, &parameters, values);
-        let eps = SENSITIVITY_STEP;
-        let perturbed: Vec<[_; STENCIL.len()]> = (0..parameters.len())
-            .map(|j| {
-                std::array::from_fn(|k| {
-                    let mut at = start.clone();
-                    at[j] = start[j] + STENCIL[k] * eps * parameters[j].scale;
-                    build(&at)
-                })
-            })
-            .collect();
         let t: Vec<f64> = (1..=40).map(|k| t_end * k as f64 / 40.0 - 1.0).collect();
-        let run = trajectory_sensitivities(&build(&start), &perturbed, eps, &t, Method::Auto, 1e-8).unwrap();
-        let plain =
-            |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, &t, Method::Auto, 1e-8).unwrap();
-        for j in 0..parameters.len() {
-            let difference = |step: f64| {
-                let mut at = start.clone();
-                at[j] = start[j] + step * parameters[j].scale;
-                let plus = plain(&at);
-                at[j] = start[j] - step * parameters[j].scale;
-                let minus = plain(&at);
-                (0..plus.times.len().min(minus.times.len()))
-                    .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
-                    .collect::<Vec<_>>()
-            };
-            let h = 1e-4;
-            let (wide, narrow) = (difference(2.0 * h), difference(h));
-            let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
-            for i in 0..narrow.len().min(run.times.len()) {
-                for k in 0..narrow[i].len() {
-                    let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
-                    worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
-                    largest = largest.max(fd.abs());
-                }
-            }
-            eprintln!(
-                "{file} {}: {} samples, max |S| {largest:.4e}, max |S - FD| {worst:.3e}",
-                parameters[j].path,
-                run.times.len()
-            );
+        let (_, gaps) = against_whole_runs(&document, &free, &t);
+        for (parameter, (worst, largest)) in free.iter().zip(gaps) {
             assert!(
                 largest > 0.0 && worst <= 1e-6 * largest,
                 "{file} {}: {worst:e} against {largest:e}",
-                parameters[j].path
+                parameter.path
             );
         }
     }
