@@ -3,8 +3,9 @@
 //! each undecided run gives) and timed. What the engine's changes are measured by, outcome
 //! beside time (`docs/model.md#contact-forces`).
 //!
-//! `cargo run --release --example closing_census [SHAPE] [NETS] [FRONT_DEG]` (default the
-//! cube's 11 best nets, every front; the octahedron's 11, or one front alone, likewise).
+//! `cargo run --release --example closing_census [SHAPE] [NETS] [FRONT_DEG] [FRICTION]`
+//! (default the cube's 11 best nets, every front, frictionless; the octahedron's 11, one
+//! front alone (`all` for every one), or Coulomb friction between faces, likewise).
 
 use nanofold::commands::nets::*;
 use std::collections::BTreeMap;
@@ -14,7 +15,15 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let shape = args.get(1).map_or("cube", String::as_str);
     let count: usize = args.get(2).map_or(11, |a| a.parse().expect("NETS: a count of nets"));
-    let only: Option<f64> = args.get(3).map(|a| a.parse().expect("FRONT_DEG: an angle in degrees"));
+    let only: Option<f64> = args
+        .get(3)
+        .filter(|a| a.as_str() != "all")
+        .map(|a| a.parse().expect("FRONT_DEG: an angle in degrees, or all"));
+    let friction: f64 = args.get(4).map_or(0.0, |a| a.parse().expect("FRICTION: a coefficient"));
+    let settings = ClosingSettings {
+        friction_coefficient: friction,
+        ..ClosingSettings::default()
+    };
     let (name, solid) = open_solid(shape).expect("SHAPE: a solid nanofold generates");
     let options = NetsOptions {
         top: count,
@@ -50,7 +59,15 @@ fn main() {
                 let (forcing, stiffness) = variation.device(&model.forcing, &model.stiffness(), sample);
                 let clock = Instant::now();
                 let run = closing
-                    .run(model, &forcing, &stiffness, &options.closing())
+                    .run(
+                        model,
+                        &forcing,
+                        &stiffness,
+                        &ClosingSettings {
+                            capture_percent: options.closing().capture_percent,
+                            ..settings
+                        },
+                    )
                     .expect("a run");
                 let ms = clock.elapsed().as_secs_f64() * 1e3;
                 total += ms;
@@ -70,7 +87,7 @@ fn main() {
         }
     }
     println!(
-        "{shape}: {runs} runs, {:.2} ms a run (slowest {slowest:.0} ms), one core; {outcomes:?}; undecided: {reasons:?}",
+        "{shape} (friction {friction}): {runs} runs, {:.2} ms a run (slowest {slowest:.0} ms), one core; {outcomes:?}; undecided: {reasons:?}",
         total / runs.max(1) as f64
     );
 }
