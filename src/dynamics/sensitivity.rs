@@ -55,6 +55,13 @@ pub const STATE_SHIFT: f64 = 1e-4;
 /// rate by more than this many [`STATE_SHIFT`]s.
 const TOGETHER_RATIO: f64 = 2.0;
 
+/// Whether a run's sample at `time` is one of the asked times still ahead in `requested`
+/// (ascending), passing over those the run skipped.
+fn asked(requested: &mut std::iter::Peekable<std::slice::Iter<'_, f64>>, time: f64) -> bool {
+    while requested.next_if(|&&t| t < time).is_some() {}
+    requested.next_if(|&&t| t == time).is_some()
+}
+
 /// The central difference from values at the [`STENCIL`] offsets.
 fn stencil(values: [f64; POINTS], epsilon: f64) -> f64 {
     values.iter().zip(WEIGHTS).map(|(v, w)| v * w).sum::<f64>() / epsilon
@@ -222,8 +229,7 @@ fn run<P: Plant>(
     };
     let mut requested = times.iter().peekable();
     for sample in &run.samples {
-        while requested.next_if(|&&t| t < sample.time).is_some() {}
-        if requested.next_if(|&&t| t == sample.time).is_none() {
+        if !asked(&mut requested, sample.time) {
             continue;
         }
         result.times.push(sample.time);

@@ -8,7 +8,7 @@
 //! closed chains on their curve, fitted curves, trees of panels); a plant that projects
 //! onto closures is the contact engine's or refused.
 
-use super::{stencil, TrajectorySensitivity, POINTS};
+use super::{asked, stencil, TrajectorySensitivity, POINTS};
 use crate::dynamics::plant::Plant;
 use crate::dynamics::quasi_static::quasi_static_path;
 use crate::error::{NumericalError, Result};
@@ -51,8 +51,7 @@ pub(super) fn balanced_sensitivities<P: Plant>(
     };
     let mut requested = times.iter().peekable();
     for sample in &path.samples {
-        while requested.next_if(|&&t| t < sample.time).is_some() {}
-        if requested.next_if(|&&t| t == sample.time).is_none() {
+        if !asked(&mut requested, sample.time) {
             continue;
         }
         let t = sample.time;

@@ -11,7 +11,7 @@
 //! solid are redundant (a box's 20 rows fix 5 angles), so the system is solved on J's row
 //! space and its null space: the particular part from the rows, the rest from H there.
 
-use super::{stencil, TrajectorySensitivity, POINTS};
+use super::{asked, stencil, TrajectorySensitivity, POINTS};
 use crate::dynamics::network::closing::{ClosingSettings, HeldRows, NetClosing};
 use crate::dynamics::network::NetworkModel;
 use crate::error::{NanofoldError, NumericalError, Result};
@@ -60,8 +60,7 @@ pub(super) fn released_sensitivities(
     };
     let mut requested = times.iter().peekable();
     for sample in &path.samples {
-        while requested.next_if(|&&t| t < sample.time_s).is_some() {}
-        if requested.next_if(|&&t| t == sample.time_s).is_none() {
+        if !asked(&mut requested, sample.time_s) {
             continue;
         }
         let columns = if perturbed.is_empty() {
