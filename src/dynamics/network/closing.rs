@@ -756,6 +756,7 @@ impl NetClosing {
     fn events(
         &self,
         data: &NetworkData,
+        placed: &PlacedFaces,
         holds: &Holds,
         sides: &Sides,
         capture: f64,
@@ -773,7 +774,6 @@ impl NetClosing {
                         && (self.seam_touching(holds, k) || self.seam_passed(data, sides, k)))
             }
         };
-        let placed = self.contacts.placed(data);
         let crosses = |k: usize, state: &FeatureState| {
             sides.orientation(&self.contacts, k).0 != 0.0
                 && !holds.touching.contains(&k)
@@ -788,7 +788,7 @@ impl NetClosing {
                 for &happening in among {
                     let happens = match happening {
                         Happening::Seam(k) => seam_meets(k),
-                        Happening::Feature(k) => crosses(k, &self.contacts.state(&placed, k)),
+                        Happening::Feature(k) => crosses(k, &self.contacts.state(placed, k)),
                     };
                     if happens {
                         found.push(happening);
@@ -798,11 +798,11 @@ impl NetClosing {
             None => {
                 found.extend((0..self.seams.len()).filter(|&k| seam_meets(k)).map(Happening::Seam));
                 for pair in 0..self.contacts.pairs.len() {
-                    if !sides.watched[pair] || !self.pair_open(&placed, holds, pair) {
+                    if !sides.watched[pair] || !self.pair_open(placed, holds, pair) {
                         continue;
                     }
                     for &k in &self.contacts.pair_features[pair] {
-                        let state = self.contacts.state(&placed, k);
+                        let state = self.contacts.state(placed, k);
                         raw[k] = Some(state);
                         if crosses(k, &state) {
                             found.push(Happening::Feature(k));
@@ -2026,14 +2026,15 @@ impl Run<'_> {
             turn = (turn * 2.0).min(MAX_STEP);
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
-            let happenings = net.events(&self.data, &holds, &self.sides, self.capture, None, &mut raw);
+            let placed = net.contacts.placed(&self.data);
+            let happenings = net.events(&self.data, &placed, &holds, &self.sides, self.capture, None, &mut raw);
             if happenings.is_empty() {
                 let before = std::mem::replace(&mut self.theta, trial);
                 self.previous = (self.holds.touching == holds.touching && self.holds.latched == holds.latched)
                     .then_some((u, before));
                 self.holds = holds;
                 self.raw = raw;
-                self.after_step();
+                self.after_step_at(placed);
                 u = next;
                 self.sample_stops(u);
                 if self.spaced && u - last_frame >= FRAME_SPACING {
@@ -2119,10 +2120,15 @@ impl Run<'_> {
     /// After a step: features that parted or slid off the other face let go; features that
     /// came over another face take the side they are on.
     fn after_step(&mut self) {
+        let placed = self.net.contacts.placed(&self.data);
+        self.after_step_at(placed);
+    }
+
+    /// [`Run::after_step`] with the faces already `placed` at the accepted poses.
+    fn after_step_at(&mut self, placed: PlacedFaces) {
         let net = self.net;
         let tolerance = TOLERANCE * net.size;
         let mut keep = Vec::new();
-        let placed = net.contacts.placed(&self.data);
         for (i, &k) in self.holds.touching.iter().enumerate() {
             let state = self.sides.state(&net.contacts, &placed, k);
             // A contact lets go once its faces part. One that slides off the other face's
@@ -2373,8 +2379,9 @@ impl Run<'_> {
                 &mut state,
                 &mut self.data,
             );
+            let placed = net.contacts.placed(&self.data);
             if !net
-                .events(&self.data, &holds, &self.sides, self.capture, Some(happenings), &mut [])
+                .events(&self.data, &placed, &holds, &self.sides, self.capture, Some(happenings), &mut [])
                 .is_empty()
             {
                 hi = mid;

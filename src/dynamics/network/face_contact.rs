@@ -135,7 +135,9 @@ impl FeatureState {
 /// Every face's corners (in its loop's order) and unit normal at one set of poses, m.
 #[derive(Debug, Clone)]
 pub struct PlacedFaces {
-    corners: Vec<Vec<Vector3<f64>>>,
+    /// Every face's corners, face after face ([`FaceContacts`]' `corner_start` says where
+    /// each face's begin).
+    corners: Vec<Vector3<f64>>,
     normals: Vec<Vector3<f64>>,
 }
 
@@ -160,6 +162,10 @@ pub struct FaceContacts {
     bounds: Vec<(Vector3<f64>, f64)>,
     /// Each panel's tree columns to the anchored panel.
     paths: Vec<Vec<usize>>,
+    /// Where each face's corners begin among the placed corners (one more entry than faces).
+    corner_start: Vec<usize>,
+    /// Each feature's corners among the placed corners, in the order its state reads them.
+    slots: Vec<[usize; 6]>,
     size: f64,
 }
 
@@ -303,6 +309,82 @@ impl FaceContacts {
                 (centre, radius)
             })
             .collect();
+        let mut corner_start = vec![0];
+        for face in &faces {
+            corner_start.push(corner_start.last().copied().unwrap_or(0) + face.len());
+        }
+        let slot = |f: usize, v: usize| {
+            corner_start[f] + faces[f].iter().position(|&w| w == v).expect("a corner of the face")
+        };
+        // A slot no state reads.
+        const UNUSED: usize = usize::MAX;
+        let slots = features
+            .iter()
+            .map(|feature| match *feature {
+                Feature::CornerOnFace {
+                    face,
+                    vertex,
+                    other,
+                    copy,
+                } => [
+                    slot(face, vertex),
+                    copy.map_or(UNUSED, |w| slot(other, w)),
+                    UNUSED,
+                    UNUSED,
+                    UNUSED,
+                    UNUSED,
+                ],
+                Feature::EdgeMiddleOnFace {
+                    face,
+                    edge,
+                    other,
+                    copies,
+                } => [
+                    slot(face, edge[0]),
+                    slot(face, edge[1]),
+                    slot(other, copies[0]),
+                    slot(other, copies[1]),
+                    UNUSED,
+                    UNUSED,
+                ],
+                Feature::EdgeOnCorner {
+                    face,
+                    corner,
+                    far,
+                    other,
+                    apex,
+                } => {
+                    let loop_ = &faces[other];
+                    let k = loop_.iter().position(|&v| v == apex).expect("a corner of the face");
+                    let (next, previous) = (loop_[(k + 1) % loop_.len()], loop_[(k + loop_.len() - 1) % loop_.len()]);
+                    [
+                        slot(other, apex),
+                        slot(face, far),
+                        slot(face, corner),
+                        slot(other, next),
+                        slot(other, previous),
+                        UNUSED,
+                    ]
+                }
+                Feature::EdgeOnEdge {
+                    face,
+                    edge,
+                    other,
+                    other_edge,
+                    copy,
+                } => {
+                    let [v, w] = copy.map_or([UNUSED; 2], |[v, w]| [slot(face, v), slot(other, w)]);
+                    [
+                        slot(face, edge[0]),
+                        slot(face, edge[1]),
+                        slot(other, other_edge[0]),
+                        slot(other, other_edge[1]),
+                        v,
+                        w,
+                    ]
+                }
+            })
+            .collect();
         FaceContacts {
             faces,
             face_panel,
@@ -313,8 +395,15 @@ impl FaceContacts {
             feature_pair,
             bounds,
             paths,
+            corner_start,
+            slots,
             size: model.size(),
         }
+    }
+
+    /// Face `f`'s corners among the `placed` ones.
+    fn corners_of<'p>(&self, placed: &'p PlacedFaces, f: usize) -> &'p [Vector3<f64>] {
+        &placed.corners[self.corner_start[f]..self.corner_start[f + 1]]
     }
 
     /// Where pattern vertex `v` of face `f` is, m.
@@ -344,19 +433,10 @@ impl FaceContacts {
     pub fn placed(&self, data: &NetworkData) -> PlacedFaces {
         PlacedFaces {
             corners: (0..self.faces.len())
-                .map(|f| self.faces[f].iter().map(|&v| self.corner(data, f, v)).collect())
+                .flat_map(|f| self.faces[f].iter().map(move |&v| self.corner(data, f, v)))
                 .collect(),
             normals: (0..self.faces.len()).map(|f| self.normal(data, f)).collect(),
         }
-    }
-
-    /// Pattern vertex `v` of face `f` among the `placed` corners.
-    fn at(&self, placed: &PlacedFaces, f: usize, v: usize) -> Vector3<f64> {
-        let k = self.faces[f]
-            .iter()
-            .position(|&w| w == v)
-            .expect("a corner of the face");
-        placed.corners[f][k]
     }
 
     /// Whether pair `pair`'s faces are apart across a plane of one of them: every corner of
@@ -366,8 +446,8 @@ impl FaceContacts {
     pub fn plane_separated(&self, placed: &PlacedFaces, pair: usize, tolerance: f64) -> bool {
         let [f, g] = self.pairs[pair];
         let apart = |plane: usize, other: usize| {
-            let (normal, origin) = (placed.normals[plane], placed.corners[plane][0]);
-            let mut sides = placed.corners[other].iter().map(|x| normal.dot(&(x - origin)));
+            let (normal, origin) = (placed.normals[plane], self.corners_of(placed, plane)[0]);
+            let mut sides = self.corners_of(placed, other).iter().map(|x| normal.dot(&(x - origin)));
             let first = sides.next().unwrap_or(0.0);
             first.abs() > tolerance && sides.all(|d| d.abs() > tolerance && d.signum() == first.signum())
         };
@@ -377,55 +457,35 @@ impl FaceContacts {
     /// Feature `k` with the faces `placed`.
     pub fn state(&self, placed: &PlacedFaces, k: usize) -> FeatureState {
         let margin = GATE_MARGIN * self.size;
+        let slots = &self.slots[k];
+        let at = |i: usize| placed.corners[slots[i]];
         match self.features[k] {
-            Feature::CornerOnFace {
-                face,
-                vertex,
-                other,
-                copy,
-            } => {
-                let point = self.at(placed, face, vertex);
+            Feature::CornerOnFace { other, copy, .. } => {
+                let point = at(0);
                 let normal = placed.normals[other];
-                let corners = &placed.corners[other];
+                let corners = self.corners_of(placed, other);
                 let distance = normal.dot(&(point - corners[0]));
-                let apart = copy.is_none_or(|w| (self.at(placed, other, w) - point).norm() > MET * self.size);
+                let apart = copy.is_none_or(|_| (at(1) - point).norm() > MET * self.size);
                 let over = apart && inside_outline(corners, &normal, &point, margin);
                 FeatureState::on_plane(point, normal, distance, over)
             }
-            Feature::EdgeMiddleOnFace {
-                face,
-                edge,
-                other,
-                copies,
-            } => {
-                let point = (self.at(placed, face, edge[0]) + self.at(placed, face, edge[1])) * 0.5;
+            Feature::EdgeMiddleOnFace { other, .. } => {
+                let point = (at(0) + at(1)) * 0.5;
                 let normal = placed.normals[other];
-                let corners = &placed.corners[other];
+                let corners = self.corners_of(placed, other);
                 let distance = normal.dot(&(point - corners[0]));
-                let middle = (self.at(placed, other, copies[0]) + self.at(placed, other, copies[1])) * 0.5;
+                let middle = (at(2) + at(3)) * 0.5;
                 let over =
                     (middle - point).norm() > MET * self.size && inside_outline(corners, &normal, &point, margin);
                 FeatureState::on_plane(point, normal, distance, over)
             }
-            Feature::EdgeOnCorner {
-                face,
-                corner,
-                far,
-                other,
-                apex: apex_vertex,
-            } => {
-                let (apex, point) = (self.at(placed, other, apex_vertex), self.at(placed, face, far));
-                let met = (self.at(placed, face, corner) - apex).norm() <= MET * self.size;
+            Feature::EdgeOnCorner { other, .. } => {
+                let (apex, point) = (at(0), at(1));
+                let met = (at(2) - apex).norm() <= MET * self.size;
                 let normal = placed.normals[other];
                 let distance = normal.dot(&(point - apex));
-                let loop_ = &self.faces[other];
-                let k = loop_
-                    .iter()
-                    .position(|&v| v == apex_vertex)
-                    .expect("a corner of the face");
-                let (next, previous) = (loop_[(k + 1) % loop_.len()], loop_[(k + loop_.len() - 1) % loop_.len()]);
-                let first = self.at(placed, other, next) - apex;
-                let second = self.at(placed, other, previous) - apex;
+                let first = at(3) - apex;
+                let second = at(4) - apex;
                 let within = point - normal * distance - apex;
                 let reach = margin * within.norm();
                 // Counter-clockwise about the normal from the corner's next edge to its
@@ -435,18 +495,9 @@ impl FaceContacts {
                     && within.cross(&second.normalize()).dot(&normal) >= reach;
                 FeatureState::on_plane(point, normal, distance, over)
             }
-            Feature::EdgeOnEdge {
-                face,
-                edge,
-                other,
-                other_edge,
-                copy,
-            } => {
-                let (p0, p1) = (self.at(placed, face, edge[0]), self.at(placed, face, edge[1]));
-                let (q0, q1) = (
-                    self.at(placed, other, other_edge[0]),
-                    self.at(placed, other, other_edge[1]),
-                );
+            Feature::EdgeOnEdge { copy, .. } => {
+                let (p0, p1) = (at(0), at(1));
+                let (q0, q1) = (at(2), at(3));
                 let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
                 let cross = d1.cross(&d2);
                 let (l1, l2) = (d1.norm(), d2.norm());
@@ -478,9 +529,7 @@ impl FaceContacts {
                         && s < 1.0 - ms
                         && t > mt
                         && t < 1.0 - mt
-                        && copy.is_none_or(|[v, w]| {
-                            (self.at(placed, face, v) - self.at(placed, other, w)).norm() > MET * self.size
-                        }),
+                        && copy.is_none_or(|_| (at(4) - at(5)).norm() > MET * self.size),
                 }
             }
         }
