@@ -2381,7 +2381,15 @@ impl Run<'_> {
             );
             let placed = net.contacts.placed(&self.data);
             if !net
-                .events(&self.data, &placed, &holds, &self.sides, self.capture, Some(happenings), &mut [])
+                .events(
+                    &self.data,
+                    &placed,
+                    &holds,
+                    &self.sides,
+                    self.capture,
+                    Some(happenings),
+                    &mut [],
+                )
                 .is_empty()
             {
                 hi = mid;

@@ -313,9 +313,8 @@ impl FaceContacts {
         for face in &faces {
             corner_start.push(corner_start.last().copied().unwrap_or(0) + face.len());
         }
-        let slot = |f: usize, v: usize| {
-            corner_start[f] + faces[f].iter().position(|&w| w == v).expect("a corner of the face")
-        };
+        let slot =
+            |f: usize, v: usize| corner_start[f] + faces[f].iter().position(|&w| w == v).expect("a corner of the face");
         // A slot no state reads.
         const UNUSED: usize = usize::MAX;
         let slots = features
