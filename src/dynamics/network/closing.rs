@@ -598,6 +598,13 @@ impl Sides {
     }
 }
 
+/// What a test for events reads: only the happenings a step found (bisecting it), or
+/// every watched feature, each one's raw state kept in the list.
+enum EventScan<'r> {
+    Among(&'r [Happening]),
+    Every(&'r mut [Option<FeatureState>]),
+}
+
 /// Something that happens in a step: a seam meets, or a feature crosses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Happening {
@@ -749,19 +756,18 @@ impl NetClosing {
         self.seams.iter().position(|s| s.faces == [f, g] || s.faces == [g, f])
     }
 
-    /// What happens at these poses: an open seam aligned, a seam whose faces touch come
-    /// within the capture, or a feature over another face crossed to the wrong side of it.
-    /// Only `among` these when given (a step's events, bisected); otherwise every watched
-    /// feature's raw state is left in `raw` for the step's bookkeeping.
+    /// What happens at these poses (`data`, its faces `placed`): an open seam aligned, a
+    /// seam whose faces touch come within the capture, or a feature over another face
+    /// crossed to the wrong side of it. Only among the happenings `scan` names (a step's
+    /// events, bisected), or everything, each watched feature's raw state left in `scan`'s
+    /// list for the step's bookkeeping.
     fn events(
         &self,
-        data: &NetworkData,
-        placed: &PlacedFaces,
+        (data, placed): (&NetworkData, &PlacedFaces),
         holds: &Holds,
         sides: &Sides,
         capture: f64,
-        among: Option<&[Happening]>,
-        raw: &mut [Option<FeatureState>],
+        scan: EventScan<'_>,
     ) -> Vec<Happening> {
         let tolerance = TOLERANCE * self.size;
         let mut found = Vec::new();
@@ -783,8 +789,8 @@ impl NetClosing {
                     state.over && state.distance < -tolerance
                 }
         };
-        match among {
-            Some(among) => {
+        match scan {
+            EventScan::Among(among) => {
                 for &happening in among {
                     let happens = match happening {
                         Happening::Seam(k) => seam_meets(k),
@@ -795,7 +801,7 @@ impl NetClosing {
                     }
                 }
             }
-            None => {
+            EventScan::Every(raw) => {
                 found.extend((0..self.seams.len()).filter(|&k| seam_meets(k)).map(Happening::Seam));
                 for pair in 0..self.contacts.pairs.len() {
                     if !sides.watched[pair] || !self.pair_open(placed, holds, pair) {
@@ -2027,7 +2033,13 @@ impl Run<'_> {
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
             let placed = net.contacts.placed(&self.data);
-            let happenings = net.events(&self.data, &placed, &holds, &self.sides, self.capture, None, &mut raw);
+            let happenings = net.events(
+                (&self.data, &placed),
+                &holds,
+                &self.sides,
+                self.capture,
+                EventScan::Every(&mut raw),
+            );
             if happenings.is_empty() {
                 let before = std::mem::replace(&mut self.theta, trial);
                 self.previous = (self.holds.touching == holds.touching && self.holds.latched == holds.latched)
@@ -2382,13 +2394,11 @@ impl Run<'_> {
             let placed = net.contacts.placed(&self.data);
             if !net
                 .events(
-                    &self.data,
-                    &placed,
+                    (&self.data, &placed),
                     &holds,
                     &self.sides,
                     self.capture,
-                    Some(happenings),
-                    &mut [],
+                    EventScan::Among(happenings),
                 )
                 .is_empty()
             {
