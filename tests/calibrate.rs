@@ -1,6 +1,7 @@
 //! Calibration: the sensitivities against central differences of whole runs, recovery of
 //! known parameters from noisy synthetic measurements, identifiability, bad input.
 
+mod common;
 use nanofold::calibrate::{fit, resolve, with_values, FitSettings, FitStatus, FreeParameter, SENSITIVITY_STEP};
 use nanofold::dynamics::sensitivity::{trajectory_sensitivities, STENCIL};
 use nanofold::dynamics::Method;
@@ -70,24 +71,18 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
     // Central differences of whole runs at a tight tolerance, Richardson-extrapolated from
     // steps 2h and h (the trajectory's phase makes the plain difference's h² error large).
     let h = 1e-4;
-    let plain = |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, &t, Method::Tsit45, 1e-13).unwrap();
+    let plain = |values: &[f64]| {
+        trajectory_sensitivities(&build(values), &[], eps, &t, Method::Tsit45, 1e-13)
+            .unwrap()
+            .angles
+    };
     for j in 0..3 {
-        let difference = |step: f64| {
-            let mut at = start.clone();
-            at[j] = start[j] + step * parameters[j].scale;
-            let plus = plain(&at);
-            at[j] = start[j] - step * parameters[j].scale;
-            let minus = plain(&at);
-            (0..t.len())
-                .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
-                .collect::<Vec<_>>()
-        };
-        let (wide, narrow) = (difference(2.0 * h), difference(h));
+        let columns = common::richardson_column(&plain, &start, j, parameters[j].scale, h);
         let mut worst: f64 = 0.0;
         let mut largest: f64 = 0.0;
         for i in 0..t.len() {
             for k in 0..4 {
-                let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
+                let fd = columns[i][k];
                 let s = run.sensitivities[i][(k, j)];
                 worst = worst.max((fd - s).abs());
                 largest = largest.max(fd.abs());

@@ -2,6 +2,7 @@
 //! through contact; a strip's and a closed chain's quasi-static balance) against central
 //! differences of whole runs, and a synthetic etch-ramp film of a cube fitted.
 
+mod common;
 use nanofold::calibrate::{
     fit, resolve, with_values, FitSettings, FitStatus, FreeParameter, ResolvedParameter, SENSITIVITY_STEP,
 };
@@ -59,25 +60,18 @@ fn against_whole_runs(
         .collect();
     let run = trajectory_sensitivities(&build(&start), &perturbed, eps, times, Method::Auto, 1e-8).unwrap();
     assert_eq!(run.times.len(), times.len(), "every asked time has a state");
-    let plain = |values: &[f64]| trajectory_sensitivities(&build(values), &[], eps, times, Method::Auto, 1e-8).unwrap();
+    let plain = |values: &[f64]| {
+        trajectory_sensitivities(&build(values), &[], eps, times, Method::Auto, 1e-8)
+            .unwrap()
+            .angles
+    };
     let gaps = (0..parameters.len())
         .map(|j| {
-            let difference = |step: f64| {
-                let mut at = start.clone();
-                at[j] = start[j] + step * parameters[j].scale;
-                let plus = plain(&at);
-                at[j] = start[j] - step * parameters[j].scale;
-                let minus = plain(&at);
-                (0..times.len())
-                    .map(|i| (&plus.angles[i] - &minus.angles[i]) / (2.0 * step))
-                    .collect::<Vec<_>>()
-            };
-            let h = 1e-4;
-            let (wide, narrow) = (difference(2.0 * h), difference(h));
+            let columns = common::richardson_column(&plain, &start, j, parameters[j].scale, 1e-4);
             let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
             for i in 0..times.len() {
-                for k in 0..narrow[i].len() {
-                    let fd = (4.0 * narrow[i][k] - wide[i][k]) / 3.0;
+                for k in 0..columns[i].len() {
+                    let fd = columns[i][k];
                     worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
                     largest = largest.max(fd.abs());
                 }

@@ -142,3 +142,28 @@ pub fn null_in(value: &serde_json::Value, at: String) -> Option<String> {
         _ => None,
     }
 }
+
+/// Central differences of whole runs in value `j` (`angles_at`: the fold angles at each asked
+/// time for a set of values), by steps of 2h and h times `scale` from `start`,
+/// Richardson-extrapolated: one column of the sensitivities per time.
+pub fn richardson_column(
+    angles_at: impl Fn(&[f64]) -> Vec<nalgebra::DVector<f64>>,
+    start: &[f64],
+    j: usize,
+    scale: f64,
+    h: f64,
+) -> Vec<nalgebra::DVector<f64>> {
+    let difference = |step: f64| {
+        let mut at = start.to_vec();
+        at[j] = start[j] + step * scale;
+        let plus = angles_at(&at);
+        at[j] = start[j] - step * scale;
+        let minus = angles_at(&at);
+        plus.iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * step))
+            .collect::<Vec<_>>()
+    };
+    let (wide, narrow) = (difference(2.0 * h), difference(h));
+    narrow.iter().zip(&wide).map(|(n, w)| (n * 4.0 - w) / 3.0).collect()
+}
