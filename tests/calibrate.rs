@@ -76,13 +76,12 @@ fn sensitivities_of_the_bridge_match_central_differences_of_whole_runs() {
             .unwrap()
             .angles
     };
-    for j in 0..3 {
-        let columns = common::richardson_column(&plain, &start, j, parameters[j].scale, h);
+    for (j, parameter) in parameters.iter().enumerate().take(3) {
+        let columns = common::richardson_column(plain, &start, j, parameter.scale, h);
         let mut worst: f64 = 0.0;
         let mut largest: f64 = 0.0;
-        for i in 0..t.len() {
-            for k in 0..4 {
-                let fd = columns[i][k];
+        for (i, column) in columns.iter().enumerate() {
+            for (k, &fd) in column.iter().take(4).enumerate() {
                 let s = run.sensitivities[i][(k, j)];
                 worst = worst.max((fd - s).abs());
                 largest = largest.max(fd.abs());

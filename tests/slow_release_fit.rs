@@ -67,11 +67,10 @@ fn against_whole_runs(
     };
     let gaps = (0..parameters.len())
         .map(|j| {
-            let columns = common::richardson_column(&plain, &start, j, parameters[j].scale, 1e-4);
+            let columns = common::richardson_column(plain, &start, j, parameters[j].scale, 1e-4);
             let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
-            for i in 0..times.len() {
-                for k in 0..columns[i].len() {
-                    let fd = columns[i][k];
+            for (i, column) in columns.iter().enumerate() {
+                for (k, &fd) in column.iter().enumerate() {
                     worst = worst.max((fd - run.sensitivities[i][(k, j)]).abs());
                     largest = largest.max(fd.abs());
                 }
