@@ -16,9 +16,14 @@ use crate::pattern::net::NetPattern;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// The most any drive angle moves between two tests of the faces, rad (0.5°): a meeting
-/// that begins and ends inside a smaller turn is not seen.
+/// The most any drive angle moves between two tests of the faces while contacts are held,
+/// rad (0.5°): a meeting that begins and ends inside a smaller turn is not seen.
 const MAX_STEP: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// The largest step while no contact is held, rad (2°): the balance is then the drives
+/// (or their projection on the latched seams), crossings and a seam's closest approach
+/// are located wherever the steps fall, and the step only says how finely a crossing is
+/// watched for.
+const FREE_STEP: f64 = 2.0 * std::f64::consts::PI / 180.0;
 /// A step is halved down to this turn, rad, before a jump of the balance is called a snap.
 const MIN_TURN: f64 = 1e-9;
 /// A step whose balance is not found is halved at most this many times in a row.
@@ -121,6 +126,14 @@ const SINGULAR_STEP: f64 = 1e-4;
 const RANK_READ: f64 = 1e-6;
 /// A latched seam's rows: a hinge's five.
 const SEAM_ROWS: usize = 5;
+/// Seams are watched for their closest approach within this many captures: a step would
+/// have to carry a seam's ends across a whole capture to pass one unseen (some 6° of turn
+/// a seam's length from its hinge at the default capture, twelve of the largest steps).
+const NEAR_CAPTURE: f64 = 2.0;
+/// The least move of a seam's ends over a step that says whether they approach or recede,
+/// a fraction of its length: below it (a seam at rest, the balance's tolerance) the last
+/// direction holds.
+const SEAM_MOVE: f64 = 1e-9;
 /// The rows count as held below this (over the net's size).
 const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
@@ -487,8 +500,11 @@ struct Sides {
     /// Coulomb's coefficient between faces (0: frictionless).
     friction: f64,
     /// Each seam's end offsets (first face's corner less the second's) at the last accepted
-    /// poses: a seam whose offsets turn back has passed through line within the step.
+    /// poses, the start of every step's chord.
     seam_offsets: Vec<[Vector3<f64>; 2]>,
+    /// Whether each seam's ends were approaching over the last step that moved them: one
+    /// that now recedes has passed its closest approach.
+    approaching: Vec<bool>,
 }
 
 impl Sides {
@@ -503,6 +519,7 @@ impl Sides {
             solves: std::cell::Cell::new(0),
             friction: 0.0,
             seam_offsets: Vec::new(),
+            approaching: Vec::new(),
         }
     }
 
@@ -733,13 +750,25 @@ impl NetClosing {
             .map(|[v, w]| self.place(data, seam.faces[0], v) - self.place(data, seam.faces[1], w))
     }
 
-    /// Whether seam `k`'s edges passed through line since the last accepted poses (their
-    /// ends' offsets turned back): a face swinging onto its place within one step.
-    fn seam_passed(&self, data: &NetworkData, sides: &Sides, k: usize) -> bool {
-        sides.seam_offsets.get(k).is_some_and(|before| {
+    /// How seam `k`'s ends moved since the last accepted poses: Σ o·(o − o₀) over its two
+    /// ends' offsets o (o₀ there), m², with the least that counts as a move (rounding and
+    /// the balance's tolerance below it). Positive: they recede along the step's chord;
+    /// negative: they approach. For ends moving in line its zero is their closest point.
+    fn seam_chord(&self, data: &NetworkData, sides: &Sides, k: usize) -> Option<(f64, f64)> {
+        sides.seam_offsets.get(k).map(|before| {
             let now = self.seam_offsets(data, k);
-            (0..2).map(|e| now[e].dot(&before[e])).sum::<f64>() < 0.0
+            let chord = (0..2).map(|e| now[e].dot(&(now[e] - before[e]))).sum::<f64>();
+            let floor = SEAM_MOVE * self.seams[k].length * (0..2).map(|e| now[e].norm()).sum::<f64>();
+            (chord, floor)
         })
+    }
+
+    /// Whether seam `k`'s ends have passed their closest approach since the last accepted
+    /// poses: approaching before, receding along the step's chord now. Wherever the steps
+    /// fall, this happens once per approach, located at its closest point.
+    fn seam_passed(&self, data: &NetworkData, sides: &Sides, k: usize) -> bool {
+        sides.approaching.get(k).copied().unwrap_or(false)
+            && self.seam_chord(data, sides, k).is_some_and(|(chord, floor)| chord > floor)
     }
 
     fn misalignment(&self, data: &NetworkData, k: usize) -> f64 {
@@ -771,13 +800,15 @@ impl NetClosing {
     ) -> Vec<Happening> {
         let tolerance = TOLERANCE * self.size;
         let mut found = Vec::new();
+        // A seam's closest approach near the capture is a happening wherever its ends are:
+        // located, its misalignment there decides whether it latches.
         let seam_meets = |k: usize| {
             holds.state[k] == SeamState::Open && {
                 let m = self.misalignment(data, k);
                 m <= ALIGNED
-                    || (m <= capture
-                        && !holds.blocked[k]
-                        && (self.seam_touching(holds, k) || self.seam_passed(data, sides, k)))
+                    || (!holds.blocked[k]
+                        && ((m <= capture && self.seam_touching(holds, k))
+                            || (m <= NEAR_CAPTURE * capture && self.seam_passed(data, sides, k))))
             }
         };
         let crosses = |k: usize, state: &FeatureState| {
@@ -2029,7 +2060,8 @@ impl Run<'_> {
                 turn *= 0.5;
                 continue;
             }
-            turn = (turn * 2.0).min(MAX_STEP);
+            let largest = if holds.touching.is_empty() { FREE_STEP } else { MAX_STEP };
+            turn = (turn * 2.0).min(largest);
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
             let placed = net.contacts.placed(&self.data);
@@ -2198,8 +2230,20 @@ impl Run<'_> {
         self.keep_seam_offsets();
     }
 
+    /// The seams' offsets at the accepted poses `data` holds, and whether each was
+    /// approaching over the step to them (kept as it was over a step that did not move it).
     fn keep_seam_offsets(&mut self) {
         let net = self.net;
+        self.sides.approaching.resize(net.seams.len(), false);
+        for k in 0..net.seams.len() {
+            if let Some((chord, floor)) = net.seam_chord(&self.data, &self.sides, k) {
+                if chord < -floor {
+                    self.sides.approaching[k] = true;
+                } else if chord > floor {
+                    self.sides.approaching[k] = false;
+                }
+            }
+        }
         self.sides.seam_offsets = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
     }
 
@@ -2468,6 +2512,9 @@ impl Run<'_> {
                 })
                 .collect();
             if new.is_empty() && touched.is_empty() && !unbalanced {
+                // Nothing latches (a closest approach outside the capture): the run goes on
+                // from here, the seams' chords too.
+                self.keep_seam_offsets();
                 return Ok(false);
             }
             unbalanced = false;
