@@ -768,7 +768,9 @@ impl NetClosing {
     /// fall, this happens once per approach, located at its closest point.
     fn seam_passed(&self, data: &NetworkData, sides: &Sides, k: usize) -> bool {
         sides.approaching.get(k).copied().unwrap_or(false)
-            && self.seam_chord(data, sides, k).is_some_and(|(chord, floor)| chord > floor)
+            && self
+                .seam_chord(data, sides, k)
+                .is_some_and(|(chord, floor)| chord > floor)
     }
 
     fn misalignment(&self, data: &NetworkData, k: usize) -> f64 {
