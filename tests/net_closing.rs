@@ -94,9 +94,9 @@ fn the_cube_closing_along_its_front_carries_on_to_the_lid_and_lands_on_the_cube(
     let run = net_closing(&made, "cube", &options, &ClosingSettings::default()).unwrap();
     assert_eq!(run.outcome, Outcome::Closes, "{run:?}");
     assert_eq!(run.latches.len(), 7, "a cube's net has 7 seams");
-    // The walls' seams latch at their ends' closest approach, inside the capture, before
-    // the walls would touch (the network dynamics' first contact): the approach found
-    // here by a golden-section search over the free ramps, the walls at their drives.
+    // The walls' seams latch at their ends' closest approach, inside the capture, which is
+    // where the walls meet (the network dynamics' first contact): the approach found here
+    // by a golden-section search over the free ramps, the walls at their drives.
     let scene = net_device(&made, "cube", &options).unwrap();
     let model = scene.network().unwrap();
     let closing = NetClosing::new(&made, model).unwrap();
@@ -133,7 +133,7 @@ fn the_cube_closing_along_its_front_carries_on_to_the_lid_and_lands_on_the_cube(
         }
     }
     let closest = 0.5 * (lo + hi);
-    assert!(first < contact, "{first} against the touch at {contact}");
+    assert!((first - contact).abs() <= 1e-9 * contact, "{first} against {contact}");
     assert!((first - closest).abs() <= 1e-9 * closest, "{first} against {closest}");
     // It closes when the last hinge reaches 90°: released when the front has passed its
     // crease, then turning at a/ρ_c. Both from the net's own coordinates, not from the

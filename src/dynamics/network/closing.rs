@@ -1657,6 +1657,7 @@ impl NetClosing {
             spaced: sample_times.is_none(),
             stops,
             samples: Vec::new(),
+            located: Vec::new(),
             path,
             stiffness,
             capture: settings.capture_percent / 100.0,
@@ -1963,6 +1964,8 @@ struct Run<'a> {
     /// as the progress maps back).
     stops: Vec<(f64, f64)>,
     samples: Vec<PathSample>,
+    /// The seams whose closest approach the last bisection located (see [`Run::locate`]).
+    located: Vec<usize>,
 }
 
 impl Run<'_> {
@@ -2423,6 +2426,7 @@ impl Run<'_> {
     fn locate(&mut self, u: f64, next: f64, at_next: Vec<f64>, holds_next: Holds, happenings: &[Happening]) -> f64 {
         let net = self.net;
         let (mut lo, mut hi, mut at_hi, mut holds_hi) = (u, next, at_next, holds_next);
+        let mut found_at_hi = happenings.to_vec();
         while hi - lo > LOCATE * (1.0 + hi.abs()) {
             let mid = 0.5 * (lo + hi);
             let mut state = self.theta.clone();
@@ -2438,27 +2442,36 @@ impl Run<'_> {
                 &mut self.data,
             );
             let placed = net.contacts.placed(&self.data);
-            if !net
-                .events(
-                    (&self.data, &placed),
-                    &holds,
-                    &self.sides,
-                    self.capture,
-                    EventScan::Among(happenings),
-                )
-                .is_empty()
-            {
+            let found = net.events(
+                (&self.data, &placed),
+                &holds,
+                &self.sides,
+                self.capture,
+                EventScan::Among(happenings),
+            );
+            if !found.is_empty() {
                 hi = mid;
                 at_hi = state;
                 holds_hi = holds;
+                found_at_hi = found;
             } else {
                 lo = mid;
                 self.theta = state;
                 self.holds = holds;
+                // A seam's chord runs from the bracket's lower end: as it closes, the chord
+                // turns to the path's tangent, and the bisection onto the closest approach.
+                self.sides.seam_offsets = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
             }
         }
         self.theta = at_hi;
         self.holds = holds_hi;
+        self.located = found_at_hi
+            .iter()
+            .filter_map(|h| match h {
+                Happening::Seam(k) => Some(*k),
+                Happening::Feature(_) => None,
+            })
+            .collect();
         hi
     }
 
@@ -2509,14 +2522,17 @@ impl Run<'_> {
                     (m <= ALIGNED_TOGETHER
                         || (m <= self.capture
                             && !self.holds.blocked[k]
-                            && (net.seam_touching(&self.holds, k) || net.seam_passed(&self.data, &self.sides, k))))
+                            && (net.seam_touching(&self.holds, k) || self.located.contains(&k))))
                     .then_some((k, m))
                 })
                 .collect();
             if new.is_empty() && touched.is_empty() && !unbalanced {
-                // Nothing latches (a closest approach outside the capture): the run goes on
-                // from here, the seams' chords too.
+                // Nothing more happens: the run goes on from here, the seams' chords too, and
+                // a seam whose closest approach was located here recedes from it.
                 self.keep_seam_offsets();
+                for k in std::mem::take(&mut self.located) {
+                    self.sides.approaching[k] = false;
+                }
                 return Ok(false);
             }
             unbalanced = false;
