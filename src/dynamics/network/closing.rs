@@ -134,6 +134,9 @@ const NEAR_CAPTURE: f64 = 2.0;
 /// a fraction of its length: below it (a seam at rest, the balance's tolerance) the last
 /// direction holds.
 const SEAM_MOVE: f64 = 1e-9;
+/// Accepted points closer than this (progress) do not replace the older one a seam's
+/// parabola runs through.
+const HISTORY_SPACING: f64 = 1e-9;
 /// The rows count as held below this (over the net's size).
 const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
@@ -502,6 +505,13 @@ struct Sides {
     /// Each seam's end offsets (first face's corner less the second's) at the last accepted
     /// poses, the start of every step's chord.
     seam_offsets: Vec<[Vector3<f64>; 2]>,
+    /// The progress of those offsets.
+    base_at: f64,
+    /// The progress of the poses being tested.
+    at: f64,
+    /// The offsets at the accepted poses before, with their progress: with them a step's
+    /// direction is read from a parabola's tangent, not its chord.
+    history: Option<(f64, Vec<[Vector3<f64>; 2]>)>,
     /// Whether each seam's ends were approaching over the last step that moved them: one
     /// that now recedes has passed its closest approach.
     approaching: Vec<bool>,
@@ -519,6 +529,9 @@ impl Sides {
             solves: std::cell::Cell::new(0),
             friction: 0.0,
             seam_offsets: Vec::new(),
+            base_at: 0.0,
+            at: 0.0,
+            history: None,
             approaching: Vec::new(),
         }
     }
@@ -757,7 +770,20 @@ impl NetClosing {
     fn seam_chord(&self, data: &NetworkData, sides: &Sides, k: usize) -> Option<(f64, f64)> {
         sides.seam_offsets.get(k).map(|before| {
             let now = self.seam_offsets(data, k);
-            let chord = (0..2).map(|e| now[e].dot(&(now[e] - before[e]))).sum::<f64>();
+            let (p1, p2) = (sides.base_at, sides.at);
+            let older = sides.history.as_ref().and_then(|(p0, offsets)| offsets.get(k).map(|o| (*p0, o)));
+            let moved: [Vector3<f64>; 2] = match older {
+                // The tangent at p2 of the parabola through the three, times the step: the
+                // chord's first-order error in the direction gone.
+                Some((p0, older)) if p0 < p1 && p1 < p2 => {
+                    let w0 = (p2 - p1) / ((p0 - p1) * (p0 - p2));
+                    let w1 = (p2 - p0) / ((p1 - p0) * (p1 - p2));
+                    let w2 = (2.0 * p2 - p0 - p1) / ((p2 - p0) * (p2 - p1));
+                    [0, 1].map(|e| (older[e] * w0 + before[e] * w1 + now[e] * w2) * (p2 - p1))
+                }
+                _ => [0, 1].map(|e| now[e] - before[e]),
+            };
+            let chord = (0..2).map(|e| now[e].dot(&moved[e])).sum::<f64>();
             let floor = SEAM_MOVE * self.seams[k].length * (0..2).map(|e| now[e].norm()).sum::<f64>();
             (chord, floor)
         })
@@ -2070,6 +2096,7 @@ impl Run<'_> {
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
             let placed = net.contacts.placed(&self.data);
+            self.sides.at = next;
             let happenings = net.events(
                 (&self.data, &placed),
                 &holds,
@@ -2249,7 +2276,13 @@ impl Run<'_> {
                 }
             }
         }
-        self.sides.seam_offsets = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
+        let now = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
+        let before = std::mem::replace(&mut self.sides.seam_offsets, now);
+        // A point a bisection's width from the last is no point for the parabola.
+        if self.sides.at - self.sides.base_at > HISTORY_SPACING && !before.is_empty() {
+            self.sides.history = Some((self.sides.base_at, before));
+        }
+        self.sides.base_at = self.sides.at;
     }
 
     /// The state at every asked progress reached by `u`, with its rates.
@@ -2442,6 +2475,7 @@ impl Run<'_> {
                 &mut self.data,
             );
             let placed = net.contacts.placed(&self.data);
+            self.sides.at = mid;
             let found = net.events(
                 (&self.data, &placed),
                 &holds,
@@ -2461,6 +2495,7 @@ impl Run<'_> {
                 // A seam's chord runs from the bracket's lower end: as it closes, the chord
                 // turns to the path's tangent, and the bisection onto the closest approach.
                 self.sides.seam_offsets = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
+                self.sides.base_at = mid;
             }
         }
         self.theta = at_hi;
@@ -2480,6 +2515,7 @@ impl Run<'_> {
     /// over (closed).
     fn resolve(&mut self, u: f64) -> std::result::Result<bool, Stop> {
         let net = self.net;
+        self.sides.at = u;
         let tolerance = TOLERANCE * net.size;
         // Whether a round's contacts have yet to be balanced (its latches were undone).
         let mut unbalanced = false;
