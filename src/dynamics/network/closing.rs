@@ -130,13 +130,10 @@ const SEAM_ROWS: usize = 5;
 /// have to carry a seam's ends across a whole capture to pass one unseen (some 6° of turn
 /// a seam's length from its hinge at the default capture, twelve of the largest steps).
 const NEAR_CAPTURE: f64 = 2.0;
-/// The least move of a seam's ends over a step that says whether they approach or recede,
-/// a fraction of its length: below it (a seam at rest, the balance's tolerance) the last
-/// direction holds.
+/// The least rate at which a seam's ends approach or recede that says which they do, a
+/// fraction of its length times their offsets and the fastest fold rate: below it (a seam
+/// at rest, rounding) the last direction holds.
 const SEAM_MOVE: f64 = 1e-9;
-/// Accepted points closer than this (progress) do not replace the older one a seam's
-/// parabola runs through.
-const HISTORY_SPACING: f64 = 1e-9;
 /// The rows count as held below this (over the net's size).
 const SETTLE_HELD: f64 = 1e-10;
 /// The largest turn of one settling step, rad.
@@ -502,18 +499,12 @@ struct Sides {
     solves: std::cell::Cell<usize>,
     /// Coulomb's coefficient between faces (0: frictionless).
     friction: f64,
-    /// Each seam's end offsets (first face's corner less the second's) at the last accepted
-    /// poses, the start of every step's chord.
-    seam_offsets: Vec<[Vector3<f64>; 2]>,
-    /// The progress of those offsets.
-    base_at: f64,
-    /// The progress of the poses being tested.
-    at: f64,
-    /// The offsets at the accepted poses before, with their progress: with them a step's
-    /// direction is read from a parabola's tangent, not its chord.
-    history: Option<(f64, Vec<[Vector3<f64>; 2]>)>,
-    /// Whether each seam's ends were approaching over the last step that moved them: one
-    /// that now recedes has passed its closest approach.
+    /// Each seam's approach rate at the poses being tested, Σ o·ȯ over its ends' offsets
+    /// o along the path's tangent (m² per unit of progress; positive: receding), with the
+    /// least that counts (see [`SEAM_MOVE`]).
+    approach: Vec<(f64, f64)>,
+    /// Whether each seam's ends were approaching at the last accepted poses (the step's
+    /// end, read on that step's path): one that now recedes has passed its closest approach.
     approaching: Vec<bool>,
 }
 
@@ -528,10 +519,7 @@ impl Sides {
             tolerance,
             solves: std::cell::Cell::new(0),
             friction: 0.0,
-            seam_offsets: Vec::new(),
-            base_at: 0.0,
-            at: 0.0,
-            history: None,
+            approach: Vec::new(),
             approaching: Vec::new(),
         }
     }
@@ -756,47 +744,77 @@ impl NetClosing {
         self.contacts.corner(data, face, v)
     }
 
-    /// How far apart seam `k`'s edges' ends are, a fraction of its length.
-    fn seam_offsets(&self, data: &NetworkData, k: usize) -> [Vector3<f64>; 2] {
-        let seam = &self.seams[k];
-        seam.ends
-            .map(|[v, w]| self.place(data, seam.faces[0], v) - self.place(data, seam.faces[1], w))
+    /// The balance's tangent dθ/du at the poses `data` holds with `holds` held, for drives
+    /// moving at `drive_rate` (dr/du): the drive rates projected on the held rows' null
+    /// space in the stiffness's metric, min Σ Kᵢ (θ̇ᵢ − ṙᵢ)² with J θ̇ = 0. It leaves out the
+    /// rows' curvature under their forces (first order in them), so it is exact while no row
+    /// is held and a function of the state, never of the step, when one is.
+    fn path_tangent(
+        &self,
+        data: &NetworkData,
+        holds: &Holds,
+        sides: &Sides,
+        drive_rate: &[f64],
+        stiffness: &[f64],
+    ) -> Vec<f64> {
+        let n = drive_rate.len();
+        if holds.latched.is_empty() && holds.touching.is_empty() {
+            return drive_rate.to_vec();
+        }
+        let (_, seam_rows) = self.seam_rows(data, holds, n);
+        let (_, contact_rows) = self.contact_rows(data, holds, sides, n);
+        let root = scaled(stiffness).map(f64::sqrt);
+        let mut rows = DMatrix::zeros(seam_rows.nrows() + contact_rows.nrows(), n);
+        rows.rows_mut(0, seam_rows.nrows()).copy_from(&seam_rows);
+        rows.rows_mut(seam_rows.nrows(), contact_rows.nrows())
+            .copy_from(&(contact_rows / self.size));
+        for c in 0..n {
+            rows.column_mut(c).unscale_mut(root[c]);
+        }
+        let (_, null) = Self::row_and_null_space(&rows, None);
+        let weighted = DVector::from_iterator(n, (0..n).map(|c| root[c] * drive_rate[c]));
+        let mut projected = DVector::zeros(n);
+        for direction in &null {
+            projected += direction * direction.dot(&weighted);
+        }
+        (0..n).map(|c| projected[c] / root[c]).collect()
     }
 
-    /// How seam `k`'s ends moved since the last accepted poses: Σ o·(o − o₀) over its two
-    /// ends' offsets o (o₀ there), m², with the least that counts as a move (rounding and
-    /// the balance's tolerance below it). Positive: they recede along the step's chord;
-    /// negative: they approach. For ends moving in line its zero is their closest point.
-    fn seam_chord(&self, data: &NetworkData, sides: &Sides, k: usize) -> Option<(f64, f64)> {
-        sides.seam_offsets.get(k).map(|before| {
-            let now = self.seam_offsets(data, k);
-            let (p1, p2) = (sides.base_at, sides.at);
-            let older = sides.history.as_ref().and_then(|(p0, offsets)| offsets.get(k).map(|o| (*p0, o)));
-            let moved: [Vector3<f64>; 2] = match older {
-                // The tangent at p2 of the parabola through the three, times the step: the
-                // chord's first-order error in the direction gone.
-                Some((p0, older)) if p0 < p1 && p1 < p2 => {
-                    let w0 = (p2 - p1) / ((p0 - p1) * (p0 - p2));
-                    let w1 = (p2 - p0) / ((p1 - p0) * (p1 - p2));
-                    let w2 = (2.0 * p2 - p0 - p1) / ((p2 - p0) * (p2 - p1));
-                    [0, 1].map(|e| (older[e] * w0 + before[e] * w1 + now[e] * w2) * (p2 - p1))
+    /// Every open seam's approach rate at the poses `data` holds along `tangent` (dθ/du),
+    /// with the least that counts: Σ o·ȯ over its ends' offsets o = x − y, ȯ from the
+    /// twists of the creases on each face's path.
+    fn read_approach(&self, data: &NetworkData, holds: &Holds, tangent: &[f64], approach: &mut Vec<(f64, f64)>) {
+        let fastest = tangent.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        approach.clear();
+        approach.extend((0..self.seams.len()).map(|k| {
+            if holds.state[k] != SeamState::Open {
+                return (0.0, 0.0);
+            }
+            let seam = &self.seams[k];
+            let [a, b] = seam.faces;
+            let (mut rate, mut size) = (0.0, 0.0);
+            for &[v, w] in &seam.ends {
+                let (x, y) = (self.place(data, a, v), self.place(data, b, w));
+                let offset = x - y;
+                let mut moving = Vector3::zeros();
+                for (point, face, sign) in [(x, a, 1.0), (y, b, -1.0)] {
+                    for &c in &self.paths[self.contacts.face_panel[face]] {
+                        moving += data.twist[c].point_velocity(&point) * (sign * tangent[c]);
+                    }
                 }
-                _ => [0, 1].map(|e| now[e] - before[e]),
-            };
-            let chord = (0..2).map(|e| now[e].dot(&moved[e])).sum::<f64>();
-            let floor = SEAM_MOVE * self.seams[k].length * (0..2).map(|e| now[e].norm()).sum::<f64>();
-            (chord, floor)
-        })
+                rate += offset.dot(&moving);
+                size += offset.norm();
+            }
+            (rate, SEAM_MOVE * seam.length * size * fastest)
+        }));
     }
 
     /// Whether seam `k`'s ends have passed their closest approach since the last accepted
-    /// poses: approaching before, receding along the step's chord now. Wherever the steps
-    /// fall, this happens once per approach, located at its closest point.
-    fn seam_passed(&self, data: &NetworkData, sides: &Sides, k: usize) -> bool {
+    /// poses: approaching there, receding at the poses tested. A function of the state, so
+    /// wherever the steps fall it happens once per approach, located at its closest point.
+    fn seam_passed(&self, sides: &Sides, k: usize) -> bool {
         sides.approaching.get(k).copied().unwrap_or(false)
-            && self
-                .seam_chord(data, sides, k)
-                .is_some_and(|(chord, floor)| chord > floor)
+            && sides.approach.get(k).is_some_and(|&(rate, floor)| rate > floor)
     }
 
     fn misalignment(&self, data: &NetworkData, k: usize) -> f64 {
@@ -836,7 +854,7 @@ impl NetClosing {
                 m <= ALIGNED
                     || (!holds.blocked[k]
                         && ((m <= capture && self.seam_touching(holds, k))
-                            || (m <= NEAR_CAPTURE * capture && self.seam_passed(data, sides, k))))
+                            || (m <= NEAR_CAPTURE * capture && self.seam_passed(sides, k))))
             }
         };
         let crosses = |k: usize, state: &FeatureState| {
@@ -1684,6 +1702,7 @@ impl NetClosing {
             stops,
             samples: Vec::new(),
             located: Vec::new(),
+            drive_rate: Vec::new(),
             path,
             stiffness,
             capture: settings.capture_percent / 100.0,
@@ -1992,6 +2011,9 @@ struct Run<'a> {
     samples: Vec<PathSample>,
     /// The seams whose closest approach the last bisection located (see [`Run::locate`]).
     located: Vec<usize>,
+    /// The drives' rates dr/du over the step being taken (they are linear in u between
+    /// the path's breaks, and no step crosses one).
+    drive_rate: Vec<f64>,
 }
 
 impl Run<'_> {
@@ -1999,7 +2021,9 @@ impl Run<'_> {
     fn drive_through(&mut self) -> std::result::Result<(), Stop> {
         let net = self.net;
         self.settle_at(0.0)?;
-        self.keep_seam_offsets();
+        self.step_rates(0.0, self.path.next(0.0, MAX_STEP));
+        self.read_approach(&self.holds.clone());
+        self.keep_approach();
         self.keep_frame(0.0);
         self.sample_stops(0.0);
         let mut last_frame = 0.0;
@@ -2034,6 +2058,11 @@ impl Run<'_> {
             self.path.drive(u, &mut self.drive);
             let before = self.drive.clone();
             self.path.drive(next, &mut self.drive);
+            if next > u {
+                for ((rate, to), from) in self.drive_rate.iter_mut().zip(&self.drive).zip(&before) {
+                    *rate = (to - from) / (next - u);
+                }
+            }
             // A drive may itself jump (a hinge released with a step); the balance is
             // measured against what its drives did.
             let driven = (0..before.len())
@@ -2096,7 +2125,7 @@ impl Run<'_> {
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
             let placed = net.contacts.placed(&self.data);
-            self.sides.at = next;
+            self.read_approach(&holds);
             let happenings = net.events(
                 (&self.data, &placed),
                 &holds,
@@ -2111,6 +2140,7 @@ impl Run<'_> {
                 self.holds = holds;
                 self.raw = raw;
                 self.after_step_at(placed);
+                self.keep_approach();
                 u = next;
                 self.sample_stops(u);
                 if self.spaced && u - last_frame >= FRAME_SPACING {
@@ -2259,30 +2289,43 @@ impl Run<'_> {
         }
         self.sides.last = Some(placed);
         self.raw.iter_mut().for_each(|r| *r = None);
-        self.keep_seam_offsets();
     }
 
-    /// The seams' offsets at the accepted poses `data` holds, and whether each was
-    /// approaching over the step to them (kept as it was over a step that did not move it).
-    fn keep_seam_offsets(&mut self) {
-        let net = self.net;
-        self.sides.approaching.resize(net.seams.len(), false);
-        for k in 0..net.seams.len() {
-            if let Some((chord, floor)) = net.seam_chord(&self.data, &self.sides, k) {
-                if chord < -floor {
-                    self.sides.approaching[k] = true;
-                } else if chord > floor {
-                    self.sides.approaching[k] = false;
-                }
+    /// The drives' rates dr/du over the step from `u` to `next`.
+    fn step_rates(&mut self, u: f64, next: f64) {
+        let n = self.theta.len();
+        self.drive_rate.resize(n, 0.0);
+        if next > u {
+            let (mut from, mut to) = (vec![0.0; n], vec![0.0; n]);
+            self.path.drive(u, &mut from);
+            self.path.drive(next, &mut to);
+            for c in 0..n {
+                self.drive_rate[c] = (to[c] - from[c]) / (next - u);
             }
         }
-        let now = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
-        let before = std::mem::replace(&mut self.sides.seam_offsets, now);
-        // A point a bisection's width from the last is no point for the parabola.
-        if self.sides.at - self.sides.base_at > HISTORY_SPACING && !before.is_empty() {
-            self.sides.history = Some((self.sides.base_at, before));
+    }
+
+    /// The open seams' approach rates at the poses `self.data` holds, along the balance's
+    /// tangent with `holds` held on this step's drives.
+    fn read_approach(&mut self, holds: &Holds) {
+        let net = self.net;
+        let tangent = net.path_tangent(&self.data, holds, &self.sides, &self.drive_rate, self.stiffness);
+        let mut approach = std::mem::take(&mut self.sides.approach);
+        net.read_approach(&self.data, holds, &tangent, &mut approach);
+        self.sides.approach = approach;
+    }
+
+    /// At accepted poses: whether each seam approaches there on the step that reached them
+    /// (as it was, for one at rest).
+    fn keep_approach(&mut self) {
+        self.sides.approaching.resize(self.net.seams.len(), false);
+        for (approaching, &(rate, floor)) in self.sides.approaching.iter_mut().zip(&self.sides.approach) {
+            if rate < -floor {
+                *approaching = true;
+            } else if rate > floor {
+                *approaching = false;
+            }
         }
-        self.sides.base_at = self.sides.at;
     }
 
     /// The state at every asked progress reached by `u`, with its rates.
@@ -2460,6 +2503,7 @@ impl Run<'_> {
         let net = self.net;
         let (mut lo, mut hi, mut at_hi, mut holds_hi) = (u, next, at_next, holds_next);
         let mut found_at_hi = happenings.to_vec();
+        let mut approach_hi = self.sides.approach.clone();
         while hi - lo > LOCATE * (1.0 + hi.abs()) {
             let mid = 0.5 * (lo + hi);
             let mut state = self.theta.clone();
@@ -2475,7 +2519,7 @@ impl Run<'_> {
                 &mut self.data,
             );
             let placed = net.contacts.placed(&self.data);
-            self.sides.at = mid;
+            self.read_approach(&holds);
             let found = net.events(
                 (&self.data, &placed),
                 &holds,
@@ -2488,18 +2532,19 @@ impl Run<'_> {
                 at_hi = state;
                 holds_hi = holds;
                 found_at_hi = found;
+                approach_hi.clone_from(&self.sides.approach);
             } else {
                 lo = mid;
                 self.theta = state;
                 self.holds = holds;
-                // A seam's chord runs from the bracket's lower end: as it closes, the chord
-                // turns to the path's tangent, and the bisection onto the closest approach.
-                self.sides.seam_offsets = (0..net.seams.len()).map(|k| net.seam_offsets(&self.data, k)).collect();
-                self.sides.base_at = mid;
             }
         }
         self.theta = at_hi;
         self.holds = holds_hi;
+        // The located poses are accepted: each seam's direction there on the step's path
+        // (where another's latch turns the path, one still approaching meets it there).
+        self.sides.approach = approach_hi;
+        self.keep_approach();
         self.located = found_at_hi
             .iter()
             .filter_map(|h| match h {
@@ -2515,7 +2560,6 @@ impl Run<'_> {
     /// over (closed).
     fn resolve(&mut self, u: f64) -> std::result::Result<bool, Stop> {
         let net = self.net;
-        self.sides.at = u;
         let tolerance = TOLERANCE * net.size;
         // Whether a round's contacts have yet to be balanced (its latches were undone).
         let mut unbalanced = false;
@@ -2563,9 +2607,8 @@ impl Run<'_> {
                 })
                 .collect();
             if new.is_empty() && touched.is_empty() && !unbalanced {
-                // Nothing more happens: the run goes on from here, the seams' chords too, and
-                // a seam whose closest approach was located here recedes from it.
-                self.keep_seam_offsets();
+                // Nothing more happens: the run goes on from here, and a seam whose closest
+                // approach was located here recedes from it.
                 for k in std::mem::take(&mut self.located) {
                     self.sides.approaching[k] = false;
                 }
