@@ -2021,7 +2021,8 @@ impl Run<'_> {
     fn drive_through(&mut self) -> std::result::Result<(), Stop> {
         let net = self.net;
         self.settle_at(0.0)?;
-        self.step_rates(0.0, self.path.next(0.0, MAX_STEP));
+        self.drive_rate = vec![0.0; self.theta.len()];
+        self.path.rates(0.0, self.path.next(0.0, MAX_STEP), &mut self.drive_rate);
         self.read_approach(&self.holds.clone());
         self.keep_approach();
         self.keep_frame(0.0);
@@ -2033,6 +2034,10 @@ impl Run<'_> {
         let mut unsettled = 0;
         let mut unpredicted = false;
         while u < 1.0 {
+            // A step that starts with contacts held is a held step, whatever the last was.
+            if !self.holds.touching.is_empty() {
+                turn = turn.min(MAX_STEP);
+            }
             let next = match self.stops.first().map(|s| s.0) {
                 Some(stop) if stop > u => self.path.next(u, turn).min(stop),
                 _ => self.path.next(u, turn),
@@ -2058,11 +2063,7 @@ impl Run<'_> {
             self.path.drive(u, &mut self.drive);
             let before = self.drive.clone();
             self.path.drive(next, &mut self.drive);
-            if next > u {
-                for ((rate, to), from) in self.drive_rate.iter_mut().zip(&self.drive).zip(&before) {
-                    *rate = (to - from) / (next - u);
-                }
-            }
+            self.path.rates(u, next, &mut self.drive_rate);
             // A drive may itself jump (a hinge released with a step); the balance is
             // measured against what its drives did.
             let driven = (0..before.len())
@@ -2289,20 +2290,6 @@ impl Run<'_> {
         }
         self.sides.last = Some(placed);
         self.raw.iter_mut().for_each(|r| *r = None);
-    }
-
-    /// The drives' rates dr/du over the step from `u` to `next`.
-    fn step_rates(&mut self, u: f64, next: f64) {
-        let n = self.theta.len();
-        self.drive_rate.resize(n, 0.0);
-        if next > u {
-            let (mut from, mut to) = (vec![0.0; n], vec![0.0; n]);
-            self.path.drive(u, &mut from);
-            self.path.drive(next, &mut to);
-            for c in 0..n {
-                self.drive_rate[c] = (to[c] - from[c]) / (next - u);
-            }
-        }
     }
 
     /// The open seams' approach rates at the poses `self.data` holds, along the balance's
@@ -2707,6 +2694,22 @@ impl<'a> DrivePath<'a> {
 
     fn time(&self, u: f64) -> f64 {
         self.forcing.time_along(u, self.t_end)
+    }
+
+    /// The drives' rates dr/du on the step from `u` to `next` (constant there: the drives
+    /// are linear in u between breaks, and no step crosses one), read from the forcing, not
+    /// differenced (a step may be a rounding's width).
+    fn rates(&self, u: f64, next: f64, out: &mut [f64]) {
+        if self.span > 0.0 {
+            let t = 0.5 * (u + next) * self.span;
+            for (i, rate) in out.iter_mut().enumerate() {
+                *rate = self.forcing.drive_rate(i, t) * self.span;
+            }
+        } else {
+            for (rate, hinge) in out.iter_mut().zip(&self.forcing.hinges) {
+                *rate = hinge.target;
+            }
+        }
     }
 
     /// The next progress to test from `u`: no drive turns more than `turn` on the way, and
