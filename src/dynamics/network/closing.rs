@@ -2022,7 +2022,7 @@ impl Run<'_> {
         let net = self.net;
         self.settle_at(0.0)?;
         self.drive_rate = vec![0.0; self.theta.len()];
-        self.path.rates(0.0, self.path.next(0.0, MAX_STEP), &mut self.drive_rate);
+        self.path.rates(0.0, &mut self.drive_rate);
         self.read_approach(&self.holds.clone());
         self.keep_approach();
         self.keep_frame(0.0);
@@ -2063,7 +2063,7 @@ impl Run<'_> {
             self.path.drive(u, &mut self.drive);
             let before = self.drive.clone();
             self.path.drive(next, &mut self.drive);
-            self.path.rates(u, next, &mut self.drive_rate);
+            self.path.rates(u, &mut self.drive_rate);
             // A drive may itself jump (a hinge released with a step); the balance is
             // measured against what its drives did.
             let driven = (0..before.len())
@@ -2696,12 +2696,13 @@ impl<'a> DrivePath<'a> {
         self.forcing.time_along(u, self.t_end)
     }
 
-    /// The drives' rates dr/du on the step from `u` to `next` (constant there: the drives
-    /// are linear in u between breaks, and no step crosses one), read from the forcing, not
-    /// differenced (a step may be a rounding's width).
-    fn rates(&self, u: f64, next: f64, out: &mut [f64]) {
+    /// The drives' rates dr/du on the steps from `u` (constant up to the next break: the
+    /// drives are linear in u between breaks, and no step crosses one), read from the
+    /// forcing inside the stretch, never at its ends, and not differenced (a step may be a
+    /// rounding's width).
+    fn rates(&self, u: f64, out: &mut [f64]) {
         if self.span > 0.0 {
-            let t = 0.5 * (u + next) * self.span;
+            let t = 0.5 * (u + self.stretch_end(u)) * self.span;
             for (i, rate) in out.iter_mut().enumerate() {
                 *rate = self.forcing.drive_rate(i, t) * self.span;
             }
@@ -2712,16 +2713,20 @@ impl<'a> DrivePath<'a> {
         }
     }
 
-    /// The next progress to test from `u`: no drive turns more than `turn` on the way, and
-    /// no break is passed.
-    fn next(&self, u: f64, turn: f64) -> f64 {
-        let next_break = self
-            .breaks
+    /// The progress where the stretch of the path from `u` ends: its next break, or 1.
+    fn stretch_end(&self, u: f64) -> f64 {
+        self.breaks
             .iter()
             .copied()
             .find(|&b| b > u + 1e-15)
             .unwrap_or(1.0)
-            .min(1.0);
+            .min(1.0)
+    }
+
+    /// The next progress to test from `u`: no drive turns more than `turn` on the way, and
+    /// no break is passed.
+    fn next(&self, u: f64, turn: f64) -> f64 {
+        let next_break = self.stretch_end(u);
         let rate = if self.span > 0.0 {
             // The rates hold between breaks: read them inside the stretch, not at its start
             // (a ramp starting exactly there reads zero, rounded a hair before it).
