@@ -77,12 +77,22 @@ fn main() {
                 runs += 1;
                 slowest = slowest.max(ms);
                 if std::env::var("ONLY").is_ok_and(|o| o == format!("{} {release:?} {sample}", rank + 1)) {
-                    for l in &run.latches { println!("LATCH seam {} t {:.9} m {:.3e}", l.seam, l.time_s, l.misalignment); }
-                    for c in &run.contacts { println!("CONTACT {:?} {} t {:.9}", c.faces, c.feature, c.time_s); }
+                    for l in &run.latches {
+                        println!("LATCH seam {} t {:.9} m {:.3e}", l.seam, l.time_s, l.misalignment);
+                    }
+                    for c in &run.contacts {
+                        println!("CONTACT {:?} {} t {:.9}", c.faces, c.feature, c.time_s);
+                    }
                     println!("{:?} {:?}", run.outcome, run.undecided);
                 }
                 if std::env::var("PER_RUN").is_ok() {
-                    println!("RUN {} {release:?} {sample} {} {:.9} {}", rank + 1, run.outcome.label(), run.time_s, run.latches.len());
+                    println!(
+                        "RUN {} {release:?} {sample} {} {:.9} {}",
+                        rank + 1,
+                        run.outcome.label(),
+                        run.time_s,
+                        run.latches.len()
+                    );
                 }
                 *here.entry(run.outcome.label()).or_insert(0) += 1;
                 *outcomes.entry(run.outcome.label()).or_insert(0) += 1;

@@ -658,6 +658,9 @@ pub struct NetClosing {
     paths: Vec<Vec<usize>>,
     size: f64,
     unit: f64,
+    /// The largest step while no contact is held ([`FREE_STEP`]; varied by the tests that
+    /// show outcomes do not depend on it).
+    free_step: f64,
 }
 
 impl NetClosing {
@@ -732,6 +735,7 @@ impl NetClosing {
             paths,
             size: model.size(),
             unit: model.unit,
+            free_step: FREE_STEP,
         })
     }
 
@@ -2121,7 +2125,11 @@ impl Run<'_> {
                 turn *= 0.5;
                 continue;
             }
-            let largest = if holds.touching.is_empty() { FREE_STEP } else { MAX_STEP };
+            let largest = if holds.touching.is_empty() {
+                net.free_step
+            } else {
+                MAX_STEP
+            };
             turn = (turn * 2.0).min(largest);
             let mut raw = std::mem::take(&mut self.raw);
             raw.iter_mut().for_each(|r| *r = None);
@@ -2831,6 +2839,77 @@ mod tests {
     /// turn in one step, wherever a hinge's ramp starts: a ramp released at a break must not
     /// be stepped over whole (its rate read at the break's start rounds to before the
     /// release). Release times from 0.013 s to 2.6 s; the drives' own change is the check.
+    /// Devices whose outcome the step decided under the earlier latches (a seam latched as
+    /// its ends' offsets turned back within one step, or at its closest approach read from
+    /// chords): the cube's nets released along a front, varied as the yield study varies
+    /// them, run with the largest free step at 0.5° and at 2°, end alike.
+    #[test]
+    fn where_the_steps_fall_decides_no_outcome() {
+        let (name, solid) = open_solid("cube").unwrap();
+        let options = NetsOptions {
+            top: 10,
+            fronts: 16,
+            yield_samples: 50,
+            unit_um: 50.0,
+            ..NetsOptions::default()
+        };
+        let report = nets(&name, &solid, &options).unwrap();
+        let made = best_net_patterns(&solid, &report, 10).unwrap();
+        // (net's rank from 1, front in degrees, device)
+        let devices = [
+            (1, 270.0, 8),
+            (1, 270.0, 14),
+            (1, 90.0, 0),
+            (1, 90.0, 24),
+            (2, 270.0, 10),
+            (2, 90.0, 17),
+            (2, 135.0, 33),
+            (3, 90.0, 14),
+            (4, 135.0, 17),
+            (5, 90.0, 12),
+            (10, 270.0, 0),
+        ];
+        let variation = options.variation();
+        for (rank, front, sample) in devices {
+            let (_, net) = &made[rank - 1];
+            let released = NetsOptions {
+                front_deg: Some(front),
+                ..options.clone()
+            };
+            let scene = net_device(net, "cube", &released).unwrap();
+            let model = scene.network().unwrap();
+            let (forcing, stiffness) = variation.device(&model.forcing, &model.stiffness(), sample);
+            let settings = ClosingSettings {
+                capture_percent: options.closing().capture_percent,
+                ..ClosingSettings::default()
+            };
+            let runs: Vec<ClosingReport> = [0.5_f64, 2.0]
+                .map(|step| {
+                    let mut closing = NetClosing::new(net, model).unwrap();
+                    closing.free_step = step.to_radians();
+                    closing.run(model, &forcing, &stiffness, &settings).unwrap()
+                })
+                .into();
+            let device = format!("net {rank}, front {front}°, device {sample}");
+            assert_eq!(runs[0].outcome, runs[1].outcome, "{device}");
+            let seams = |run: &ClosingReport| {
+                let mut latched: Vec<usize> = run.latches.iter().map(|l| l.seam).collect();
+                latched.sort_unstable();
+                latched
+            };
+            assert_eq!(seams(&runs[0]), seams(&runs[1]), "{device}");
+            for (fine, coarse) in runs[0].latches.iter().zip(&runs[1].latches) {
+                assert!(
+                    (fine.time_s - coarse.time_s).abs() <= 1e-6 * fine.time_s,
+                    "{device}: seam {} latches at {} s and {} s",
+                    fine.seam,
+                    fine.time_s,
+                    coarse.time_s
+                );
+            }
+        }
+    }
+
     #[test]
     fn no_step_of_a_ramps_path_turns_a_drive_more_than_asked() {
         let turn = 0.5_f64.to_radians();
