@@ -2,7 +2,7 @@
 //! carried through contact by mechanics. At every instant the device rests at the minimum
 //! of its hinge energy with the latched seams closed and touching faces apart (their
 //! contact forces the multipliers); a seam latches where its faces meet within the
-//! capture. It ends when every seam is shut (`closes`), when the drives are spent with
+//! capture, or where its ends come closest within it. It ends when every seam is shut (`closes`), when the drives are spent with
 //! faces held apart by contact forces (`jams`) or free (`stalls`), or where the balance
 //! jumps (`snaps`).
 
@@ -143,8 +143,9 @@ const SETTLE_DAMPING: f64 = 0.3;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ClosingSettings {
     /// A seam latches when its faces meet with its two edges' ends at most this far apart,
-    /// in % of the seam's length (above 0, at most 50): the solder or adhesive on the seam
-    /// pulls them into line. Faces that meet farther apart jam.
+    /// or where its ends come closest if that is this near, in % of the seam's length
+    /// (above 0, at most 50): the solder or adhesive on the seam pulls them into line.
+    /// Faces that meet farther apart jam.
     pub capture_percent: f64,
     /// Coulomb's coefficient of friction between touching faces (0: frictionless, the
     /// default; at most 10).
@@ -836,7 +837,8 @@ impl NetClosing {
     }
 
     /// What happens at these poses (`data`, its faces `placed`): an open seam aligned, a
-    /// seam whose faces touch come within the capture, or a feature over another face
+    /// seam whose faces touch come within the capture, a seam near the capture past its
+    /// ends' closest approach, or a feature over another face
     /// crossed to the wrong side of it. Only among the happenings `scan` names (a step's
     /// events, bisected), or everything, each watched feature's raw state left in `scan`'s
     /// list for the step's bookkeeping.
